@@ -1,0 +1,32 @@
+"""The project's own error and warning types.
+
+Every public entry point raises :class:`MocycleError` (or a subclass) for bad
+input, with one message that names the file, the line and what was expected.
+"""
+
+from __future__ import annotations
+
+from os import PathLike
+
+
+class MocycleError(Exception):
+    """Base class of every error mocycle raises on purpose."""
+
+
+class MotionFileError(MocycleError, ValueError):
+    """A motion file could not be read: says which file, which line, what was expected."""
+
+    def __init__(self, message: str, path: str | PathLike | None = None, line: int | None = None):
+        self.path = None if path is None else str(path)
+        self.line = line
+        self.reason = message
+        where = ""
+        if self.path is not None:
+            where = self.path + (f":{line}" if line is not None else "") + ": "
+        elif line is not None:
+            where = f"line {line}: "
+        super().__init__(where + message)
+
+
+class MocycleWarning(UserWarning):
+    """Something odd but recoverable in the input (e.g. a wrong ``Frames:`` count)."""

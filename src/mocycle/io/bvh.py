@@ -1,0 +1,395 @@
+"""BVH read and write, faithful and tolerant.
+
+Reading accepts what real exporters write: tabs or spaces, CRLF or CR-only
+line ends, ``End Site`` / ``End site`` with or without a name, joint names
+with spaces, 0-, 3- and 6-channel joints, position channels on any joint,
+per-joint Euler orders, and a ``Frames:`` count that disagrees with the rows
+(a :class:`~mocycle.errors.MocycleWarning`, the rows win).  Anything else
+raises :class:`~mocycle.errors.MotionFileError` naming the file, the line and
+what was expected.
+
+Writing keeps each joint's channel order and the End Sites, writes the exact
+frame time and Euler angles that are continuous in time, and replaces the
+target file in one step (never a half-written file).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import MocycleError, MocycleWarning, MotionFileError
+from ..motion import POSITION_CHANNELS, ROTATION_CHANNELS, EndSite, Motion, Skeleton
+from ..rotations import continuous_euler, euler_to_quats
+from .atomic import atomic_write
+
+_CHANNEL_NAMES = {c.lower(): c for c in ROTATION_CHANNELS + POSITION_CHANNELS}
+
+
+def read_bvh(path: str | os.PathLike) -> Motion:
+    """Read a BVH file into a :class:`Motion` (see module notes for what is accepted)."""
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise MotionFileError(f"cannot read file ({exc.strerror or exc})", p) from None
+    return parse_bvh(data, path=p)
+
+
+def _decode(data: str | bytes) -> str:
+    if isinstance(data, str):
+        text = data
+    else:
+        try:
+            text = data.decode("utf-8-sig")
+        except UnicodeDecodeError:
+            text = data.decode("latin-1")
+    if "\r" in text:
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
+    return text
+
+
+class _Header:
+    """Line-by-line parser of the HIERARCHY section."""
+
+    def __init__(self, path):
+        self.path = path
+        self.names: list[str] = []
+        self.parents: list[int] = []
+        self.offsets: list[tuple[float, float, float] | None] = []
+        self.channels: list[tuple[str, ...]] = []
+        self.end_sites: list[EndSite] = []
+        self.stack: list[tuple[str, int]] = []  # ("joint", index) or ("end", parent index)
+        self.pending: tuple[str, int, str | None] | None = None  # node waiting for "{"
+        self.end_offset: tuple[float, float, float] | None = None
+
+    def error(self, lineno: int, message: str) -> MotionFileError:
+        return MotionFileError(message, self.path, lineno)
+
+    def numbers(self, lineno: int, words: list[str], n: int, what: str) -> tuple[float, ...]:
+        if len(words) != n:
+            raise self.error(lineno, f"expected {n} numbers after {what}, found {len(words)}")
+        try:
+            vals = tuple(float(w) for w in words)
+        except ValueError:
+            raise self.error(lineno, f"expected {n} numbers after {what}, found {' '.join(words)!r}") from None
+        if not all(np.isfinite(vals)):
+            raise self.error(lineno, f"{what} values must be finite, found {' '.join(words)!r}")
+        return vals
+
+    def open_node(self, lineno: int):
+        if self.pending is None:
+            raise self.error(lineno, "found '{' without a ROOT, JOINT or End Site before it")
+        kind, parent, name = self.pending
+        self.pending = None
+        if kind == "end":
+            self.stack.append(("end", parent))
+            self.end_offset = None
+            self._end_name = name
+            return
+        if len(self.names) != 0 and not self.stack:
+            raise self.error(lineno, "found a second ROOT; only one skeleton per file is supported")
+        self.names.append(name)
+        self.parents.append(parent)
+        self.offsets.append(None)
+        self.channels.append(())
+        self.stack.append(("joint", len(self.names) - 1))
+
+    def close_node(self, lineno: int):
+        if not self.stack:
+            raise self.error(lineno, "found '}' with no open ROOT, JOINT or End Site")
+        kind, idx = self.stack.pop()
+        if kind == "end":
+            if self.end_offset is None:
+                raise self.error(lineno, "End Site has no OFFSET")
+            self.end_sites.append(EndSite(idx, self.end_offset, self._end_name))
+        elif self.offsets[idx] is None:
+            raise self.error(lineno, f"joint {self.names[idx]!r} has no OFFSET")
+
+    def line(self, lineno: int, raw: str):
+        s = raw.strip()
+        if not s:
+            return
+        opens = closes = 0
+        while s.endswith("{") and len(s) > 1:
+            opens += 1
+            s = s[:-1].rstrip()
+        words = s.split()
+        key = words[0].upper()
+        if self.pending is not None and s != "{":
+            raise self.error(lineno, f"expected '{{' after {self.pending[0].upper()}, found {s!r}")
+        if s == "{":
+            opens += 1
+        elif s == "}":
+            closes += 1
+        elif key in ("ROOT", "JOINT"):
+            name = s[len(words[0]):].strip()
+            if not name:
+                raise self.error(lineno, f"expected a joint name after {words[0]}")
+            if key == "ROOT" and (self.names or self.stack):
+                raise self.error(lineno, "found a second ROOT; only one skeleton per file is supported")
+            if key == "JOINT" and not (self.stack and self.stack[-1][0] == "joint"):
+                raise self.error(lineno, "JOINT outside of a ROOT or JOINT block")
+            if name in self.names:
+                raise self.error(lineno, f"joint name {name!r} is used twice")
+            parent = self.stack[-1][1] if self.stack else -1
+            self.pending = ("joint", parent, name)
+        elif key == "END" and len(words) >= 2 and words[1].upper() == "SITE":
+            if not (self.stack and self.stack[-1][0] == "joint"):
+                raise self.error(lineno, "End Site outside of a JOINT block")
+            name = s.split(None, 2)[2].strip() if len(words) > 2 else None
+            self.pending = ("end", self.stack[-1][1], name)
+        elif key == "OFFSET":
+            if not self.stack:
+                raise self.error(lineno, "OFFSET outside of a ROOT, JOINT or End Site block")
+            vals = self.numbers(lineno, words[1:], 3, "OFFSET")
+            kind, idx = self.stack[-1]
+            if kind == "end":
+                self.end_offset = vals
+            else:
+                self.offsets[idx] = vals
+        elif key == "CHANNELS":
+            if not self.stack or self.stack[-1][0] != "joint":
+                raise self.error(lineno, "CHANNELS outside of a ROOT or JOINT block")
+            if len(words) < 2 or not words[1].isdigit():
+                raise self.error(lineno, "expected the channel count after CHANNELS")
+            n = int(words[1])
+            names = words[2:]
+            if len(names) != n:
+                raise self.error(lineno, f"CHANNELS says {n} channels but lists {len(names)}")
+            try:
+                chans = tuple(_CHANNEL_NAMES[c.lower()] for c in names)
+            except KeyError as exc:
+                raise self.error(
+                    lineno, f"unknown channel {exc.args[0]!r}; expected X/Y/Z position or rotation"
+                ) from None
+            if len(set(chans)) != n:
+                raise self.error(lineno, f"a channel is listed twice: {' '.join(names)}")
+            self.channels[self.stack[-1][1]] = chans
+        else:
+            raise self.error(lineno, f"expected ROOT, JOINT, End Site, OFFSET, CHANNELS, '{{' or '}}', found {s!r}")
+        for _ in range(opens):
+            self.open_node(lineno)
+        for _ in range(closes):
+            self.close_node(lineno)
+
+    def skeleton(self, lineno: int) -> Skeleton:
+        if self.pending is not None or self.stack:
+            raise self.error(lineno, "hierarchy ends before every '{' is closed; expected '}'")
+        if not self.names:
+            raise self.error(lineno, "no ROOT joint in HIERARCHY")
+        try:
+            return Skeleton(tuple(self.names), self.parents, self.offsets, tuple(self.channels),
+                            tuple(self.end_sites))
+        except MocycleError as exc:
+            raise self.error(lineno, str(exc)) from None
+
+
+def _motion_header(lines: list[str], first: int, path) -> tuple[int | None, float, int]:
+    """Parse ``Frames:`` and ``Frame Time:``; return (frames, frame time, index of first data line)."""
+    frames: int | None = None
+    i = first
+    n = len(lines)
+    while i < n and not lines[i].strip():
+        i += 1
+    if i < n and lines[i].strip().lower().startswith("frames"):
+        key, _, val = lines[i].partition(":")
+        try:
+            frames = int(val.strip())
+        except ValueError:
+            raise MotionFileError(f"expected 'Frames: <count>', found {lines[i].strip()!r}", path, i + 1) from None
+        i += 1
+        while i < n and not lines[i].strip():
+            i += 1
+    else:
+        warnings.warn(f"{path or 'BVH'}:{i + 1}: no 'Frames:' line; counting the rows", MocycleWarning, stacklevel=3)
+    if i >= n or not lines[i].strip().lower().replace(" ", "").startswith("frametime"):
+        raise MotionFileError("expected 'Frame Time: <seconds>' after MOTION", path, min(i, n - 1) + 1)
+    key, _, val = lines[i].partition(":")
+    try:
+        frame_time = float(val.strip())
+    except ValueError:
+        raise MotionFileError(f"expected 'Frame Time: <seconds>', found {lines[i].strip()!r}", path, i + 1) from None
+    if not np.isfinite(frame_time) or frame_time <= 0:
+        raise MotionFileError(f"Frame Time must be a positive number of seconds, found {val.strip()!r}", path, i + 1)
+    return frames, frame_time, i + 1
+
+
+def _parse_rows(lines: list[str], start: int, n_channels: int, path) -> np.ndarray:
+    """The data rows as a ``(T, C)`` float array; errors name the first bad line.
+
+    numpy's C ``loadtxt`` does the work (blank lines are skipped); only when it
+    fails are the lines scanned one by one to say which line is wrong and why.
+    """
+    body = lines[start:]
+    values = None
+    if n_channels:
+        try:
+            values = np.loadtxt(body, dtype=np.float64, ndmin=2, comments=None)
+        except ValueError:
+            values = None
+    if values is None or values.shape[1] != n_channels or not np.all(np.isfinite(values)):
+        _find_bad_row(body, start, n_channels, path)
+    if values.shape[0] == 0:
+        raise MotionFileError("no frame rows after 'Frame Time:'; expected at least one", path, len(lines))
+    return values
+
+
+def _find_bad_row(body: list[str], start: int, n_channels: int, path) -> None:
+    """Raise the error for the first malformed frame row."""
+    for k, line in enumerate(body):
+        words = line.split()
+        if not words:
+            continue
+        if len(words) != n_channels:
+            raise MotionFileError(
+                f"expected {n_channels} values in this frame row (one per channel), found {len(words)}",
+                path, start + k + 1,
+            )
+        for word in words:
+            try:
+                v = float(word)
+            except ValueError:
+                v = np.nan
+            if not np.isfinite(v):
+                raise MotionFileError(f"expected a finite number, found {word!r}", path, start + k + 1)
+    if n_channels == 0:
+        raise MotionFileError("the hierarchy declares no channels; nothing to read", path, start)
+    raise MotionFileError("no frame rows after 'Frame Time:'; expected at least one", path, start)
+
+
+def _channel_layout(skel: Skeleton):
+    """Per joint: (rotation channel columns, order), (position columns, axes)."""
+    col = 0
+    layout = []
+    for j in range(skel.n_joints):
+        rot_cols, pos_cols, pos_axes = [], [], []
+        for c in skel.channels[j]:
+            if c in ROTATION_CHANNELS:
+                rot_cols.append(col)
+            else:
+                pos_cols.append(col)
+                pos_axes.append(POSITION_CHANNELS.index(c))
+            col += 1
+        layout.append((rot_cols, skel.euler_order(j), pos_cols, pos_axes))
+    return layout
+
+
+def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motion:
+    """Parse BVH text (``str`` or ``bytes``) into a :class:`Motion`; ``path`` only names errors."""
+    text = _decode(data)
+    lines = text.split("\n")
+    first = next((i for i, ln in enumerate(lines) if ln.strip()), None)
+    if first is None:
+        raise MotionFileError("file is empty; expected 'HIERARCHY'", path, 1)
+    if lines[first].strip().upper() != "HIERARCHY":
+        raise MotionFileError(f"expected 'HIERARCHY', found {lines[first].strip()[:40]!r}", path, first + 1)
+    header = _Header(path)
+    motion_line = None
+    for i in range(first + 1, len(lines)):
+        if lines[i].strip().upper() == "MOTION":
+            motion_line = i
+            break
+        header.line(i + 1, lines[i])
+    if motion_line is None:
+        header.skeleton(len(lines))
+        raise MotionFileError("no MOTION section; expected 'MOTION' after the hierarchy", path, len(lines))
+    skel = header.skeleton(motion_line + 1)
+    frames, frame_time, data_start = _motion_header(lines, motion_line + 1, path)
+    values = _parse_rows(lines, data_start, skel.n_channels, path)
+    T = values.shape[0]
+    if frames is not None and frames != T:
+        warnings.warn(
+            f"{path or 'BVH'}: 'Frames: {frames}' but {T} frame rows follow; using the {T} rows",
+            MocycleWarning, stacklevel=2,
+        )
+    return _motion_from_channels(skel, values, frame_time)
+
+
+def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float) -> Motion:
+    T, J = values.shape[0], skel.n_joints
+    quats = np.zeros((T, J, 4))
+    quats[..., 3] = 1.0
+    trans = np.broadcast_to(skel.offsets, (T, J, 3)).copy()
+    by_order: dict[str, list[tuple[int, list[int]]]] = {}
+    for j, (rot_cols, order, pos_cols, pos_axes) in enumerate(_channel_layout(skel)):
+        if rot_cols:
+            by_order.setdefault(order, []).append((j, rot_cols))
+        if pos_cols:
+            trans[:, j, pos_axes] = values[:, pos_cols]
+    for order, items in by_order.items():
+        joints = [j for j, _ in items]
+        cols = [c for _, cs in items for c in cs]
+        angles = values[:, cols].reshape(T, len(joints), len(order))
+        quats[:, joints] = euler_to_quats(angles, order, degrees=True)
+    return Motion(skel, quats, trans, frame_time)
+
+
+def motion_channels(motion: Motion) -> np.ndarray:
+    """The BVH channel values ``(T, C)`` of ``motion`` in file order (degrees, continuous)."""
+    skel = motion.skeleton
+    T = motion.n_frames
+    out = np.empty((T, skel.n_channels))
+    by_order: dict[str, list[tuple[int, list[int]]]] = {}
+    for j, (rot_cols, order, pos_cols, pos_axes) in enumerate(_channel_layout(skel)):
+        if rot_cols:
+            by_order.setdefault(order, []).append((j, rot_cols))
+        if pos_cols:
+            out[:, pos_cols] = motion.translations[:, j, pos_axes]
+    for order, items in by_order.items():
+        joints = [j for j, _ in items]
+        cols = [c for _, cs in items for c in cs]
+        angles = np.degrees(continuous_euler(motion.rotations[:, joints], order))
+        out[:, cols] = angles.reshape(T, -1)
+    return out
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.9g}"
+
+
+def format_bvh(motion: Motion) -> str:
+    """The BVH text of ``motion``."""
+    skel = motion.skeleton
+    out = io.StringIO()
+    out.write("HIERARCHY\n")
+    children = [skel.children(j) for j in range(skel.n_joints)]
+    sites = [[s for s in skel.end_sites if s.parent == j] for j in range(skel.n_joints)]
+
+    def joint(j: int, depth: int):
+        tab = "\t" * depth
+        out.write(f"{tab}{'ROOT' if j == 0 else 'JOINT'} {skel.names[j]}\n{tab}{{\n")
+        out.write(f"{tab}\tOFFSET {' '.join(_fmt(v) for v in skel.offsets[j])}\n")
+        chans = skel.channels[j]
+        out.write(f"{tab}\tCHANNELS {len(chans)}{''.join(' ' + c for c in chans)}\n")
+        for c in children[j]:
+            joint(c, depth + 1)
+        for s in sites[j]:
+            label = "End Site" + (f" {s.name}" if s.name else "")
+            out.write(f"{tab}\t{label}\n{tab}\t{{\n")
+            out.write(f"{tab}\t\tOFFSET {' '.join(_fmt(v) for v in s.offset)}\n{tab}\t}}\n")
+        out.write(f"{tab}}}\n")
+
+    joint(0, 0)
+    out.write(f"MOTION\nFrames: {motion.n_frames}\nFrame Time: {motion.frame_time!r}\n")
+    values = motion_channels(motion)
+    if values.shape[1]:
+        # Write tiny values as 0 so files stay readable; keep 9 significant digits.
+        values = np.where(np.abs(values) < 1e-9, 0.0, values)
+        np.savetxt(out, values, fmt="%.9g", delimiter=" ")
+    else:
+        out.write("\n" * motion.n_frames)
+    return out.getvalue()
+
+
+def write_bvh(motion: Motion, path: str | os.PathLike) -> Path:
+    """Write ``motion`` as a BVH file at ``path`` (atomically).  Returns the path."""
+    text = format_bvh(motion)
+    try:
+        return atomic_write(path, text)
+    except OSError as exc:
+        raise MotionFileError(f"cannot write file ({exc.strerror or exc})", path) from None

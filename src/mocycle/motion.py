@@ -1,0 +1,384 @@
+"""The one data model: :class:`Skeleton` and :class:`Motion`.
+
+Conventions
+-----------
+* Joints are ordered parents before children (the order of a BVH file).
+* Rotations are local (relative to the parent), stored as unit quaternions in
+  scipy's scalar-last order ``(x, y, z, w)``, shape ``(T, J, 4)``, and kept
+  sign-continuous in time (``q[t] . q[t-1] >= 0``).
+* Translations are local too, shape ``(T, J, 3)``: for a joint with position
+  channels they are the channel values (they *replace* the rest offset, as BVH
+  exporters write them); for every other joint they equal the rest offset.
+  ``root_positions`` is ``translations[:, 0]``.
+* Lengths are in the file's units; angles inside mocycle are radians.
+* Objects are immutable in practice: every operation returns a new object.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
+
+from .errors import MocycleError
+from .rotations import continuous_quats
+
+ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
+POSITION_CHANNELS = ("Xposition", "Yposition", "Zposition")
+
+
+@dataclass(frozen=True)
+class EndSite:
+    """A BVH ``End Site``: a leaf point below joint ``parent`` at ``offset``."""
+
+    parent: int
+    offset: tuple[float, float, float]
+    name: str | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Skeleton:
+    """Joint hierarchy with rest offsets and per-joint channel layout.
+
+    Parameters
+    ----------
+    names : joint names, ``J`` strings (may contain spaces).
+    parents : parent index per joint, ``-1`` for the root; parents come first.
+    offsets : rest offsets from the parent, ``(J, 3)`` in file length units.
+    channels : per joint, the channel names in file order, e.g.
+        ``("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")``.
+    end_sites : the End Sites, each with its parent joint and offset.
+    """
+
+    names: tuple[str, ...]
+    parents: np.ndarray
+    offsets: np.ndarray
+    channels: tuple[tuple[str, ...], ...]
+    end_sites: tuple[EndSite, ...] = field(default=())
+
+    def __post_init__(self):
+        names = tuple(str(n) for n in self.names)
+        parents = np.asarray(self.parents, dtype=np.int64).reshape(-1)
+        offsets = np.asarray(self.offsets, dtype=np.float64)
+        channels = tuple(tuple(c) for c in self.channels)
+        J = len(names)
+        if J == 0:
+            raise MocycleError("a skeleton needs at least one joint")
+        if parents.shape != (J,) or offsets.shape != (J, 3) or len(channels) != J:
+            raise MocycleError(
+                f"skeleton arrays disagree: {J} names, parents {parents.shape}, "
+                f"offsets {offsets.shape} (expected ({J}, 3)), {len(channels)} channel lists"
+            )
+        if parents[0] != -1 or np.any(parents[1:] < 0) or np.any(parents[1:] >= np.arange(1, J)):
+            raise MocycleError("skeleton parents must list the root first (-1) and parents before children")
+        if len(set(names)) != J:
+            dup = sorted({n for n in names if names.count(n) > 1})
+            raise MocycleError(f"joint names must be unique; repeated: {', '.join(dup)}")
+        for name, ch in zip(names, channels, strict=True):
+            bad = [c for c in ch if c not in ROTATION_CHANNELS + POSITION_CHANNELS]
+            if bad or len(set(ch)) != len(ch):
+                raise MocycleError(f"joint {name!r}: bad channel list {list(ch)}")
+        parents.setflags(write=False)
+        offsets.setflags(write=False)
+        object.__setattr__(self, "names", names)
+        object.__setattr__(self, "parents", parents)
+        object.__setattr__(self, "offsets", offsets)
+        object.__setattr__(self, "channels", channels)
+        object.__setattr__(self, "end_sites", tuple(self.end_sites))
+
+    # -- structure -------------------------------------------------------
+    @property
+    def n_joints(self) -> int:
+        return len(self.names)
+
+    @property
+    def n_channels(self) -> int:
+        return sum(len(c) for c in self.channels)
+
+    def index(self, name: str) -> int:
+        """Index of the joint called ``name`` (exact match)."""
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise MocycleError(f"no joint named {name!r}; joints are: {', '.join(self.names)}") from None
+
+    def children(self, j: int) -> list[int]:
+        return [int(c) for c in np.flatnonzero(self.parents == j)]
+
+    def euler_order(self, j: int) -> str:
+        """Rotation axes of joint ``j`` in channel order, e.g. ``"ZYX"`` ('' for none)."""
+        return "".join(c[0] for c in self.channels[j] if c in ROTATION_CHANNELS)
+
+    def position_axes(self, j: int) -> list[int]:
+        """Axes (0=x, 1=y, 2=z) that joint ``j`` has position channels for, in channel order."""
+        return [POSITION_CHANNELS.index(c) for c in self.channels[j] if c in POSITION_CHANNELS]
+
+    def bone_lengths(self) -> np.ndarray:
+        """Length of the bone each joint turns, ``(J,)``: its longest child offset.
+
+        Children include End Sites; a joint with no child gets 0.
+        """
+        lengths = np.zeros(self.n_joints)
+        norms = np.linalg.norm(self.offsets, axis=1)
+        for j in range(1, self.n_joints):
+            p = self.parents[j]
+            lengths[p] = max(lengths[p], norms[j])
+        for site in self.end_sites:
+            lengths[site.parent] = max(lengths[site.parent], float(np.linalg.norm(site.offset)))
+        return lengths
+
+    def select(self, patterns: str | Iterable[str] | None) -> list[int]:
+        """Joint indices matching names, glob patterns (case-insensitive) or group names.
+
+        ``None`` selects every joint.  Group names are the keys of
+        :data:`JOINT_GROUPS` (``"legs"``, ``"arms"``, ``"spine"``).  Unknown
+        names raise with the list of joints.
+        """
+        if patterns is None:
+            return list(range(self.n_joints))
+        if isinstance(patterns, str):
+            patterns = [p for p in patterns.split(",") if p.strip()]
+        chosen: set[int] = set()
+        for pat in patterns:
+            pat = pat.strip()
+            if pat in self.names:
+                chosen.add(self.names.index(pat))
+                continue
+            globs = JOINT_GROUPS.get(pat.lower(), [pat])
+            hits = [
+                j
+                for j, n in enumerate(self.names)
+                if any(fnmatch.fnmatch(n.lower(), g.lower()) for g in globs)
+            ]
+            if not hits:
+                raise MocycleError(
+                    f"no joint matches {pat!r}; joints are: {', '.join(self.names)}"
+                )
+            chosen.update(hits)
+        return sorted(chosen)
+
+    def same_as(self, other: Skeleton) -> bool:
+        return (
+            self.names == other.names
+            and np.array_equal(self.parents, other.parents)
+            and np.allclose(self.offsets, other.offsets)
+        )
+
+
+#: Name patterns for common joint groups (CMU, Character Creator, Bandai and
+#: the synthetic humanoid naming).
+JOINT_GROUPS: dict[str, list[str]] = {
+    "legs": ["*hip*", "*upleg*", "*thigh*", "*femur*", "*leg*", "*knee*", "*calf*", "*tibia*",
+             "*shin*", "*foot*", "*ankle*", "*toe*"],
+    "arms": ["*shoulder*", "*clavicle*", "*arm*", "*humerus*", "*elbow*", "*radius*",
+             "*forearm*", "*wrist*", "*hand*"],
+    "spine": ["*spine*", "*back*", "*chest*", "*thorax*", "*neck*", "*head*", "*pelvis*"],
+}
+
+
+class Motion:
+    """A take: skeleton, local rotations, local translations and the exact frame time.
+
+    Parameters
+    ----------
+    skeleton : :class:`Skeleton` with ``J`` joints.
+    rotations : ``(T, J, 4)`` unit quaternions ``(x, y, z, w)`` (normalised and
+        made sign-continuous here), or a ``(T, J, 3, 3)`` array of matrices.
+    translations : ``(T, J, 3)`` local translations, or ``None`` for the rest
+        offsets at every frame.
+    frame_time : seconds per frame (> 0).
+    root_positions : ``(T, 3)``; a shortcut that sets ``translations[:, 0]``.
+    """
+
+    __slots__ = ("skeleton", "rotations", "translations", "frame_time")
+
+    def __init__(
+        self,
+        skeleton: Skeleton,
+        rotations: np.ndarray,
+        translations: np.ndarray | None = None,
+        frame_time: float = 1 / 30,
+        root_positions: np.ndarray | None = None,
+    ):
+        J = skeleton.n_joints
+        rot = np.asarray(rotations, dtype=np.float64)
+        if rot.ndim == 4 and rot.shape[-2:] == (3, 3):
+            T = rot.shape[0]
+            rot = Rotation.from_matrix(rot.reshape(-1, 3, 3)).as_quat().reshape(T, J, 4)
+        if rot.ndim != 3 or rot.shape[1:] != (J, 4):
+            raise MocycleError(f"rotations must have shape (T, {J}, 4); got {rot.shape}")
+        T = rot.shape[0]
+        if T < 1:
+            raise MocycleError("a motion needs at least one frame")
+        norms = np.linalg.norm(rot, axis=-1, keepdims=True)
+        if not np.all(np.isfinite(rot)) or np.any(norms < 1e-12):
+            raise MocycleError("rotations contain NaN, infinite or zero quaternions")
+        rot = continuous_quats(rot / norms)
+        if translations is None:
+            trans = np.broadcast_to(skeleton.offsets, (T, J, 3)).copy()
+        else:
+            trans = np.array(translations, dtype=np.float64, copy=True)
+            if trans.shape != (T, J, 3):
+                raise MocycleError(f"translations must have shape ({T}, {J}, 3); got {trans.shape}")
+        if root_positions is not None:
+            rp = np.asarray(root_positions, dtype=np.float64)
+            if rp.shape != (T, 3):
+                raise MocycleError(f"root_positions must have shape ({T}, 3); got {rp.shape}")
+            trans[:, 0] = rp
+        if not np.all(np.isfinite(trans)):
+            raise MocycleError("translations contain NaN or infinite values")
+        frame_time = float(frame_time)
+        if not np.isfinite(frame_time) or frame_time <= 0:
+            raise MocycleError(f"frame time must be a positive number of seconds; got {frame_time}")
+        rot.setflags(write=False)
+        trans.setflags(write=False)
+        self.skeleton = skeleton
+        self.rotations = rot
+        self.translations = trans
+        self.frame_time = frame_time
+
+    # -- basic facts -----------------------------------------------------
+    @property
+    def n_frames(self) -> int:
+        return self.rotations.shape[0]
+
+    def __len__(self) -> int:
+        return self.n_frames
+
+    @property
+    def n_joints(self) -> int:
+        return self.skeleton.n_joints
+
+    @property
+    def fps(self) -> float:
+        return 1.0 / self.frame_time
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the first to the last frame."""
+        return (self.n_frames - 1) * self.frame_time
+
+    @property
+    def root_positions(self) -> np.ndarray:
+        """``(T, 3)`` root translation per frame."""
+        return self.translations[:, 0]
+
+    def __repr__(self) -> str:
+        return (
+            f"Motion({self.n_frames} frames, {self.n_joints} joints, "
+            f"{self.fps:.6g} fps, {self.duration:.3f} s)"
+        )
+
+    # -- rotations -------------------------------------------------------
+    def rotation(self, joint: int | str) -> Rotation:
+        """The local rotations of one joint as a scipy ``Rotation`` of length T."""
+        j = self.skeleton.index(joint) if isinstance(joint, str) else joint
+        return Rotation.from_quat(self.rotations[:, j])
+
+    def rotation_matrices(self) -> np.ndarray:
+        """``(T, J, 3, 3)`` local rotation matrices."""
+        T, J = self.n_frames, self.n_joints
+        return Rotation.from_quat(self.rotations.reshape(-1, 4)).as_matrix().reshape(T, J, 3, 3)
+
+    # -- forward kinematics ---------------------------------------------
+    def world_transforms(self) -> tuple[np.ndarray, np.ndarray]:
+        """World rotations ``(T, J, 3, 3)`` and world joint positions ``(T, J, 3)``."""
+        local = self.rotation_matrices()
+        parents = self.skeleton.parents
+        world_r = np.empty_like(local)
+        world_p = np.empty((self.n_frames, self.n_joints, 3))
+        world_r[:, 0] = local[:, 0]
+        world_p[:, 0] = self.translations[:, 0]
+        for j in range(1, self.n_joints):
+            p = parents[j]
+            world_r[:, j] = world_r[:, p] @ local[:, j]
+            world_p[:, j] = world_p[:, p] + np.einsum("tab,tb->ta", world_r[:, p], self.translations[:, j])
+        return world_r, world_p
+
+    def world_positions(self, end_sites: bool = False) -> np.ndarray:
+        """Forward kinematics: world joint positions ``(T, J, 3)`` in file units.
+
+        With ``end_sites=True`` the End Site points are appended: ``(T, J + E, 3)``.
+        """
+        world_r, world_p = self.world_transforms()
+        if not end_sites or not self.skeleton.end_sites:
+            return world_p
+        extra = [
+            world_p[:, s.parent] + world_r[:, s.parent] @ np.asarray(s.offset)
+            for s in self.skeleton.end_sites
+        ]
+        return np.concatenate([world_p, np.stack(extra, axis=1)], axis=1)
+
+    # -- new motions -----------------------------------------------------
+    def replace(self, **changes) -> Motion:
+        """A copy with some of ``skeleton``, ``rotations``, ``translations``, ``frame_time`` changed."""
+        args = dict(
+            skeleton=self.skeleton,
+            rotations=self.rotations,
+            translations=self.translations,
+            frame_time=self.frame_time,
+        )
+        args.update(changes)
+        return Motion(**args)
+
+    def __getitem__(self, index) -> Motion:
+        """Frames by slice (``motion[10:200]``, ``motion[::2]``) or index array."""
+        if isinstance(index, (int, np.integer)):
+            index = slice(int(index), int(index) + 1 if index != -1 else None)
+        step = index.step if isinstance(index, slice) and index.step else 1
+        rot = self.rotations[index]
+        if rot.shape[0] == 0:
+            raise MocycleError(f"frame selection {index!r} is empty (motion has {self.n_frames} frames)")
+        return Motion(self.skeleton, rot, self.translations[index], self.frame_time * step)
+
+    def slice(self, start: int = 0, stop: int | None = None) -> Motion:
+        """Frames ``start`` (inclusive) to ``stop`` (exclusive); negative indices count from the end."""
+        return self[start:stop]
+
+    def resample(self, fps: float) -> Motion:
+        """Resample to ``fps`` frames per second over the same duration.
+
+        Rotations are interpolated by slerp, translations linearly.  The first
+        frame is kept; the last new frame is at or before the old last frame.
+        """
+        fps = float(fps)
+        if not np.isfinite(fps) or fps <= 0:
+            raise MocycleError(f"fps must be a positive number; got {fps}")
+        new_dt = 1.0 / fps
+        if self.n_frames == 1:
+            return self.replace(frame_time=new_dt)
+        old_t = np.arange(self.n_frames) * self.frame_time
+        n_new = int(np.floor(self.duration / new_dt + 1e-9)) + 1
+        new_t = np.minimum(np.arange(n_new) * new_dt, old_t[-1])
+        rot = np.empty((n_new, self.n_joints, 4))
+        for j in range(self.n_joints):
+            rot[:, j] = Slerp(old_t, Rotation.from_quat(self.rotations[:, j]))(new_t).as_quat()
+        flat = self.translations.reshape(self.n_frames, -1)
+        trans = np.stack([np.interp(new_t, old_t, col) for col in flat.T], axis=1)
+        return Motion(self.skeleton, rot, trans.reshape(n_new, self.n_joints, 3), new_dt)
+
+    @classmethod
+    def rest(cls, skeleton: Skeleton, n_frames: int = 1, frame_time: float = 1 / 30) -> Motion:
+        """The rest pose (identity rotations, rest offsets) repeated ``n_frames`` times."""
+        q = np.zeros((n_frames, skeleton.n_joints, 4))
+        q[..., 3] = 1.0
+        return cls(skeleton, q, None, frame_time)
+
+
+def concatenate(motions: Sequence[Motion]) -> Motion:
+    """Frames of several motions with the same skeleton and frame time, one after another."""
+    first = motions[0]
+    for m in motions[1:]:
+        if not m.skeleton.same_as(first.skeleton):
+            raise MocycleError("cannot concatenate motions with different skeletons")
+        if not np.isclose(m.frame_time, first.frame_time):
+            raise MocycleError("cannot concatenate motions with different frame times")
+    return Motion(
+        first.skeleton,
+        np.concatenate([m.rotations for m in motions]),
+        np.concatenate([m.translations for m in motions]),
+        first.frame_time,
+    )

@@ -1,0 +1,34 @@
+"""Shared fixtures: where the real captures live, and a skip when they are absent."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED_DATA = Path(os.environ.get("MOCYCLE_SHARED_DATA", REPO.parent / "shared" / "data"))
+
+
+def shared_path(*parts: str) -> Path:
+    """Path to a file in ../shared/data; skips the calling test with a clear message if absent."""
+    p = SHARED_DATA.joinpath(*parts)
+    if not p.exists():
+        pytest.skip(f"shared capture {p} is absent (clone ../shared beside the repo to run this test)")
+    return p
+
+
+def shared_files(folder: str, pattern: str = "*.bvh") -> list[Path]:
+    """All files in a ../shared/data folder, or a skip when the folder is absent."""
+    d = SHARED_DATA / folder
+    if not d.is_dir():
+        pytest.skip(f"shared data folder {d} is absent (clone ../shared beside the repo)")
+    return sorted(d.glob(pattern))
+
+
+@pytest.fixture
+def shared_data() -> Path:
+    if not SHARED_DATA.is_dir():
+        pytest.skip(f"shared data {SHARED_DATA} is absent (clone ../shared beside the repo)")
+    return SHARED_DATA
