@@ -171,11 +171,11 @@ class Skeleton:
 #: Name patterns for common joint groups (CMU, Character Creator, Bandai and
 #: the synthetic humanoid naming).
 JOINT_GROUPS: dict[str, list[str]] = {
-    "legs": ["*hip*", "*upleg*", "*thigh*", "*femur*", "*leg*", "*knee*", "*calf*", "*tibia*",
-             "*shin*", "*foot*", "*ankle*", "*toe*"],
-    "arms": ["*shoulder*", "*clavicle*", "*arm*", "*humerus*", "*elbow*", "*radius*",
-             "*forearm*", "*wrist*", "*hand*"],
-    "spine": ["*spine*", "*back*", "*chest*", "*thorax*", "*neck*", "*head*", "*pelvis*"],
+    "legs": ["*hipjoint*", "*leg*", "*thigh*", "*femur*", "*knee*", "*calf*", "*tibia*", "*shin*",
+             "*foot*", "*ankle*", "*toe*"],
+    "arms": ["*shoulder*", "*clavicle*", "*arm*", "*humerus*", "*elbow*", "*radius*", "*wrist*",
+             "*hand*"],
+    "spine": ["*spine*", "*back*", "*chest*", "*thorax*", "*waist*", "*neck*", "*head*", "*pelvis*"],
 }
 
 

@@ -1,0 +1,124 @@
+import warnings
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from conftest import SHARED_DATA, shared_path
+from helpers import max_angle, random_motion
+from mocycle.errors import MotionFileError
+from mocycle.io.bvh import format_bvh, motion_channels, parse_bvh, read_bvh, write_bvh
+
+SHARED_BVH = sorted(SHARED_DATA.glob("*/*.bvh")) if SHARED_DATA.is_dir() else []
+
+
+def _round_trip_errors(m, m2):
+    ang = max_angle(m.rotations, m2.rotations)
+    scale = max(float(np.abs(m.translations).max()), 1e-12)
+    rel = float(np.abs(m.translations - m2.translations).max()) / scale
+    return ang, rel
+
+
+def test_round_trip_synthetic_keeps_everything(tmp_path):
+    m = random_motion(80, spin=True)
+    path = write_bvh(m, tmp_path / "m.bvh")
+    m2 = read_bvh(path)
+    ang, rel = _round_trip_errors(m, m2)
+    assert ang < 1e-6 and rel < 1e-6
+    assert m2.skeleton.names == m.skeleton.names
+    assert m2.skeleton.channels == m.skeleton.channels  # per-joint orders kept
+    assert [(s.parent, s.offset, s.name) for s in m2.skeleton.end_sites] == [
+        (s.parent, s.offset, s.name) for s in m.skeleton.end_sites
+    ]
+    assert m2.frame_time == m.frame_time  # exact, not rounded to 6 digits
+
+
+def test_written_euler_curves_are_continuous():
+    m = random_motion(200, spin=True)  # joint 1 turns five full circles
+    values = motion_channels(m)
+    assert np.abs(np.diff(values, axis=0))[:, 3:].max() < 60  # degrees per frame, no 360 flips
+    text = format_bvh(m)
+    assert "Frame Time: 0.016666666666666666" in text
+
+
+def test_position_channels_on_non_root_joints_survive():
+    text = """HIERARCHY
+ROOT joint_Root
+{
+  OFFSET 0 0 0
+  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+  JOINT Hips
+  {
+    OFFSET 0 93.9 -3
+    CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+    End Site
+    {
+      OFFSET 0 10 0
+    }
+  }
+}
+MOTION
+Frames: 2
+Frame Time: 0.0333333
+1 2 3 10 20 30 4 90 -400 5 6 7
+1 2 3 10 20 30 5 91 -401 5 6 7
+"""
+    m = parse_bvh(text)
+    assert np.allclose(m.translations[:, 1], [[4, 90, -400], [5, 91, -401]])
+    m2 = parse_bvh(format_bvh(m))
+    assert np.allclose(m2.translations, m.translations)
+    r = Rotation.from_euler("ZXY", [5, 6, 7], degrees=True)
+    assert max_angle(m2.rotations[:, 1], np.tile(r.as_quat(), (2, 1))) < 1e-9
+
+
+def test_missing_frame_time_and_zero_frame_time_are_errors():
+    base = "HIERARCHY\nROOT a\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n}\nMOTION\nFrames: 1\n"
+    with pytest.raises(MotionFileError, match="Frame Time"):
+        parse_bvh(base + "1\n", path="x.bvh")
+    with pytest.raises(MotionFileError, match=r"x\.bvh:9: Frame Time must be a positive"):
+        parse_bvh(base + "Frame Time: 0\n1\n", path="x.bvh")
+
+
+def test_frames_count_mismatch_warns_and_rows_win():
+    text = "HIERARCHY\nROOT a\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n}\nMOTION\nFrames: 5\nFrame Time: 0.1\n1\n2\n3\n"
+    with pytest.warns(UserWarning, match="Frames: 5"):
+        m = parse_bvh(text)
+    assert m.n_frames == 3
+
+
+@pytest.mark.parametrize("path", SHARED_BVH, ids=[p.name for p in SHARED_BVH])
+def test_round_trip_shared_files(path, tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = read_bvh(path)
+        out = write_bvh(m, tmp_path / path.name)
+        m2 = read_bvh(out)
+    ang, rel = _round_trip_errors(m, m2)
+    assert ang < 1e-6, f"rotation differs by {ang} rad"
+    assert rel < 1e-6, f"translation differs by {rel} (relative)"
+    assert m2.skeleton.channels == m.skeleton.channels
+    assert m2.frame_time == m.frame_time
+    assert len(m2.skeleton.end_sites) == len(m.skeleton.end_sites)
+    # Written Euler curves never flip: where a joint turns less than 20 degrees between
+    # frames, our channel steps stay under 180 degrees and no larger than the file's own.
+    ours = motion_channels(m2)
+    lines = path.read_text().splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.lower().startswith("frame time")) + 1
+    orig = np.loadtxt(lines[start:], ndmin=2)
+    col = 0
+    for j, chans in enumerate(m.skeleton.channels):
+        cols = [col + k for k, c in enumerate(chans) if "rotation" in c]
+        col += len(chans)
+        r = Rotation.from_quat(m.rotations[:, j])
+        small = np.degrees((r[:-1].inv() * r[1:]).magnitude()) < 20
+        if cols and small.any():
+            ours_step = np.abs(np.diff(ours[:, cols], axis=0))[small].max()
+            file_step = np.abs(np.diff(orig[:, cols], axis=0))[small].max()
+            assert ours_step < 180 and ours_step <= file_step + 1e-6, m.skeleton.names[j]
+
+
+def test_cmu_bvh_facts():
+    m = read_bvh(shared_path("cmu", "01_01.bvh"))
+    assert m.n_frames == 2752 and m.n_joints == 31
+    assert np.isclose(m.frame_time, 0.0083333)
+    assert m.skeleton.euler_order(0) == "ZYX"

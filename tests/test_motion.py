@@ -1,0 +1,101 @@
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from helpers import max_angle, random_motion, tiny_skeleton
+from mocycle.errors import MocycleError
+from mocycle.motion import Motion, Skeleton, concatenate
+
+
+def test_skeleton_validation_messages():
+    with pytest.raises(MocycleError, match="parents"):
+        Skeleton(("a", "b"), [0, -1], np.zeros((2, 3)), ((), ()))
+    with pytest.raises(MocycleError, match="unique"):
+        Skeleton(("a", "a"), [-1, 0], np.zeros((2, 3)), ((), ()))
+    with pytest.raises(MocycleError, match="channel"):
+        Skeleton(("a",), [-1], np.zeros((1, 3)), (("Wrotation",),))
+
+
+def test_skeleton_select_names_globs_and_groups():
+    s = tiny_skeleton()
+    assert s.select(None) == [0, 1, 2, 3]
+    assert s.select(["Spine"]) == [3]
+    assert s.select("legs") == [1, 2]
+    assert s.select("*leg*,Hips") == [0, 1, 2]
+    with pytest.raises(MocycleError, match="no joint matches"):
+        s.select(["Tail"])
+    assert s.euler_order(1) == "ZXY"
+    assert s.position_axes(0) == [0, 1, 2]
+    assert np.isclose(s.bone_lengths()[1], 40.0)  # Left Up Leg turns the 40-long shin
+    assert np.isclose(s.bone_lengths()[2], np.hypot(40, 5))  # End Site
+
+
+def test_motion_is_immutable_and_sign_continuous():
+    m = random_motion()
+    with pytest.raises(ValueError):
+        m.rotations[0, 0, 0] = 1.0
+    assert np.all(np.sum(m.rotations[1:] * m.rotations[:-1], axis=-1) >= 0)
+    assert m.root_positions.shape == (50, 3)
+    assert np.isclose(m.fps, 60) and np.isclose(m.duration, 49 / 60)
+
+
+def test_motion_rejects_bad_input():
+    s = tiny_skeleton()
+    with pytest.raises(MocycleError, match="shape"):
+        Motion(s, np.zeros((5, 3, 4)))
+    q = np.zeros((5, 4, 4))
+    q[..., 3] = 1
+    with pytest.raises(MocycleError, match="frame time"):
+        Motion(s, q, frame_time=0)
+    q[2, 1] = np.nan
+    with pytest.raises(MocycleError, match="NaN"):
+        Motion(s, q)
+
+
+def test_forward_kinematics_by_hand():
+    s = tiny_skeleton()
+    q = np.zeros((1, 4, 4))
+    q[..., 3] = 1
+    q[0, 0] = Rotation.from_euler("Z", 90, degrees=True).as_quat()  # root turns 90 deg about z
+    m = Motion(s, q, root_positions=[[1.0, 2.0, 3.0]])
+    p = m.world_positions(end_sites=True)
+    # Left Up Leg offset (10, -5, 0) rotated by 90 deg about z -> (5, 10, 0)
+    assert np.allclose(p[0, 1], [1 + 5, 2 + 10, 3])
+    # LeftLeg: further (0, -40, 0) -> (40, 0, 0)
+    assert np.allclose(p[0, 2], [1 + 5 + 40, 2 + 10, 3])
+    assert p.shape == (1, 6, 3)
+    assert np.allclose(p[0, 4], p[0, 2] + [40, 0, 5])
+
+
+def test_slicing_and_indexing():
+    m = random_motion(40)
+    part = m.slice(10, 20)
+    assert part.n_frames == 10 and np.allclose(part.rotations, m.rotations[10:20])
+    every_other = m[::2]
+    assert every_other.n_frames == 20 and np.isclose(every_other.frame_time, 2 * m.frame_time)
+    with pytest.raises(MocycleError, match="empty"):
+        m.slice(30, 30)
+
+
+def test_resample_keeps_frames_at_shared_times_and_interpolates_between():
+    m = random_motion(61)  # 1 s at 60 fps
+    down = m.resample(30)
+    assert down.n_frames == 31 and np.isclose(down.fps, 30)
+    assert max_angle(down.rotations, m.rotations[::2]) < 1e-9
+    assert np.allclose(down.root_positions, m.root_positions[::2])
+    up = m.resample(120)
+    assert up.n_frames == 121
+    assert max_angle(up.rotations[::2], m.rotations) < 1e-9
+    # midpoints are slerp halfway between neighbours
+    mid = Rotation.from_quat(up.rotations[1, 1])
+    a, b = Rotation.from_quat(m.rotations[0, 1]), Rotation.from_quat(m.rotations[1, 1])
+    assert np.isclose((a.inv() * mid).magnitude(), (mid.inv() * b).magnitude(), atol=1e-9)
+
+
+def test_concatenate_checks_skeleton():
+    m = random_motion(10)
+    both = concatenate([m, m])
+    assert both.n_frames == 20
+    other = Motion.rest(Skeleton(("x",), [-1], [[0, 0, 0]], ((),)), 3)
+    with pytest.raises(MocycleError, match="skeleton"):
+        concatenate([m, other])
