@@ -63,3 +63,13 @@ def test_quat_log_is_continuous_through_half_turn_and_inverts():
     v = quat_log(q)
     assert np.allclose(v[:, 2], angle, atol=1e-9)  # scipy's as_rotvec would wrap at pi
     assert (Rotation.from_quat(quat_exp(v)).inv() * r).magnitude().max() < 1e-9
+
+
+def test_continuous_rotvec_follows_several_full_turns():
+    from mocycle.rotations import continuous_rotvec
+
+    angle = np.linspace(0, 5 * 2 * np.pi, 500)
+    r = Rotation.from_rotvec(angle[:, None] * [0, 1.0, 0])
+    v = continuous_rotvec(r.as_quat()[:, None])[:, 0]
+    assert np.allclose(v[:, 1], angle, atol=1e-9)
+    assert (Rotation.from_rotvec(v).inv() * r).magnitude().max() < 1e-9

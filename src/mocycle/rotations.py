@@ -151,6 +151,34 @@ def quat_log(quats: np.ndarray) -> np.ndarray:
     return v * scale
 
 
+def continuous_rotvec(quats: np.ndarray) -> np.ndarray:
+    """Rotation vectors continuous in time, even for joints that turn several full circles.
+
+    ``quats``: ``(T, N, 4)``.  Each frame takes, among the equivalent vectors
+    ``u·(θ + 2πk)``, the one closest to the frame before; frame 0 is canonical
+    (angle ≤ π).  Returns ``(T, N, 3)`` radians.
+    """
+    q = continuous_quats(quats)
+    q = q * np.where(q[:1, :, 3:4] < 0, -1.0, 1.0)  # frame 0 canonical
+    v = quat_log(q)  # continuous while the angle stays in [0, 2π]
+    if v.shape[0] < 2:
+        return v
+    jumps = np.linalg.norm(np.diff(v, axis=0), axis=-1) > np.pi  # (T-1, N)
+    cols = np.flatnonzero(jumps.any(axis=0))
+    if cols.size:
+        start = int(np.argmax(jumps[:, cols].any(axis=1)))
+        prev = v[start, cols]
+        for t in range(start + 1, v.shape[0]):
+            cur = v[t, cols]
+            theta = np.linalg.norm(cur, axis=-1, keepdims=True)
+            pnorm = np.linalg.norm(prev, axis=-1, keepdims=True)
+            u = np.where(theta > 1e-9, cur / np.maximum(theta, 1e-300), prev / np.maximum(pnorm, 1e-300))
+            k = np.round((np.sum(prev * u, axis=-1, keepdims=True) - theta) / TWO_PI)
+            prev = u * (theta + TWO_PI * k)
+            v[t, cols] = prev
+    return v
+
+
 def quat_exp(rotvecs: np.ndarray) -> np.ndarray:
     """Quaternions ``(..., 4)`` from rotation vectors ``(..., 3)`` (any angle)."""
     r = np.asarray(rotvecs, dtype=np.float64)

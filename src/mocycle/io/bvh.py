@@ -229,7 +229,9 @@ def _parse_rows(lines: list[str], start: int, n_channels: int, path) -> np.ndarr
     values = None
     if n_channels:
         try:
-            values = np.loadtxt(body, dtype=np.float64, ndmin=2, comments=None)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", UserWarning)  # "input contained no data": handled below
+                values = np.loadtxt(body, dtype=np.float64, ndmin=2, comments=None)
         except ValueError:
             values = None
     if values is None or values.shape[1] != n_channels or not np.all(np.isfinite(values)):

@@ -1,0 +1,302 @@
+"""Pose features: a :class:`~mocycle.motion.Motion` as a matrix X (T×D) and back.
+
+``pose_matrix`` is the one way from a motion to numbers for every algorithm;
+its decoder is the one way back, so anything an algorithm makes (a cycle, a
+blend, a reconstruction) returns to a Motion and to a BVH file the same way.
+
+Representations of the joint rotations (``rep``):
+
+``euler``     the joint's own Euler angles (radians), unwrapped in time
+``expmap``    rotation vector (axis × angle, radians), continuous in time
+``quatlog``   quaternion logarithm of ``ref⁻¹·q`` about a reference pose
+              (θ/2 · axis; the reference defaults to each joint's mean rotation)
+``rotmat``    the 9 entries of the rotation matrix (decoding projects back to
+              the nearest rotation)
+
+Root translation (``root``): ``keep`` (positions), ``velocity`` (first
+differences per frame, as paper 001 does; row 0 repeats row 1) or ``drop``.
+
+Optional per-DOF normalisation (z-score) and per-joint weights, e.g. the bone
+lengths of the KTH thesis, chapter 4: ``X = (raw - mean) / std * weight``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .errors import MocycleError
+from .motion import Motion
+from .rotations import continuous_euler, continuous_rotvec, euler_to_quats, quat_exp
+
+REPS = ("euler", "expmap", "quatlog", "rotmat")
+ROOTS = ("keep", "velocity", "drop")
+_AXES = ("x", "y", "z")
+
+
+@dataclass(frozen=True, eq=False)
+class PoseDecoder:
+    """Turns pose matrices made by :func:`pose_matrix` back into motions.
+
+    Attributes
+    ----------
+    template : the motion that was encoded; joints that are not features
+        (unselected joints, non-root translations, a dropped root) come from it.
+    rep, root : the representation and root handling used.
+    joints : indices of the joints whose rotations are columns.
+    columns : a name per column, e.g. ``"LeftUpLeg:rx"``, ``"root:vz"``.
+    dof_joint : ``(D,)`` joint index per column (root translation columns: 0).
+    mean, scale : ``(D,)``: ``X = (raw - mean) / scale``.
+    reference : ``(J, 4)`` reference quaternions of the ``quatlog`` rep.
+    """
+
+    template: Motion
+    rep: str
+    root: str
+    joints: tuple[int, ...]
+    columns: tuple[str, ...]
+    dof_joint: np.ndarray
+    mean: np.ndarray
+    scale: np.ndarray
+    reference: np.ndarray
+
+    @property
+    def n_features(self) -> int:
+        return len(self.columns)
+
+    def encode(self, motion: Motion) -> np.ndarray:
+        """The pose matrix of another motion with the same skeleton, same transform."""
+        if not motion.skeleton.same_as(self.template.skeleton):
+            raise MocycleError("cannot encode a motion whose skeleton differs from the template's")
+        raw = _raw_features(motion, self.rep, self.root, self.joints, self.reference)
+        return (raw - self.mean) / self.scale
+
+    def decode(self, X: np.ndarray, frame_time: float | None = None) -> Motion:
+        """A :class:`Motion` from ``X`` (``(T, D)``; T may differ from the template's).
+
+        Non-feature parts come from the template frame by frame when T matches,
+        otherwise from its mean pose (rotations) and first frame (root).
+        """
+        X = np.asarray(X, dtype=np.float64)
+        if X.ndim != 2 or X.shape[1] != self.n_features:
+            raise MocycleError(f"X must have shape (T, {self.n_features}); got {X.shape}")
+        if not np.all(np.isfinite(X)):
+            raise MocycleError("X contains NaN or infinite values")
+        raw = X * self.scale + self.mean
+        tpl = self.template
+        T, J = X.shape[0], tpl.n_joints
+        same_length = T == tpl.n_frames
+        if same_length:
+            quats = tpl.rotations.copy()
+            trans = tpl.translations.copy()
+        else:
+            mean_q = np.stack([Rotation.from_quat(tpl.rotations[:, j]).mean().as_quat() for j in range(J)])
+            quats = np.broadcast_to(mean_q, (T, J, 4)).copy()
+            trans = np.broadcast_to(tpl.translations.mean(axis=0), (T, J, 3)).copy()
+            trans[:, 0] = tpl.translations[0, 0]
+        col = 0
+        skel = tpl.skeleton
+        if self.rep == "euler":
+            for order, joints in _joints_by_order(skel, self.joints).items():
+                k = len(order)
+                block = np.stack([raw[:, col + i * k: col + (i + 1) * k] for i in range(len(joints))], 1)
+                quats[:, joints] = euler_to_quats(block, order)
+                col += k * len(joints)
+        else:
+            n = len(self.joints)
+            width = 9 if self.rep == "rotmat" else 3
+            block = raw[:, col: col + width * n].reshape(T, n, width)
+            col += width * n
+            js = list(self.joints)
+            if self.rep == "expmap":
+                quats[:, js] = quat_exp(block)
+            elif self.rep == "quatlog":
+                rel = Rotation.from_quat(quat_exp(2.0 * block).reshape(-1, 4))
+                ref = Rotation.from_quat(np.broadcast_to(self.reference[js], (T, n, 4)).reshape(-1, 4))
+                quats[:, js] = (ref * rel).as_quat().reshape(T, n, 4)
+            else:
+                quats[:, js] = Rotation.from_matrix(block.reshape(-1, 3, 3)).as_quat().reshape(T, n, 4)
+        if self.root == "keep":
+            trans[:, 0] = raw[:, col: col + 3]
+        elif self.root == "velocity":
+            v = raw[:, col: col + 3]
+            start = tpl.translations[0, 0]
+            trans[:, 0] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
+        return Motion(skel, quats, trans, tpl.frame_time if frame_time is None else frame_time)
+
+
+def _joints_by_order(skel, joints: Iterable[int]) -> dict[str, list[int]]:
+    groups: dict[str, list[int]] = {}
+    for j in joints:
+        groups.setdefault(skel.euler_order(j), []).append(j)
+    return groups
+
+
+def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
+                  reference: np.ndarray) -> np.ndarray:
+    T = motion.n_frames
+    js = list(joints)
+    parts = []
+    if rep == "euler":
+        for order, group in _joints_by_order(motion.skeleton, js).items():
+            parts.append(continuous_euler(motion.rotations[:, group], order).reshape(T, -1))
+    elif rep == "expmap":
+        parts.append(continuous_rotvec(motion.rotations[:, js]).reshape(T, -1))
+    elif rep == "quatlog":
+        n = len(js)
+        ref = Rotation.from_quat(np.broadcast_to(reference[js], (T, n, 4)).reshape(-1, 4))
+        rel = (ref.inv() * Rotation.from_quat(motion.rotations[:, js].reshape(-1, 4))).as_quat()
+        rel = rel.reshape(T, n, 4)
+        parts.append(0.5 * continuous_rotvec(rel).reshape(T, -1))
+    else:
+        parts.append(Rotation.from_quat(motion.rotations[:, js].reshape(-1, 4)).as_matrix().reshape(T, -1))
+    if root == "keep":
+        parts.append(motion.root_positions)
+    elif root == "velocity":
+        p = motion.root_positions
+        v = np.diff(p, axis=0) if T > 1 else np.zeros((1, 3))
+        parts.append(np.concatenate([v[:1], v]) if T > 1 else v)
+    return np.concatenate(parts, axis=1) if parts else np.zeros((T, 0))
+
+
+def _columns(motion: Motion, rep: str, root: str, joints) -> tuple[list[str], list[int]]:
+    skel = motion.skeleton
+    names: list[str] = []
+    owner: list[int] = []
+    if rep == "euler":
+        for order, group in _joints_by_order(skel, joints).items():
+            for j in group:
+                names += [f"{skel.names[j]}:r{a.lower()}" for a in order]
+                owner += [j] * len(order)
+    else:
+        labels = [f"m{r}{c}" for r in range(3) for c in range(3)] if rep == "rotmat" else (
+            ["rx", "ry", "rz"] if rep == "expmap" else ["qx", "qy", "qz"])
+        for j in joints:
+            names += [f"{skel.names[j]}:{lab}" for lab in labels]
+            owner += [j] * len(labels)
+    if root != "drop":
+        prefix = "v" if root == "velocity" else ""
+        names += [f"root:{prefix}{a}" for a in _AXES]
+        owner += [0, 0, 0]
+    return names, owner
+
+
+def _joint_weights(motion: Motion, weights, joints) -> np.ndarray:
+    """Per-joint weights ``(J,)`` from None, ``"bone"``, a mapping or an array."""
+    skel = motion.skeleton
+    J = skel.n_joints
+    if weights is None:
+        return np.ones(J)
+    if isinstance(weights, str):
+        if weights != "bone":
+            raise MocycleError(f"weights must be None, 'bone', a mapping or an array; got {weights!r}")
+        lengths = skel.bone_lengths()
+        top = lengths[list(joints)].max() if len(joints) else 0.0
+        if top <= 0:
+            return np.ones(J)
+        w = lengths / top
+        w[0] = 1.0  # the root (its translation) weighs like the longest bone
+        return np.maximum(w, 1e-3)
+    if isinstance(weights, Mapping):
+        w = np.ones(J)
+        for name, value in weights.items():
+            w[skel.index(name)] = float(value)
+    else:
+        w = np.asarray(weights, dtype=np.float64)
+        if w.shape != (J,):
+            raise MocycleError(f"weights must have one value per joint ({J}); got shape {w.shape}")
+    if not np.all(np.isfinite(w)) or np.any(w <= 0):
+        raise MocycleError("joint weights must be positive finite numbers")
+    return w
+
+
+def pose_matrix(
+    motion: Motion,
+    rep: str = "expmap",
+    root: str = "velocity",
+    joints: str | Iterable[str] | None = None,
+    weights: str | Mapping[str, float] | np.ndarray | None = None,
+    normalize: bool = False,
+    reference: Motion | np.ndarray | None = None,
+) -> tuple[np.ndarray, PoseDecoder]:
+    """The pose matrix X (T×D) of ``motion`` and a decoder back to a Motion.
+
+    Parameters
+    ----------
+    rep : ``"euler"``, ``"expmap"``, ``"quatlog"`` or ``"rotmat"`` (module notes).
+    root : ``"keep"``, ``"velocity"`` or ``"drop"`` for the root translation.
+    joints : joint names, glob patterns or group names (``"legs"``, ``"arms"``,
+        ``"spine"``), a comma-separated string or a list; ``None``: every joint
+        with rotation channels.
+    weights : ``None``, ``"bone"`` (bone-length weights, KTH thesis ch. 4),
+        ``{joint name: weight}`` or a ``(J,)`` array; multiplies the joint's columns.
+    normalize : z-score every column (constant columns keep scale 1).
+    reference : the ``quatlog`` reference pose: a motion (its frame 0) or
+        ``(J, 4)`` quaternions; default each joint's mean rotation.
+
+    Returns
+    -------
+    X : ``(T, D)`` float array.
+    decoder : :class:`PoseDecoder` (``decoder.decode(X)`` gives the motion back).
+    """
+    if rep not in REPS:
+        raise MocycleError(f"rep must be one of {', '.join(REPS)}; got {rep!r}")
+    if root not in ROOTS:
+        raise MocycleError(f"root must be one of {', '.join(ROOTS)}; got {root!r}")
+    if not isinstance(motion, Motion):
+        raise MocycleError(f"pose_matrix needs a Motion; got {type(motion).__name__}")
+    skel = motion.skeleton
+    chosen = skel.select(joints)
+    chosen = tuple(j for j in chosen if skel.euler_order(j))
+    if not chosen and root == "drop":
+        raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
+    if rep == "quatlog":
+        if reference is None:
+            ref = np.stack([Rotation.from_quat(motion.rotations[:, j]).mean().as_quat()
+                            for j in range(skel.n_joints)])
+        elif isinstance(reference, Motion):
+            ref = reference.rotations[0]
+        else:
+            ref = np.asarray(reference, dtype=np.float64)
+            if ref.shape != (skel.n_joints, 4):
+                raise MocycleError(f"reference must be a Motion or ({skel.n_joints}, 4) quaternions")
+    else:
+        ref = np.tile([0.0, 0.0, 0.0, 1.0], (skel.n_joints, 1))
+    raw = _raw_features(motion, rep, root, chosen, ref)
+    columns, owner = _columns(motion, rep, root, chosen)
+    owner_arr = np.asarray(owner, dtype=np.int64)
+    D = raw.shape[1]
+    mean = np.zeros(D)
+    scale = np.ones(D)
+    if normalize:
+        mean = raw.mean(axis=0)
+        std = raw.std(axis=0)
+        scale = np.where(std > 1e-12 * (1.0 + np.abs(mean)), std, 1.0)
+    w = _joint_weights(motion, weights, chosen)
+    scale = scale / w[owner_arr]
+    X = (raw - mean) / scale
+    decoder = PoseDecoder(motion, rep, root, chosen, tuple(columns), owner_arr, mean, scale, ref)
+    return X, decoder
+
+
+def delay_embed(X: np.ndarray, m: int, step: int = 1) -> np.ndarray:
+    """Delay embedding of the KTH thesis eq. 3.26.
+
+    Row i of the result is ``(x_i, x_{i+step}, ..., x_{i+m*step})``; shape
+    ``(T - m*step, D*(m+1))``.  Row i belongs to frame i; the first D columns
+    are X itself.  ``m = 0`` returns X.
+    """
+    X = np.asarray(X)
+    if X.ndim != 2:
+        raise MocycleError(f"X must be a 2-D array (T, D); got shape {X.shape}")
+    m, step = int(m), int(step)
+    if m < 0 or step < 1:
+        raise MocycleError(f"delay embedding needs m >= 0 and step >= 1; got m={m}, step={step}")
+    T = X.shape[0]
+    n = T - m * step
+    if n < 1:
+        raise MocycleError(f"delay embedding with m={m}, step={step} needs more than {m * step} frames; got {T}")
+    return np.concatenate([X[k * step: k * step + n] for k in range(m + 1)], axis=1)
