@@ -113,3 +113,16 @@ def test_delay_embedding_eq_3_26():
     assert delay_embed(X, 2, step=3).shape == (4, 6)
     with pytest.raises(MocycleError, match="needs more than"):
         delay_embed(X, 10)
+
+
+def test_root_columns_follow_the_travel_joint_when_the_root_is_static():
+    # Bandai-style file: a static joint_Root, the travel in Hips' position channels.
+    m = random_motion(30)
+    trans = np.array(m.translations)
+    trans[:, 1] = trans[:, 0]
+    trans[:, 0] = 0.0
+    bandai_like = m.replace(translations=trans)
+    assert bandai_like.travel_joint == 1 and m.travel_joint == 0
+    X, dec = pose_matrix(bandai_like, rep="expmap", root="velocity")
+    assert np.allclose(X[1:, -3:], np.diff(trans[:, 1], axis=0))
+    assert np.allclose(dec.decode(X).translations, trans)

@@ -15,6 +15,8 @@ Representations of the joint rotations (``rep``):
 
 Root translation (``root``): ``keep`` (positions), ``velocity`` (first
 differences per frame, as paper 001 does; row 0 repeats row 1) or ``drop``.
+"Root" means ``motion.travel_joint``: the root, or the first joint whose
+translation moves when the root is static (Bandai files move ``Hips``).
 
 Optional per-DOF normalisation (z-score) and per-joint weights, e.g. the bone
 lengths of the KTH thesis, chapter 4: ``X = (raw - mean) / std * weight``.
@@ -51,6 +53,7 @@ class PoseDecoder:
     dof_joint : ``(D,)`` joint index per column (root translation columns: 0).
     mean, scale : ``(D,)``: ``X = (raw - mean) / scale``.
     reference : ``(J, 4)`` reference quaternions of the ``quatlog`` rep.
+    travel : the joint whose translation the root columns hold.
     """
 
     template: Motion
@@ -62,6 +65,7 @@ class PoseDecoder:
     mean: np.ndarray
     scale: np.ndarray
     reference: np.ndarray
+    travel: int = 0
 
     @property
     def n_features(self) -> int:
@@ -71,7 +75,7 @@ class PoseDecoder:
         """The pose matrix of another motion with the same skeleton, same transform."""
         if not motion.skeleton.same_as(self.template.skeleton):
             raise MocycleError("cannot encode a motion whose skeleton differs from the template's")
-        raw = _raw_features(motion, self.rep, self.root, self.joints, self.reference)
+        raw = _raw_features(motion, self.rep, self.root, self.joints, self.reference, self.travel)
         return (raw - self.mean) / self.scale
 
     def decode(self, X: np.ndarray, frame_time: float | None = None) -> Motion:
@@ -96,7 +100,7 @@ class PoseDecoder:
             mean_q = np.stack([Rotation.from_quat(tpl.rotations[:, j]).mean().as_quat() for j in range(J)])
             quats = np.broadcast_to(mean_q, (T, J, 4)).copy()
             trans = np.broadcast_to(tpl.translations.mean(axis=0), (T, J, 3)).copy()
-            trans[:, 0] = tpl.translations[0, 0]
+            trans[:, self.travel] = tpl.translations[0, self.travel]
         col = 0
         skel = tpl.skeleton
         if self.rep == "euler":
@@ -120,11 +124,11 @@ class PoseDecoder:
             else:
                 quats[:, js] = Rotation.from_matrix(block.reshape(-1, 3, 3)).as_quat().reshape(T, n, 4)
         if self.root == "keep":
-            trans[:, 0] = raw[:, col: col + 3]
+            trans[:, self.travel] = raw[:, col: col + 3]
         elif self.root == "velocity":
             v = raw[:, col: col + 3]
-            start = tpl.translations[0, 0]
-            trans[:, 0] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
+            start = tpl.translations[0, self.travel]
+            trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
         return Motion(skel, quats, trans, tpl.frame_time if frame_time is None else frame_time)
 
 
@@ -136,7 +140,7 @@ def _joints_by_order(skel, joints: Iterable[int]) -> dict[str, list[int]]:
 
 
 def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
-                  reference: np.ndarray) -> np.ndarray:
+                  reference: np.ndarray, travel: int) -> np.ndarray:
     T = motion.n_frames
     js = list(joints)
     parts = []
@@ -154,9 +158,9 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
     else:
         parts.append(Rotation.from_quat(motion.rotations[:, js].reshape(-1, 4)).as_matrix().reshape(T, -1))
     if root == "keep":
-        parts.append(motion.root_positions)
+        parts.append(motion.translations[:, travel])
     elif root == "velocity":
-        p = motion.root_positions
+        p = motion.translations[:, travel]
         v = np.diff(p, axis=0) if T > 1 else np.zeros((1, 3))
         parts.append(np.concatenate([v[:1], v]) if T > 1 else v)
     return np.concatenate(parts, axis=1) if parts else np.zeros((T, 0))
@@ -265,7 +269,8 @@ def pose_matrix(
                 raise MocycleError(f"reference must be a Motion or ({skel.n_joints}, 4) quaternions")
     else:
         ref = np.tile([0.0, 0.0, 0.0, 1.0], (skel.n_joints, 1))
-    raw = _raw_features(motion, rep, root, chosen, ref)
+    travel = motion.travel_joint
+    raw = _raw_features(motion, rep, root, chosen, ref, travel)
     columns, owner = _columns(motion, rep, root, chosen)
     owner_arr = np.asarray(owner, dtype=np.int64)
     D = raw.shape[1]
@@ -278,7 +283,7 @@ def pose_matrix(
     w = _joint_weights(motion, weights, chosen)
     scale = scale / w[owner_arr]
     X = (raw - mean) / scale
-    decoder = PoseDecoder(motion, rep, root, chosen, tuple(columns), owner_arr, mean, scale, ref)
+    decoder = PoseDecoder(motion, rep, root, chosen, tuple(columns), owner_arr, mean, scale, ref, travel)
     return X, decoder
 
 

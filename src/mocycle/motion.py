@@ -266,6 +266,17 @@ class Motion:
         """``(T, 3)`` root translation per frame."""
         return self.translations[:, 0]
 
+    @property
+    def travel_joint(self) -> int:
+        """Index of the joint whose translation carries the travel: the first joint
+        (parents first) whose local translation changes over the take, else 0.
+
+        Usually the root; in files such as the Bandai Namco set the root is a
+        static ``joint_Root`` and ``Hips`` carries the motion in its position channels.
+        """
+        moving = np.ptp(self.translations, axis=0).max(axis=1) > 1e-9  # (J,)
+        return int(np.argmax(moving)) if moving.any() else 0
+
     def __repr__(self) -> str:
         return (
             f"Motion({self.n_frames} frames, {self.n_joints} joints, "
