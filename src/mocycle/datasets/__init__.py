@@ -1,0 +1,21 @@
+"""Built-in demo data and test ground truth (synthetic takes with exact phase)."""
+
+from .synthetic import (
+    SyntheticTake,
+    humanoid_skeleton,
+    synthetic_nonperiodic,
+    synthetic_run,
+    synthetic_still,
+    synthetic_walk,
+    synthetic_walk_then_run,
+)
+
+__all__ = [
+    "SyntheticTake",
+    "humanoid_skeleton",
+    "synthetic_nonperiodic",
+    "synthetic_run",
+    "synthetic_still",
+    "synthetic_walk",
+    "synthetic_walk_then_run",
+]
