@@ -155,9 +155,12 @@ class _Header:
         elif key == "CHANNELS":
             if not self.stack or self.stack[-1][0] != "joint":
                 raise self.error(lineno, "CHANNELS outside of a ROOT or JOINT block")
-            if len(words) < 2 or not words[1].isdigit():
+            try:
+                n = int(words[1]) if len(words) > 1 and words[1].isascii() else -1
+            except ValueError:
+                n = -1
+            if n < 0:
                 raise self.error(lineno, "expected the channel count after CHANNELS")
-            n = int(words[1])
             names = words[2:]
             if len(names) != n:
                 raise self.error(lineno, f"CHANNELS says {n} channels but lists {len(names)}")
@@ -253,8 +256,8 @@ def _find_bad_row(body: list[str], start: int, n_channels: int, path) -> None:
                 path, start + k + 1,
             )
         for word in words:
-            try:
-                v = float(word)
+            try:  # the same numbers loadtxt takes: ASCII, no digit separators
+                v = float(word) if word.isascii() and "_" not in word else np.nan
             except ValueError:
                 v = np.nan
             if not np.isfinite(v):
@@ -302,6 +305,11 @@ def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motio
         raise MotionFileError("no MOTION section; expected 'MOTION' after the hierarchy", path, len(lines))
     skel = header.skeleton(motion_line + 1)
     frames, frame_time, data_start = _motion_header(lines, motion_line + 1, path)
+    if skel.n_channels == 0:  # nothing moves: the Frames: count is all there is
+        if not frames or frames < 1:
+            raise MotionFileError("the hierarchy declares no channels and 'Frames:' gives no count", path,
+                                  data_start)
+        return _motion_from_channels(skel, np.zeros((frames, 0)), frame_time)
     values = _parse_rows(lines, data_start, skel.n_channels, path)
     T = values.shape[0]
     if frames is not None and frames != T:
