@@ -4,7 +4,8 @@
 
 Times reading and writing ../shared/data/cmu/01_01.bvh and the largest file in
 ../shared/data/cmu-iclone with each installed parser (median of N runs after
-one warm-up), prints one table and whether the two reading goals are met.
+one warm-up), prints one table and whether the two reading goals are met,
+then the ASF/AMC read time of cmu/01.asf + 01_01.amc (mocycle only).
 """
 
 from __future__ import annotations
@@ -121,6 +122,13 @@ def main(argv: list[str] | None = None) -> int:
         )
     else:
         print("read speed-up vs fastest other parser: no other parser installed")
+
+    asf, amc = args.data / "cmu" / "01.asf", args.data / "cmu" / "01_01.amc"
+    if asf.is_file() and amc.is_file():
+        from mocycle.io.asfamc import read_asfamc
+
+        ms, m = median_ms(repeat, read_asfamc, asf, amc)
+        print(f"mocycle read {asf.name} + {amc.name} (ASF/AMC, {m.n_frames} frames): {ms:.1f} ms")
     return 0
 
 
