@@ -1,18 +1,24 @@
 # Two commands on a fresh machine with Python 3.11 and pip:
 #   make demo   set up .venv and run the main job on the built-in synthetic walk
-#   make test   set up .venv with the test tools, lint with ruff, run the whole suite
+#   make test   lint with ruff, run the whole suite with numpy 2.x (.venv) and again
+#               with numpy 1.26 (.venv-numpy1, the line Blender bundles)
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV   := .venv
 BIN    := $(VENV)/bin
+NP1    := .venv-numpy1
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test test-numpy2 test-numpy1 lint bench clean
 
-$(BIN)/python:
+$(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-
-$(VENV)/.installed: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e ".[test]"
+	touch $@
+
+$(NP1)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(NP1)
+	$(NP1)/bin/python -m pip install --quiet --upgrade pip
+	$(NP1)/bin/python -m pip install --quiet "numpy>=1.26,<2" -e ".[test]"
 	touch $@
 
 demo: $(VENV)/.installed
@@ -21,12 +27,19 @@ demo: $(VENV)/.installed
 lint: $(VENV)/.installed
 	$(BIN)/ruff check src tests benchmarks
 
-test: lint
+test-numpy2: $(VENV)/.installed
+	$(BIN)/python -c "import numpy; print('numpy', numpy.__version__)"
 	$(BIN)/python -m pytest -q
+
+test-numpy1: $(NP1)/.installed
+	$(NP1)/bin/python -c "import numpy; print('numpy', numpy.__version__)"
+	$(NP1)/bin/python -m pytest -q -p no:cacheprovider
+
+test: lint test-numpy1 test-numpy2
 
 bench: $(VENV)/.installed
 	$(BIN)/python -m pip install --quiet -e ".[bench]"
 	$(BIN)/python benchmarks/io.py
 
 clean:
-	rm -rf $(VENV) out .pytest_cache .ruff_cache
+	rm -rf $(VENV) $(NP1) out .pytest_cache .ruff_cache
