@@ -1,0 +1,415 @@
+"""Circular coordinates from persistent cohomology (paper 001, sections 3-4).
+
+Every frame is a point; the Vietoris-Rips filtration of a greedy-permutation
+subsample (the *landmarks*) is built by ripser with Z/p cocycles.  For each
+chosen H1 class:
+
+1. the Z/p cocycle is lifted to Z (values above p/2 become negative) and the
+   lift is checked on every triangle at the chosen scale; when it fails, the
+   next prime is tried (KTH thesis, section 2.2);
+2. the L2-smoothest representative ``z̄ = z + δw`` is found with a sparse
+   least-squares solve (``scipy.sparse.linalg.lsqr``); ``w mod 1`` is the
+   coordinate of each landmark;
+3. every frame gets a coordinate from the landmarks around it by the
+   partition-of-unity formula of sparse circular coordinates (Perea 2018):
+   ``θ(x) = w_j + Σ_k φ_k(x) z̄(j, k)`` with ``j`` the landmark nearest ``x``;
+4. with several classes, the integer basis is changed (a class replaced by its
+   sum or difference with another) while that makes a class wind less in
+   total: ripser may return "walk + run" and "run" for a walk-then-run take,
+   the reduced basis is "walk" and "run" (paper 001 §7 suggests such
+   combinations of coclasses);
+5. a class must wind at least ``min_cycles`` times over the take (rows are
+   frames in time order) to count as a periodic motion: a single loop in a
+   non-periodic take winds about once;
+6. the direction is chosen so that the coordinate increases with time.
+
+The scale is taken late in the class's lifetime (paper 001 §4.3), and the
+number of classes can be read from the barcode (a gap between long bars and
+the rest), with the reason recorded.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from ripser import ripser
+from scipy import sparse
+from scipy.sparse.linalg import lsqr
+from scipy.spatial.distance import cdist
+from sklearn.base import BaseEstimator, TransformerMixin
+
+from ..errors import MocycleError, MocycleWarning
+
+PRIMES = (47, 43, 41, 37, 31, 29, 23, 19, 17, 13)
+MIN_FRAMES = 20
+
+
+@dataclass(frozen=True)
+class CircleClass:
+    """One H1 class turned into a landmark coordinate.
+
+    ``bar`` is the index into ``barcode_``; ``scale`` the filtration value α
+    used; ``w`` the landmark coordinates ``(L,)``; ``zbar`` the smoothed
+    cocycle as an antisymmetric ``(L, L)`` matrix; ``prime`` the coefficient
+    field the lift to Z succeeded with.
+    """
+
+    bar: int
+    birth: float
+    death: float
+    scale: float
+    prime: int
+    w: np.ndarray
+    zbar: np.ndarray
+
+    @property
+    def persistence(self) -> float:
+        return self.death - self.birth
+
+
+@dataclass(frozen=True)
+class CircleCoordinate:
+    """A reported circular coordinate: an integer combination of :class:`CircleClass` es.
+
+    ``combination`` has one integer per fitted class (usually a single 1);
+    ``bar``/``birth``/``death`` are those of the longest bar in the
+    combination; ``sign`` makes the coordinate increase with time;
+    ``n_cycles`` is its net winding over the fitted frames.
+    """
+
+    bar: int
+    birth: float
+    death: float
+    combination: tuple[int, ...]
+    sign: float
+    n_cycles: float
+
+    @property
+    def persistence(self) -> float:
+        return self.death - self.birth
+
+
+def choose_classes(barcode: np.ndarray, n_classes: int | str = "auto", min_ratio: float = 1.5,
+                   max_classes: int = 5) -> tuple[list[int], str]:
+    """Pick H1 bars: the ``n_classes`` longest, or with ``"auto"`` the long bars before the largest gap.
+
+    A bar is *long* when ``death / birth >= min_ratio`` (multiplicative
+    persistence: noise bars die soon after they are born at any scale).
+    Among the long bars, sorted by persistence, ``"auto"`` keeps the first
+    ``k`` where the ratio ``persistence_k / persistence_{k+1}`` is largest
+    (``k <= max_classes``; bar ``k+1`` may be a short one).
+    Returns the bar indices (longest first) and the reason in words.
+    """
+    barcode = np.asarray(barcode, dtype=float).reshape(-1, 2)
+    if barcode.shape[0] == 0:
+        return [], "the H1 barcode is empty: the poses form no loop at any scale"
+    pers = barcode[:, 1] - barcode[:, 0]
+    order = [int(i) for i in np.argsort(-pers, kind="stable")]
+    ratio = barcode[:, 1] / np.maximum(barcode[:, 0], 1e-12)
+
+    def bar(i):
+        return f"[{barcode[i, 0]:.3g}, {barcode[i, 1]:.3g})"
+
+    if n_classes != "auto":
+        n = int(n_classes)
+        if n < 1:
+            raise MocycleError(f"n_classes must be 'auto' or a positive integer; got {n_classes!r}")
+        chosen = order[:n]
+        reason = f"the {len(chosen)} longest H1 bar(s) as asked: " + ", ".join(bar(i) for i in chosen)
+        if len(chosen) < n:
+            reason += f" (only {len(chosen)} bar(s) exist)"
+        return chosen, reason
+    long_bars = [i for i in order if ratio[i] >= min_ratio]
+    if not long_bars:
+        top = order[0]
+        return [], (f"no long H1 bar: the longest is {bar(top)} with death/birth = {ratio[top]:.2f} "
+                    f"< {min_ratio:g}")
+    cands = long_bars[:max_classes]
+    rest = [i for i in order if i not in cands]
+    nxt = [pers[i] for i in cands[1:]] + [pers[rest[0]] if rest else 0.0]
+    gaps = [pers[i] / max(n, 1e-12 * pers[cands[0]]) for i, n in zip(cands, nxt, strict=True)]
+    k = int(np.argmax(gaps)) + 1
+    chosen = cands[:k]
+    after = f"the next bar {bar(cands[k] if k < len(cands) else rest[0])}" if (k < len(cands) or rest) \
+        else "no further bar"
+    reason = (f"{k} long H1 bar(s) {', '.join(bar(i) for i in chosen)} (death/birth >= {min_ratio:g}); "
+              f"largest persistence gap ({gaps[k - 1]:.1f}x) before {after}")
+    return chosen, reason
+
+
+def _lift(cocycle: np.ndarray, prime: int, position: np.ndarray, L: int) -> np.ndarray:
+    """Z/p cocycle rows ``[i, j, v]`` (point indices) -> antisymmetric integer matrix on landmarks."""
+    Z = np.zeros((L, L))
+    if cocycle.size == 0:
+        return Z
+    a = position[cocycle[:, 0].astype(int)]
+    b = position[cocycle[:, 1].astype(int)]
+    v = np.mod(cocycle[:, 2], prime)
+    v = np.where(v > (prime - 1) / 2, v - prime, v)
+    Z[a, b] = v
+    Z[b, a] = -v
+    return Z
+
+
+def _is_cocycle(Z: np.ndarray, adjacent: np.ndarray) -> bool:
+    """True when ``Z`` sums to zero around every triangle of the graph ``adjacent``.
+
+    Only triangles through a vertex touched by the cocycle can fail, so only
+    those vertices are visited.
+    """
+    for b in np.flatnonzero(np.any(Z != 0, axis=1)):
+        around = Z[:, b][:, None] + Z[b, :][None, :] + Z.T  # z(a,b) + z(b,c) + z(c,a) at [a, c]
+        mask = adjacent[:, b][:, None] & adjacent[b, :][None, :] & adjacent
+        if np.any(around[mask] != 0):
+            return False
+    return True
+
+
+def _smooth(Z: np.ndarray, adjacent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Harmonic representative: ``w = argmin ||z + δw||`` on the edges of ``adjacent``.
+
+    Returns ``w`` ``(L,)`` and ``z̄ = z + δw`` as an antisymmetric ``(L, L)`` matrix.
+    """
+    L = Z.shape[0]
+    a, b = np.nonzero(np.triu(adjacent, 1))
+    E = a.size
+    rows = np.r_[np.arange(E), np.arange(E)]
+    delta = sparse.csr_matrix((np.r_[-np.ones(E), np.ones(E)], (rows, np.r_[a, b])), shape=(E, L))
+    z = Z[a, b]
+    w = lsqr(delta, -z, atol=1e-10, btol=1e-10, iter_lim=20 * L)[0]
+    zbar = np.zeros((L, L))
+    zbar[a, b] = z + delta @ w
+    zbar[b, a] = -zbar[a, b]
+    return w, zbar
+
+
+def _extend(dist: np.ndarray, w: np.ndarray, zbar: np.ndarray, radius: float) -> np.ndarray:
+    """Partition-of-unity extension from landmarks to points.
+
+    ``dist``: ``(L, N)`` landmark-to-point distances.  Points farther than
+    ``radius`` from every landmark take the coordinate of the nearest one.
+    """
+    phi = np.maximum(radius - dist, 0.0)
+    total = phi.sum(axis=0)
+    nearest = np.argmin(dist, axis=0)
+    theta = w[nearest].copy()
+    ok = total > 0
+    j = nearest[ok]
+    theta[ok] += np.einsum("ln,nl->n", phi[:, ok] / total[ok], zbar[j])
+    return theta
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    """Circle differences (cycles) wrapped into [-0.5, 0.5)."""
+    return x - np.round(x)
+
+
+def _reduce_basis(coords: np.ndarray, max_rounds: int = 10) -> np.ndarray:
+    """Integer unimodular basis change ``(k, k)`` that makes each coordinate wind as little as it can.
+
+    A column is replaced by its sum or difference with another while that
+    lowers its total variation (sum of |wrapped frame-to-frame steps|) by at
+    least 5 %.  ``coords``: ``(T, k)`` raw coordinates in time order.
+    """
+    k = coords.shape[1]
+    basis = np.eye(k, dtype=np.int64)
+    if k < 2:
+        return basis
+    steps = _wrap(np.diff(coords, axis=0))
+
+    def variation(col):
+        return np.abs(_wrap(steps @ col)).sum()
+
+    for _ in range(max_rounds):
+        changed = False
+        for i in range(k):
+            for j in range(k):
+                if i == j:
+                    continue
+                for s in (1, -1):
+                    cand = basis[:, i] + s * basis[:, j]
+                    if variation(cand) < 0.95 * variation(basis[:, i]):
+                        basis[:, i] = cand
+                        changed = True
+        if not changed:
+            break
+    return basis
+
+
+class CircularCoordinates(TransformerMixin, BaseEstimator):
+    """Circle-valued coordinates of the points of X from persistent cohomology.
+
+    Parameters
+    ----------
+    n_landmarks : landmarks taken by greedy permutation (ripser ``n_perm``);
+        all points are used when there are fewer.
+    prime : first coefficient field Z/p tried; others from ``PRIMES`` follow
+        when the lift to Z fails.
+    scale : ``"auto"`` (``scale_fraction`` of the way through each class's
+        lifetime, raised if needed so the landmark balls cover every point) or
+        a filtration value α that every chosen class must be alive at.
+    n_classes : ``"auto"`` (read from the barcode, see :func:`choose_classes`)
+        or how many of the longest H1 bars to use.
+    scale_fraction : where in ``[birth, death)`` the auto scale lies (paper 001:
+        late in the lifetime works best).
+    min_ratio : death/birth a bar needs to count as long ("auto").
+    max_classes : at most this many classes with ``"auto"``.
+    min_cycles : net windings over the frames a coordinate needs to count as a
+        periodic motion (rows of X must be frames in time order); ``None``
+        keeps every chosen class.
+
+    Attributes (after ``fit``)
+    --------------------------
+    barcode_ : ``(n, 2)`` H1 bars (birth, death) of the landmark filtration.
+    cocycle_classes_ : the fitted :class:`CircleClass` es (chosen bars).
+    classes_ : the reported :class:`CircleCoordinate` s, longest bar first.
+    coords_ : ``(T, k)`` coordinates in ``[0, 1)`` (k = len(classes_), may be 0).
+    reason_ : why these classes (which bars, which gap).
+    landmarks_ : ``(L,)`` indices of the landmark points; ``cover_radius_`` their covering radius.
+    """
+
+    def __init__(self, n_landmarks: int = 120, prime: int = 47, scale: str | float = "auto",
+                 n_classes: int | str = 1, scale_fraction: float = 0.75, min_ratio: float = 1.5,
+                 max_classes: int = 5, min_cycles: float | None = 1.25):
+        self.n_landmarks = n_landmarks
+        self.prime = prime
+        self.scale = scale
+        self.n_classes = n_classes
+        self.scale_fraction = scale_fraction
+        self.min_ratio = min_ratio
+        self.max_classes = max_classes
+        self.min_cycles = min_cycles
+
+    # -- validation ----------------------------------------------------------
+    def _check_X(self, X) -> np.ndarray:
+        X = np.asarray(X, dtype=np.float64)
+        if X.ndim == 1:
+            X = X[:, None]
+        if X.ndim != 2:
+            raise MocycleError(f"X must be a 2-D array (frames × features); got shape {X.shape}")
+        if X.shape[0] < MIN_FRAMES:
+            raise MocycleError(f"circular coordinates need at least {MIN_FRAMES} frames; got {X.shape[0]}")
+        return X
+
+    def _check_params(self):
+        if not isinstance(self.n_landmarks, (int, np.integer)) or self.n_landmarks < 3:
+            raise MocycleError(f"n_landmarks must be an integer >= 3; got {self.n_landmarks!r}")
+        if not 0 < self.scale_fraction < 1:
+            raise MocycleError(f"scale_fraction must lie in (0, 1); got {self.scale_fraction!r}")
+        if self.scale != "auto" and not (isinstance(self.scale, (int, float)) and self.scale > 0):
+            raise MocycleError(f"scale must be 'auto' or a positive filtration value; got {self.scale!r}")
+
+    # -- fitting ---------------------------------------------------------------
+    def fit(self, X, y=None):
+        """Compute the barcode, choose classes and the coordinate of every row of X."""
+        self._check_params()
+        X = self._check_X(X)
+        self.n_features_in_ = X.shape[1]
+        self.columns_used_ = np.all(np.isfinite(X), axis=0)
+        if not self.columns_used_.any():
+            raise MocycleError("every column of X contains NaN or infinite values")
+        if not self.columns_used_.all():
+            warnings.warn(f"dropping {int((~self.columns_used_).sum())} column(s) of X with NaN or infinite "
+                          "values", MocycleWarning, stacklevel=2)
+            X = X[:, self.columns_used_]
+        N = X.shape[0]
+        L = int(min(self.n_landmarks, N))
+        primes = [self.prime] + [p for p in PRIMES if p != self.prime]
+        for prime in primes:
+            result = ripser(X, maxdim=1, coeff=prime, do_cocycles=True, n_perm=L)
+            dist = result["dperm2all"]  # (L, N)
+            idx = np.asarray(result["idx_perm"], dtype=int)
+            position = np.full(N, -1)
+            position[idx] = np.arange(L)
+            barcode = np.asarray(result["dgms"][1], dtype=float).reshape(-1, 2)
+            finite = np.isfinite(barcode[:, 1])
+            chosen, reason = choose_classes(barcode[finite], self.n_classes, self.min_ratio, self.max_classes)
+            bars = np.flatnonzero(finite)[chosen]
+            classes, failed = self._make_classes(result, bars, prime, position, dist[:, idx], dist,
+                                                 float(result["r_cover"]))
+            if not failed:
+                break
+        else:  # pragma: no cover - every prime failed
+            raise MocycleError("could not lift the cohomology class to integer coefficients with any prime tried")
+        self.barcode_ = barcode
+        self.cocycle_classes_ = classes
+        self.landmarks_ = idx
+        self.landmark_points_ = X[idx]
+        self.cover_radius_ = float(result["r_cover"])
+        raw = self._coords(dist, classes)
+        self.basis_ = _reduce_basis(raw)
+        self.classes_, keep, notes = self._report(raw @ self.basis_, classes)
+        self.basis_ = self.basis_[:, keep]
+        self.reason_ = reason + "".join(notes)
+        self.coords_ = self._combine(raw)
+        return self
+
+    def _report(self, combined: np.ndarray, classes: list[CircleClass]):
+        """Orientation, winding and the kept columns of the reduced basis."""
+        out, keep, notes = [], [], []
+        for k in range(combined.shape[1]):
+            steps = _wrap(np.diff(combined[:, k]))
+            net = float(steps.sum())
+            members = [i for i in range(len(classes)) if self.basis_[i, k] != 0]
+            main = max(members, key=lambda i: classes[i].persistence)
+            c = classes[main]
+            sign = -1.0 if net < 0 else 1.0
+            if self.min_cycles is not None and abs(net) < self.min_cycles:
+                notes.append(f"; the class of bar [{c.birth:.3g}, {c.death:.3g}) winds only {abs(net):.2f} "
+                             f"times over the take (< {self.min_cycles:g}), so it is not a periodic motion")
+                continue
+            keep.append(k)
+            out.append(CircleCoordinate(c.bar, c.birth, c.death, tuple(int(v) for v in self.basis_[:, k]),
+                                        sign, abs(net)))
+        return out, keep, notes
+
+    def _combine(self, raw: np.ndarray) -> np.ndarray:
+        if not self.classes_:
+            return np.zeros((raw.shape[0], 0))
+        signs = np.array([c.sign for c in self.classes_])
+        return np.mod((raw @ self.basis_) * signs, 1.0)
+
+    def _make_classes(self, result, bars, prime, position, dist_ll, dist, r_cover):
+        classes = []
+        for bar in bars:
+            birth, death = result["dgms"][1][bar]
+            if self.scale == "auto":
+                alpha = birth + self.scale_fraction * (death - birth)
+                if alpha < 2 * r_cover:  # make the landmark balls cover every point, if the class allows
+                    alpha = min(2 * r_cover * 1.001, birth + 0.99 * (death - birth))
+            else:
+                alpha = float(self.scale)
+                if not birth <= alpha < death:
+                    raise MocycleError(f"scale {alpha:g} is outside the lifetime [{birth:.4g}, {death:.4g}) "
+                                       "of a chosen class")
+            adjacent = dist_ll <= alpha
+            np.fill_diagonal(adjacent, False)
+            Z = _lift(np.asarray(result["cocycles"][1][bar]), prime, position, dist_ll.shape[0])
+            if not _is_cocycle(Z, adjacent):
+                return classes, True
+            w, zbar = _smooth(Z, adjacent)
+            classes.append(CircleClass(int(bar), float(birth), float(death), float(alpha), prime, w, zbar))
+        return classes, False
+
+    @staticmethod
+    def _coords(dist, classes) -> np.ndarray:
+        if not classes:
+            return np.zeros((dist.shape[1], 0))
+        return np.stack([_extend(dist, c.w, c.zbar, c.scale / 2) for c in classes], axis=1)
+
+    def fit_transform(self, X, y=None, **fit_params) -> np.ndarray:
+        return self.fit(X).coords_
+
+    def transform(self, X) -> np.ndarray:
+        """Coordinates ``(N, k)`` in ``[0, 1)`` of new points from the fitted landmarks."""
+        if not hasattr(self, "classes_"):
+            raise MocycleError("CircularCoordinates is not fitted yet; call fit(X) first")
+        X = np.asarray(X, dtype=np.float64)
+        if X.ndim != 2 or X.shape[1] != self.n_features_in_:
+            raise MocycleError(f"X must have shape (N, {self.n_features_in_}); got {X.shape}")
+        X = X[:, self.columns_used_]
+        if not np.all(np.isfinite(X)):
+            raise MocycleError("X contains NaN or infinite values in the columns used for fitting")
+        return self._combine(self._coords(cdist(self.landmark_points_, X), self.cocycle_classes_))

@@ -1,0 +1,358 @@
+"""Periods and phase remaps of a circular coordinate (pure functions on numpy arrays).
+
+A circular coordinate is one value per frame in *cycles* (the circle is
+``[0, 1)``).  This module turns it into:
+
+* an unwrapped phase (KTH thesis, Fig. 3.8) and a least-squares period
+  (thesis §3.6): :func:`unwrap_phase`, :func:`fit_period`;
+* a time-uniform phase, by rank (thesis eq. 3.20, :func:`rank_uniform`) or by
+  the CDF of a Gaussian mixture fitted to three shifted copies of the values
+  (thesis eq. 3.21, paper 001 §5.2, :func:`gmm_cdf_remap`);
+* the frame ranges where the coordinate winds, the "excitation regions" of
+  paper 001 §4.6 (:func:`excitation_regions`).
+
+:func:`autocorrelation_period` is independent of any coordinate: the
+fundamental cycle of a pose matrix from its windowed circular autocorrelation
+(paper 004), used as a cross-check.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import fft as sp_fft
+from scipy.ndimage import uniform_filter1d
+from scipy.signal import find_peaks
+from scipy.signal.windows import hann
+from scipy.stats import norm
+from sklearn.exceptions import ConvergenceWarning
+from sklearn.mixture import GaussianMixture
+
+from ..errors import MocycleError
+
+__all__ = [
+    "PeriodFit",
+    "autocorrelation_period",
+    "excitation_regions",
+    "fit_period",
+    "gmm_cdf_remap",
+    "rank_uniform",
+    "unwrap_phase",
+]
+
+#: A fitted slope below this many cycles over the whole fitted span counts as no winding (period ``inf``).
+_FLAT_CYCLES = 1e-9
+
+
+def _series(values, name: str, min_len: int = 1) -> np.ndarray:
+    """``values`` as a finite 1-D float array of at least ``min_len`` frames, or a MocycleError."""
+    try:
+        x = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise MocycleError(f"{name} must be a 1-D array of numbers; got {type(values).__name__} ({exc})") from None
+    if x.ndim != 1:
+        raise MocycleError(f"{name} must be a 1-D array (one value per frame); got shape {x.shape}")
+    if x.size < min_len:
+        raise MocycleError(f"{name} needs at least {min_len} frame{'s' if min_len > 1 else ''}; got {x.size}")
+    bad = ~np.isfinite(x)
+    if bad.any():
+        raise MocycleError(f"{name} must be finite; {int(bad.sum())} of {x.size} values are NaN or infinite "
+                           f"(first at frame {int(np.argmax(bad))})")
+    return x
+
+
+def _circle(values, name: str, min_len: int = 1) -> np.ndarray:
+    """Finite 1-D circle values reduced to ``[0, 1)`` (``np.mod`` can round tiny negatives up to 1.0)."""
+    x = np.mod(_series(values, name, min_len), 1.0)
+    x[x >= 1.0] = 0.0
+    return x
+
+
+def _wrapped_diff(x: np.ndarray) -> np.ndarray:
+    """Differences of consecutive circle values, wrapped to ``[-0.5, 0.5)`` cycles."""
+    return np.mod(np.diff(x) + 0.5, 1.0) - 0.5
+
+
+def _positive_int(value, name: str, minimum: int = 1) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise MocycleError(f"{name} must be an integer >= {minimum}; got {value!r}")
+    if value < minimum:
+        raise MocycleError(f"{name} must be an integer >= {minimum}; got {value}")
+    return int(value)
+
+
+# -- unwrapping and the least-squares period ---------------------------------------------------------------------
+
+
+def unwrap_phase(coords) -> np.ndarray:
+    """Unwrap circle values (cycles) into a continuous phase: ``(T,)`` -> ``(T,)`` cycles.
+
+    KTH thesis Fig. 3.8: ``x̂_1 = x_1``; ``x̂_i = x_i + floor(x̂_{i-1} - x_i + 0.5)``, i.e. every step is
+    taken as the shorter way round the circle (a step of exactly half a cycle counts as forward).
+    Vectorised: ``x̂ = x + cumsum(floor(0.5 - diff(x)))``.  The first value is kept as given.
+    """
+    x = _series(coords, "coords")
+    offsets = np.zeros_like(x)
+    offsets[1:] = np.cumsum(np.floor(0.5 - np.diff(x)))
+    return x + offsets
+
+
+@dataclass(frozen=True)
+class PeriodFit:
+    """A least-squares line through an unwrapped phase.
+
+    slope_cycles_per_frame : signed slope (cycles per frame; negative when the phase runs backwards).
+    intercept : the line's value at frame 0 (cycles).
+    period_frames : ``1 / |slope|`` in frames (``inf`` when the phase does not wind).
+    period_s : ``period_frames * frame_time`` in seconds, ``None`` without a frame time.
+    n_periods : cycles covered over the frames used: ``|slope| * (last frame - first frame)``.
+    residual_rms : root mean square distance of the phase from the line (cycles).
+    """
+
+    slope_cycles_per_frame: float
+    intercept: float
+    period_frames: float
+    period_s: float | None
+    n_periods: float
+    residual_rms: float
+
+
+def fit_period(unwrapped, frame_time: float | None = None, frames=None) -> PeriodFit:
+    """Fit a line to an unwrapped phase (cycles, ``(T,)``) against the frame index (KTH thesis §3.6).
+
+    ``frames``: the frames to use, as an index array, a boolean mask of length T or a slice (default all);
+    at least two distinct frames.  ``frame_time``: seconds per frame, for :attr:`PeriodFit.period_s`.
+    """
+    y_all = _series(unwrapped, "unwrapped", min_len=2)
+    T = y_all.size
+    if frame_time is not None:
+        try:
+            frame_time = float(frame_time)
+        except (TypeError, ValueError):
+            raise MocycleError(f"frame_time must be a positive number of seconds; got {frame_time!r}") from None
+        if not np.isfinite(frame_time) or frame_time <= 0:
+            raise MocycleError(f"frame_time must be a positive number of seconds; got {frame_time!r}")
+    index = np.arange(T)
+    if frames is None:
+        idx = index
+    elif isinstance(frames, slice):
+        idx = index[frames]
+    else:
+        sel = np.asarray(frames)
+        if sel.ndim != 1:
+            raise MocycleError(f"frames must be a 1-D index array, a boolean mask or a slice; got shape {sel.shape}")
+        if sel.dtype == bool:
+            if sel.size != T:
+                raise MocycleError(f"a boolean frames mask must have one value per frame ({T}); got {sel.size}")
+            idx = index[sel]
+        elif sel.size == 0 or np.issubdtype(sel.dtype, np.integer):
+            idx = sel.astype(np.intp)
+            if idx.size and (idx.min() < -T or idx.max() >= T):
+                raise MocycleError(f"frames must be frame indices in [0, {T}); got values from {idx.min()} "
+                                   f"to {idx.max()}")
+            idx = index[idx]
+        else:
+            raise MocycleError(f"frames must be integer frame indices, a boolean mask or a slice; got dtype "
+                               f"{sel.dtype}")
+    if np.unique(idx).size < 2:
+        raise MocycleError(f"fitting a period needs at least two distinct frames; got {np.unique(idx).size}")
+    y = y_all[idx]
+    x = idx.astype(np.float64)
+    slope, intercept = np.polyfit(x, y, 1)
+    slope, intercept = float(slope), float(intercept)
+    span = float(x.max() - x.min())
+    if abs(slope) * span < _FLAT_CYCLES:
+        period = float("inf")
+    else:
+        period = 1.0 / abs(slope)
+    resid = y - (slope * x + intercept)
+    return PeriodFit(
+        slope_cycles_per_frame=slope,
+        intercept=intercept,
+        period_frames=period,
+        period_s=None if frame_time is None else period * frame_time,
+        n_periods=abs(slope) * span,
+        residual_rms=float(np.sqrt(np.mean(resid**2))),
+    )
+
+
+# -- windowed circular autocorrelation (paper 004) ---------------------------------------------------------------
+
+
+def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_strength: float = 0.1) -> float:
+    """The fundamental cycle (frames) of ``X`` (``(T,)`` or ``(T, D)``) by windowed circular autocorrelation.
+
+    Paper 004: every column is centred and multiplied by a Hann window ``w``, then
+    ``r(k) = sum_n w(n)x(n) w((n+k) mod T) x((n+k) mod T)`` (circular, no zero padding, by FFT), summed over
+    columns and divided by ``r(0)``.  The window favours the smallest period: ``r`` decays with the lag, so the
+    first multiple of the cycle gives the highest maximum.  The period is the lag of the highest local maximum
+    in ``[min_lag, max_lag]`` (default ``max_lag = T // 2``), refined to sub-frame precision by a parabola
+    through the peak and its two neighbours of ``r(k)`` divided by the window's own autocorrelation (which
+    removes the window's pull towards shorter lags).
+
+    Columns with a NaN or infinite value are dropped; constant columns contribute nothing.  Returns NaN when no
+    column is usable, when the signal is constant, or when no maximum reaches ``min_strength * r(0)`` (white
+    noise, say; on short noisy signals a chance maximum can pass ``0.1``).
+    """
+    try:
+        A = np.asarray(X, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise MocycleError(f"X must be a (T,) or (T, D) array of numbers; got {type(X).__name__} ({exc})") from None
+    if A.ndim == 1:
+        A = A[:, None]
+    if A.ndim != 2:
+        raise MocycleError(f"X must be a (T,) or (T, D) array; got shape {A.shape}")
+    T = A.shape[0]
+    min_lag = _positive_int(min_lag, "min_lag")
+    if T < 4:
+        raise MocycleError(f"the autocorrelation period needs at least 4 frames; got {T}")
+    if max_lag is None:
+        max_lag = T // 2
+    max_lag = _positive_int(max_lag, "max_lag")
+    if max_lag > T - 2:
+        raise MocycleError(f"max_lag must be at most T - 2 = {T - 2} frames; got {max_lag}")
+    if max_lag < min_lag:
+        raise MocycleError(f"max_lag ({max_lag}) must not be smaller than min_lag ({min_lag})")
+    try:
+        min_strength = float(min_strength)
+    except (TypeError, ValueError):
+        raise MocycleError(f"min_strength must be a number in [0, 1); got {min_strength!r}") from None
+    if not 0.0 <= min_strength < 1.0:
+        raise MocycleError(f"min_strength must be a number in [0, 1); got {min_strength!r}")
+
+    A = A[:, np.all(np.isfinite(A), axis=0)]
+    if A.shape[1] == 0:
+        return float("nan")
+    A = A - A.mean(axis=0)
+    A[:, np.ptp(A, axis=0) == 0.0] = 0.0  # exactly constant columns: remove the rounding left by centring
+    window = hann(T, sym=False)
+    Y = A * window[:, None]
+    spectrum = sp_fft.rfft(Y, axis=0)
+    r = sp_fft.irfft(np.sum(np.abs(spectrum) ** 2, axis=1), n=T)
+    if not r[0] > 0.0:
+        return float("nan")
+    r = r / r[0]
+    seg = r[: max_lag + 2]  # the peak's right neighbour must be inside
+    peaks, _ = find_peaks(seg)
+    peaks = peaks[(peaks >= min_lag) & (peaks <= max_lag)]
+    peaks = peaks[seg[peaks] > min_strength]
+    if peaks.size == 0:
+        return float("nan")
+    p = int(peaks[np.argmax(seg[peaks])])
+    # Refine on r / (the window's own circular autocorrelation): the window's decay would pull the vertex
+    # towards smaller lags by up to ~1 % of the period; the division undoes that bias for a stationary signal.
+    env = sp_fft.irfft(np.abs(sp_fft.rfft(window)) ** 2, n=T)
+    q = np.arange(p - 2, p + 3) % T  # r is circular
+    u = r[q] / env[q]
+    c = 1 + int(np.argmax(u[1:4]))  # the largest of lags p-1, p, p+1
+    p += c - 2
+    left, mid, right = u[c - 1], u[c], u[c + 1]
+    curvature = left - 2.0 * mid + right
+    shift = 0.5 * (left - right) / curvature if curvature < 0 else 0.0
+    return float(p + np.clip(shift, -0.5, 0.5))
+
+
+# -- remaps of a coordinate to time-uniform phase ----------------------------------------------------------------
+
+
+def rank_uniform(coords) -> np.ndarray:
+    """Spread circle values (cycles) uniformly over ``[0, 1)`` by rank: ``(T,)`` -> ``(T,)`` (KTH eq. 3.20).
+
+    ``x_new_i = rank(x_i) / T`` with 0-based ranks, ties broken by frame order; the output holds exactly the
+    values ``0, 1/T, ..., (T-1)/T``.  Inputs are first reduced to ``[0, 1)``.
+    """
+    x = _circle(coords, "coords")
+    ranks = np.empty(x.size, dtype=np.float64)
+    ranks[np.argsort(x, kind="stable")] = np.arange(x.size)
+    return ranks / x.size
+
+
+def gmm_cdf_remap(coords, n_components: int = 30, random_state: int | None = 0) -> np.ndarray:
+    """Remap circle values (cycles) through a Gaussian-mixture CDF: ``(T,)`` -> ``(T,)`` in ``[0, 1]``.
+
+    KTH thesis eq. 3.21 with paper 001 §5.2: a 1-D mixture of ``n_components`` Gaussians (``reg_covar=1e-5``,
+    100 EM iterations) is fitted to the values and their copies shifted by -1 and +1, so its middle part is
+    close to periodic; then ``x -> (G(x) - G(0)) / (G(1) - G(0))`` with ``G(x) = sum_k w_k Phi((x - mu_k) /
+    sigma_k)``.  The result is non-decreasing in the value, and near uniform over ``[0, 1)`` when the values
+    are spread like time.  ``n_components`` is capped at the number of distinct values (at least 1).
+    Inputs are first reduced to ``[0, 1)``.  EM that stops at 100 iterations without converging is accepted
+    silently (as in paper 001).
+    """
+    x = _circle(coords, "coords")
+    n_components = _positive_int(n_components, "n_components")
+    k = max(1, min(n_components, np.unique(x).size))
+    data = np.concatenate([x - 1.0, x, x + 1.0])[:, None]
+    gmm = GaussianMixture(n_components=k, covariance_type="full", reg_covar=1e-5, max_iter=100,
+                          random_state=random_state)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        gmm.fit(data)
+    mu = gmm.means_[:, 0]
+    sigma = np.sqrt(gmm.covariances_.reshape(k))
+    w = gmm.weights_
+
+    def cdf(v: np.ndarray) -> np.ndarray:
+        return norm.cdf((np.asarray(v, dtype=np.float64)[:, None] - mu) / sigma) @ w
+
+    g0, g1 = cdf(np.array([0.0, 1.0]))
+    if not g1 > g0:
+        raise MocycleError("the Gaussian mixture put no mass on [0, 1); cannot remap the coordinate")
+    return np.clip((cdf(x) - g0) / (g1 - g0), 0.0, 1.0)
+
+
+# -- excitation regions (paper 001 §4.6) -------------------------------------------------------------------------
+
+
+def excitation_regions(coords, window: int, threshold: float = 0.3, min_length: int | None = None,
+                       max_gap: int | None = None, min_rate: float | None = None,
+                       min_cycles: float = 0.5) -> list[tuple[int, int]]:
+    """Frame ranges ``[start, end)`` where a circular coordinate (cycles, ``(T,)``) winds.
+
+    Paper 001 §4.6: "connected parts of the timeseries exhibiting most variation in circular coordinate".
+    The winding rate (cycles/frame) is the wrapped difference of consecutive values (in ``[-0.5, 0.5)``,
+    centred on the frames), averaged over ``window`` frames (a moving average, so the sign counts and jitter
+    cancels).  A frame is excited when ``|rate| >= threshold * (90th percentile of |rate|)`` and ``|rate| >=
+    min_rate`` (default ``1 / T``: a coordinate that never reaches one cycle per take has no region).  Runs of
+    excited frames closer than ``max_gap`` frames (default ``window``) are merged, then runs shorter than
+    ``min_length`` frames (default ``window``) or winding less than ``min_cycles`` cycles in total are dropped.
+    Returns sorted, non-overlapping ranges; ``[]`` for a constant coordinate.  The moving average widens each
+    region by about ``0.2 * window`` frames at both ends.
+    """
+    x = _series(coords, "coords")
+    T = x.size
+    window = _positive_int(window, "window")
+    min_length = window if min_length is None else _positive_int(min_length, "min_length")
+    max_gap = window if max_gap is None else _positive_int(max_gap, "max_gap", minimum=0)
+    for name, value in (("threshold", threshold), ("min_cycles", min_cycles)):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not np.isfinite(value) \
+                or value < 0:
+            raise MocycleError(f"{name} must be a finite number >= 0; got {value!r}")
+    if min_rate is None:
+        min_rate = 1.0 / T
+    elif isinstance(min_rate, bool) or not isinstance(min_rate, (int, float, np.number)) \
+            or not np.isfinite(min_rate) or min_rate < 0:
+        raise MocycleError(f"min_rate must be a finite number >= 0 (cycles per frame); got {min_rate!r}")
+    if T < 2:
+        return []
+    d = _wrapped_diff(x)
+    rate = np.concatenate([d[:1], 0.5 * (d[:-1] + d[1:]), d[-1:]])
+    smooth = np.abs(uniform_filter1d(rate, size=min(window, T), mode="nearest"))
+    ref = float(np.percentile(smooth, 90))
+    if not ref > 0.0:
+        return []
+    excited = (smooth >= threshold * ref) & (smooth >= min_rate) & (smooth > 0.0)
+    edges = np.diff(np.concatenate([[0], excited.astype(np.int8), [0]]))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    if starts.size == 0:
+        return []
+    merged = [[int(starts[0]), int(ends[0])]]
+    for s, e in zip(starts[1:], ends[1:], strict=True):
+        if s - merged[-1][1] < max_gap:
+            merged[-1][1] = int(e)
+        else:
+            merged.append([int(s), int(e)])
+    cum = np.concatenate([[0.0], np.cumsum(d)])  # cum[i] = unwrapped x[i] - x[0]
+    return [(s, e) for s, e in merged
+            if e - s >= min_length and abs(cum[e - 1] - cum[s]) >= min_cycles]

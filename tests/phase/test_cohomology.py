@@ -1,0 +1,133 @@
+import warnings
+
+import numpy as np
+import pytest
+
+from mocycle.datasets import synthetic_nonperiodic, synthetic_still, synthetic_walk, synthetic_walk_then_run
+from mocycle.errors import MocycleError, MocycleWarning
+from mocycle.phase import CircularCoordinates, choose_classes
+from mocycle.phase.analysis import phase_features
+from mocycle.phase.cohomology import _is_cocycle, _lift
+
+
+def circular_error(a, b):
+    """Mean |a - b| on the circle (cycles) after the best constant rotation."""
+    offset = np.angle(np.mean(np.exp(2j * np.pi * (a - b)))) / (2 * np.pi)
+    return float(np.mean(np.abs(np.angle(np.exp(2j * np.pi * (a - b - offset)))) / (2 * np.pi)))
+
+
+def circular_rank_correlation(a, b):
+    """Fisher-Lee style rank correlation of two circular samples (1 = same order up to rotation)."""
+    n = len(a)
+    ra = 2 * np.pi * np.argsort(np.argsort(a)) / n
+    rb = 2 * np.pi * np.argsort(np.argsort(b)) / n
+    return float(np.abs(np.mean(np.exp(1j * (ra - rb)))))
+
+
+@pytest.fixture(scope="module")
+def walk():
+    take = synthetic_walk(n_frames=600, noise_deg=1.0, seed=4)
+    return take, phase_features(take.motion)
+
+
+def test_coordinate_follows_the_true_phase(walk):
+    take, X = walk
+    cc = CircularCoordinates().fit(X)
+    assert cc.coords_.shape == (600, 1)
+    f = cc.coords_[:, 0]
+    assert np.all((f >= 0) & (f < 1))
+    assert circular_rank_correlation(f, take.phase) > 0.99
+    rank = np.argsort(np.argsort(f, kind="stable")) / f.size  # eq. 3.20
+    assert circular_error(rank, take.phase) < 0.02
+    # increases with time: the unwrapped coordinate goes forward about once per true cycle
+    steps = np.diff(f) - np.round(np.diff(f))
+    assert np.isclose(steps.sum(), take.unwrapped_phase[-1] - take.unwrapped_phase[0], atol=0.3)
+    assert cc.classes_[0].n_cycles > 9
+
+
+def test_transform_of_the_training_points_gives_the_same_coordinates(walk):
+    _, X = walk
+    cc = CircularCoordinates().fit(X)
+    again = cc.transform(X)
+    d = np.abs(again - cc.coords_)
+    assert np.minimum(d, 1 - d).max() < 1e-9
+
+
+def test_reversed_take_still_increases_with_time(walk):
+    take, X = walk
+    f = CircularCoordinates().fit(X[::-1]).coords_[:, 0]
+    steps = np.diff(f) - np.round(np.diff(f))
+    assert steps.sum() > 9
+
+
+@pytest.mark.parametrize("make", [lambda: synthetic_still(noise_deg=0.5), lambda: synthetic_nonperiodic(seed=0),
+                                  lambda: synthetic_nonperiodic(seed=1)], ids=["still", "nonperiodic0", "nonperiodic1"])
+def test_no_periodic_motion_gives_no_class_and_a_reason(make):
+    X = phase_features(make().motion)
+    cc = CircularCoordinates(n_classes="auto").fit(X)
+    assert cc.coords_.shape == (X.shape[0], 0) and cc.classes_ == []
+    assert "no long H1 bar" in cc.reason_ or "not a periodic motion" in cc.reason_
+
+
+def test_random_noise_has_no_periodic_motion():
+    X = np.random.default_rng(0).normal(size=(400, 8))
+    cc = CircularCoordinates(n_classes="auto").fit(X)
+    assert cc.classes_ == []
+
+
+def test_walk_then_run_gives_two_classes_one_per_gait():
+    take = synthetic_walk_then_run(seed=2, noise_deg=1.0)
+    cc = CircularCoordinates(n_classes="auto").fit(phase_features(take.motion))
+    assert len(cc.classes_) == 2, cc.reason_
+    (_, w0, w1), (_, r0, r1) = take.segments
+    cycles = sorted(round(c.n_cycles) for c in cc.classes_)
+    u = take.unwrapped_phase  # NaN inside the blend between the gaits
+    walk_cycles = round(np.nanmax(u[w0:w1]) - np.nanmin(u[w0:w1]))
+    run_cycles = round(np.nanmax(u[r0:r1]) - np.nanmin(u[r0:r1]))
+    assert cycles == sorted([walk_cycles, run_cycles])
+
+
+def test_too_few_frames_and_bad_parameters_are_rejected():
+    with pytest.raises(MocycleError, match="at least 20 frames"):
+        CircularCoordinates().fit(np.zeros((10, 3)))
+    with pytest.raises(MocycleError, match="n_landmarks"):
+        CircularCoordinates(n_landmarks=1).fit(np.zeros((30, 3)))
+    with pytest.raises(MocycleError, match="scale_fraction"):
+        CircularCoordinates(scale_fraction=1.5).fit(np.zeros((30, 3)))
+    with pytest.raises(MocycleError, match="not fitted"):
+        CircularCoordinates().transform(np.zeros((3, 3)))
+
+
+def test_constant_and_nan_columns_do_not_break_the_fit(walk):
+    take, X = walk
+    X = np.c_[X, np.full(len(X), 3.0), np.full(len(X), np.nan)]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cc = CircularCoordinates().fit(X)
+    assert any(issubclass(w.category, MocycleWarning) for w in caught)
+    assert circular_rank_correlation(cc.coords_[:, 0], take.phase) > 0.99
+    with pytest.raises(MocycleError, match="every column"):
+        CircularCoordinates().fit(np.full((40, 3), np.nan))
+
+
+def test_lift_maps_large_residues_to_negative_integers_and_checks_triangles():
+    cocycle = np.array([[0, 1, 46], [1, 2, 1]])  # 46 = -1 mod 47
+    Z = _lift(cocycle, 47, np.arange(3), 3)
+    assert Z[0, 1] == -1 and Z[1, 0] == 1 and Z[1, 2] == 1
+    triangle = np.ones((3, 3), bool)
+    np.fill_diagonal(triangle, False)
+    assert _is_cocycle(Z, triangle)  # -1 + 1 + 0 = 0 around (0, 1, 2)
+    Z[1, 2], Z[2, 1] = 2, -2
+    assert not _is_cocycle(Z, triangle)
+    assert _is_cocycle(Z, np.zeros((3, 3), bool))  # no triangle, nothing to violate
+
+
+def test_choose_classes_reads_the_gap():
+    bars = np.array([[1.0, 6.0], [1.1, 5.0], [1.0, 1.4], [2.0, 2.3]])
+    chosen, reason = choose_classes(bars, "auto")
+    assert chosen == [0, 1] and "gap" in reason
+    chosen, reason = choose_classes(bars, 3)
+    assert chosen == [0, 1, 2]
+    chosen, reason = choose_classes(np.array([[1.0, 1.3]]), "auto")
+    assert chosen == [] and "no long H1 bar" in reason
+    assert choose_classes(np.zeros((0, 2)))[0] == []
