@@ -7,7 +7,7 @@ from mocycle.datasets import synthetic_nonperiodic, synthetic_still, synthetic_w
 from mocycle.errors import MocycleError, MocycleWarning
 from mocycle.phase import CircularCoordinates, choose_classes
 from mocycle.phase.analysis import phase_features
-from mocycle.phase.cohomology import _is_cocycle, _lift
+from mocycle.phase.cohomology import _is_cocycle, _lift, greedy_permutation
 
 
 def circular_error(a, b):
@@ -112,7 +112,7 @@ def test_constant_and_nan_columns_do_not_break_the_fit(walk):
 
 def test_lift_maps_large_residues_to_negative_integers_and_checks_triangles():
     cocycle = np.array([[0, 1, 46], [1, 2, 1]])  # 46 = -1 mod 47
-    Z = _lift(cocycle, 47, np.arange(3), 3)
+    Z = _lift(cocycle, 47, 3)
     assert Z[0, 1] == -1 and Z[1, 0] == 1 and Z[1, 2] == 1
     triangle = np.ones((3, 3), bool)
     np.fill_diagonal(triangle, False)
@@ -131,3 +131,10 @@ def test_choose_classes_reads_the_gap():
     chosen, reason = choose_classes(np.array([[1.0, 1.3]]), "auto")
     assert chosen == [] and "no long H1 bar" in reason
     assert choose_classes(np.zeros((0, 2)))[0] == []
+
+
+def test_greedy_permutation_picks_farthest_points_and_reports_distances():
+    X = np.array([[0.0, 0], [1, 0], [10, 0], [5, 0], [9, 0]])
+    idx, dist = greedy_permutation(X, 3)
+    assert idx.tolist() == [0, 2, 3]  # start, farthest from 0, farthest from {0, 2}
+    assert np.allclose(dist, np.abs(X[idx, 0][:, None] - X[:, 0][None, :]))

@@ -168,6 +168,28 @@ def _periodic_motion(coords: np.ndarray, cls, frame_time: float, n_frames: int) 
                           frame_time, cls.combination)
 
 
+def _distinct(found: list[PeriodicMotion]) -> list[PeriodicMotion]:
+    """Drop classes that describe a motion another class already describes.
+
+    Two classes are the same motion when their excited frames overlap by more
+    than half and their numbers of periods differ by less than 20 %; the one
+    whose excitation covers more frames is kept (paper 001 §7: several
+    coordinates for one motion).  The result is ordered by first excited frame.
+    """
+    order = sorted(found, key=lambda c: -len(c.frames()))
+    kept: list[PeriodicMotion] = []
+    for c in order:
+        frames = set(c.frames().tolist())
+        same = any(
+            len(frames & set(k.frames().tolist())) > 0.5 * min(len(frames), len(k.frames()))
+            and abs(c.n_periods - k.n_periods) < 0.2 * max(c.n_periods, k.n_periods)
+            for k in kept
+        )
+        if not same:
+            kept.append(c)
+    return sorted(kept, key=lambda c: c.excitation[0][0] if c.excitation else 0)
+
+
 def find_phase(motion: Motion, classes: int | str = "auto", joints: str | Iterable[str] | None = None,
                pca: int | str | None = "auto", delay: int = 2, n_landmarks: int = 120,
                scale: str | float = "auto", min_cycles: float = 1.25, **feature_options) -> PhaseResult:
@@ -188,8 +210,8 @@ def find_phase(motion: Motion, classes: int | str = "auto", joints: str | Iterab
     X = phase_features(motion, joints=joints, pca=pca, delay=delay, **feature_options)
     estimator = CircularCoordinates(n_landmarks=n_landmarks, scale=scale, n_classes=classes,
                                     min_cycles=min_cycles).fit(X)
-    found = [_periodic_motion(estimator.coords_[:, k], c, motion.frame_time, motion.n_frames)
-             for k, c in enumerate(estimator.classes_)]
+    found = _distinct([_periodic_motion(estimator.coords_[:, k], c, motion.frame_time, motion.n_frames)
+                       for k, c in enumerate(estimator.classes_)])
     # Periods under a quarter of a second are not motions people capture; shorter
     # lags pick up frame-to-frame jitter (e.g. takes resampled by frame doubling).
     acf = autocorrelation_period(X, min_lag=max(2, int(round(0.25 / motion.frame_time))))
