@@ -40,6 +40,7 @@ test: lint test-numpy1 test-numpy2
 bench: $(VENV)/.installed
 	$(BIN)/python -m pip install --quiet -e ".[bench]"
 	$(BIN)/python benchmarks/io.py
+	$(BIN)/python benchmarks/phase.py
 
 clean:
 	rm -rf $(VENV) $(NP1) out .pytest_cache .ruff_cache
