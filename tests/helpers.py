@@ -50,3 +50,9 @@ def max_angle(q1: np.ndarray, q2: np.ndarray) -> float:
     r1 = Rotation.from_quat(np.asarray(q1).reshape(-1, 4))
     r2 = Rotation.from_quat(np.asarray(q2).reshape(-1, 4))
     return float((r1.inv() * r2).magnitude().max())
+
+
+def circular_error(a: np.ndarray, b: np.ndarray) -> float:
+    """Mean |a - b| on the circle (cycles) after the best constant rotation."""
+    offset = np.angle(np.mean(np.exp(2j * np.pi * (a - b)))) / (2 * np.pi)
+    return float(np.mean(np.abs(np.angle(np.exp(2j * np.pi * (a - b - offset)))) / (2 * np.pi)))

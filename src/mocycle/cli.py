@@ -212,27 +212,17 @@ def convert(
 
 
 # -------------------------------------------------------------------- phase
-def _classes_option(text: str) -> int | str:
-    if text == "auto":
-        return "auto"
+def _count_option(text: str, option: str, words: dict[str, object]) -> object:
+    """A positive integer option that also takes a few words (e.g. 'auto')."""
+    if text in words:
+        return words[text]
     try:
         n = int(text)
     except ValueError:
         n = 0
     if n < 1:
-        raise MocycleError(f"--classes must be 'auto' or a positive integer; got {text!r}")
-    return n
-
-
-def _pca_option(text: str) -> int | str | None:
-    if text in ("auto", "none", "0"):
-        return None if text != "auto" else "auto"
-    try:
-        n = int(text)
-    except ValueError:
-        n = 0
-    if n < 1:
-        raise MocycleError(f"--pca must be 'auto', 'none' or a positive integer; got {text!r}")
+        raise MocycleError(f"{option} must be {' or '.join(repr(w) for w in words)} or a positive integer; "
+                           f"got {text!r}")
     return n
 
 
@@ -261,7 +251,8 @@ def phase(
         raise MocycleError(f"--delay must be >= 0; got {delay}")
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
-    result = find_phase(motion, classes=_classes_option(classes), joints=joints, pca=_pca_option(pca),
+    result = find_phase(motion, classes=_count_option(classes, "--classes", {"auto": "auto"}), joints=joints,
+                        pca=_count_option(pca, "--pca", {"auto": "auto", "none": None, "0": None}),
                         delay=delay, n_landmarks=landmarks)
     if plot is not None:
         from .viz import plot_phase

@@ -5,6 +5,7 @@ import pytest
 from typer.testing import CliRunner
 
 from conftest import shared_path
+from helpers import circular_error
 from mocycle.cli import app
 from mocycle.datasets import synthetic_still, synthetic_walk, synthetic_walk_then_run
 from mocycle.errors import MocycleError
@@ -12,11 +13,6 @@ from mocycle.io import read_bvh, write_bvh
 from mocycle.phase import find_phase
 
 runner = CliRunner()
-
-
-def circular_error(a, b):
-    offset = np.angle(np.mean(np.exp(2j * np.pi * (a - b)))) / (2 * np.pi)
-    return float(np.mean(np.abs(np.angle(np.exp(2j * np.pi * (a - b - offset)))) / (2 * np.pi)))
 
 
 @pytest.mark.parametrize("period_s, speed_change", [(1.0, 0.0), (0.75, 0.0), (1.0, 0.3)])

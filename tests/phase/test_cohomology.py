@@ -3,17 +3,12 @@ import warnings
 import numpy as np
 import pytest
 
+from helpers import circular_error
 from mocycle.datasets import synthetic_nonperiodic, synthetic_still, synthetic_walk, synthetic_walk_then_run
 from mocycle.errors import MocycleError, MocycleWarning
 from mocycle.phase import CircularCoordinates, choose_classes
 from mocycle.phase.analysis import phase_features
 from mocycle.phase.cohomology import _is_cocycle, _lift, greedy_permutation
-
-
-def circular_error(a, b):
-    """Mean |a - b| on the circle (cycles) after the best constant rotation."""
-    offset = np.angle(np.mean(np.exp(2j * np.pi * (a - b)))) / (2 * np.pi)
-    return float(np.mean(np.abs(np.angle(np.exp(2j * np.pi * (a - b - offset)))) / (2 * np.pi)))
 
 
 def circular_rank_correlation(a, b):
