@@ -24,6 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError
 from ..motion import EndSite, Motion, Skeleton
+from ..rotations import euler_to_quats
 
 __all__ = [
     "SyntheticTake",
@@ -374,9 +375,8 @@ def _quats_from_channels(skel: Skeleton, chan: np.ndarray) -> np.ndarray:
     for j in range(J):
         groups.setdefault(skel.euler_order(j), []).append(j)
     q = np.empty((T, J, 4))
-    for order, js in groups.items():  # one scipy call per Euler order
-        r = Rotation.from_euler(order, chan[:, js].reshape(-1, 3), degrees=True)
-        q[:, js] = r.as_quat().reshape(T, len(js), 4)
+    for order, js in groups.items():  # one call per Euler order
+        q[:, js] = euler_to_quats(chan[:, js], order, degrees=True)
     return q
 
 

@@ -365,32 +365,33 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
         self.cover_radius_ = cover_radius
         raw = self._coords(dist, classes)
         self.basis_ = _reduce_basis(raw)
-        self.basis_ = self._join_single_loops(raw, X)
+        self.basis_, joined = self._join_single_loops(raw, X)
         self.classes_, keep, notes = self._report(raw @ self.basis_, classes)
         self.basis_ = self.basis_[:, keep]
-        self.reason_ = reason + getattr(self, "_joined_note", "") + "".join(notes)
+        self.reason_ = reason + joined + "".join(notes)
         self.coords_ = self._combine(raw)
         return self
 
-    def _join_single_loops(self, raw: np.ndarray, X: np.ndarray) -> np.ndarray:
-        """Append the signed sum of classes that wind about once each, if it is periodic (module notes)."""
+    def _join_single_loops(self, raw: np.ndarray, X: np.ndarray) -> tuple[np.ndarray, str]:
+        """The basis with the signed sum of classes that wind about once each appended, if it is
+        periodic (module notes), and a note saying so ('' when nothing was joined)."""
         if self.min_cycles is None or raw.shape[1] < 2:
-            return self.basis_
+            return self.basis_, ""
         nets = _wrap(np.diff(raw @ self.basis_, axis=0)).sum(axis=0)
         if np.any(np.abs(nets) >= self.min_cycles):
-            return self.basis_
+            return self.basis_, ""
         single = np.flatnonzero(np.abs(nets) >= 0.5)
         if single.size < 2:
-            return self.basis_
+            return self.basis_, ""
         total = self.basis_[:, single] @ np.sign(nets[single]).astype(np.int64)
         cycles = abs(_wrap(np.diff(raw @ total)).sum())
         period = autocorrelation_period(X)
         expected = X.shape[0] / period if np.isfinite(period) else np.nan
         if cycles >= self.min_cycles and abs(cycles / expected - 1) <= 0.25:
-            self._joined_note = (f"; {single.size} classes that wind about once each were joined into one that "
-                                 f"winds {cycles:.2f} times (the autocorrelation expects {expected:.2f})")
-            return np.c_[self.basis_, total]
-        return self.basis_
+            note = (f"; {single.size} classes that wind about once each were joined into one that "
+                    f"winds {cycles:.2f} times (the autocorrelation expects {expected:.2f})")
+            return np.c_[self.basis_, total], note
+        return self.basis_, ""
 
     def _report(self, combined: np.ndarray, classes: list[CircleClass]):
         """Orientation, winding and the kept columns of the reduced basis."""
