@@ -1,0 +1,112 @@
+"""What every ``mocycle`` sub-command shares: the typer app, consoles, exit codes, error handling."""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from collections.abc import Callable
+from functools import wraps
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+from .. import __version__
+from ..errors import MocycleError
+
+app = typer.Typer(
+    name="mocycle",
+    help="Turn raw motion capture into reusable animation.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+out = Console(highlight=False)
+err = Console(stderr=True, highlight=False)
+
+EXIT_ERROR = 1
+EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion
+
+
+def friendly(func: Callable) -> Callable:
+    """Run a command: MocycleError -> one 'error:' line and exit 1; warnings -> 'warning:' lines."""
+
+    @wraps(func)
+    def wrapper(*args, **kwargs):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                result = func(*args, **kwargs)
+            except MocycleError as exc:
+                _print_warnings(caught)
+                err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
+                raise typer.Exit(EXIT_ERROR) from None
+        _print_warnings(caught)
+        return result
+
+    return wrapper
+
+
+def _print_warnings(caught) -> None:
+    for w in caught:
+        if issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)):
+            continue
+        err.print(f"[yellow]warning:[/] {w.message}", markup=True, soft_wrap=True)
+
+
+def _version(value: bool):
+    if value:
+        out.print(f"mocycle {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main_options(
+    version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True,
+                                          help="Print the version and exit.")] = False,
+):
+    """mocycle: periodic motion, seamless cycles, swings and keyframes from mocap files."""
+
+
+
+# ------------------------------------------------------------ option parsing
+def parse_range(text: str | None, n_frames: int) -> tuple[int, int]:
+    if not text:
+        return 0, n_frames
+    try:
+        a, _, b = text.partition(":")
+        start = int(a) if a.strip() else 0
+        stop = int(b) if b.strip() else n_frames
+    except ValueError:
+        raise MocycleError(f"--range must look like START:STOP (frame numbers); got {text!r}") from None
+    if start < 0:
+        start += n_frames
+    if stop < 0:
+        stop += n_frames
+    if not 0 <= start < stop <= n_frames:
+        raise MocycleError(f"--range {text} is outside the take's {n_frames} frames")
+    return start, stop
+
+
+def count_option(text: str, option: str, words: dict[str, object]) -> object:
+    """A positive integer option that also takes a few words (e.g. 'auto')."""
+    if text in words:
+        return words[text]
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise MocycleError(f"{option} must be {' or '.join(repr(w) for w in words)} or a positive integer; "
+                           f"got {text!r}")
+    return n
+
+
+
+def main() -> None:  # the console script
+    try:
+        app()
+    except KeyboardInterrupt:  # pragma: no cover
+        err.print("interrupted")
+        sys.exit(130)
+

@@ -1,0 +1,44 @@
+"""``mocycle convert``: ASF/AMC to BVH, frame ranges, resampling."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ..errors import MocycleError
+from ..io import read, write
+from .common import app, friendly, out, parse_range
+
+
+@app.command()
+@friendly
+def convert(
+    paths: Annotated[list[Path], typer.Argument(
+        help="Input then output: IN.bvh OUT.bvh, or SKELETON.asf MOTION.amc OUT.bvh.")],
+    fps: Annotated[float | None, typer.Option(help="Resample to this frame rate (slerp).")] = None,
+    amc_fps: Annotated[float, typer.Option(help="Frame rate of the AMC input (CMU: 120).")] = 120.0,
+    frame_range: Annotated[str | None, typer.Option("--range", help="Keep frames START:STOP.")] = None,
+):
+    """Convert ASF/AMC to BVH, or rewrite a BVH (optionally a frame range, another fps)."""
+    if len(paths) == 2:
+        motion = read(paths[0], fps=amc_fps)
+    elif len(paths) == 3:
+        asf, amc = paths[0], paths[1]
+        if asf.suffix.lower() != ".asf" or amc.suffix.lower() != ".amc":
+            raise MocycleError(f"with three paths, expected SKELETON.asf MOTION.amc OUT.bvh; got {asf} {amc}")
+        motion = read(amc, asf=asf, fps=amc_fps)
+    else:
+        raise MocycleError("expected IN OUT.bvh or SKELETON.asf MOTION.amc OUT.bvh")
+    target = paths[-1]
+    if target.suffix.lower() != ".bvh":
+        raise MocycleError(f"{target}: the output must be a .bvh file")
+    start, stop = parse_range(frame_range, motion.n_frames)
+    motion = motion[start:stop]
+    if fps is not None:
+        motion = motion.resample(fps)
+    write(motion, target)
+    out.print(f"wrote {target}: {motion.n_frames} frames, {motion.n_joints} joints, {motion.fps:.6g} fps")
+
+
