@@ -30,3 +30,7 @@ class MotionFileError(MocycleError, ValueError):
 
 class MocycleWarning(UserWarning):
     """Something odd but recoverable in the input (e.g. a wrong ``Frames:`` count)."""
+
+
+class NoPeriodicMotion(MocycleError):
+    """The input is fine but holds no periodic motion (the CLI exits with code 3)."""

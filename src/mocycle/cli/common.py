@@ -12,7 +12,7 @@ import typer
 from rich.console import Console
 
 from .. import __version__
-from ..errors import MocycleError
+from ..errors import MocycleError, NoPeriodicMotion
 
 app = typer.Typer(
     name="mocycle",
@@ -29,7 +29,8 @@ EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion
 
 
 def friendly(func: Callable) -> Callable:
-    """Run a command: MocycleError -> one 'error:' line and exit 1; warnings -> 'warning:' lines."""
+    """Run a command: MocycleError -> one 'error:' line and exit 1 (3 for NoPeriodicMotion); warnings ->
+    'warning:' lines."""
 
     @wraps(func)
     def wrapper(*args, **kwargs):
@@ -40,7 +41,7 @@ def friendly(func: Callable) -> Callable:
             except MocycleError as exc:
                 _print_warnings(caught)
                 err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
-                raise typer.Exit(EXIT_ERROR) from None
+                raise typer.Exit(EXIT_NOT_FOUND if isinstance(exc, NoPeriodicMotion) else EXIT_ERROR) from None
         _print_warnings(caught)
         return result
 

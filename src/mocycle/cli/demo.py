@@ -11,7 +11,6 @@ import typer
 
 from ..io import read, write
 from .common import app, friendly, out
-from .info import _print_info, motion_info
 
 
 @app.command()
@@ -20,22 +19,30 @@ def demo(
     out_dir: Annotated[Path, typer.Option("--out", help="Folder for the demo files.")] = Path("mocycle-demo"),
     seed: Annotated[int, typer.Option(help="Random seed of the synthetic take.")] = 0,
 ):
-    """Make the built-in synthetic walk, write it as BVH and print its facts."""
+    """Loop the built-in synthetic walk: write the take, its cycle (BVH) and the loop plot."""
+    from ..cycle import extract_cycle, loop_metrics
     from ..datasets import synthetic_walk
+    from ..viz import plot_loop
+    from .loop import METRIC_LABELS
 
     t0 = time.perf_counter()
-    take = synthetic_walk(seed=seed, noise_deg=0.5)
+    take = synthetic_walk(seed=seed, noise_deg=1.0, speed_change=0.1)
     out_dir.mkdir(parents=True, exist_ok=True)
-    target = out_dir / "synthetic_walk.bvh"
-    write(take.motion, target)
-    back = read(target)
-    facts = motion_info(back)
-    facts["file"] = str(target)
-    _print_info(facts)
-    n_cycles = float(take.unwrapped_phase[-1] - take.unwrapped_phase[0])
-    out.print(
-        f"synthetic walk: period {float(np.median(take.period_frames)):.1f} frames, "
-        f"{n_cycles:.2f} cycles; written and read back in {time.perf_counter() - t0:.2f} s"
-    )
-
-
+    source = write(take.motion, out_dir / "synthetic_walk.bvh")
+    motion = read(source)
+    true_period = float(np.median(take.period_frames))
+    out.print(f"[bold]{source}[/]: synthetic walk, {motion.n_frames} frames at {motion.fps:.6g} fps, 1° noise, "
+              f"tempo +10 % over the take; true period {true_period:.1f} frames")
+    cycle = extract_cycle(motion)
+    loop_file = write(cycle.motion("inplace"), out_dir / "walk_cycle.bvh")
+    walk_file = write(cycle.repeat(4, root="motion"), out_dir / "walk_cycle_x4.bvh")
+    metrics = loop_metrics(motion, cycle)
+    plot = plot_loop(motion, cycle, out_dir / "walk_cycle.png", title="mocycle demo: synthetic walk")
+    out.print(f"  found {cycle.n_periods:.2f} periods of {cycle.period_frames:.2f} frames; cycle of "
+              f"{cycle.n_frames} frames by harmonic regression M1, K = {cycle.n_harmonics}")
+    for key in ("template_error", "jerk_ratio", "seam_pose", "seam_velocity", "foot_sliding",
+                "input_foot_sliding"):
+        label, unit = METRIC_LABELS[key]
+        out.print(f"  {label:28s} {metrics[key]:8.3f} {unit}")
+    out.print(f"wrote {loop_file} (one cycle, in place), {walk_file} (4 cycles walking on), {plot} "
+              f"in {time.perf_counter() - t0:.2f} s")

@@ -269,16 +269,15 @@ def rank_uniform(coords) -> np.ndarray:
     return ranks / x.size
 
 
-def gmm_cdf_remap(coords, n_components: int = 30, random_state: int | None = 0) -> np.ndarray:
-    """Remap circle values (cycles) through a Gaussian-mixture CDF: ``(T,)`` -> ``(T,)`` in ``[0, 1]``.
+def circle_gmm_cdf(coords, n_components: int = 30, random_state: int | None = 0):
+    """The CDF on ``[0, 1)`` of a Gaussian mixture fitted to circle values (cycles) and their copies at -1, +1.
 
-    KTH thesis eq. 3.21 with paper 001 §5.2: a 1-D mixture of ``n_components`` Gaussians (``reg_covar=1e-5``,
-    100 EM iterations) is fitted to the values and their copies shifted by -1 and +1, so its middle part is
-    close to periodic; then ``x -> (G(x) - G(0)) / (G(1) - G(0))`` with ``G(x) = sum_k w_k Phi((x - mu_k) /
-    sigma_k)``.  The result is non-decreasing in the value, and near uniform over ``[0, 1)`` when the values
-    are spread like time.  ``n_components`` is capped at the number of distinct values (at least 1).
-    Inputs are first reduced to ``[0, 1)``.  EM that stops at 100 iterations without converging is accepted
-    silently (as in paper 001).
+    Paper 001 §5.2: a 1-D mixture of ``n_components`` Gaussians (``reg_covar=1e-5``, 100 EM iterations) is
+    fitted to the values and their copies shifted by -1 and +1, so its middle part is close to periodic.
+    Returns ``cdf(v)`` with ``cdf(0) = 0``, ``cdf(1) = 1``, non-decreasing: ``(G(v) - G(0)) / (G(1) - G(0))``
+    with ``G(v) = sum_k w_k Phi((v - mu_k) / sigma_k)``.  ``n_components`` is capped at the number of
+    distinct values (at least 1).  EM that stops at 100 iterations without converging is accepted silently
+    (as in paper 001).
     """
     x = _circle(coords, "coords")
     n_components = _positive_int(n_components, "n_components")
@@ -293,13 +292,28 @@ def gmm_cdf_remap(coords, n_components: int = 30, random_state: int | None = 0) 
     sigma = np.sqrt(gmm.covariances_.reshape(k))
     w = gmm.weights_
 
-    def cdf(v: np.ndarray) -> np.ndarray:
-        return norm.cdf((np.asarray(v, dtype=np.float64)[:, None] - mu) / sigma) @ w
+    def raw(v: np.ndarray) -> np.ndarray:
+        return norm.cdf((np.asarray(v, dtype=np.float64).reshape(-1)[:, None] - mu) / sigma) @ w
 
-    g0, g1 = cdf(np.array([0.0, 1.0]))
+    g0, g1 = raw(np.array([0.0, 1.0]))
     if not g1 > g0:
         raise MocycleError("the Gaussian mixture put no mass on [0, 1); cannot remap the coordinate")
-    return np.clip((cdf(x) - g0) / (g1 - g0), 0.0, 1.0)
+
+    def cdf(v) -> np.ndarray:
+        return np.clip((raw(v) - g0) / (g1 - g0), 0.0, 1.0)
+
+    return cdf
+
+
+def gmm_cdf_remap(coords, n_components: int = 30, random_state: int | None = 0) -> np.ndarray:
+    """Remap circle values (cycles) through a Gaussian-mixture CDF: ``(T,)`` -> ``(T,)`` in ``[0, 1]``.
+
+    KTH thesis eq. 3.21 with paper 001 §5.2 (see :func:`circle_gmm_cdf`).  The result is non-decreasing in
+    the value, and near uniform over ``[0, 1)`` when the values are spread like time.  Inputs are first
+    reduced to ``[0, 1)``.
+    """
+    x = _circle(coords, "coords")
+    return circle_gmm_cdf(x, n_components=n_components, random_state=random_state)(x)
 
 
 # -- excitation regions (paper 001 §4.6) -------------------------------------------------------------------------

@@ -1,0 +1,13 @@
+"""Seamless typical cycles from a take: harmonic regression (M1/M2/M3), centroids, cut; loop metrics."""
+
+from .extract import METHODS, ROOT_MODES, Cycle, centroid_cycle, cut_cycle, extract_cycle, harmonic_cycle
+from .harmonic import MODELS, HarmonicRegression, harmonic_basis
+from .metrics import loop_metrics
+from .representation import CycleSpace
+from .timeaxis import TIME_AXES, TimeAxis, time_axis
+
+__all__ = [
+    "METHODS", "MODELS", "ROOT_MODES", "TIME_AXES", "Cycle", "CycleSpace", "HarmonicRegression", "TimeAxis",
+    "centroid_cycle", "cut_cycle", "extract_cycle", "harmonic_basis", "harmonic_cycle", "loop_metrics",
+    "time_axis",
+]

@@ -1,0 +1,372 @@
+"""Extract one seamless, typical cycle from a take: three methods, one result type.
+
+* ``"harmonic"`` — weighted harmonic regression (KTH thesis ch. 3, models M1/M2/M3),
+  sampled at ``N`` frames per period;
+* ``"centroid"`` — paper 001 §4.4: Gaussian-mixture density of the circular
+  coordinate, ``S`` quantile samples, centroid of the ``k`` nearest frames in phase,
+  resampled to ``N`` frames;
+* ``"cut"`` — the baseline animators know: the two most similar poses about one
+  period apart, the frames between them, the seam cross-faded.
+
+All three work in the :class:`~mocycle.cycle.representation.CycleSpace`
+(rotation matrices, translations; travel-joint translation and heading with a
+per-cycle drift) and return a :class:`Cycle`, which decodes to a Motion with
+the root in place or moving on, and repeats seamlessly.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Iterable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
+from ..motion import Motion
+from ..phase.analysis import PeriodicMotion, PhaseResult, find_phase
+from ..phase.period import circle_gmm_cdf
+from ..rotations import continuous_rotvec, quat_multiply
+from .differences import HALF, central_acceleration, central_velocity
+from .harmonic import MODELS, HarmonicRegression, max_harmonics
+from .representation import CycleSpace, axis_rotations
+from .seam import calmest_start
+from .timeaxis import TIME_AXES, TimeAxis, time_axis
+
+METHODS = ("harmonic", "centroid", "cut")
+ROOT_MODES = ("inplace", "motion")
+DEFAULT_HARMONICS = 20   # the thesis' K
+FEW_PERIODS = 1.5        # fewer periods than this: warn
+CENTROID_SAMPLES = 500   # paper 001 §6: 500 sampled coordinate values
+CENTROID_NEIGHBOURS = 10  # paper 001 §6: 10 nearest neighbours
+
+
+@dataclass
+class Cycle:
+    """One cycle of ``N`` frames (frame ``N`` would equal frame 0) and how it was made.
+
+    ``P``: ``(N, n_periodic)`` and ``L``: ``(N, 4)`` in the cycle space, ``L`` with its drift;
+    ``drift``: ``(4,)`` change of ``L`` over one cycle (travel per cycle, turn per cycle);
+    ``positions``: ``(M,)`` where each frame of ``axis.frames()`` falls in the cycle, in cycle frames.
+    """
+
+    space: CycleSpace
+    P: np.ndarray
+    L: np.ndarray
+    drift: np.ndarray
+    method: str
+    model: str | None
+    n_harmonics: int | None
+    axis: TimeAxis
+    positions: np.ndarray
+    periodic: PeriodicMotion
+    regression: HarmonicRegression | None = field(default=None, repr=False)
+    seconds: float = 0.0
+
+    @property
+    def n_frames(self) -> int:
+        return self.P.shape[0]
+
+    @property
+    def period_frames(self) -> float:
+        """The input's period in frames (the cycle has ``round`` of it, the cut its own length)."""
+        return self.axis.period_frames
+
+    @property
+    def n_periods(self) -> float:
+        return self.axis.n_periods
+
+    def rolled(self, k: int) -> Cycle:
+        """The same loop started at its frame ``k``."""
+        N, k = self.n_frames, int(k) % self.n_frames
+        if k == 0:
+            return self
+        idx = (np.arange(N) + k) % N
+        L = self.L[idx] + np.outer(np.arange(N) + k >= N, self.drift)
+        return replace(self, P=self.P[idx], L=L, positions=np.mod(self.positions - k, N))
+
+    def _inplace_L(self) -> np.ndarray:
+        ramp = np.arange(self.n_frames)[:, None] / self.n_frames
+        return self.L - ramp * self.drift
+
+    def motion(self, root: str = "inplace") -> Motion:
+        """The cycle as a Motion; ``root="inplace"`` walks on the spot, ``"motion"`` moves on by ``drift``."""
+        _check_choice(root, ROOT_MODES, "root")
+        return self.space.decode(self.P, self._inplace_L() if root == "inplace" else self.L)
+
+    def repeat(self, count: int, root: str = "inplace") -> Motion:
+        """The cycle ``count`` times, seamlessly; with ``root="motion"`` each repeat starts where the last ends."""
+        _check_choice(root, ROOT_MODES, "root")
+        if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+            raise MocycleError(f"the number of cycles must be a positive integer; got {count!r}")
+        P = np.tile(self.P, (count, 1))
+        if root == "inplace":
+            return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)))
+        Ls = []
+        turn, move = self.drift[3], self.drift[:3]
+        p0 = self.L[0, :3]
+        offset = np.zeros(3)
+        for j in range(count):
+            R = axis_rotations(self.space.up, np.array([j * turn]))[0]
+            Lj = self.L.copy()
+            Lj[:, :3] = (self.L[:, :3] - p0) @ R.T + p0 + offset
+            Lj[:, 3] += j * turn
+            Ls.append(Lj)
+            offset = offset + R @ move
+        return self.space.decode(P, np.concatenate(Ls))
+
+    def to_dict(self) -> dict:
+        return {
+            "period_frames": self.period_frames,
+            "cycle_frames": self.n_frames,
+            "n_periods": self.n_periods,
+            "method": self.method,
+            "model": self.model,
+            "harmonics": self.n_harmonics,
+            "time_axis": self.axis.method,
+            "travel_per_cycle": self.drift[:3].tolist(),
+            "turn_per_cycle_deg": float(np.degrees(self.drift[3])),
+        }
+
+
+def _check_choice(value, choices, name):
+    if value not in choices:
+        raise MocycleError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
+
+
+# ------------------------------------------------------------------ harmonic
+def _derivative_rows(Y: np.ndarray, axis: TimeAxis):
+    """Velocities and accelerations per period (eq. 3.23-3.25) on the interior frames of every region."""
+    xs, dYs, ddYs = [], [], []
+    for s, e in axis.regions:
+        if e - s < 2 * HALF + 1:
+            continue
+        x = axis.x[s:e]
+        if axis.method in ("smooth", "line"):  # the local tempo, frames per period, follows the axis
+            rate = central_velocity(x, 1.0)[:, 0]
+        else:                                  # the thesis: t = 1/N everywhere (eq. 3.25)
+            rate = np.full(e - s - 2 * HALF, 1.0 / axis.period_frames)
+        xs.append(x[HALF:e - s - HALF])
+        dYs.append(central_velocity(Y[s:e], 1.0) / rate[:, None])
+        ddYs.append(central_acceleration(Y[s:e], 1.0) / rate[:, None] ** 2)
+    if not xs:
+        return None, None, None
+    return np.concatenate(xs), np.concatenate(dYs), np.concatenate(ddYs)
+
+
+def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
+    limit = max_harmonics(n_rows, cycle_frames)
+    if n_harmonics in (None, "auto"):
+        if limit < 1:
+            raise MocycleError(f"too few frames for a harmonic fit: {n_rows} frames, {cycle_frames} per cycle")
+        return min(DEFAULT_HARMONICS, limit)
+    if isinstance(n_harmonics, bool) or not isinstance(n_harmonics, (int, np.integer)) or n_harmonics < 1:
+        raise MocycleError(f"the number of harmonics must be 'auto' or a positive integer; got {n_harmonics!r}")
+    if n_harmonics > limit:
+        raise MocycleError(f"K = {n_harmonics} harmonics is too many for {n_rows} frames with {cycle_frames} "
+                           f"frames per cycle: K must be <= {limit} (2K+1 <= frames and K < frames per cycle / 2)")
+    return int(n_harmonics)
+
+
+def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, periodic: PeriodicMotion,
+                   model: str = "M1", n_harmonics: int | str = "auto") -> Cycle:
+    """Fit ``P`` periodically and ``L`` with a linear term on ``axis``, sample one period at ``N`` frames."""
+    _check_choice(model, MODELS, "model")
+    frames = axis.frames()
+    N = int(round(axis.period_frames))
+    K = _harmonics(n_harmonics, frames.size, N)
+    x = axis.x[frames]
+    xd, dP, ddP = _derivative_rows(P, axis) if model != "M2" else (None, None, None)
+    _, dL, ddL = _derivative_rows(L, axis) if model != "M2" else (None, None, None)
+    if model != "M2" and (xd is None or xd.size < 2 * K):
+        raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the excited "
+                           f"regions are too short: use --model M2 or fewer harmonics")
+    fit_p = HarmonicRegression(K, model).fit(x, P[frames], xd, dP, ddP)
+    fit_l = HarmonicRegression(K, model, linear=True).fit(x, L[frames], xd, dL, ddL)
+    x0 = float(np.floor(x[0]))  # frame 0 of the cycle is phase 0 of the axis
+    xs = x0 + np.arange(N) / N
+    return Cycle(space, fit_p.predict(xs), fit_l.predict(xs), fit_l.drift_, "harmonic", model, K, axis,
+                 np.mod(x - x0, 1.0) * N, periodic, fit_p)
+
+
+# ------------------------------------------------------------------ centroid
+def _detrend(L: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Drift per period ``(4,)`` of ``L`` along ``x`` (least squares) and ``L`` without it."""
+    B = np.column_stack([np.ones_like(x), x])
+    coef = np.linalg.lstsq(B, L, rcond=None)[0]
+    return coef[1], L - np.outer(x, coef[1])
+
+
+def _circular_resample(Y: np.ndarray, n: int, shift: float = 0.0) -> np.ndarray:
+    """Linear resampling of one cycle ``(S, D)`` (row ``S`` = row 0) to ``n`` rows; new row ``k`` is read at
+    old row position ``k * S / n + shift``."""
+    S = Y.shape[0]
+    t = np.arange(n) * S / n + shift
+    i0 = np.floor(t).astype(int)
+    f = (t - i0)[:, None]
+    return (1 - f) * Y[i0 % S] + f * Y[(i0 + 1) % S]
+
+
+def centroid_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, periodic: PeriodicMotion,
+                   n_samples: int = CENTROID_SAMPLES, n_neighbours: int | None = None) -> Cycle:
+    """Paper 001 §4.4: GMM density of the phase, quantile samples, centroids of the k nearest frames."""
+    frames = axis.frames()
+    phi = periodic.coords[frames]
+    k = n_neighbours or max(CENTROID_NEIGHBOURS, int(np.ceil(axis.n_periods)) + 1)
+    k = min(k, frames.size)
+    cdf = circle_gmm_cdf(phi)
+    grid = np.linspace(0.0, 1.0, 4097)
+    cgrid = np.maximum.accumulate(cdf(grid))
+    # Deterministic samples from the density: its quantiles at evenly spaced probabilities (time runs evenly).
+    theta = np.interp((np.arange(n_samples) + 0.5) / n_samples, cgrid, grid)
+    d = np.abs(np.mod(theta[:, None] - phi[None, :] + 0.5, 1.0) - 0.5)  # (S, M) circular distance
+    nearest = np.argpartition(d, k - 1, axis=1)[:, :k]
+    drift, flat = _detrend(L[frames], axis.x[frames])
+    N = int(round(axis.period_frames))
+    # Sample s sits at time (s + 0.5) / S of the cycle; output frame k at time k / N.
+    Pn = _circular_resample(P[frames][nearest].mean(axis=1), N, shift=-0.5)
+    Ln = _circular_resample(flat[nearest].mean(axis=1), N, shift=-0.5) + np.outer(np.arange(N) / N, drift)
+    positions = np.mod((cdf(phi) * n_samples - 0.5) * N / n_samples, N)
+    return Cycle(space, Pn, Ln, drift, "centroid", None, None, axis, positions, periodic)
+
+
+# ----------------------------------------------------------------------- cut
+def _smoothstep(t: np.ndarray) -> np.ndarray:
+    return t * t * (3 - 2 * t)
+
+
+def cut_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, periodic: PeriodicMotion,
+              features: np.ndarray, blend: float = 0.2) -> Cycle:
+    """The baseline: frames ``a .. b-1`` between the most similar poses about one period apart
+    (pose and velocity distance in ``features``), the last ``blend`` of the cycle cross-faded into
+    the frames before ``a`` so the wrap is seamless."""
+    s, e = max(axis.regions, key=lambda r: r[1] - r[0])
+    N = axis.period_frames
+    lags = np.arange(max(2, int(np.floor(0.85 * N))), int(np.ceil(1.15 * N)) + 1)
+    lags = lags[lags < e - s - 1]
+    if lags.size == 0:
+        raise MocycleError(f"the longest excited region ({e - s} frames) is shorter than one period ({N:.1f} "
+                           f"frames): nothing to cut")
+    F = features[s:e]
+    V = np.gradient(F, axis=0) * N / (2 * np.pi)  # velocity per radian of phase: same scale as the pose
+    best = (np.inf, 0, 0)
+    for lag in lags:
+        cost = ((F[:-lag] - F[lag:]) ** 2).sum(axis=1) + ((V[:-lag] - V[lag:]) ** 2).sum(axis=1)
+        first = min(round(blend * lag), cost.size - 1)  # starts with room before them for the cross-fade
+        i = first + int(np.argmin(cost[first:]))
+        if cost[i] < best[0]:
+            best = (float(cost[i]), i + s, int(lag))
+    _, a, lag = best
+    b = a + lag
+    w = int(min(round(blend * lag), a - s))
+    Pc, Lc = P[a:b].copy(), L[a:b].copy()
+    drift = L[b] - L[a]
+    if w >= 1:
+        k = np.arange(lag - w, lag)
+        t = _smoothstep((k - (lag - w) + 1) / (w + 1))[:, None]
+        src = a + k - lag
+        Pc[k] = (1 - t) * P[a + k] + t * P[src]
+        Lc[k] = (1 - t) * L[a + k] + t * (L[src] + drift)
+    x = axis.x[axis.frames()]
+    positions = np.mod(x - axis.x[a], 1.0) * lag
+    return Cycle(space, Pc, Lc, drift, "cut", None, None, axis, positions, periodic)
+
+
+# ------------------------------------------------------------------ pipeline
+def metric_features(motion: Motion, reference: np.ndarray | None = None) -> np.ndarray:
+    """``(T, 3J)`` rotation vectors of every joint relative to ``reference`` ``(J, 4)`` (default: the
+    motion's own mean rotation per joint), in radians: the space the loop metrics are measured in."""
+    q = motion.rotations
+    if reference is None:
+        reference = mean_rotations(motion)
+    inv = reference * np.array([-1.0, -1.0, -1.0, 1.0])
+    rel = quat_multiply(np.broadcast_to(inv, q.shape), q)
+    return continuous_rotvec(rel).reshape(motion.n_frames, -1)
+
+
+def loop_blocks(cycle: Cycle, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """What the seam of a cycle is judged on: its in-place rotations as :func:`metric_features` ``(N, 3J)``
+    and the world path of its travel joint ``(N, 3)``."""
+    inplace = cycle.motion("inplace")
+    return metric_features(inplace, reference), inplace.world_positions()[:, cycle.space.travel]
+
+
+def mean_rotations(motion: Motion) -> np.ndarray:
+    """``(J, 4)`` chordal mean rotation of each joint over the take."""
+    return np.stack([Rotation.from_quat(motion.rotations[:, j]).mean().as_quat() for j in range(motion.n_joints)])
+
+
+def choose_periodic(result: PhaseResult, which: int | None = None) -> PeriodicMotion:
+    """The periodic motion to loop: ``which`` (0-based), or the one whose excitation covers most frames."""
+    if not result.classes:
+        raise NoPeriodicMotion(f"no periodic motion found: {result.reason}")
+    if which is None:
+        return max(result.classes, key=lambda c: len(c.frames()))
+    if not 0 <= which < len(result.classes):
+        raise MocycleError(f"class {which} does not exist: {len(result.classes)} periodic motion(s) found")
+    return result.classes[which]
+
+
+def _phase_at_full_rate(result: PhaseResult, step: int, n_frames: int) -> PhaseResult:
+    """A phase found on every ``step``-th frame, brought back to all ``n_frames`` frames (the unwrapped
+    coordinate interpolated linearly; excitation regions and periods scaled by ``step``)."""
+    frames = np.arange(n_frames)
+    classes = []
+    for c in result.classes:
+        unwrapped = np.interp(frames, np.arange(c.unwrapped.size) * step, c.unwrapped)
+        excitation = [(s * step, min(n_frames, (e - 1) * step + 1)) for s, e in c.excitation]
+        classes.append(replace(c, coords=np.mod(unwrapped, 1.0), unwrapped=unwrapped, excitation=excitation,
+                               period_frames=c.period_frames * step, frame_time=c.frame_time / step))
+    return replace(result, classes=classes, n_frames=n_frames, frame_time=result.frame_time / step,
+                   autocorrelation_period_frames=result.autocorrelation_period_frames * step)
+
+
+def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n_harmonics: int | str = "auto",
+                  time_axis_method: str = "smooth", joints: str | Iterable[str] | None = None,
+                  classes: int | str = "auto", which: int | None = None, phase: PhaseResult | None = None,
+                  phase_step: int = 1, **phase_options) -> Cycle:
+    """One seamless cycle of ``motion``.
+
+    ``method``: ``harmonic`` | ``centroid`` | ``cut``; ``model``: M1 | M2 | M3 (harmonic only);
+    ``n_harmonics``: K or ``"auto"`` (20, capped by the frames); ``time_axis_method``: see
+    :mod:`~mocycle.cycle.timeaxis`; ``joints``: the joints the *phase* is found on (every joint is
+    looped); ``classes``/``which``: how many periodic motions to look for and which to loop;
+    ``phase``: a :class:`PhaseResult` already computed for this motion (skips :func:`find_phase`);
+    ``phase_step``: find the phase on every ``phase_step``-th frame only (the thesis plugin's subsampling;
+    the cycle is still built from every frame at the capture's rate).
+    Raises :class:`NoPeriodicMotion` when the take has none; warns below 1.5 periods.
+    """
+    t0 = time.perf_counter()
+    if not isinstance(motion, Motion):
+        raise MocycleError(f"extract_cycle needs a Motion; got {type(motion).__name__}")
+    _check_choice(method, METHODS, "method")
+    _check_choice(time_axis_method, TIME_AXES, "the time axis")
+    if method == "harmonic":
+        _check_choice(model, MODELS, "model")
+    if isinstance(phase_step, bool) or not isinstance(phase_step, (int, np.integer)) or phase_step < 1:
+        raise MocycleError(f"the phase step must be a positive integer; got {phase_step!r}")
+    if phase is None:
+        if phase_step > 1:
+            phase = _phase_at_full_rate(find_phase(motion[::phase_step], classes=classes, joints=joints,
+                                                   **phase_options), phase_step, motion.n_frames)
+        else:
+            phase = find_phase(motion, classes=classes, joints=joints, **phase_options)
+    periodic = choose_periodic(phase, which)
+    axis = time_axis(periodic, time_axis_method)
+    if axis.n_periods < FEW_PERIODS:
+        warnings.warn(f"only {axis.n_periods:.2f} periods found (fewer than {FEW_PERIODS}); the cycle rests on "
+                      f"little evidence", MocycleWarning, stacklevel=2)
+    space = CycleSpace.fit(motion)
+    P, L = space.encode(motion)
+    if method == "harmonic":
+        cycle = harmonic_cycle(space, P, L, axis, periodic, model, n_harmonics)
+    elif method == "centroid":
+        cycle = centroid_cycle(space, P, L, axis, periodic)
+    else:
+        cycle = cut_cycle(space, P, L, axis, periodic, metric_features(motion))
+    if method != "cut":  # the cut's wrap is its seam; the others have none, so they start at the calmest pose
+        cycle = cycle.rolled(calmest_start(*loop_blocks(cycle, mean_rotations(motion))))
+    cycle.seconds = time.perf_counter() - t0
+    return cycle

@@ -1,0 +1,193 @@
+"""Harmonic regression of a periodic motion (KTH thesis ch. 3).
+
+Per degree of freedom ``j`` the model is
+
+    h_j(x) = c_j + sum_{k=1..K} a_jk sin(2 pi k x) + b_jk cos(2 pi k x)  [+ l_j x]     (eq. 3.6, 3.27)
+
+with ``x`` the time axis in periods.  Three ways to fit it (Tables A-B):
+
+* **M1** — positions, velocities and accelerations, weighted by feasible
+  generalised least squares: separate OLS fits give the group variances
+  ``s2_p, s2_v, s2_a`` (eq. 3.11-3.13), then ``alpha_j = s2_p / s2_v`` and
+  ``gamma_j = s2_p / s2_a`` weight the velocity and acceleration rows (eq. 3.19);
+* **M2** — positions only (eq. 3.8);
+* **M3** — positions, velocities and accelerations, unweighted (eq. 3.9).
+
+Every DOF shares one design matrix, so M2 and M3 are one least-squares call
+with ``D`` right-hand sides and M1 is one batched solve of ``D`` normal
+equations of size ``2K+1`` (+1 with the linear term).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import MocycleError
+
+MODELS = ("M1", "M2", "M3")
+WEIGHT_LIMIT = 1e8  # alpha, gamma are clipped here: a DOF whose derivatives fit perfectly stays solvable
+
+
+def harmonic_basis(x: np.ndarray, n_harmonics: int, derivative: int = 0, linear: bool = False) -> np.ndarray:
+    """Design matrix ``(M, 2K+1[+1])`` of the model or of its 1st/2nd derivative in ``x`` (periods).
+
+    Columns: ``1, sin(2 pi x), cos(2 pi x), ..., sin(2 pi K x), cos(2 pi K x)[, x]``.
+    """
+    x = np.asarray(x, dtype=np.float64).reshape(-1)
+    w = 2.0 * np.pi * np.arange(1, n_harmonics + 1)
+    arg = np.outer(x, w)
+    s, c = np.sin(arg), np.cos(arg)
+    cols = np.empty((x.size, 2 * n_harmonics + 1 + int(linear)))
+    if derivative == 0:
+        cols[:, 0] = 1.0
+        cols[:, 1:2 * n_harmonics + 1:2], cols[:, 2:2 * n_harmonics + 1:2] = s, c
+        if linear:
+            cols[:, -1] = x
+    elif derivative == 1:
+        cols[:, 0] = 0.0
+        cols[:, 1:2 * n_harmonics + 1:2], cols[:, 2:2 * n_harmonics + 1:2] = w * c, -w * s
+        if linear:
+            cols[:, -1] = 1.0
+    elif derivative == 2:
+        cols[:, 0] = 0.0
+        cols[:, 1:2 * n_harmonics + 1:2], cols[:, 2:2 * n_harmonics + 1:2] = -w ** 2 * s, -w ** 2 * c
+        if linear:
+            cols[:, -1] = 0.0
+    else:
+        raise MocycleError(f"derivative must be 0, 1 or 2; got {derivative!r}")
+    return cols
+
+
+def max_harmonics(n_rows: int, cycle_frames: int | None = None) -> int:
+    """The largest K a fit supports: ``2K+1 <= rows``, and ``K < N/2`` (no harmonic above the cycle's Nyquist)."""
+    k = (n_rows - 1) // 2
+    if cycle_frames is not None:
+        k = min(k, (int(cycle_frames) - 1) // 2)
+    return max(k, 0)
+
+
+class HarmonicRegression:
+    """Harmonic regression of ``D`` curves on a shared time axis (scikit-learn style).
+
+    Parameters
+    ----------
+    n_harmonics : K (the thesis used 20).
+    model : ``"M1"`` (FGLS-weighted, default), ``"M2"`` (positions only) or ``"M3"`` (unweighted).
+    linear : add the linear term ``l_j x`` (eq. 3.27) for curves that drift (root translation, heading).
+
+    Fitted attributes
+    -----------------
+    coef_ : ``(p, D)``; ``alpha_``, ``gamma_`` : ``(D,)`` velocity and acceleration weights (1 for M3, 0 for M2);
+    sigma2_ : ``(3, D)`` the FGLS group variances of position, velocity, acceleration (M1 only, else NaN);
+    rmse_ : ``(3,)`` thesis eq. 4.1-4.3 on the training rows (velocity/acceleration errors weighted by
+    ``sqrt(alpha)``, ``sqrt(gamma)``).
+    """
+
+    def __init__(self, n_harmonics: int = 20, model: str = "M1", linear: bool = False):
+        self.n_harmonics = n_harmonics
+        self.model = model
+        self.linear = linear
+
+    def _check(self, x, Y, xd, dY, ddY):
+        if self.model not in MODELS:
+            raise MocycleError(f"model must be one of {', '.join(MODELS)}; got {self.model!r}")
+        K = self.n_harmonics
+        if isinstance(K, bool) or not isinstance(K, (int, np.integer)) or K < 1:
+            raise MocycleError(f"the number of harmonics K must be a positive integer; got {K!r}")
+        x = np.asarray(x, dtype=np.float64).reshape(-1)
+        Y = np.asarray(Y, dtype=np.float64)
+        Y = Y[:, None] if Y.ndim == 1 else Y
+        if Y.shape[0] != x.size:
+            raise MocycleError(f"x has {x.size} rows but Y has {Y.shape[0]}")
+        p = 2 * K + 1 + int(self.linear)
+        if x.size < p:
+            raise MocycleError(f"K = {K} harmonics need at least {p} frames; got {x.size} "
+                               f"(K <= {max_harmonics(x.size)})")
+        if not (np.isfinite(x).all() and np.isfinite(Y).all()):
+            raise MocycleError("the time axis and the curves must be finite numbers")
+        if self.model != "M2":
+            if xd is None or dY is None or ddY is None:
+                raise MocycleError(f"model {self.model} needs velocities and accelerations (xd, dY, ddY)")
+            xd = np.asarray(xd, dtype=np.float64).reshape(-1)
+            dY = np.asarray(dY, dtype=np.float64).reshape(xd.size, -1)
+            ddY = np.asarray(ddY, dtype=np.float64).reshape(xd.size, -1)
+            if dY.shape[1] != Y.shape[1] or ddY.shape[1] != Y.shape[1]:
+                raise MocycleError("velocities and accelerations must have the columns of Y")
+            if xd.size < 2 * K:
+                raise MocycleError(f"K = {K} harmonics need velocities on at least {2 * K} frames; got {xd.size}")
+        return x, Y, xd, dY, ddY
+
+    def fit(self, x, Y, xd=None, dY=None, ddY=None) -> HarmonicRegression:
+        """Fit positions ``Y (M, D)`` at times ``x (M,)`` (periods); velocities ``dY`` and accelerations
+        ``ddY`` ``(M', D)`` per period (and per period²) at times ``xd (M',)`` for M1 and M3."""
+        x, Y, xd, dY, ddY = self._check(x, Y, xd, dY, ddY)
+        K, lin, D = self.n_harmonics, self.linear, Y.shape[1]
+        P = harmonic_basis(x, K, 0, lin)
+        if self.model == "M2":
+            self.coef_ = np.linalg.lstsq(P, Y, rcond=None)[0]
+            self.alpha_, self.gamma_ = np.zeros(D), np.zeros(D)
+            self.sigma2_ = np.full((3, D), np.nan)
+        else:
+            V, A = harmonic_basis(xd, K, 1, lin), harmonic_basis(xd, K, 2, lin)
+            if self.model == "M3":
+                self.alpha_, self.gamma_ = np.ones(D), np.ones(D)
+                self.sigma2_ = np.full((3, D), np.nan)
+                self.coef_ = np.linalg.lstsq(np.vstack([P, V, A]), np.vstack([Y, dY, ddY]), rcond=None)[0]
+            else:
+                self._fit_fgls(P, V, A, Y, dY, ddY)
+        self.rmse_ = self._rmse(P, Y, xd, dY, ddY)
+        return self
+
+    def _fit_fgls(self, P, V, A, Y, dY, ddY) -> None:
+        """M1: group variances from separate OLS fits (eq. 3.11-3.13), then WLS (eq. 3.19), all DOFs at once."""
+        K = self.n_harmonics
+        M, Md = P.shape[0], V.shape[0]
+
+        def resid_var(B, T, dof):
+            cols = np.flatnonzero(np.abs(B).max(axis=0) > 0)  # derivative designs lose the constant column
+            beta = np.linalg.lstsq(B[:, cols], T, rcond=None)[0]
+            return ((B[:, cols] @ beta - T) ** 2).sum(axis=0) / max(dof, 1)
+
+        s2p = resid_var(P, Y, M - 2 * K - 1 - int(self.linear))
+        s2v = resid_var(V, dY, Md - 2 * K)
+        s2a = resid_var(A, ddY, Md - 2 * K)
+        tiny = np.finfo(np.float64).tiny
+        self.alpha_ = np.clip(s2p / np.maximum(s2v, tiny), 0.0, WEIGHT_LIMIT)
+        self.gamma_ = np.clip(s2p / np.maximum(s2a, tiny), 0.0, WEIGHT_LIMIT)
+        self.sigma2_ = np.vstack([s2p, s2v, s2a])
+        PtP, VtV, AtA = P.T @ P, V.T @ V, A.T @ A
+        G = PtP + self.alpha_[:, None, None] * VtV + self.gamma_[:, None, None] * AtA  # (D, p, p)
+        b = (P.T @ Y).T + self.alpha_[:, None] * (V.T @ dY).T + self.gamma_[:, None] * (A.T @ ddY).T  # (D, p)
+        # A tiny ridge keeps DOFs that never move (all-zero rows and columns but the constant) solvable.
+        G = G + 1e-12 * np.trace(PtP) / PtP.shape[0] * np.eye(G.shape[-1])
+        self.coef_ = np.linalg.solve(G, b[..., None])[..., 0].T
+
+    def _rmse(self, P, Y, xd, dY, ddY) -> np.ndarray:
+        rp = np.sqrt(((P @ self.coef_ - Y) ** 2).sum(axis=1).mean())
+        if xd is None or dY is None:
+            return np.array([rp, np.nan, np.nan])
+        K, lin = self.n_harmonics, self.linear
+        a = np.sqrt(self.alpha_ if self.model != "M2" else np.ones_like(self.alpha_))
+        g = np.sqrt(self.gamma_ if self.model != "M2" else np.ones_like(self.gamma_))
+        rv = np.sqrt(((a * (harmonic_basis(xd, K, 1, lin) @ self.coef_ - dY)) ** 2).sum(axis=1).mean())
+        ra = np.sqrt(((g * (harmonic_basis(xd, K, 2, lin) @ self.coef_ - ddY)) ** 2).sum(axis=1).mean())
+        return np.array([rp, rv, ra])
+
+    def predict(self, x, derivative: int = 0, drift: bool = True) -> np.ndarray:
+        """``h(x)`` (or ``h'``, ``h''``) at times ``x (N,)`` in periods: ``(N, D)``.
+
+        ``drift=False`` leaves out the linear term (a cycle that stays in place).
+        """
+        if not hasattr(self, "coef_"):
+            raise MocycleError("fit the regression before predicting")
+        B = harmonic_basis(x, self.n_harmonics, derivative, self.linear)
+        coef = self.coef_
+        if self.linear and not drift:
+            coef = coef.copy()
+            coef[-1] = 0.0
+        return B @ coef
+
+    @property
+    def drift_(self) -> np.ndarray:
+        """``(D,)`` change per period of the linear term (zeros without it)."""
+        return self.coef_[-1].copy() if self.linear else np.zeros(self.coef_.shape[1])

@@ -1,0 +1,167 @@
+"""How good is a loop?  The numbers ``mocycle loop --json`` and ``benchmarks/cycles.py`` print.
+
+All pose errors are measured in one space for every method: the rotation
+vector of each joint relative to the input's mean rotation of that joint
+(radians, ``(T, 3J)``; :func:`~mocycle.cycle.extract.metric_features`).
+
+* ``rmse_h``, ``rmse_dh``, ``rmse_ddh`` — KTH thesis eq. 4.1-4.3: the cycle read
+  at each input frame's phase against the input, for poses (rad), velocities
+  (rad/s) and accelerations (rad/s², 8th-order central differences).  Unlike
+  the thesis the velocity and acceleration errors are not weighted by the M1
+  weights, so every method is measured with the same ruler.
+* ``template_error`` — eq. 4.4-4.5: the repeated cycle slid along the input's
+  longest excited region; the RMS pose error (rad per frame) at the best offset.
+* ``jerk_ratio`` — paper 001 §6.3: RMS jerk (4th-order forward differences) of
+  the looped cycle over that of the input; 1 means as smooth as the capture.
+* ``seam_pose``, ``seam_velocity`` — the change across the wrap (frame N-1 to 0)
+  of the pose, and of the velocity (second difference), divided by the median
+  of the same change between the cycle's other frames; the larger of the
+  rotations' and the in-place root path's ratio.  1 means the wrap is an
+  ordinary frame step.  ``seam_pose_local``, ``seam_velocity_local`` divide by
+  the median over the eight frames next to the wrap instead: a pop detector
+  that does not depend on where in the motion the wrap is placed
+  (:mod:`~mocycle.cycle.seam`).
+* ``foot_sliding`` and ``input_foot_sliding`` — mean horizontal speed (file
+  units/s) of the lowest foot while it is within 2 % of the body height of the
+  floor, for the cycle repeated with its root motion and for the input.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from ..motion import Motion
+from .differences import HALF, central_acceleration, central_velocity, forward_jerk
+from .extract import Cycle, loop_blocks, mean_rotations, metric_features
+from .representation import vertical_axis
+from .seam import seam_ratios
+
+CONTACT_HEIGHT = 0.02  # of the body height
+
+
+def _spline(F: np.ndarray) -> CubicSpline:
+    """Periodic cubic spline through a cycle ``(N, D)`` on positions ``0 .. N``."""
+    return CubicSpline(np.arange(F.shape[0] + 1), np.vstack([F, F[:1]]), bc_type="periodic", axis=0)
+
+
+def _rms(E: np.ndarray) -> float:
+    return float(np.sqrt((E ** 2).sum(axis=1).mean())) if E.size else float("nan")
+
+
+def regression_errors(Y: np.ndarray, C: np.ndarray, positions: np.ndarray, regions, frames: np.ndarray,
+                      frame_time: float, rate: float) -> tuple[float, float, float]:
+    """Eq. 4.1-4.3 (unweighted): the cycle ``C (N, D)`` read at ``positions`` (cycle frames) against ``Y``.
+
+    ``rate``: cycle frames per input frame (the cycle's length over the input's period).
+    """
+    spline = _spline(C)
+    h = spline(positions)
+    pos_of = dict(zip(frames.tolist(), positions, strict=True))
+    e_p = h - Y[frames]
+    e_v, e_a = [], []
+    for s, e in regions:
+        if e - s < 2 * HALF + 1:
+            continue
+        p = np.array([pos_of[i] for i in range(s + HALF, e - HALF)])
+        e_v.append(spline(p, 1) * rate / frame_time - central_velocity(Y[s:e], frame_time))
+        e_a.append(spline(p, 2) * (rate / frame_time) ** 2 - central_acceleration(Y[s:e], frame_time))
+    e_v = np.concatenate(e_v) if e_v else np.zeros((0, Y.shape[1]))
+    e_a = np.concatenate(e_a) if e_a else np.zeros((0, Y.shape[1]))
+    return _rms(e_p), _rms(e_v), _rms(e_a)
+
+
+def template_error(Y: np.ndarray, C: np.ndarray) -> tuple[float, int]:
+    """Eq. 4.4-4.5: slide the repeated cycle ``C (N, D)`` along ``Y (M, D)``; (RMS error, best offset n)."""
+    M, N = Y.shape[0], C.shape[0]
+    d2 = (Y ** 2).sum(1)[:, None] + (C ** 2).sum(1)[None, :] - 2 * Y @ C.T  # (M, N) squared distances
+    d = np.sqrt(np.maximum(d2, 0.0))
+    idx = (np.arange(M)[:, None] + np.arange(N)[None, :]) % N               # [i, n] -> cycle frame i + n
+    rows = np.arange(M)[:, None]
+    n = int(np.argmin(d[rows, idx].sum(axis=0)))                            # eq. 4.4
+    return float(np.sqrt(np.maximum(d2[np.arange(M), idx[:, n]], 0).mean())), n   # eq. 4.5
+
+
+def jerk_ratio(Y_regions: list[np.ndarray], C: np.ndarray, frame_time: float) -> float:
+    """RMS jerk of the looped cycle over the RMS jerk of the input regions (paper 001 §6.3)."""
+    j_in = [forward_jerk(Y, frame_time) for Y in Y_regions if Y.shape[0] >= 7]
+    if not j_in:
+        return float("nan")
+    return _rms(forward_jerk(C, frame_time, periodic=True)) / _rms(np.concatenate(j_in))
+
+
+def foot_points(motion: Motion) -> list[int]:
+    """Indices (in ``world_positions(end_sites=True)``) of the feet: in each of the two branches below the
+    travel joint whose leaves hang lowest on average, the lowest leaf (joint without children, or End Site)."""
+    skel = motion.skeleton
+    up = vertical_axis(motion)
+    parents = list(skel.parents) + [site.parent for site in skel.end_sites]
+    has_child = np.zeros(len(parents), bool)
+    for p in parents:
+        if p >= 0:
+            has_child[p] = True
+    leaves = [i for i in range(len(parents)) if not has_child[i]]
+    travel = motion.travel_joint
+
+    def branch(i: int) -> int:
+        path = [i]
+        while parents[path[-1]] >= 0:
+            path.append(parents[path[-1]])
+        return path[path.index(travel) - 1] if travel in path and path.index(travel) > 0 else path[-1]
+
+    step = max(1, motion.n_frames // 50)
+    heights = motion[::step].world_positions(end_sites=True).mean(axis=0) @ up
+    lowest: dict[int, int] = {}
+    for leaf in leaves:
+        b = branch(leaf)
+        if b not in lowest or heights[leaf] < heights[lowest[b]]:
+            lowest[b] = leaf
+    feet = sorted(lowest.values(), key=lambda i: heights[i])
+    return feet[:2]
+
+
+def foot_sliding(motion: Motion) -> float:
+    """Mean horizontal speed (units/s) of the lowest foot while it touches the floor (height test)."""
+    up = vertical_axis(motion)
+    feet = foot_points(motion)
+    W = motion.world_positions(end_sites=True)
+    pts = W[:, feet]                                     # (T, 2, 3)
+    h = pts @ up                                         # (T, 2)
+    low = np.argmin(h, axis=1)
+    height = np.ptp(W.mean(axis=0) @ up)
+    floor = np.percentile(h.min(axis=1), 5)
+    foot = pts[np.arange(len(low)), low]                 # (T, 3)
+    contact = (h.min(axis=1) <= floor + CONTACT_HEIGHT * height)[:-1] & (low[:-1] == low[1:])
+    step = np.diff(foot, axis=0)
+    horiz = step - np.outer(step @ up, up)
+    speed = np.linalg.norm(horiz, axis=1) / motion.frame_time
+    return float(speed[contact].mean()) if contact.any() else float("nan")
+
+
+def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
+    """Every metric of the module docstring for ``cycle`` extracted from ``motion``."""
+    ref = mean_rotations(motion)
+    Y = metric_features(motion, ref)
+    C, root = loop_blocks(cycle, ref)
+    frames = cycle.axis.frames()
+    rate = cycle.n_frames / cycle.period_frames
+    rmse_h, rmse_dh, rmse_ddh = regression_errors(Y, C, cycle.positions, cycle.axis.regions, frames,
+                                                  motion.frame_time, rate)
+    s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
+    tmpl, offset = template_error(Y[s:e], C)
+    seams = [seam_ratios(C), seam_ratios(root)]
+    travelling = cycle.repeat(2, root="motion")
+    return {
+        "rmse_h": rmse_h,
+        "rmse_dh": rmse_dh,
+        "rmse_ddh": rmse_ddh,
+        "template_error": tmpl,
+        "template_offset": offset,
+        "jerk_ratio": jerk_ratio([Y[a:b] for a, b in cycle.axis.regions], C, motion.frame_time),
+        "seam_pose": max(r["pose"] for r in seams),
+        "seam_velocity": max(r["velocity"] for r in seams),
+        "seam_pose_local": max(r["pose_local"] for r in seams),
+        "seam_velocity_local": max(r["velocity_local"] for r in seams),
+        "foot_sliding": foot_sliding(travelling),
+        "input_foot_sliding": foot_sliding(motion[frames[0]:frames[-1] + 1]),
+    }
