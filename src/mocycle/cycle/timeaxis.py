@@ -55,7 +55,7 @@ def _line(u: np.ndarray) -> np.ndarray:
 
 
 def _period_average(u: np.ndarray, period: float) -> np.ndarray:
-    """Sliding mean of ``u`` over one period, continued with slope ``1/period`` where the window does not fit."""
+    """Sliding mean of ``u`` over one period, continued at the local slope where the window does not fit."""
     w = int(round(period))
     n = u.size
     if w < 2 or n < w + 2:
@@ -65,10 +65,13 @@ def _period_average(u: np.ndarray, period: float) -> np.ndarray:
     centres = np.arange(mean.size) + (w - 1) / 2.0
     i = np.arange(n, dtype=np.float64)
     x = np.interp(i, centres, mean)
-    rate = 1.0 / period
+    # Beyond the first and last window centre, continue at the local tempo of the nearest period.
+    m = min(w, mean.size)
+    rate0 = np.polyfit(centres[:m], mean[:m], 1)[0] if m >= 2 else 1.0 / period
+    rate1 = np.polyfit(centres[-m:], mean[-m:], 1)[0] if m >= 2 else 1.0 / period
     before, after = i < centres[0], i > centres[-1]
-    x[before] = mean[0] + (i[before] - centres[0]) * rate
-    x[after] = mean[-1] + (i[after] - centres[-1]) * rate
+    x[before] = mean[0] + (i[before] - centres[0]) * rate0
+    x[after] = mean[-1] + (i[after] - centres[-1]) * rate1
     return x
 
 

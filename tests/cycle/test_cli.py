@@ -1,0 +1,77 @@
+import json
+
+import numpy as np
+from typer.testing import CliRunner
+
+from mocycle.cli import app
+from mocycle.datasets import synthetic_still, synthetic_walk
+from mocycle.io import read, write
+
+runner = CliRunner()
+
+
+def _walk(tmp_path, n=400):
+    return write(synthetic_walk(n_frames=n, noise_deg=1.0).motion, tmp_path / "walk.bvh")
+
+
+def test_loop_json_and_bvh(tmp_path):
+    src = _walk(tmp_path)
+    out = tmp_path / "cycle.bvh"
+    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--json", "--cycles", "3", "--root", "motion"])
+    assert result.exit_code == 0, result.output
+    facts = json.loads(result.stdout)
+    for key in ("period_frames", "n_periods", "method", "model", "metrics", "seconds"):
+        assert key in facts
+    assert abs(facts["period_frames"] - 60) < 1 and facts["method"] == "harmonic" and facts["model"] == "M1"
+    cycle = read(out)
+    assert cycle.n_frames == 3 * facts["cycle_frames"] and np.isclose(cycle.fps, 60)
+    assert cycle.root_positions[-1, 2] - cycle.root_positions[0, 2] > 2.5 * 130  # walks on
+
+
+def test_loop_table_plot_and_other_methods(tmp_path):
+    src = _walk(tmp_path, 300)
+    for method in ("centroid", "cut"):
+        out, png = tmp_path / f"{method}.bvh", tmp_path / f"{method}.png"
+        result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--method", method, "--plot", str(png),
+                                     "--range", "20:", "--joints", "legs"])
+        assert result.exit_code == 0, result.output
+        assert "seam jump" in result.output and out.exists() and png.stat().st_size > 10_000
+
+
+def test_no_periodic_motion_exits_3_and_writes_nothing(tmp_path):
+    src = write(synthetic_still(noise_deg=0.5).motion, tmp_path / "still.bvh")
+    out = tmp_path / "cycle.bvh"
+    result = runner.invoke(app, ["loop", str(src), "-o", str(out)])
+    assert result.exit_code == 3
+    assert "no periodic motion found: " in result.stderr and "H1 bar" in result.stderr
+    assert not out.exists()
+
+
+def test_bad_options_exit_1_with_one_message(tmp_path):
+    src = _walk(tmp_path, 200)
+    cases = [
+        (["--harmonics", "80"], "K must be <="),
+        (["--harmonics", "many"], "--harmonics must be"),
+        (["--model", "M7"], "model must be one of"),
+        (["--root", "flying"], "root must be one of"),
+        (["--cycles", "0"], "--cycles must be a positive integer"),
+        (["--range", "150:100"], "outside the take"),
+    ]
+    for extra, message in cases:
+        out = tmp_path / "x.bvh"
+        result = runner.invoke(app, ["loop", str(src), "-o", str(out)] + extra)
+        assert result.exit_code == 1, (extra, result.output)
+        assert message in result.stderr and result.stderr.count("error:") == 1, (extra, result.stderr)
+        assert not out.exists()
+    result = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.txt")])
+    assert result.exit_code == 1 and "must name a .bvh file" in result.stderr
+    result = runner.invoke(app, ["loop", str(tmp_path / "missing.bvh"), "-o", str(tmp_path / "x.bvh")])
+    assert result.exit_code == 1 and "missing.bvh" in result.stderr
+
+
+def test_demo_writes_the_take_the_cycle_and_the_plot(tmp_path):
+    result = runner.invoke(app, ["demo", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    for name in ("synthetic_walk.bvh", "walk_cycle.bvh", "walk_cycle_x4.bvh", "walk_cycle.png"):
+        assert (tmp_path / name).exists(), name
+    assert "periods of" in result.output

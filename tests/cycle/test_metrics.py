@@ -1,0 +1,71 @@
+import numpy as np
+
+from mocycle.cycle import extract_cycle
+from mocycle.cycle.metrics import foot_points, foot_sliding, jerk_ratio, loop_metrics, template_error
+from mocycle.cycle.seam import calmest_start, seam_ratios
+from mocycle.datasets import synthetic_still, synthetic_walk
+
+
+def _loop(N=40, D=3, phase=0.0):
+    t = (np.arange(N) / N + phase)[:, None]
+    return np.hstack([np.sin(2 * np.pi * (t + k / D)) + 0.3 * np.cos(4 * np.pi * t) for k in range(D)])
+
+
+def test_template_error_is_zero_for_the_repeated_cycle_and_finds_the_offset():
+    C = _loop()
+    Y = np.tile(C, (3, 1))[7:90]
+    err, n = template_error(Y, C)
+    assert err < 1e-6 and n == 7
+    noisy = Y + 0.01 * np.random.default_rng(0).normal(size=Y.shape)
+    assert 0.005 < template_error(noisy, C)[0] < 0.03
+
+
+def test_seam_ratios_flag_a_pop_and_pass_a_smooth_loop():
+    smooth = seam_ratios(_loop())
+    assert all(0.0 < v < 1.6 for v in smooth.values()), smooth
+    popped = _loop()
+    popped[-1] += 0.5  # the last frame jumps away and back
+    pops = seam_ratios(popped)
+    assert pops["pose"] > 3 and pops["pose_local"] > 3 and pops["velocity_local"] > 3
+
+
+def test_calmest_start_picks_the_slowest_step():
+    t = np.arange(48) / 48
+    C = np.c_[np.sin(2 * np.pi * t) + 0.5 * np.sin(4 * np.pi * t)]
+    k = calmest_start(C)
+    rolled = np.roll(C, -k, axis=0)
+    r = seam_ratios(rolled)
+    assert r["pose"] <= 1.0 and r["velocity"] <= 1.0
+    assert r["pose"] <= min(seam_ratios(np.roll(C, -j, axis=0))["pose"] for j in range(48)) + 0.6
+
+
+def test_jerk_ratio_is_one_for_the_input_itself_and_small_for_a_denoised_cycle():
+    C = _loop(60)
+    Y = np.tile(C, (4, 1))
+    assert abs(jerk_ratio([Y], C, 1 / 60) - 1) < 0.05
+    noisy = Y + 0.002 * np.random.default_rng(1).normal(size=Y.shape)
+    assert jerk_ratio([noisy], C, 1 / 60) < 0.2
+
+
+def test_feet_are_one_per_leg_and_a_still_take_does_not_slide():
+    walk = synthetic_walk(n_frames=120).motion
+    names = walk.skeleton.names
+    n = walk.n_joints
+    feet = foot_points(walk)
+    chains = []
+    for i in feet:
+        j = i if i < n else walk.skeleton.end_sites[i - n].parent
+        chains.append(names[j])
+    assert sorted(c[:4] for c in chains) == ["Left", "Righ"], chains
+    assert foot_sliding(synthetic_still(noise_deg=0.0).motion) < 1e-6
+
+
+def test_loop_metrics_has_every_number_the_cli_prints():
+    take = synthetic_walk(n_frames=400, noise_deg=1.0)
+    m = loop_metrics(take.motion, extract_cycle(take.motion))
+    for key in ("rmse_h", "rmse_dh", "rmse_ddh", "template_error", "jerk_ratio", "seam_pose", "seam_velocity",
+                "seam_pose_local", "seam_velocity_local", "foot_sliding", "input_foot_sliding"):
+        assert np.isfinite(m[key]), key
+    # the template error and the phase-aligned RMSE measure the same fit two ways
+    assert 0.5 < m["template_error"] / m["rmse_h"] < 2.0
+    assert m["foot_sliding"] < m["input_foot_sliding"] * 1.5
