@@ -22,8 +22,8 @@ vector of each joint relative to the input's mean rotation of that joint
   that does not depend on where in the motion the wrap is placed
   (:mod:`~mocycle.cycle.seam`).
 * ``foot_sliding`` and ``input_foot_sliding`` — mean horizontal speed (file
-  units/s) of the lowest foot while it is within 2 % of the body height of the
-  floor, for the cycle repeated with its root motion and for the input.
+  units/s) of each foot while it is within 2 % of the body height of its
+  floor, for the cycle repeated twice with its root motion and for the input.
 """
 
 from __future__ import annotations
@@ -121,21 +121,26 @@ def foot_points(motion: Motion) -> list[int]:
 
 
 def foot_sliding(motion: Motion) -> float:
-    """Mean horizontal speed (units/s) of the lowest foot while it touches the floor (height test)."""
+    """Mean horizontal speed (units/s) of the feet while they touch the floor.
+
+    A foot touches the floor on a frame step when it is, at both ends of the step, within
+    ``CONTACT_HEIGHT`` of the body height above its own floor (its 5th-percentile height over the take).
+    """
     up = vertical_axis(motion)
     feet = foot_points(motion)
     W = motion.world_positions(end_sites=True)
-    pts = W[:, feet]                                     # (T, 2, 3)
-    h = pts @ up                                         # (T, 2)
-    low = np.argmin(h, axis=1)
-    height = np.ptp(W.mean(axis=0) @ up)
-    floor = np.percentile(h.min(axis=1), 5)
-    foot = pts[np.arange(len(low)), low]                 # (T, 3)
-    contact = (h.min(axis=1) <= floor + CONTACT_HEIGHT * height)[:-1] & (low[:-1] == low[1:])
-    step = np.diff(foot, axis=0)
-    horiz = step - np.outer(step @ up, up)
-    speed = np.linalg.norm(horiz, axis=1) / motion.frame_time
-    return float(speed[contact].mean()) if contact.any() else float("nan")
+    body = np.ptp(W.mean(axis=0) @ up)
+    speeds = []
+    for f in feet:
+        p = W[:, f]
+        h = p @ up
+        down = h <= np.percentile(h, 5) + CONTACT_HEIGHT * body
+        contact = down[:-1] & down[1:]
+        step = np.diff(p, axis=0)
+        horiz = step - np.outer(step @ up, up)
+        speeds.append(np.linalg.norm(horiz, axis=1)[contact] / motion.frame_time)
+    speeds = np.concatenate(speeds)
+    return float(speeds.mean()) if speeds.size else float("nan")
 
 
 def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
