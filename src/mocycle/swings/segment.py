@@ -1,0 +1,498 @@
+"""Joint-swing segmentation (paper 003, "Motion Segmentation Based on Joint Swings", section 4.2).
+
+For each chosen joint:
+
+1. **Angular velocity** from consecutive local rotations as an exponential map,
+   ``ω_t = log(R_{t+1} R_tᵀ)`` (radians per frame, parent frame), ``(T-1, 3)``.
+2. **Box filter** of ``window_s`` seconds (the paper's 20 frames at 120 fps =
+   1/6 s, so other frame rates get the same time span).
+3. **Geodesic-swing error** ``E_t`` of the window centred on each frame: the
+   mean of ``1 - cos`` of the angle between frame ``t``'s rotation axis and the
+   axes in the window (0 = perfectly geodesic, 2 = reversed).
+4. **Greedy growth** from the unprocessed frame with the lowest error: add the
+   left or right neighbour whose axis is closer to the seed's, while the
+   average error of the swing stays within the *Acceptable Swing Error*
+   (``threshold``, default 0.4, range 0-2).
+5. Each swing gets its axis (mean of the frame axes), the angles about that
+   axis at its ends (and, beyond the paper, the angular speeds at its ends so
+   playback can follow the ease-in / ease-out of a real swing); the still
+   parts between swings become **holds** with their mean rotation.
+
+The result :class:`Segmentation` is a table of :class:`Swing` and :class:`Hold`
+records (``to_records()``) that playback, the codec, search and editing read.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+from collections.abc import Iterable
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from scipy.ndimage import uniform_filter1d
+
+from ..errors import MocycleError
+from ..motion import Motion, Skeleton
+from ..rotations import quat_log, quat_multiply
+
+#: The paper's box filter and error window: 20 frames at 120 fps, in seconds.
+PAPER_WINDOW_S = 20.0 / 120.0
+#: The paper's Acceptable Swing Error.
+DEFAULT_THRESHOLD = 0.4
+
+#: Name patterns of small bones left out by default (fingers, toes, twist and helper bones, face).
+MINOR_JOINT_PATTERNS = (
+    "*finger*", "*thumb*", "*index*", "*middle*", "*mid[0-9]*", "*ring[0-9]*", "*ring", "*pinky*",
+    "*toe*", "*twist*", "*sharebone*", "*eye*", "*jaw*", "*tongue*", "*teeth*", "*facial*",
+    "*breast*", "*end*", "*nub*",
+)
+
+
+# ---------------------------------------------------------------- records
+@dataclass(frozen=True)
+class Swing:
+    """One geodesic swing of one joint: ``q(t) = Rot(axis, θ(t)) ⊗ base`` for frames ``start..end``.
+
+    ``start``/``end`` are frame indices (inclusive); ``axis`` a unit vector in the
+    parent's frame; ``start_angle``/``end_angle`` radians about ``axis``;
+    ``start_speed``/``end_speed`` the angular speed (rad/s) at the ends (the
+    cubic Hermite shape of ``θ(t)``); ``base`` the rotation vector (radians) of
+    the fixed part ``base``; ``error`` the swing's mean axis error (0-2).
+    """
+
+    joint: int
+    name: str
+    start: int
+    end: int
+    axis: tuple[float, float, float]
+    start_angle: float
+    end_angle: float
+    start_speed: float = 0.0
+    end_speed: float = 0.0
+    base: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    error: float = 0.0
+
+    @property
+    def n_frames(self) -> int:
+        return self.end - self.start + 1
+
+    def angles(self, frames: np.ndarray, frame_time: float, profile: str = "hermite") -> np.ndarray:
+        """``θ`` (radians) at (fractional) ``frames`` inside the swing: cubic Hermite or the paper's linear."""
+        span = max(self.end - self.start, 1)
+        u = np.clip((np.asarray(frames, dtype=np.float64) - self.start) / span, 0.0, 1.0)
+        if profile == "linear":
+            return self.start_angle + (self.end_angle - self.start_angle) * u
+        dur = span * frame_time
+        h00 = 2 * u**3 - 3 * u**2 + 1
+        h10 = u**3 - 2 * u**2 + u
+        h01 = -2 * u**3 + 3 * u**2
+        h11 = u**3 - u**2
+        return (h00 * self.start_angle + h10 * dur * self.start_speed + h01 * self.end_angle
+                + h11 * dur * self.end_speed)
+
+    def quats(self, frames: np.ndarray, frame_time: float, profile: str = "hermite") -> np.ndarray:
+        """Local rotations ``(n, 4)`` (x, y, z, w) of the swing at ``frames``."""
+        theta = self.angles(frames, frame_time, profile)
+        return quat_multiply(axis_angle_quats(np.asarray(self.axis), theta), rotvec_quat(np.asarray(self.base)))
+
+
+@dataclass(frozen=True)
+class Hold:
+    """A still part of one joint: frames ``start..end`` (inclusive) and their mean rotation (rotation vector, rad)."""
+
+    joint: int
+    name: str
+    start: int
+    end: int
+    mean: tuple[float, float, float]
+
+    @property
+    def n_frames(self) -> int:
+        return self.end - self.start + 1
+
+
+@dataclass
+class Segmentation:
+    """Swings and holds of every joint of a take, plus what playback needs to rebuild it.
+
+    ``joints`` are the indices that were segmented into swings; every other
+    joint is one or more holds.  ``translation_keys`` maps a joint index to
+    ``(frames (K,), values (K, 3))``, a piecewise-linear track of its local
+    translation (one key when it never changes).
+    """
+
+    skeleton: Skeleton
+    n_frames: int
+    frame_time: float
+    joints: list[int]
+    swings: list[Swing]
+    holds: list[Hold]
+    translation_keys: dict[int, tuple[np.ndarray, np.ndarray]]
+    threshold: float = DEFAULT_THRESHOLD
+    window_s: float = PAPER_WINDOW_S
+    params: dict = field(default_factory=dict)
+
+    @property
+    def n_swings(self) -> int:
+        return len(self.swings)
+
+    @property
+    def fps(self) -> float:
+        return 1.0 / self.frame_time
+
+    def swings_of(self, joint: int | str) -> list[Swing]:
+        """The swings of one joint in time order."""
+        j = self.skeleton.index(joint) if isinstance(joint, str) else int(joint)
+        return sorted((s for s in self.swings if s.joint == j), key=lambda s: s.start)
+
+    def holds_of(self, joint: int | str) -> list[Hold]:
+        j = self.skeleton.index(joint) if isinstance(joint, str) else int(joint)
+        return sorted((h for h in self.holds if h.joint == j), key=lambda h: h.start)
+
+    def to_records(self) -> list[dict]:
+        """One flat dict per swing and hold (``kind``, ``joint``, frames, seconds, axis, angles in degrees)."""
+        dt = self.frame_time
+        rows = []
+        for s in sorted(self.swings, key=lambda s: (s.joint, s.start)):
+            rows.append(dict(kind="swing", joint=s.name, start=s.start, end=s.end, start_s=s.start * dt,
+                             end_s=s.end * dt, axis_x=s.axis[0], axis_y=s.axis[1], axis_z=s.axis[2],
+                             start_angle_deg=float(np.degrees(s.start_angle)),
+                             end_angle_deg=float(np.degrees(s.end_angle)),
+                             start_speed_deg_s=float(np.degrees(s.start_speed)),
+                             end_speed_deg_s=float(np.degrees(s.end_speed)), error=s.error))
+        for h in sorted(self.holds, key=lambda h: (h.joint, h.start)):
+            rows.append(dict(kind="hold", joint=h.name, start=h.start, end=h.end, start_s=h.start * dt,
+                             end_s=h.end * dt, mean_rotvec=list(h.mean)))
+        return rows
+
+    def to_dict(self) -> dict:
+        """Everything as JSON-ready values (read back with :meth:`from_dict`)."""
+        from .codec import skeleton_text
+
+        return dict(
+            frames=self.n_frames, frame_time=self.frame_time, fps=self.fps, threshold=self.threshold,
+            window_s=self.window_s, params=dict(self.params),
+            joints=[self.skeleton.names[j] for j in self.joints], n_swings=self.n_swings,
+            swings=[asdict(s) for s in sorted(self.swings, key=lambda s: (s.joint, s.start))],
+            holds=[asdict(h) for h in sorted(self.holds, key=lambda h: (h.joint, h.start))],
+            translation_keys={str(j): dict(frames=f.tolist(), values=v.tolist())
+                              for j, (f, v) in self.translation_keys.items()},
+            skeleton_bvh=skeleton_text(self.skeleton),
+        )
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Segmentation:
+        from .codec import skeleton_from_text
+
+        try:
+            skel = skeleton_from_text(d["skeleton_bvh"])
+            return cls(
+                skeleton=skel, n_frames=int(d["frames"]), frame_time=float(d["frame_time"]),
+                joints=[skel.index(n) for n in d["joints"]],
+                swings=[Swing(**{**s, "axis": tuple(s["axis"]), "base": tuple(s["base"])}) for s in d["swings"]],
+                holds=[Hold(**{**h, "mean": tuple(h["mean"])}) for h in d["holds"]],
+                translation_keys={int(j): (np.asarray(t["frames"], dtype=np.int64),
+                                           np.asarray(t["values"], dtype=np.float64).reshape(-1, 3))
+                                  for j, t in d["translation_keys"].items()},
+                threshold=float(d["threshold"]), window_s=float(d["window_s"]), params=dict(d.get("params", {})),
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MocycleError(f"not a swings JSON document (missing or bad field: {exc})") from None
+
+
+# ---------------------------------------------------------------- quaternion helpers
+def axis_angle_quats(axis: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """Quaternions ``(n, 4)`` of rotations by ``theta`` (n,) radians about one unit ``axis``."""
+    half = 0.5 * np.asarray(theta, dtype=np.float64)
+    return np.concatenate([np.sin(half)[:, None] * np.asarray(axis)[None, :], np.cos(half)[:, None]], axis=1)
+
+
+def rotvec_quat(v: np.ndarray) -> np.ndarray:
+    """Quaternion ``(4,)`` of a rotation vector ``(3,)`` (radians)."""
+    v = np.asarray(v, dtype=np.float64)
+    angle = float(np.linalg.norm(v))
+    if angle < 1e-12:
+        return np.array([0.5 * v[0], 0.5 * v[1], 0.5 * v[2], 1.0]) / np.sqrt(1 + 0.25 * angle**2)
+    return np.concatenate([np.sin(angle / 2) * v / angle, [np.cos(angle / 2)]])
+
+
+def quat_rotvec(q: np.ndarray) -> np.ndarray:
+    """Rotation vector ``(3,)`` (angle ≤ π) of a quaternion ``(4,)``."""
+    q = np.asarray(q, dtype=np.float64)
+    return quat_log(q if q[3] >= 0 else -q)
+
+
+def conj(q: np.ndarray) -> np.ndarray:
+    return np.asarray(q) * np.array([-1.0, -1.0, -1.0, 1.0])
+
+
+def mean_quat(q: np.ndarray) -> np.ndarray:
+    """Mean ``(4,)`` of nearby quaternions ``(n, 4)``: the sign-aligned normalised sum (chordal mean)."""
+    q = np.asarray(q, dtype=np.float64)
+    q = q * np.where(q @ q[0] < 0, -1.0, 1.0)[:, None]
+    s = q.sum(axis=0)
+    return s / np.linalg.norm(s)
+
+
+def twist_angles(q: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """Angle (radians, unwrapped in time) of the twist of each quaternion ``(n, 4)`` about ``axis``."""
+    return np.unwrap(2.0 * np.arctan2(q[:, :3] @ axis, q[:, 3]))
+
+
+# ---------------------------------------------------------------- the paper's steps
+def window_frames(window_s: float, fps: float) -> int:
+    """Box-filter length in frames for ``window_s`` seconds at ``fps`` (at least 1)."""
+    return max(1, int(round(window_s * fps)))
+
+
+def angular_velocity(quats: np.ndarray, frame_time: float) -> np.ndarray:
+    """Angular velocity as an exponential map, ``(T-1, ...)`` → rad/s: ``log(q_{t+1} ⊗ q_t⁻¹) / dt``.
+
+    ``quats``: ``(T, ..., 4)`` local rotations.  The velocity is in the parent's
+    frame (left difference), so a joint turning about a fixed parent axis gives
+    a constant direction.
+    """
+    q = np.asarray(quats, dtype=np.float64)
+    dq = quat_multiply(q[1:], conj(q[:-1]))
+    dq = dq * np.where(dq[..., 3:4] < 0, -1.0, 1.0)  # shortest way
+    return quat_log(dq) / frame_time
+
+
+def smooth_velocity(omega: np.ndarray, n: int) -> np.ndarray:
+    """Box filter of ``n`` frames along time (the paper's convolution of the exponential maps)."""
+    if n <= 1 or omega.shape[0] == 0:
+        return np.array(omega, dtype=np.float64)
+    return uniform_filter1d(np.asarray(omega, dtype=np.float64), size=n, axis=0, mode="nearest")
+
+
+def unit_axes(omega: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation axes (unit, 0 where the joint is still) and speeds of ``(n, 3)`` velocities."""
+    speed = np.linalg.norm(omega, axis=-1)
+    axes = omega / np.maximum(speed, 1e-12)[..., None]
+    axes[speed < 1e-9] = 0.0
+    return axes, speed
+
+
+def swing_error(axes: np.ndarray, n: int) -> np.ndarray:
+    """``E_t``: mean of ``1 - cos(angle(axis_t, axis_k))`` over the ``n``-frame window centred on ``t`` (0-2)."""
+    if axes.shape[0] == 0:
+        return np.zeros(0)
+    mean_axis = uniform_filter1d(axes, size=max(n, 1), axis=0, mode="nearest")
+    return 1.0 - np.sum(axes * mean_axis, axis=-1)
+
+
+def grow_swings(axes: np.ndarray, error: np.ndarray, eligible: np.ndarray, threshold: float,
+                min_length: int) -> list[tuple[int, int, float]]:
+    """Greedy growth (paper 4.2): swings as ``(first, last, mean error)`` velocity-sample ranges.
+
+    Seeds are taken in order of increasing ``error``; a swing adds its left or
+    right neighbour, whichever has the smaller axis error ``1 - cos`` against
+    the seed, while the average error stays ``<= threshold``.  Swings shorter
+    than ``min_length`` samples are dropped (their frames stay free).
+    """
+    n = axes.shape[0]
+    taken = ~np.asarray(eligible, dtype=bool)
+    ax = axes.tolist()
+    free = (~taken).tolist()
+    out = []
+    for f in np.argsort(error, kind="stable").tolist():
+        if not free[f]:
+            continue
+        rx, ry, rz = ax[f]
+        lo = hi = f
+        total, count = 0.0, 1
+        el = er = None
+        while True:
+            if el is None and lo > 0 and free[lo - 1]:
+                a = ax[lo - 1]
+                el = 1.0 - (a[0] * rx + a[1] * ry + a[2] * rz)
+            if er is None and hi < n - 1 and free[hi + 1]:
+                a = ax[hi + 1]
+                er = 1.0 - (a[0] * rx + a[1] * ry + a[2] * rz)
+            if el is None and er is None:
+                break
+            go_left = er is None or (el is not None and el <= er)
+            e = el if go_left else er
+            if (total + e) / (count + 1) > threshold:
+                break
+            total += e
+            count += 1
+            if go_left:
+                lo -= 1
+                el = None
+            else:
+                hi += 1
+                er = None
+        if hi - lo + 1 >= min_length:
+            for k in range(lo, hi + 1):
+                free[k] = False
+            out.append((lo, hi, total / count))
+        else:
+            free[f] = False  # processed: it seeds nothing, and other swings may not grow over it either
+    return sorted(out)
+
+
+# ---------------------------------------------------------------- joint choice
+def choose_joints(motion: Motion, joints: str | Iterable[str] | None = None, min_energy: float = 0.05,
+                  exclude: Iterable[str] = MINOR_JOINT_PATTERNS) -> list[int]:
+    """Joints to segment: ``joints`` (names, globs, groups) when given, else the major bones.
+
+    The default leaves out fingers, toes, twist and face bones by name
+    (``exclude`` patterns) and keeps the joints whose motion energy (mean
+    angular speed) is at least ``min_energy`` times the largest among the rest.
+    """
+    skel = motion.skeleton
+    if joints is not None:
+        chosen = skel.select(joints)
+        if not chosen:
+            raise MocycleError("--joints selected no joint")
+        return chosen
+    pats = [p.lower() for p in exclude]
+    major = [j for j, n in enumerate(skel.names) if not any(fnmatch.fnmatch(n.lower(), p) for p in pats)]
+    if motion.n_frames < 2 or not major:
+        return major
+    speed = np.linalg.norm(angular_velocity(motion.rotations[:, major], 1.0), axis=-1).mean(axis=0)
+    top = float(speed.max())
+    if top <= 1e-9:
+        return []
+    return [j for j, s in zip(major, speed, strict=True) if s >= min_energy * top]
+
+
+# ---------------------------------------------------------------- fitting
+def fit_swing(q: np.ndarray, axes: np.ndarray, speed: np.ndarray, first: int, last: int, joint: int, name: str,
+              frame_time: float, err: float) -> Swing:
+    """Swing record for velocity samples ``first..last`` (frames ``first..last+1``) of one joint's quats ``q``."""
+    w = speed[first:last + 1]
+    axis = (axes[first:last + 1] * w[:, None]).sum(axis=0)
+    norm = np.linalg.norm(axis)
+    axis = axes[first] if norm < 1e-12 else axis / norm
+    qs = q[first:last + 2]
+    theta = twist_angles(qs, axis)
+    rest = quat_multiply(axis_angle_quats(axis, -theta), qs)  # Rot(a, -θ) ⊗ q: the part off the axis
+    base = mean_quat(rest)
+    theta = twist_angles(quat_multiply(qs, conj(base)[None, :]), axis)
+    n = theta.size
+    u = np.linspace(0.0, 1.0, n)
+    dur = (n - 1) * frame_time
+    a0, a1 = float(theta[0]), float(theta[-1])  # the ends are kept exactly; the end speeds fit the inside
+    if n >= 3:
+        h = np.stack([u**3 - 2 * u**2 + u, u**3 - u**2], axis=1) * dur
+        rest_theta = theta - (2 * u**3 - 3 * u**2 + 1) * a0 - (-2 * u**3 + 3 * u**2) * a1
+        (v0, v1), *_ = np.linalg.lstsq(h, rest_theta, rcond=None)
+    else:
+        v0 = v1 = (a1 - a0) / dur
+    shift = 2 * np.pi * np.round(a0 / (2 * np.pi))  # Rot(a, θ) has period 2π: keep the start in [-π, π]
+    return Swing(joint=joint, name=name, start=first, end=last + 1, axis=tuple(float(x) for x in axis),
+                 start_angle=float(a0 - shift), end_angle=float(a1 - shift), start_speed=float(v0),
+                 end_speed=float(v1), base=tuple(float(x) for x in quat_rotvec(base)), error=float(err))
+
+
+def _holds(q: np.ndarray, spans: list[tuple[int, int]], n_frames: int, joint: int, name: str,
+           max_hold: int | None) -> list[Hold]:
+    """Holds for the frames outside the swing ``spans`` (inclusive frame ranges), split every ``max_hold`` frames."""
+    covered = np.zeros(n_frames, dtype=bool)
+    for s, e in spans:
+        covered[s:e + 1] = True
+    free = np.flatnonzero(~covered)
+    if free.size == 0:
+        return []
+    breaks = np.flatnonzero(np.diff(free) > 1) + 1
+    holds = []
+    for run in np.split(free, breaks):
+        a, b = int(run[0]), int(run[-1])
+        pieces = 1 if not max_hold else max(1, int(np.ceil((b - a + 1) / max_hold)))
+        edges = np.linspace(a, b + 1, pieces + 1).round().astype(int)
+        for s, e in zip(edges[:-1], edges[1:] - 1, strict=True):
+            holds.append(Hold(joint=joint, name=name, start=int(s), end=int(e),
+                              mean=tuple(float(x) for x in quat_rotvec(mean_quat(q[s:e + 1])))))
+    return holds
+
+
+def translation_track(values: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Piecewise-linear keys ``(frames, values)`` within ``tol`` of ``values`` (T, 3) (Ramer-Douglas-Peucker)."""
+    values = np.asarray(values, dtype=np.float64)
+    T = values.shape[0]
+    if T == 1 or np.ptp(values, axis=0).max() <= 1e-9:
+        return np.array([0]), values[:1].copy()
+    keep = np.zeros(T, dtype=bool)
+    keep[[0, T - 1]] = True
+    stack = [(0, T - 1)]
+    while stack:
+        a, b = stack.pop()
+        if b - a < 2:
+            continue
+        u = (np.arange(a + 1, b) - a) / (b - a)
+        line = values[a] + u[:, None] * (values[b] - values[a])
+        dev = np.linalg.norm(values[a + 1:b] - line, axis=1)
+        k = int(np.argmax(dev))
+        if dev[k] > tol:
+            m = a + 1 + k
+            keep[m] = True
+            stack += [(a, m), (m, b)]
+    frames = np.flatnonzero(keep)
+    return frames, values[frames].copy()
+
+
+# ---------------------------------------------------------------- entry point
+def segment(motion: Motion, threshold: float = DEFAULT_THRESHOLD, joints: str | Iterable[str] | None = None,
+            window_s: float = PAPER_WINDOW_S, min_swing_s: float | None = None, still_deg_s: float = 20.0,
+            max_hold_s: float | None = 0.5, translation_tol: float | None = None) -> Segmentation:
+    """Segment ``motion`` into joint swings and holds (paper 003, section 4.2).
+
+    Parameters
+    ----------
+    threshold : the Acceptable Swing Error, 0-2 (0 accepts only perfectly geodesic swings).
+    joints : joints to segment (names, globs, groups); ``None`` chooses the major bones
+        (:func:`choose_joints`).  The other joints become holds.
+    window_s : box filter and error window in seconds (paper: 20 frames at 120 fps).
+    min_swing_s : shortest swing kept, seconds (default half the window, at least 2 frames).
+    still_deg_s : smoothed angular speed (deg/s) under which a joint counts as still: such
+        frames seed no swing and join none (their axis is noise).
+    max_hold_s : long holds are split into holds of at most this many seconds (``None``: never),
+        so slow drifts are kept by interpolation between their means.
+    translation_tol : tolerance of the piecewise-linear translation track in file units
+        (default 0.1 % of the skeleton's height).
+    """
+    if not isinstance(motion, Motion):
+        raise MocycleError(f"segment() needs a Motion; got {type(motion).__name__}")
+    threshold = float(threshold)
+    if not np.isfinite(threshold) or not 0.0 <= threshold <= 2.0:
+        raise MocycleError(f"the Acceptable Swing Error (threshold) must be within 0-2; got {threshold}")
+    window_s = float(window_s)
+    if not np.isfinite(window_s) or not 0.0 < window_s <= 10.0:
+        raise MocycleError(f"window_s must be within (0, 10] seconds; got {window_s}")
+    if still_deg_s < 0 or not np.isfinite(still_deg_s):
+        raise MocycleError(f"still_deg_s must be >= 0 degrees per second; got {still_deg_s}")
+    if max_hold_s is not None and not max_hold_s > 0:
+        raise MocycleError(f"max_hold_s must be > 0 seconds or None; got {max_hold_s}")
+    skel, T, dt = motion.skeleton, motion.n_frames, motion.frame_time
+    n_win = window_frames(window_s, motion.fps)
+    min_len = max(2, int(round((0.5 * window_s if min_swing_s is None else min_swing_s) / dt)))
+    max_hold = None if max_hold_s is None else max(1, int(round(max_hold_s / dt)))
+    chosen = choose_joints(motion, joints)
+    swings: list[Swing] = []
+    holds: list[Hold] = []
+    if T >= 3 and chosen:
+        omega = smooth_velocity(angular_velocity(motion.rotations[:, chosen], dt), n_win)  # (T-1, J', 3)
+    for k, j in enumerate(chosen if T >= 3 else []):
+        axes, speed = unit_axes(omega[:, k])
+        error = swing_error(axes, n_win)
+        eligible = speed >= np.radians(still_deg_s)
+        error = np.where(eligible, error, np.inf)
+        q = motion.rotations[:, j]
+        for first, last, err in grow_swings(axes, error, eligible, threshold, min_len):
+            swings.append(fit_swing(q, axes, speed, first, last, j, skel.names[j], dt, err))
+    spans: dict[int, list[tuple[int, int]]] = {}
+    for s in swings:
+        spans.setdefault(s.joint, []).append((s.start, s.end))
+    for j in range(skel.n_joints):
+        holds += _holds(motion.rotations[:, j], spans.get(j, []), T, j, skel.names[j], max_hold)
+    if translation_tol is None:
+        height = float(np.ptp(Motion.rest(skel).world_positions(end_sites=True)[0], axis=0).max())
+        translation_tol = 1e-3 * max(height, 1e-9)
+    keys = {j: translation_track(motion.translations[:, j], translation_tol) for j in range(skel.n_joints)}
+    return Segmentation(skeleton=skel, n_frames=T, frame_time=dt, joints=list(chosen), swings=swings, holds=holds,
+                        translation_keys=keys, threshold=threshold, window_s=window_s,
+                        params=dict(min_swing_frames=min_len, still_deg_s=float(still_deg_s),
+                                    max_hold_s=max_hold_s, translation_tol=float(translation_tol),
+                                    window_frames=n_win))

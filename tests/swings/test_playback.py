@@ -1,0 +1,78 @@
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from conftest import shared_path
+from helpers import tiny_skeleton
+from mocycle.datasets import synthetic_walk
+from mocycle.errors import MocycleError
+from mocycle.io import read
+from mocycle.motion import Motion
+from mocycle.swings import geodesic_errors, playback, playback_errors, segment, segmentation_error
+
+
+def pendulum(fps=120, seconds=3.0, amp_deg=40.0, period_s=1.0):
+    """Joint 1 swings back and forth about one axis (ease in / ease out); the root travels."""
+    t = np.arange(int(seconds * fps)) / fps
+    theta = np.radians(amp_deg) * np.sin(2 * np.pi * t / period_s)
+    skel = tiny_skeleton()
+    q = np.zeros((t.size, skel.n_joints, 4))
+    q[..., 3] = 1.0
+    axis = np.array([1.0, 0.2, 0.0]) / np.linalg.norm([1.0, 0.2, 0.0])
+    q[:, 1] = (Rotation.from_rotvec(theta[:, None] * axis) * Rotation.from_rotvec([0, 0.3, 0])).as_quat()
+    root = np.c_[100 * t, 90 + 2 * np.sin(4 * np.pi * t), 0 * t]
+    return Motion(skel, q, None, 1.0 / fps, root_positions=root)
+
+
+def test_pure_swing_motion_plays_back_closely():
+    m = pendulum()
+    seg = segment(m)
+    assert seg.joints == [1] and seg.n_swings >= 5  # two swings per period
+    pb = playback(seg)
+    geo = geodesic_errors(m, pb)
+    assert geo[1] < 0.5 and geo[[0, 2, 3]].max() < 1e-6
+    assert np.abs(pb.root_positions - m.root_positions).max() < 0.2  # the translation track's tolerance
+    errs = playback_errors(m, pb)
+    assert errs["segmentation_error"] < 1.0 and errs["rotation_dofs"] == 12
+    assert errs["per_angle_error_deg"] == pytest.approx(errs["segmentation_error"] / 12)
+
+
+def test_hermite_profile_beats_the_papers_linear_one_on_eased_swings():
+    m = pendulum()
+    seg = segment(m)
+    lin = geodesic_errors(m, playback(seg, "linear"))[1]
+    her = geodesic_errors(m, playback(seg, "hermite"))[1]
+    assert her < lin
+    with pytest.raises(MocycleError, match="profile"):
+        playback(seg, "cubic")
+
+
+def test_segmentation_error_is_the_mean_euclidean_distance_of_euler_vectors():
+    m = pendulum(seconds=1.0)
+    assert segmentation_error(m, m) == pytest.approx(0.0, abs=1e-9)
+    # turn joint 3 (order YXZ) by 10° about its own first channel axis (Y) at every frame
+    q = np.array(m.rotations)
+    q[:, 3] = (Rotation.from_quat(q[:, 3]) * Rotation.from_euler("Y", 10, degrees=True)).as_quat()
+    assert segmentation_error(m, m.replace(rotations=q)) == pytest.approx(10.0, abs=1e-6)
+    # the other Euler solution of the same rotation is the same pose: no error
+    q2 = np.array(m.rotations)
+    q2[:, 2] = Rotation.from_euler("XYZ", [170, 20, -160], degrees=True).as_quat()
+    other = m.replace(rotations=q2)
+    assert segmentation_error(other, other.replace(rotations=-q2)) == pytest.approx(0.0, abs=1e-6)
+    with pytest.raises(MocycleError, match="differ"):
+        segmentation_error(m, m[:10])
+
+
+def test_synthetic_walk_plays_back_within_a_few_degrees():
+    m = synthetic_walk(n_frames=300, fps=60, seed=2).motion
+    pb = playback(segment(m))
+    errs = playback_errors(m, pb)
+    assert errs["geodesic_error_deg"] < 2.0
+    assert errs["per_angle_error_deg"] < 0.41  # the paper's figure
+
+
+def test_real_bandai_walk_plays_back():
+    m = read(shared_path("bandai", "dataset-1_walk_normal_001.bvh"))
+    errs = playback_errors(m, playback(segment(m)))
+    assert errs["geodesic_error_deg"] < 3.0
+    assert max(errs["geodesic_error_by_joint_deg"].values()) < 8.0
