@@ -1,0 +1,61 @@
+"""``mocycle stretch``: lengthen a take by time-frequency warping (paper 004), keeping its cycle."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from ..errors import MocycleError
+from ..io import read, write
+from .common import app, count_option, friendly, out
+
+
+@app.command()
+@friendly
+def stretch(
+    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    factor: Annotated[float, typer.Option(help="Length ratio: 2 doubles the take (frames out = round(frames * F)).")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The .bvh file to write.")],
+    window: Annotated[str, typer.Option(
+        help="Block length in frames: 'auto' (each joint group's largest fundamental cycle) or N.")] = "auto",
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+):
+    """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
+
+    The lapped cosine transform of every joint curve is dilated in time by
+    replicating its atoms (paper 004); each joint group (legs, arms, spine)
+    uses its own fundamental cycle as the window; the travelling joint keeps
+    its mean velocity.
+    """
+    from ..warp import stretch_motion
+
+    if output.suffix.lower() != ".bvh":
+        raise MocycleError(f"-o must name a .bvh file; got {output}")
+    win = count_option(window, "--window", {"auto": "auto"})
+    t0 = time.perf_counter()
+    motion = read(path, fps=fps)
+    result, report = stretch_motion(motion, factor, window=win)
+    write(result, output)
+    facts = report.to_dict()
+    facts["seconds"] = time.perf_counter() - t0
+    if as_json:
+        print(json.dumps(facts, indent=2))
+        return
+    out.print(f"[bold]{path}[/]: {report.frames_in} frames -> {output}: {report.frames_out} frames "
+              f"(factor {report.factor:g}, {motion.fps:.6g} fps)", soft_wrap=True)
+    table = Table(title="windows (frames)")
+    for col in ("group", "window", "cycle found", "joints"):
+        table.add_column(col, justify="left" if col in ("group", "joints") else "right")
+    for g, n in report.windows.items():
+        cycle = report.cycles[g]
+        table.add_row(g, str(n), "given" if cycle is None else f"{cycle:.2f}", str(len(report.groups[g])))
+    out.print(table)
+    if report.trend_curves:
+        out.print(f"  warped as line + residual: {', '.join(report.trend_curves)}", soft_wrap=True)
+    out.print(f"  {facts['seconds']:.3f} s")

@@ -1,0 +1,385 @@
+"""Lengthening takes by time-frequency warping (paper 004 §4-§6).
+
+A curve is taken to the time-frequency domain with the lapped cosine transform (:mod:`.lct`), on blocks of
+one *fundamental cycle* (the window size).  The coefficient image is dilated along its time axis by the
+factor: each block of atoms is *replicated*, not stretched (output block ``k`` holds the coefficients of the
+input block nearest to time ``(k + 1/2) / factor`` blocks), and the inverse transform gives a longer curve
+that keeps every frequency of the original; a factor of 2 doubles the length with the same cycle.  Two
+details make the seams between copies of a block smooth:
+
+* a copy of the first block that does not stand at the start is folded, on its left, against the end of its
+  own cycle (the cycle "before" it), not left unfolded as at the start of the take;
+* the last block (one cycle plus the ``T mod N`` remainder) is never replicated, and stays last.
+
+With a window equal to an integer period, a periodic curve comes back as its exact continuation.
+
+For a motion (§6), joints are grouped (legs, arms, spine/head: :func:`joint_groups`), the fundamental cycle of
+every rotation curve is found by windowed circular autocorrelation (eq. 1, :func:`fundamental_cycles`), and
+each group uses its *largest* cycle as its window, so the shorter cycles of the group (whose periods divide
+it) are replicated whole.  Rotations are warped as continuous curves (the quaternion logarithm about each
+joint's mean rotation, ``features.pose_matrix(rep="quatlog")``) and decoded back; a rotation curve dominated
+by a linear trend (a character turning) and the travelling joint's translation are split into a
+least-squares line and a residual: the residual is warped, the line extended, so the character keeps
+travelling at its mean velocity.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import MocycleError
+from ..features import pose_matrix
+from ..motion import JOINT_GROUPS, Motion, Skeleton
+from ..phase.period import autocorrelation_period
+from .lct import block_edges, ilct, lct
+
+__all__ = [
+    "MAX_FRAMES_OUT",
+    "StretchReport",
+    "fundamental_cycles",
+    "group_cycle",
+    "joint_groups",
+    "refine_window",
+    "stretch_motion",
+    "warp_curves",
+]
+
+#: The longest output :func:`warp_curves` and :func:`stretch_motion` make (frames).
+MAX_FRAMES_OUT = 200_000
+#: Groups in the order they are reported.
+GROUP_NAMES = ("legs", "arms", "spine")
+#: A per-curve cycle counts when its autocorrelation maximum reaches this fraction of ``r(0)``.
+CURVE_MIN_STRENGTH = 0.3
+#: Curves whose standard deviation is below this fraction of the group's largest do not vote for the window.
+WEAK_CURVE = 0.25
+#: The integer window is refined within this fraction of the estimated cycle (see :func:`refine_window`).
+REFINE_SPAN = 0.15
+#: A rotation curve is split into line + residual when the line's rise over the take exceeds this many times
+#: the residual's peak-to-peak range.
+TREND_DOMINATED = 2.0
+
+
+# -- curves --------------------------------------------------------------------------------------------------------
+
+
+def _factor(factor) -> float:
+    if isinstance(factor, bool) or not isinstance(factor, (int, float, np.integer, np.floating)):
+        raise MocycleError(f"factor must be a positive number; got {factor!r}")
+    f = float(factor)
+    if not math.isfinite(f) or f <= 0:
+        raise MocycleError(f"factor must be a positive finite number; got {factor!r}")
+    return f
+
+
+def _frames_out(n_frames: int, factor: float) -> int:
+    n = int(round(n_frames * factor))
+    if n < 2:
+        raise MocycleError(f"factor {factor:g} leaves {n} frame(s) of {n_frames}; the result needs at least 2")
+    if n > MAX_FRAMES_OUT:
+        raise MocycleError(f"factor {factor:g} would make {n} frames; the limit is {MAX_FRAMES_OUT}")
+    return n
+
+
+def _window(window, n_frames: int) -> int:
+    if isinstance(window, bool) or not isinstance(window, (int, np.integer)):
+        raise MocycleError(f"window must be 'auto' or an integer number of frames; got {window!r}")
+    limit = n_frames // 2
+    if not 1 <= window <= limit:
+        raise MocycleError(f"window must be between 1 and half the take ({limit} frames of {n_frames}); "
+                           f"got {window}")
+    return int(window)
+
+
+def warp_curves(X, factor: float, window: int, overlap: int | None = None) -> np.ndarray:
+    """Time-frequency warping of curves (paper 004 §4): ``(T,)`` or ``(T, D)`` -> ``round(T * factor)`` frames.
+
+    ``window``: the block length N in frames (the fundamental cycle; ``1 <= N <= T // 2``).  ``overlap``: the
+    fold half-width (default ``N // 2``, the smoothest).  The LCT image on blocks of N frames is dilated in
+    time by replicating blocks (module notes), then inverted.  ``factor = 1`` returns ``X`` (to rounding);
+    ``factor < 1`` drops whole blocks (time compression), which keeps frequencies too.
+    """
+    try:
+        A = np.asarray(X, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise MocycleError(f"X must be a (T,) or (T, D) array of numbers; got {type(X).__name__} ({exc})") from None
+    one = A.ndim == 1
+    if one:
+        A = A[:, None]
+    if A.ndim != 2 or A.shape[0] < 2:
+        raise MocycleError(f"X must be a (T,) or (T, D) array with at least 2 frames; got shape {np.shape(X)}")
+    if not np.all(np.isfinite(A)):
+        raise MocycleError("X must be finite (no NaN or infinite values)")
+    T = A.shape[0]
+    factor = _factor(factor)
+    N = _window(window, T)
+    n_out = _frames_out(T, factor)
+    if overlap is None:
+        overlap = N // 2
+    elif isinstance(overlap, bool) or not isinstance(overlap, (int, np.integer)) or not 0 <= overlap <= N // 2:
+        raise MocycleError(f"overlap must be an integer between 0 and window // 2 = {N // 2}; got {overlap!r}")
+    overlap = int(overlap)
+
+    edges = block_edges(T, N)
+    K = edges.size - 1  # >= 2 since N <= T // 2
+    last = T - (K - 1) * N  # the last block: one cycle plus the remainder, never replicated
+    C = lct(A, edges, overlap)
+    first_cyclic = C[:N]
+    if overlap:
+        # Block 0 folded on its left against the end of its own cycle, for copies that follow another copy.
+        Z = np.concatenate([A[N - overlap: N], A[: N + overlap]])
+        first_cyclic = lct(Z, np.array([0, overlap, overlap + N, 2 * overlap + N]), overlap)[overlap: overlap + N]
+    r = K - 1  # replicable blocks
+    m = max(1, math.ceil((n_out - last) / N))
+    # Output block k stands for input time (k + 1/2) N K / (m + 1): nearest-block replication of the image
+    # dilated by (m + 1) / K ~ factor; the final input block is the last output block.
+    sources = np.minimum(((np.arange(m) + 0.5) * K / (m + 1)).astype(np.int64), r - 1)
+    parts = [first_cyclic if (s == 0 and k > 0) else C[s * N: (s + 1) * N] for k, s in enumerate(sources)]
+    parts.append(C[(K - 1) * N:])
+    out_edges = np.concatenate([np.arange(m + 1) * N, [m * N + last]])
+    Y = ilct(np.concatenate(parts), out_edges, overlap)[:n_out]
+    return Y[:, 0] if one else Y
+
+
+def fundamental_cycles(X, min_strength: float = CURVE_MIN_STRENGTH) -> np.ndarray:
+    """The fundamental cycle (frames) of every curve of ``X`` (``(T, D)``): ``(D,)``, NaN where none is found.
+
+    Paper 004 eq. 1, curve by curve: :func:`mocycle.phase.period.autocorrelation_period` (Hann-windowed
+    circular autocorrelation, highest maximum in ``[2, T // 2]``) on each column, with a maximum needed of
+    ``min_strength * r(0)`` (0.3: drifting, weakly periodic curves such as a head slowly turning give no
+    cycle rather than a spurious long one).  Constant curves give NaN.
+    """
+    A = np.asarray(X, dtype=np.float64)
+    if A.ndim == 1:
+        A = A[:, None]
+    if A.ndim != 2:
+        raise MocycleError(f"X must be a (T,) or (T, D) array; got shape {A.shape}")
+    if A.shape[0] < 4:
+        raise MocycleError(f"the fundamental cycle needs at least 4 frames; got {A.shape[0]}")
+    out = np.full(A.shape[1], np.nan)
+    for d in range(A.shape[1]):
+        if np.ptp(A[:, d]) > 0:
+            out[d] = autocorrelation_period(A[:, d], min_strength=min_strength)
+    return out
+
+
+def group_cycle(X, min_strength: float = CURVE_MIN_STRENGTH, weak: float = WEAK_CURVE) -> float:
+    """The window of a group of curves (``(T, D)``): the largest fundamental cycle among its curves (§6).
+
+    Curves whose standard deviation is below ``weak`` times the group's largest do not vote (fingers and
+    twist bones that barely move carry mostly noise).  NaN when no voting curve has a cycle (a still or
+    aperiodic group: :func:`stretch_motion` then borrows the largest cycle of the other groups).
+    """
+    A = np.asarray(X, dtype=np.float64)
+    if A.ndim == 1:
+        A = A[:, None]
+    if A.size == 0:
+        return float("nan")
+    sd = A.std(axis=0)
+    if not sd.max() > 0:
+        return float("nan")
+    cycles = fundamental_cycles(A[:, sd >= weak * sd.max()], min_strength=min_strength)
+    return float(np.nanmax(cycles)) if np.any(np.isfinite(cycles)) else float("nan")
+
+
+def refine_window(X, cycle: float, span: float = REFINE_SPAN) -> int:
+    """The integer window near ``cycle`` (frames) over which the curves ``X`` (``(T, D)``) repeat best.
+
+    Minimises the mean squared difference ``x[t + N] - x[t]`` over ``N`` within ``cycle * (1 +- span)``
+    (and ``2 <= N <= T // 2``): what replicating a block of N frames puts side by side at a seam.  The
+    autocorrelation peak of eq. 1 is biased by the window on short takes (two or three cycles) and has
+    to be rounded anyway; this picks the integer that makes the seams smoothest.  Returns
+    ``round(cycle)`` clipped to the allowed range when the range is empty.
+    """
+    A = np.asarray(X, dtype=np.float64)
+    if A.ndim == 1:
+        A = A[:, None]
+    T = A.shape[0]
+    limit = max(1, T // 2)
+    lo = max(2, int(math.floor(cycle * (1 - span))))
+    hi = min(limit, int(math.ceil(cycle * (1 + span))))
+    if lo > hi or A.shape[1] == 0:
+        return int(min(max(1, round(cycle)), limit))
+    candidates = np.arange(lo, hi + 1)
+    A = A - A.mean(axis=0)
+    errors = [float(np.sum((A[n:] - A[:-n]) ** 2) / max(np.sum(A[n:] ** 2 + A[:-n] ** 2), 1e-300))
+              for n in candidates]
+    return int(candidates[int(np.argmin(errors))])
+
+
+# -- motions -------------------------------------------------------------------------------------------------------
+
+
+def joint_groups(skeleton: Skeleton) -> dict[str, list[int]]:
+    """Joints grouped as paper 004 §6 does: ``{"legs": [...], "arms": [...], "spine": [...]}``.
+
+    A joint whose name matches a pattern of :data:`mocycle.motion.JOINT_GROUPS` (tried in the order legs,
+    arms, spine) belongs to that group; any other joint to its parent's group (fingers follow the hand, eyes
+    the head); the root and joints above every match belong to ``spine`` (the torso).  Empty groups are left
+    out.  Every joint is in exactly one group.
+    """
+    group_of: list[str] = []
+    for j, name in enumerate(skeleton.names):
+        low = name.lower()
+        own = next((g for g in GROUP_NAMES if any(fnmatch.fnmatch(low, p.lower()) for p in JOINT_GROUPS[g])), None)
+        if own is None:
+            parent = int(skeleton.parents[j])
+            own = "spine" if parent < 0 else group_of[parent]
+        group_of.append(own)
+    groups = {g: [j for j, h in enumerate(group_of) if h == g] for g in GROUP_NAMES}
+    return {g: js for g, js in groups.items() if js}
+
+
+@dataclass(frozen=True)
+class StretchReport:
+    """What :func:`stretch_motion` did.
+
+    factor : the requested factor; frames_in, frames_out : lengths (``frames_out = round(frames_in * factor)``).
+    windows : ``{group: window in frames}`` used for each joint group.
+    cycles : ``{group: fundamental cycle in frames}`` as estimated (``None`` when ``window`` was given).
+    groups : ``{group: joint names}``.
+    trend_curves : rotation curves warped as line + residual (e.g. ``"Hips:qy"``).
+    """
+
+    factor: float
+    frames_in: int
+    frames_out: int
+    windows: dict[str, int]
+    cycles: dict[str, float | None]
+    groups: dict[str, tuple[str, ...]] = field(repr=False)
+    trend_curves: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict:
+        return {
+            "factor": self.factor,
+            "frames_in": self.frames_in,
+            "frames_out": self.frames_out,
+            "windows": dict(self.windows),
+            "cycles": {g: (None if c is None else round(float(c), 3)) for g, c in self.cycles.items()},
+            "trend_curves": list(self.trend_curves),
+        }
+
+
+def _line_fit(Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares line per column of ``Y`` (``(T, D)``): ``(intercept (D,), slope per frame (D,))``."""
+    t = np.arange(Y.shape[0], dtype=np.float64)
+    slope, intercept = np.polyfit(t, Y, 1)
+    return intercept, slope
+
+
+def _warp_detrended(Y: np.ndarray, factor: float, window: int) -> np.ndarray:
+    """Warp ``Y - line`` and add the line extended over the new length (the mean velocity kept)."""
+    a, v = _line_fit(Y)
+    t = np.arange(Y.shape[0], dtype=np.float64)[:, None]
+    res = warp_curves(Y - (a + v * t), factor, window)
+    t_out = np.arange(res.shape[0], dtype=np.float64)[:, None]
+    return res + a + v * t_out
+
+
+def stretch_motion(motion: Motion, factor: float, window: str | int = "auto") -> tuple[Motion, StretchReport]:
+    """Lengthen (or shorten) a take by time-frequency warping, keeping its cycle: paper 004 §6.
+
+    Parameters
+    ----------
+    motion : the take (at least 8 frames).
+    factor : length ratio (> 0); the result has ``round(T * factor)`` frames at the same frame time.
+    window : ``"auto"`` (each joint group's largest fundamental cycle, :func:`group_cycle`) or a number of
+        frames used for every group (``1 <= window <= T // 2``).
+
+    Returns
+    -------
+    ``(new motion, StretchReport)``.  Raises MocycleError when ``"auto"`` finds no cycle in any group (the
+    take does not look periodic; pass a window).
+    """
+    if not isinstance(motion, Motion):
+        raise MocycleError(f"stretch_motion needs a Motion; got {type(motion).__name__}")
+    T = motion.n_frames
+    if T < 8:
+        raise MocycleError(f"stretching needs a take of at least 8 frames; got {T}")
+    factor = _factor(factor)
+    n_out = _frames_out(T, factor)
+    skel = motion.skeleton
+    groups = joint_groups(skel)
+    X, decoder = pose_matrix(motion, rep="quatlog", root="drop")
+    owner = decoder.dof_joint
+    group_of = np.empty(skel.n_joints, dtype=object)
+    for g, js in groups.items():
+        group_of[js] = g
+    cols = {g: np.flatnonzero(np.isin(owner, js)) for g, js in groups.items()}
+
+    cycles: dict[str, float | None] = {}
+    windows: dict[str, int] = {}
+    if isinstance(window, str):
+        if window != "auto":
+            raise MocycleError(f"window must be 'auto' or a number of frames; got {window!r}")
+        limit = T // 2
+        found = {g: group_cycle(X[:, c]) if c.size else float("nan") for g, c in cols.items()}
+        for g, c in found.items():
+            if np.isfinite(c):
+                A = X[:, cols[g]]
+                sd = A.std(axis=0)
+                cycles[g], windows[g] = c, refine_window(A[:, sd >= WEAK_CURVE * sd.max()], c)
+        if cycles:  # a still or aperiodic group borrows the largest cycle (and its window) of the others
+            lender = max(cycles, key=cycles.get)
+            fallback, fallback_window = cycles[lender], windows[lender]
+        else:  # no group has a cycle: the whole pose matrix (autocorrelation summed over every curve)
+            fallback = autocorrelation_period(X) if X.shape[1] else float("nan")
+            if not np.isfinite(fallback):
+                raise MocycleError(f"no fundamental cycle found in any joint group ({', '.join(groups)}) of this "
+                                   f"{T}-frame take: it does not look periodic; give the window in frames "
+                                   f"(1 to {limit})")
+            fallback_window = refine_window(X, fallback)
+        for g in groups:
+            if g not in cycles:
+                cycles[g], windows[g] = float(fallback), fallback_window
+        cycles = {g: float(cycles[g]) for g in groups}
+        windows = {g: int(windows[g]) for g in groups}
+    else:
+        N = _window(window, T)
+        for g in groups:
+            cycles[g] = None
+            windows[g] = N
+
+    # Rotations: continuous curves about the mean pose; trend-dominated curves as line + residual.
+    Y = np.empty((n_out, X.shape[1]))
+    trend_cols: list[int] = []
+    if X.shape[1]:
+        a, v = _line_fit(X)
+        rise = np.abs(v) * (T - 1)
+        resid_ptp = np.ptp(X - (a + v * np.arange(T)[:, None]), axis=0)
+        trend = rise > TREND_DOMINATED * np.maximum(resid_ptp, 1e-12)
+        trend_cols = [int(i) for i in np.flatnonzero(trend)]
+        for g, c in cols.items():
+            if not c.size:
+                continue
+            plain, tr = c[~trend[c]], c[trend[c]]
+            if plain.size:
+                Y[:, plain] = warp_curves(X[:, plain], factor, windows[g])
+            if tr.size:
+                Y[:, tr] = _warp_detrended(X[:, tr], factor, windows[g])
+    new = decoder.decode(Y)
+
+    # Translations: the travelling joint as mean velocity + warped residual; other moving joints warped.
+    trans = np.broadcast_to(motion.translations[0], (n_out,) + motion.translations.shape[1:]).copy()
+    travel = motion.travel_joint
+    for j in range(skel.n_joints):
+        p = motion.translations[:, j]
+        if j == travel:
+            trans[:, j] = _warp_detrended(p, factor, windows[group_of[j]])
+        elif np.ptp(p, axis=0).max() > 1e-9 * (1.0 + np.abs(p).max()):
+            trans[:, j] = warp_curves(p, factor, windows[group_of[j]])
+    new = new.replace(translations=trans)
+
+    report = StretchReport(
+        factor=factor,
+        frames_in=T,
+        frames_out=n_out,
+        windows=windows,
+        cycles=cycles,
+        groups={g: tuple(skel.names[j] for j in js) for g, js in groups.items()},
+        trend_curves=tuple(decoder.columns[i] for i in trend_cols),
+    )
+    return new, report
