@@ -41,6 +41,9 @@ bench: $(VENV)/.installed
 	$(BIN)/python -m pip install --quiet -e ".[bench]"
 	$(BIN)/python benchmarks/io.py
 	$(BIN)/python benchmarks/phase.py
+	$(BIN)/python benchmarks/cycles.py
+	$(BIN)/python benchmarks/stretch.py
+	$(BIN)/python benchmarks/swings.py
 
 clean:
 	rm -rf $(VENV) $(NP1) out .pytest_cache .ruff_cache

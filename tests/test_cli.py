@@ -13,8 +13,8 @@ runner = CliRunner()
 
 
 def test_every_command_has_help():
-    for args in ([], ["info"], ["convert"], ["demo"]):
-        result = runner.invoke(app, args + ["--help"])
+    for command in ("", "info", "convert", "phase", "loop", "stretch", "swings", "search", "edit", "demo"):
+        result = runner.invoke(app, ([command] if command else []) + ["--help"])
         assert result.exit_code == 0 and "Usage" in result.output
 
 

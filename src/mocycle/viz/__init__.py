@@ -2,5 +2,6 @@
 
 from .cycle import plot_loop
 from .phase import plot_phase
+from .swings import plot_swings
 
-__all__ = ["plot_loop", "plot_phase"]
+__all__ = ["plot_loop", "plot_phase", "plot_swings"]
