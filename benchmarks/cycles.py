@@ -164,7 +164,9 @@ def main() -> None:
         files = [f for f in both if other in per_file[f]]
         closer = sum(abs(np.log(per_file[f]["harmonic M1"]["jerk"])) < abs(np.log(per_file[f][other]["jerk"]))
                      for f in files)
-        print(f"M1 jerk closer to the input's than {other}'s (|log jerk ratio|): {closer}/{len(files)} files")
+        lower = sum(per_file[f]["harmonic M1"]["jerk"] < per_file[f][other]["jerk"] for f in files)
+        print(f"M1 jerk closer to the input's than {other}'s (|log jerk ratio|): {closer}/{len(files)} files; "
+              f"M1 jerk lower than {other}'s: {lower}/{len(files)}")
     speed()
 
 

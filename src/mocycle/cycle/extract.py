@@ -41,6 +41,7 @@ DEFAULT_HARMONICS = 20   # the thesis' K
 FEW_PERIODS = 1.5        # fewer periods than this: warn
 CENTROID_SAMPLES = 500   # paper 001 §6: 500 sampled coordinate values
 CENTROID_NEIGHBOURS = 10  # paper 001 §6: 10 nearest neighbours
+SUBFRAMES = 10           # the harmonic cycle's start is chosen to a tenth of a frame
 
 
 @dataclass
@@ -171,8 +172,12 @@ def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
 
 
 def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, periodic: PeriodicMotion,
-                   model: str = "M1", n_harmonics: int | str = "auto") -> Cycle:
-    """Fit ``P`` periodically and ``L`` with a linear term on ``axis``, sample one period at ``N`` frames."""
+                   model: str = "M1", n_harmonics: int | str = "auto", reference: np.ndarray | None = None) -> Cycle:
+    """Fit ``P`` periodically and ``L`` with a linear term on ``axis``, sample one period at ``N`` frames.
+
+    With ``reference`` (the input's mean rotation per joint, ``(J, 4)``) the cycle starts at its calmest
+    point, chosen to a tenth of a frame; without, at phase 0 of the axis.
+    """
     _check_choice(model, MODELS, "model")
     frames = axis.frames()
     N = int(round(axis.period_frames))
@@ -185,7 +190,12 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
                            f"regions are too short: use --model M2 or fewer harmonics")
     fit_p = HarmonicRegression(K, model).fit(x, P[frames], xd, dP, ddP)
     fit_l = HarmonicRegression(K, model, linear=True).fit(x, L[frames], xd, dL, ddL)
-    x0 = float(np.floor(x[0]))  # frame 0 of the cycle is phase 0 of the axis
+    x0 = float(np.floor(x[0]))
+    if reference is not None:  # start where the wrap is the calmest step, choosing between frames too
+        fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
+        trial = Cycle(space, fit_p.predict(fine), fit_l.predict(fine), fit_l.drift_, "harmonic", model, K, axis,
+                      np.zeros(0), periodic)
+        x0 += calmest_start(*loop_blocks(trial, reference), stride=SUBFRAMES) / (SUBFRAMES * N)
     xs = x0 + np.arange(N) / N
     return Cycle(space, fit_p.predict(xs), fit_l.predict(xs), fit_l.drift_, "harmonic", model, K, axis,
                  np.mod(x - x0, 1.0) * N, periodic, fit_p)
@@ -368,13 +378,14 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
                       f"little evidence", MocycleWarning, stacklevel=2)
     space = CycleSpace.fit(motion)
     P, L = space.encode(motion)
+    reference = mean_rotations(motion)
+    # The cut's wrap is its seam; the others have none, so they start at the calmest point.
     if method == "harmonic":
-        cycle = harmonic_cycle(space, P, L, axis, periodic, model, n_harmonics)
+        cycle = harmonic_cycle(space, P, L, axis, periodic, model, n_harmonics, reference)
     elif method == "centroid":
         cycle = centroid_cycle(space, P, L, axis, periodic)
+        cycle = cycle.rolled(calmest_start(*loop_blocks(cycle, reference)))
     else:
-        cycle = cut_cycle(space, P, L, axis, periodic, metric_features(motion))
-    if method != "cut":  # the cut's wrap is its seam; the others have none, so they start at the calmest pose
-        cycle = cycle.rolled(calmest_start(*loop_blocks(cycle, mean_rotations(motion))))
+        cycle = cut_cycle(space, P, L, axis, periodic, metric_features(motion, reference))
     cycle.seconds = time.perf_counter() - t0
     return cycle

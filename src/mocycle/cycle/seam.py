@@ -16,11 +16,12 @@ import numpy as np
 LOCAL = 4  # frames on each side of the wrap for the local ratio
 
 
-def _changes(C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``step[k]`` into frame k and ``acc[k]`` at frame k, ``(N,)`` each, wrapping around."""
+def _changes(C: np.ndarray, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """``step[k]`` into sample k and ``acc[k]`` at sample k, ``(N,)`` each, wrapping around; one frame is
+    ``stride`` samples."""
     C = np.asarray(C, dtype=np.float64).reshape(C.shape[0], -1)
-    step = np.linalg.norm(C - np.roll(C, 1, axis=0), axis=1)
-    acc = np.linalg.norm(np.roll(C, -1, axis=0) - 2 * C + np.roll(C, 1, axis=0), axis=1)
+    step = np.linalg.norm(C - np.roll(C, stride, axis=0), axis=1)
+    acc = np.linalg.norm(np.roll(C, -stride, axis=0) - 2 * C + np.roll(C, stride, axis=0), axis=1)
     return step, acc
 
 
@@ -48,19 +49,20 @@ def seam_ratios(C: np.ndarray) -> dict[str, float]:
     }
 
 
-def calmest_start(*blocks: np.ndarray) -> int:
-    """The frame to start the cycle at so that the wrap is the most ordinary step of every block.
+def calmest_start(*blocks: np.ndarray, stride: int = 1) -> int:
+    """The sample to start the cycle at so that the wrap is the most ordinary step of every block.
 
     For each candidate start ``k`` the wrap's global pose and velocity ratios are computed for every
-    block (``(N, D_b)`` arrays of one cycle, e.g. rotations and the in-place root path); the start with
-    the smallest largest ratio wins.  Where a loop is smooth this puts the wrap at a calm pose, which is
-    where animators cut loops too.
+    block (``(n, D_b)`` arrays of one cycle sampled ``stride`` times per frame, e.g. rotations and the
+    in-place root path); the start with the smallest largest ratio wins.  Where a loop is smooth this puts
+    the wrap at a calm pose, which is where animators cut loops too.  ``stride > 1`` chooses the start
+    between frames (for cycles that can be sampled anywhere, such as a harmonic fit).
     """
     score = np.zeros(blocks[0].shape[0])
     for C in blocks:
-        step, acc = _changes(C)
+        step, acc = _changes(C, stride)
         ms, ma = np.median(step), np.median(acc)
         pose = step / ms if ms > 0 else np.zeros_like(step)
-        vel = np.maximum(acc, np.roll(acc, 1)) / ma if ma > 0 else np.zeros_like(acc)
+        vel = np.maximum(acc, np.roll(acc, stride)) / ma if ma > 0 else np.zeros_like(acc)
         score = np.maximum(score, np.maximum(pose, vel))
     return int(np.argmin(score))
