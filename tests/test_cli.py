@@ -13,7 +13,9 @@ runner = CliRunner()
 
 
 def test_every_command_has_help():
-    for command in ("", "info", "convert", "phase", "loop", "stretch", "swings", "search", "edit", "demo"):
+    commands = ("", "info", "convert", "phase", "loop", "blend", "transition", "stretch", "swings", "search", "edit",
+                "demo")
+    for command in commands:
         result = runner.invoke(app, ([command] if command else []) + ["--help"])
         assert result.exit_code == 0 and "Usage" in result.output
 

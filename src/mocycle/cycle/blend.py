@@ -62,7 +62,7 @@ from ..errors import MocycleError, NoPeriodicMotion
 from ..motion import Motion, Skeleton
 from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, mean_rotations, metric_features
 from .representation import CycleSpace, axis_rotations, nearest_rotations
-from .seam import calmest_start, seam_ratios
+from .seam import LOCAL, calmest_start, seam_ratios
 from .timeaxis import TimeAxis
 
 MAX_LISTED = 8  # joints named in a skeleton error before "and N more"
@@ -543,18 +543,34 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     return Transition(motion, phase, w, scale * ((1 - w) * pa + w * pb), offset, (pa, pb), n, cyc, seconds)
 
 
+def _local_ratios(x: np.ndarray, periodic: bool) -> float:
+    """Largest ``x[k]`` over the median of its ``2 * LOCAL`` neighbours (a pop detector, as for seams)."""
+    offsets = np.r_[-LOCAL:0, 1:LOCAL + 1]
+    if periodic:
+        near = x[(np.arange(x.size)[:, None] + offsets) % x.size]
+    else:
+        padded = np.concatenate([np.full(LOCAL, np.nan), x, np.full(LOCAL, np.nan)])
+        near = padded[np.arange(x.size)[:, None] + LOCAL + offsets]
+    ref = np.nanmedian(near, axis=1)
+    return float(np.max(x / np.maximum(ref, 1e-12 * max(float(x.max()), 1e-300))))
+
+
 def transition_smoothness(tr: Transition) -> dict[str, float]:
-    """How even a transition's frame steps are: the largest pose step and velocity change (rotations relative
-    to the mean pose, radians) over their medians, the same numbers for the two input loops for comparison."""
-    def ratios(m: Motion, periodic: bool) -> tuple[float, float]:
+    """Whether a transition jumps anywhere: its largest pose step and velocity change (rotations relative to
+    the mean pose, radians) over the median of the 8 nearest (``step_local``, ``velocity_local``) and over the
+    median of all (``step_ratio``, ``velocity_ratio``); the same for the two input loops (``input_*``)."""
+    def ratios(m: Motion, periodic: bool) -> dict[str, float]:
         F = metric_features(m, mean_rotations(m))
         if periodic:
-            F = np.vstack([F, F[:2]])
-        step = np.linalg.norm(np.diff(F, axis=0), axis=1)
-        acc = np.linalg.norm(np.diff(F, 2, axis=0), axis=1)
-        return float(step.max() / np.median(step)), float(acc.max() / np.median(acc))
+            step = np.linalg.norm(F - np.roll(F, 1, axis=0), axis=1)
+            acc = np.linalg.norm(np.roll(F, -1, axis=0) - 2 * F + np.roll(F, 1, axis=0), axis=1)
+        else:
+            step = np.linalg.norm(np.diff(F, axis=0), axis=1)
+            acc = np.linalg.norm(np.diff(F, 2, axis=0), axis=1)
+        return {"step_ratio": float(step.max() / np.median(step)), "velocity_ratio": float(acc.max() / np.median(acc)),
+                "step_local": _local_ratios(step, periodic), "velocity_local": _local_ratios(acc, periodic)}
 
-    s, v = ratios(tr.motion, False)
+    out = ratios(tr.motion, False)
     ins = [ratios(c.motion("inplace"), True) for c in tr.inputs]
-    return {"step_ratio": s, "velocity_ratio": v, "input_step_ratio": max(r[0] for r in ins),
-            "input_velocity_ratio": max(r[1] for r in ins)}
+    out.update({f"input_{k}": max(r[k] for r in ins) for k in list(out)})
+    return out
