@@ -1,0 +1,136 @@
+"""``mocycle compress``, ``mocycle decompress``, ``mocycle project``: keyframe compression (thesis 002)."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from ..errors import MocycleError
+from ..io import read, write
+from .common import app, friendly, out
+
+_SELECT_HELP = "Keyframe selection: uniform, scs (curve simplification), pb (position based) or rols."
+_PROJECTION_HELP = "2-D projection of the spatial scheme: pca, mds, isomap, lle, force, tsne, rbfp or lamp."
+_SEED_HELP = "First-step projection of rbfp and lamp (the keyframes' 2-D places): pca, mds, isomap, lle, force, tsne."
+
+
+@app.command()
+@friendly
+def compress(
+    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="The .mck file to write.")],
+    ratio: Annotated[float, typer.Option(help="Keyframes as a fraction of the frames (thesis: 0.03).")] = 0.03,
+    select: Annotated[str, typer.Option(help=_SELECT_HELP)] = "uniform",
+    scheme: Annotated[str, typer.Option(
+        help="Reconstruction: linear, hermite (Euler angles), slerp (quaternions), rbf (1-D RBF in time) or "
+             "spatial (2-D projection + Igarashi back-projection).")] = "slerp",
+    projection: Annotated[str, typer.Option(help=_PROJECTION_HELP)] = "mds",
+    seed: Annotated[str, typer.Option(help=_SEED_HELP)] = "mds",
+    optimize: Annotated[bool, typer.Option("--optimize", help="Optimise the 2-D trajectory (Algorithm 12).")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+):
+    """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size."""
+    from ..keyframes import compress as compress_motion
+    from ..keyframes import error_per_frame_per_joint
+
+    if output.suffix.lower() != ".mck":
+        raise MocycleError(f"-o {output}: compressed takes are written as .mck files")
+    t0 = time.perf_counter()
+    motion = read(path, fps=fps)
+    packed = compress_motion(motion, ratio=ratio, select=select, scheme=scheme, projection=projection,
+                             optimize=optimize, seed=seed)
+    rebuilt = packed.decompress()
+    packed.save(output)
+    bvh_bytes = path.stat().st_size if path.suffix.lower() == ".bvh" else None
+    size = packed.size_report(bvh_bytes)
+    facts = {"frames": motion.n_frames, "keyframes": packed.n_keyframes,
+             "error_per_frame_per_joint": error_per_frame_per_joint(motion, rebuilt),
+             "compressed_bytes": size["compressed_bytes"], "bvh_bytes": size["bvh_bytes"],
+             "seconds": time.perf_counter() - t0}
+    if as_json:
+        print(json.dumps(facts, indent=2))
+        return
+    what = scheme if scheme != "spatial" else f"spatial/{projection}" + ("/optimised" if optimize else "")
+    table = Table(title=f"{path.name} -> {output.name} ({what}, {select} keyframes)")
+    table.add_column("")
+    table.add_column("value", justify="right")
+    table.add_row("frames", str(facts["frames"]))
+    table.add_row("keyframes", f"{facts['keyframes']} ({size['keyframe_ratio']:.1%})")
+    table.add_row("error per frame per joint (eq. 3.2, rad)", f"{facts['error_per_frame_per_joint']:.4f}")
+    table.add_row("compressed bytes", f"{facts['compressed_bytes']:,}")
+    table.add_row("BVH bytes", f"{facts['bvh_bytes']:,}")
+    table.add_row("real ratio", f"{size['real_ratio']:.2%}")
+    table.add_row("formula 5.2/5.3 ratio (h = 0)", f"{size['formula_ratio']:.2%}")
+    table.add_row("seconds", f"{facts['seconds']:.2f}")
+    out.print(table)
+
+
+@app.command()
+@friendly
+def decompress(
+    path: Annotated[Path, typer.Argument(help="A .mck file written by 'mocycle compress'.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh file to write.")],
+):
+    """Rebuild a take from its keyframes; the keyframes come back exactly."""
+    from ..keyframes import read_compressed
+
+    if output.suffix.lower() != ".bvh":
+        raise MocycleError(f"-o {output}: decompressed takes are written as .bvh files")
+    packed = read_compressed(path)
+    motion = packed.decompress()
+    write(motion, output)
+    out.print(f"{output}: {motion.n_frames} frames rebuilt from {packed.n_keyframes} keyframes ({packed.scheme})")
+
+
+@app.command()
+@friendly
+def project(
+    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    projection: Annotated[str, typer.Option(help=_PROJECTION_HELP)] = "mds",
+    select: Annotated[str, typer.Option(help=_SELECT_HELP)] = "uniform",
+    ratio: Annotated[float, typer.Option(help="Keyframes as a fraction of the frames.")] = 0.03,
+    seed: Annotated[str, typer.Option(help=_SEED_HELP)] = "mds",
+    optimize: Annotated[bool, typer.Option("--optimize", help="Also optimise the projection (Algorithm 12) "
+                                                               "and plot both.")] = False,
+    plot: Annotated[Path | None, typer.Option(help="Write a PNG: poses as points coloured by time, keyframes "
+                                                   "marked (thesis Figure 6.2).")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON (includes the 2-D points).")] = False,
+    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+):
+    """Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."""
+    from ..keyframes import PoseSpace, keyframe_count, optimize_projection, spatial_layout, stress
+
+    t0 = time.perf_counter()
+    motion = read(path, fps=fps)
+    space = PoseSpace(motion)
+    k = keyframe_count(motion.n_frames, ratio=ratio)
+    key, points = spatial_layout(space, projection, select, k, seed=seed)
+    opt = optimize_projection(points, key, motion.rotations, space.weights).points if optimize else None
+    facts = {"frames": motion.n_frames, "keyframes": key.tolist(), "projection": projection, "select": select,
+             "stress": stress(space.distances, points) if motion.n_frames > 1 else None}
+    if opt is not None:
+        facts["stress_optimized"] = stress(space.distances, opt)
+    if plot is not None:
+        from ..viz.keyframes import plot_projection
+
+        name = projection if projection not in ("rbfp", "lamp") else f"{projection} ({seed} seed)"
+        plot_projection(points, key, plot, title=f"{path.name}: {name}, {select} keyframes", optimized=opt,
+                        labels=(name, f"{name}, optimised (Algorithm 12)"))
+    facts["seconds"] = time.perf_counter() - t0
+    if as_json:
+        facts["points"] = points.round(6).tolist()
+        if opt is not None:
+            facts["points_optimized"] = opt.round(6).tolist()
+        print(json.dumps(facts))
+        return
+    out.print(f"[bold]{path}[/]: {facts['frames']} frames, {len(key)} keyframes ({select}), projection {projection}")
+    out.print(f"  stress (eq. 4.1): {facts['stress']:.4g}" + (
+        f", optimised {facts['stress_optimized']:.4g}" if opt is not None else ""))
+    out.print(f"  keyframes: {', '.join(map(str, key.tolist()))}", soft_wrap=True)
+    out.print(f"  {facts['seconds']:.2f} s")

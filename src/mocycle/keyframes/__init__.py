@@ -1,0 +1,30 @@
+"""Keyframe compression and spatial keyframing (Costa 2018 thesis, chapters 3-5).
+
+Pose distance and errors (:mod:`.distance`), keyframe selection (:mod:`.select`),
+temporal reconstruction (:mod:`.temporal`), projections to 2-D (:mod:`.projection`),
+Igarashi back-projection and Algorithm 12 (:mod:`.spatial`), and the ``.mck``
+codec (:mod:`.codec`).
+"""
+
+from .codec import SCHEMES, Compressed, compress, read_compressed
+from .distance import (
+    error_per_frame_per_joint,
+    frame_errors,
+    joint_weights,
+    pose_distance,
+    pose_distance_matrix,
+    pose_vectors,
+    stress,
+)
+from .projection import ONE_STEP, PROJECTIONS, TWO_STEP, PoseSpace, project_one_step, select_keyframes, spatial_layout
+from .select import METHODS, keyframe_count, select_pb, select_rols, select_scs, select_uniform
+from .spatial import BackProjection, OptimizeResult, nearest_rotation, optimize_projection, reconstruct_spatial
+from .temporal import interpolate_rotations, slerp
+
+__all__ = [
+    "METHODS", "ONE_STEP", "PROJECTIONS", "SCHEMES", "TWO_STEP", "BackProjection", "Compressed", "OptimizeResult",
+    "PoseSpace", "compress", "error_per_frame_per_joint", "frame_errors", "interpolate_rotations", "joint_weights",
+    "keyframe_count", "nearest_rotation", "optimize_projection", "pose_distance", "pose_distance_matrix",
+    "pose_vectors", "project_one_step", "read_compressed", "reconstruct_spatial", "select_keyframes", "select_pb",
+    "select_rols", "select_scs", "select_uniform", "slerp", "spatial_layout", "stress",
+]
