@@ -44,6 +44,7 @@ bench: $(VENV)/.installed
 	$(BIN)/python benchmarks/cycles.py
 	$(BIN)/python benchmarks/stretch.py
 	$(BIN)/python benchmarks/swings.py
+	$(BIN)/python benchmarks/keyframes.py
 
 clean:
 	rm -rf $(VENV) $(NP1) out .pytest_cache .ruff_cache

@@ -14,7 +14,7 @@ runner = CliRunner()
 
 def test_every_command_has_help():
     commands = ("", "info", "convert", "phase", "loop", "blend", "transition", "stretch", "swings", "search", "edit",
-                "demo")
+                "compress", "decompress", "project", "demo")
     for command in commands:
         result = runner.invoke(app, ([command] if command else []) + ["--help"])
         assert result.exit_code == 0 and "Usage" in result.output
