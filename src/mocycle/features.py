@@ -32,7 +32,7 @@ from scipy.spatial.transform import Rotation
 
 from .errors import MocycleError
 from .motion import Motion
-from .rotations import continuous_euler, continuous_rotvec, euler_to_quats, quat_exp
+from .rotations import continuous_euler, continuous_rotvec, euler_to_quats, mean_rotations, quat_exp
 
 REPS = ("euler", "expmap", "quatlog", "rotmat")
 ROOTS = ("keep", "velocity", "drop")
@@ -259,8 +259,7 @@ def pose_matrix(
         raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
     if rep == "quatlog":
         if reference is None:
-            ref = np.stack([Rotation.from_quat(motion.rotations[:, j]).mean().as_quat()
-                            for j in range(skel.n_joints)])
+            ref = mean_rotations(motion.rotations)
         elif isinstance(reference, Motion):
             ref = reference.rotations[0]
         else:

@@ -187,3 +187,18 @@ def quat_exp(rotvecs: np.ndarray) -> np.ndarray:
     r = np.asarray(rotvecs, dtype=np.float64)
     shape = r.shape[:-1]
     return Rotation.from_rotvec(r.reshape(-1, 3)).as_quat().reshape(*shape, 4)
+
+
+def nearest_rotations(M: np.ndarray) -> np.ndarray:
+    """Project ``(..., 3, 3)`` matrices onto the nearest rotations (Frobenius; SVD, determinant +1)."""
+    U, _, Vt = np.linalg.svd(np.asarray(M, dtype=np.float64))
+    d = np.where(np.linalg.det(U @ Vt) < 0, -1.0, 1.0)
+    U = U.copy()
+    U[..., :, 2] *= d[..., None]
+    return U @ Vt
+
+
+def mean_rotations(quats: np.ndarray) -> np.ndarray:
+    """Mean rotation of each joint over time: ``(T, J, 4)`` -> ``(J, 4)`` (scipy's ``Rotation.mean``)."""
+    q = np.asarray(quats, dtype=np.float64)
+    return np.stack([Rotation.from_quat(q[:, j]).mean().as_quat() for j in range(q.shape[1])])

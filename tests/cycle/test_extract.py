@@ -5,11 +5,12 @@ from scipy.spatial.transform import Rotation
 
 from conftest import shared_path
 from mocycle.cycle import extract_cycle, loop_metrics
-from mocycle.cycle.extract import mean_rotations, metric_features
+from mocycle.cycle.extract import metric_features
 from mocycle.cycle.metrics import template_error
 from mocycle.datasets import synthetic_nonperiodic, synthetic_still, synthetic_walk
 from mocycle.errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from mocycle.io import read
+from mocycle.rotations import mean_rotations
 
 
 @pytest.fixture(scope="module")
@@ -24,7 +25,7 @@ def clean_walk():
 
 def _error_to_truth(cycle, clean) -> float:
     """RMS error (rad per frame, all joints) of the cycle against the noise-free take at the best offset."""
-    ref = mean_rotations(clean.motion)
+    ref = mean_rotations(clean.motion.rotations)
     return template_error(metric_features(clean.motion, ref), metric_features(cycle.motion(), ref))[0]
 
 

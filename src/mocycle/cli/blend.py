@@ -11,16 +11,11 @@ import typer
 
 from ..errors import MocycleError
 from ..io import read, write
-from .common import app, count_option, friendly, out
+from .common import app, check_suffix, count_option, friendly, out
 
 METHOD_HELP = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."
 MODEL_HELP = "Harmonic model: M1, M2 or M3 (see mocycle loop)."
 HARMONICS_HELP = "Harmonics K: 'auto' (20, capped by the frames) or a number."
-
-
-def _check_output(path: Path) -> None:
-    if path.suffix.lower() != ".bvh":
-        raise MocycleError(f"{path}: -o must name a .bvh file")
 
 
 def _parse_weights(text: str | None, n: int) -> list[float] | None:
@@ -68,7 +63,7 @@ def blend(
     t0 = time.perf_counter()
     if len(paths) < 2:
         raise MocycleError(f"blend needs at least two takes; got {len(paths)}")
-    _check_output(output)
+    check_suffix(output, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     w = _parse_weights(weights, len(paths))
@@ -130,7 +125,7 @@ def transition(
     from ..cycle.blend import transition_smoothness
 
     t0 = time.perf_counter()
-    _check_output(output)
+    check_suffix(output, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     a, b = _read_all([first, second], fps)

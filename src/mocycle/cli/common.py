@@ -6,6 +6,7 @@ import sys
 import warnings
 from collections.abc import Callable
 from functools import wraps
+from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -71,6 +72,12 @@ def main_options(
 
 
 # ------------------------------------------------------------ option parsing
+def check_suffix(path: Path | None, suffix: str, option: str = "-o") -> None:
+    """Refuse an output path without the expected suffix, before any work is done (nothing gets written)."""
+    if path is not None and path.suffix.lower() != suffix:
+        raise MocycleError(f"{path}: {option} must name a {suffix} file")
+
+
 def parse_range(text: str | None, n_frames: int) -> tuple[int, int]:
     if not text:
         return 0, n_frames

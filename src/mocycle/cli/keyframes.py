@@ -10,9 +10,8 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from ..errors import MocycleError
 from ..io import read, write
-from .common import app, friendly, out
+from .common import app, check_suffix, friendly, out
 
 _SELECT_HELP = "Keyframe selection: uniform, scs (curve simplification), pb (position based) or rols."
 _PROJECTION_HELP = "2-D projection of the spatial scheme: pca, mds, isomap, lle, force, tsne, rbfp or lamp."
@@ -39,8 +38,7 @@ def compress(
     from ..keyframes import compress as compress_motion
     from ..keyframes import error_per_frame_per_joint
 
-    if output.suffix.lower() != ".mck":
-        raise MocycleError(f"-o {output}: compressed takes are written as .mck files")
+    check_suffix(output, ".mck")
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     packed = compress_motion(motion, ratio=ratio, select=select, scheme=scheme, projection=projection,
@@ -80,8 +78,7 @@ def decompress(
     """Rebuild a take from its keyframes; the keyframes come back exactly."""
     from ..keyframes import read_compressed
 
-    if output.suffix.lower() != ".bvh":
-        raise MocycleError(f"-o {output}: decompressed takes are written as .bvh files")
+    check_suffix(output, ".bvh")
     packed = read_compressed(path)
     motion = packed.decompress()
     write(motion, output)

@@ -12,7 +12,7 @@ from rich.table import Table
 
 from ..errors import MocycleError
 from ..io import read, write
-from .common import app, count_option, friendly, out, parse_range
+from .common import app, check_suffix, count_option, friendly, out, parse_range
 
 METRIC_LABELS = {
     "template_error": ("template error", "rad"),
@@ -27,11 +27,6 @@ METRIC_LABELS = {
     "foot_sliding": ("foot sliding, cycle", "units/s"),
     "input_foot_sliding": ("foot sliding, input", "units/s"),
 }
-
-
-def _check_suffix(path: Path | None, suffix: str, option: str) -> None:
-    if path is not None and path.suffix.lower() != suffix:
-        raise MocycleError(f"{path}: {option} must name a {suffix} file")
 
 
 @app.command()
@@ -70,8 +65,8 @@ def loop(
     """
     from ..cycle import extract_cycle, loop_metrics
 
-    _check_suffix(output, ".bvh", "--output")
-    _check_suffix(plot, ".png", "--plot")
+    check_suffix(output, ".bvh", "--output")
+    check_suffix(plot, ".png", "--plot")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     t0 = time.perf_counter()

@@ -10,9 +10,8 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from ..errors import MocycleError
 from ..io import read, write
-from .common import app, count_option, friendly, out
+from .common import app, check_suffix, count_option, friendly, out
 
 
 @app.command()
@@ -35,8 +34,7 @@ def stretch(
     """
     from ..warp import stretch_motion
 
-    if output.suffix.lower() != ".bvh":
-        raise MocycleError(f"-o must name a .bvh file; got {output}")
+    check_suffix(output, ".bvh")
     win = count_option(window, "--window", {"auto": "auto"})
     t0 = time.perf_counter()
     motion = read(path, fps=fps)

@@ -12,7 +12,7 @@ from rich.table import Table
 
 from ..errors import MocycleError
 from ..io import read, write
-from .common import app, friendly, out
+from .common import app, check_suffix, friendly, out
 
 _JOINTS_HELP = "Joints to segment: names, glob patterns or groups (legs, arms, spine), comma-separated " \
                "(default: the major bones, by name and motion energy)."
@@ -153,8 +153,7 @@ def edit(
     """Scale the angle or the duration of one swing of one joint and write the edited motion."""
     from ..swings import edit_swing, segment
 
-    if output.suffix.lower() != ".bvh":
-        raise MocycleError(f"-o {output}: the edited motion is written as .bvh")
+    check_suffix(output, ".bvh")
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     seg = segment(motion, threshold=threshold, joints=joints)

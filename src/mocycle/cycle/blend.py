@@ -60,7 +60,8 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError, NoPeriodicMotion
 from ..motion import Motion, Skeleton
-from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, mean_rotations, metric_features
+from ..rotations import mean_rotations
+from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, metric_features
 from .representation import CycleSpace, axis_rotations, nearest_rotations
 from .seam import LOCAL, calmest_start, seam_ratios
 from .timeaxis import TimeAxis
@@ -351,7 +352,7 @@ def weighted_rotation_mean(quats: np.ndarray, weights: np.ndarray) -> np.ndarray
 def cycle_seam(cycle: Cycle) -> dict[str, float]:
     """Seam ratios of a loop as :func:`~mocycle.cycle.loop_metrics` measures them (rotations relative to the
     loop's own mean rotations, and the travel joint's in-place path; the larger of the two)."""
-    C, root = loop_blocks(cycle, mean_rotations(cycle.motion("inplace")))
+    C, root = loop_blocks(cycle, mean_rotations(cycle.motion("inplace").rotations))
     seams = [seam_ratios(C), seam_ratios(root)]
     return {f"seam_{k}": max(r[k] for r in seams) for k in ("pose", "velocity", "pose_local", "velocity_local")}
 
@@ -446,7 +447,7 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     L += np.outer(grid, drift)                       # the Cycle convention: L carries its drift
     axis = TimeAxis(grid.copy(), ((0, N),), period, "blend")
     cycle = Cycle(space, P, L, drift, "blend", None, None, axis, np.arange(N, dtype=np.float64), None)
-    start = calmest_start(*loop_blocks(cycle, mean_rotations(cycle.motion("inplace")))) if roll else 0
+    start = calmest_start(*loop_blocks(cycle, mean_rotations(cycle.motion("inplace").rotations))) if roll else 0
     cycle = cycle.rolled(start)
     cycle.seconds = time.perf_counter() - t0
     return BlendedCycle(cycle, w, offsets, start / N, periods, np.array([loop.turn_to for loop in loops]),
@@ -560,7 +561,7 @@ def transition_smoothness(tr: Transition) -> dict[str, float]:
     the mean pose, radians) over the median of the 8 nearest (``step_local``, ``velocity_local``) and over the
     median of all (``step_ratio``, ``velocity_ratio``); the same for the two input loops (``input_*``)."""
     def ratios(m: Motion, periodic: bool) -> dict[str, float]:
-        F = metric_features(m, mean_rotations(m))
+        F = metric_features(m)
         if periodic:
             step = np.linalg.norm(F - np.roll(F, 1, axis=0), axis=1)
             acc = np.linalg.norm(np.roll(F, -1, axis=0) - 2 * F + np.roll(F, 1, axis=0), axis=1)

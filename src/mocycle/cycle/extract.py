@@ -22,13 +22,13 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
+from ..features import pose_matrix
 from ..motion import Motion
 from ..phase.analysis import PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
-from ..rotations import continuous_rotvec, quat_multiply
+from ..rotations import mean_rotations
 from .differences import HALF, central_acceleration, central_velocity
 from .harmonic import MODELS, HarmonicRegression, max_harmonics
 from .representation import CycleSpace, axis_rotations
@@ -295,13 +295,9 @@ def cut_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, p
 # ------------------------------------------------------------------ pipeline
 def metric_features(motion: Motion, reference: np.ndarray | None = None) -> np.ndarray:
     """``(T, 3J)`` rotation vectors of every joint relative to ``reference`` ``(J, 4)`` (default: the
-    motion's own mean rotation per joint), in radians: the space the loop metrics are measured in."""
-    q = motion.rotations
-    if reference is None:
-        reference = mean_rotations(motion)
-    inv = reference * np.array([-1.0, -1.0, -1.0, 1.0])
-    rel = quat_multiply(np.broadcast_to(inv, q.shape), q)
-    return continuous_rotvec(rel).reshape(motion.n_frames, -1)
+    motion's own mean rotation per joint), in radians: the space the loop metrics are measured in.
+    It is the ``quatlog`` pose matrix (half the rotation vector) doubled."""
+    return 2.0 * pose_matrix(motion, rep="quatlog", root="drop", reference=reference)[0]
 
 
 def loop_blocks(cycle: Cycle, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -309,11 +305,6 @@ def loop_blocks(cycle: Cycle, reference: np.ndarray) -> tuple[np.ndarray, np.nda
     and the world path of its travel joint ``(N, 3)``."""
     inplace = cycle.motion("inplace")
     return metric_features(inplace, reference), inplace.world_positions()[:, cycle.space.travel]
-
-
-def mean_rotations(motion: Motion) -> np.ndarray:
-    """``(J, 4)`` chordal mean rotation of each joint over the take."""
-    return np.stack([Rotation.from_quat(motion.rotations[:, j]).mean().as_quat() for j in range(motion.n_joints)])
 
 
 def choose_periodic(result: PhaseResult, which: int | None = None) -> PeriodicMotion:
@@ -378,7 +369,7 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
                       f"little evidence", MocycleWarning, stacklevel=2)
     space = CycleSpace.fit(motion)
     P, L = space.encode(motion)
-    reference = mean_rotations(motion)
+    reference = mean_rotations(motion.rotations)
     # The cut's wrap is its seam; the others have none, so they start at the calmest point.
     if method == "harmonic":
         cycle = harmonic_cycle(space, P, L, axis, periodic, model, n_harmonics, reference)

@@ -32,8 +32,9 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from ..motion import Motion
+from ..rotations import mean_rotations
 from .differences import HALF, central_acceleration, central_velocity, forward_jerk
-from .extract import Cycle, loop_blocks, mean_rotations, metric_features
+from .extract import Cycle, loop_blocks, metric_features
 from .representation import vertical_axis
 from .seam import seam_ratios
 
@@ -145,7 +146,7 @@ def foot_sliding(motion: Motion) -> float:
 
 def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
     """Every metric of the module docstring for ``cycle`` extracted from ``motion``."""
-    ref = mean_rotations(motion)
+    ref = mean_rotations(motion.rotations)
     Y = metric_features(motion, ref)
     C, root = loop_blocks(cycle, ref)
     frames = cycle.axis.frames()

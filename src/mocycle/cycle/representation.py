@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError
 from ..motion import Motion
-from ..rotations import continuous_quats
+from ..rotations import continuous_quats, nearest_rotations
 
 
 def vertical_axis(motion: Motion) -> np.ndarray:
@@ -50,15 +50,6 @@ def axis_rotations(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
     c, s = np.cos(angles)[:, None, None], np.sin(angles)[:, None, None]
     K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
     return c * np.eye(3) + s * K + (1.0 - c) * np.outer(u, u)
-
-
-def nearest_rotations(M: np.ndarray) -> np.ndarray:
-    """Project ``(..., 3, 3)`` matrices onto the nearest rotations (SVD, determinant +1)."""
-    U, _, Vt = np.linalg.svd(M)
-    d = np.where(np.linalg.det(U @ Vt) < 0, -1.0, 1.0)
-    U = U.copy()
-    U[..., :, 2] *= d[..., None]
-    return U @ Vt
 
 
 @dataclass(frozen=True, eq=False)

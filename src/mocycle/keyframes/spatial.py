@@ -26,20 +26,13 @@ from scipy.spatial.distance import cdist
 from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError
+from ..rotations import nearest_rotations
 from .distance import moving_joints
 
 # ---------------------------------------------------------------- rotations
 
 
-def nearest_rotation(M: np.ndarray) -> np.ndarray:
-    """The pure rotation closest (Frobenius) to each ``(..., 3, 3)`` matrix: ``U·diag(1, 1, det)·Vᵀ`` by SVD."""
-    M = np.asarray(M, dtype=np.float64)
-    U, _, Vt = np.linalg.svd(M)
-    d = np.sign(np.linalg.det(U @ Vt))
-    d = np.where(d == 0, 1.0, d)
-    U = U.copy()
-    U[..., :, 2] *= d[..., None]
-    return U @ Vt
+nearest_rotation = nearest_rotations  # the pure rotation closest (Frobenius) to each (..., 3, 3) matrix
 
 
 def fast_nearest_rotation(M: np.ndarray, iterations: int = 8) -> np.ndarray:

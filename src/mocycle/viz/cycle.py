@@ -14,10 +14,13 @@ from .figure import save, subplots
 def plot_loop(motion, cycle, path: str | os.PathLike, title: str = "", n_joints: int = 3) -> Path:
     """Three panels: 2-D PCA of the input's poses and the closed cycle; the phase of every frame; the
     ``n_joints`` most moving joint curves over two repetitions of the cycle with the input frames on top."""
-    from ..cycle.extract import mean_rotations, metric_features
+    from ..cycle.extract import metric_features
+    from ..features import pose_matrix
+    from ..rotations import mean_rotations
 
-    ref = mean_rotations(motion)
+    ref = mean_rotations(motion.rotations)
     Y = metric_features(motion, ref)
+    names = pose_matrix(motion[:1], rep="quatlog", root="drop", reference=ref)[1].columns
     C = metric_features(cycle.motion("inplace"), ref)
     frames = cycle.axis.frames()
     fig, (ax_pca, ax_phase, ax_curves) = subplots(1, 3, figsize=(16, 4.6))
@@ -45,12 +48,11 @@ def plot_loop(motion, cycle, path: str | os.PathLike, title: str = "", n_joints:
 
     spread = np.ptp(Y[frames], axis=0)
     cols = np.argsort(spread)[::-1][:n_joints]
-    names = motion.skeleton.names
     t2 = np.arange(2 * cycle.n_frames)
     for n, col in enumerate(cols):
         colour = f"C{n}"
         ax_curves.plot(t2, np.degrees(np.tile(C[:, col], 2)), "-", color=colour, lw=2,
-                       label=f"{names[col // 3]} r{'xyz'[col % 3]}")
+                       label=names[col])
         ax_curves.plot(cycle.positions, np.degrees(Y[frames, col]), ".", ms=2, color=colour, alpha=0.5)
         ax_curves.plot(cycle.positions + cycle.n_frames, np.degrees(Y[frames, col]), ".", ms=2, color=colour,
                        alpha=0.5)
