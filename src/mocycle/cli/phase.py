@@ -11,7 +11,7 @@ import typer
 from rich.table import Table
 
 from ..errors import MocycleError
-from ..io import read
+from ..io import read_motion as read
 from .common import EXIT_NOT_FOUND, app, count_option, err, friendly, out
 
 
