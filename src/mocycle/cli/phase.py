@@ -42,7 +42,7 @@ def phase(
     motion = read(path, fps=fps)
     result = find_phase(motion, classes=count_option(classes, "--classes", {"auto": "auto"}), joints=joints,
                         pca=count_option(pca, "--pca", {"auto": "auto", "none": None, "0": None}),
-                        delay=delay, n_landmarks=landmarks)
+                        delay=delay, n_landmarks=landmarks, keep_features=plot is not None)
     if plot is not None:
         from ..viz import plot_phase
 

@@ -62,7 +62,7 @@ def phase_features(motion: Motion, joints: str | Iterable[str] | None = None, pc
     return X
 
 
-@dataclass
+@dataclass(kw_only=True)
 class PeriodicMotion:
     """One periodic motion found in a take.
 
@@ -114,9 +114,14 @@ class PeriodicMotion:
         }
 
 
-@dataclass
+@dataclass(kw_only=True)
 class PhaseResult:
-    """What ``find_phase`` found: zero or more periodic motions and how it decided."""
+    """What ``find_phase`` found: zero or more periodic motions and how it decided.
+
+    ``barcode``: ``(B, 2)`` H1 bars (birth, death); ``features``: the point cloud the coordinates were
+    computed on, ``(T - delay, D)``, only when ``find_phase(keep_features=True)`` asked for it (``None``
+    otherwise: a result stays about the size of its own per-frame numbers).
+    """
 
     classes: list[PeriodicMotion]
     barcode: np.ndarray
@@ -124,8 +129,7 @@ class PhaseResult:
     autocorrelation_period_frames: float
     n_frames: int
     frame_time: float
-    features: np.ndarray = field(repr=False)
-    estimator: CircularCoordinates = field(repr=False)
+    features: np.ndarray | None = field(default=None, repr=False)
     seconds: float = 0.0
 
     def to_dict(self) -> dict:
@@ -164,8 +168,9 @@ def _periodic_motion(coords: np.ndarray, cls, frame_time: float, n_frames: int) 
     slope = float(np.average(slopes, weights=weights))
     period = 1.0 / slope if slope > 0 else float("inf")
     coords = _extend_phase(coords, n_frames, period)
-    return PeriodicMotion(cls.birth, cls.death, coords, unwrap_phase(coords), regions, period, n_periods,
-                          frame_time, cls.combination)
+    return PeriodicMotion(birth=cls.birth, death=cls.death, coords=coords, unwrapped=unwrap_phase(coords),
+                          excitation=regions, period_frames=period, n_periods=n_periods, frame_time=frame_time,
+                          combination=cls.combination)
 
 
 def _distinct(found: list[PeriodicMotion]) -> list[PeriodicMotion]:
@@ -192,13 +197,15 @@ def _distinct(found: list[PeriodicMotion]) -> list[PeriodicMotion]:
 
 def find_phase(motion: Motion, classes: int | str = "auto", joints: str | Iterable[str] | None = None,
                pca: int | str | None = "auto", delay: int = 2, n_landmarks: int = 120,
-               scale: str | float = "auto", min_cycles: float = 1.25, **feature_options) -> PhaseResult:
+               scale: str | float = "auto", min_cycles: float = 1.25, keep_features: bool = False,
+               **feature_options) -> PhaseResult:
     """Periodic motions of ``motion`` with their phase per frame and their periods.
 
     ``classes``: ``"auto"`` or how many; ``joints``, ``pca``, ``delay`` and
     ``feature_options`` (``rep``, ``root``, ``normalize``, ``weights``) shape the
     input (:func:`phase_features`); ``n_landmarks``, ``scale`` and
-    ``min_cycles`` go to :class:`CircularCoordinates`.  An empty
+    ``min_cycles`` go to :class:`CircularCoordinates`; ``keep_features`` keeps the point cloud in
+    ``result.features`` (for plots; off by default so results stay small).  An empty
     ``result.classes`` means no periodic motion; ``result.reason`` says why.
     """
     t0 = time.perf_counter()
@@ -215,5 +222,6 @@ def find_phase(motion: Motion, classes: int | str = "auto", joints: str | Iterab
     # Periods under a quarter of a second are not motions people capture; shorter
     # lags pick up frame-to-frame jitter (e.g. takes resampled by frame doubling).
     acf = autocorrelation_period(X, min_lag=max(2, int(round(0.25 / motion.frame_time))))
-    return PhaseResult(found, estimator.barcode_, estimator.reason_, acf, motion.n_frames, motion.frame_time,
-                       X, estimator, time.perf_counter() - t0)
+    return PhaseResult(classes=found, barcode=estimator.barcode_, reason=estimator.reason_,
+                       autocorrelation_period_frames=acf, n_frames=motion.n_frames, frame_time=motion.frame_time,
+                       features=X if keep_features else None, seconds=time.perf_counter() - t0)
