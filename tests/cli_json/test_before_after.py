@@ -1,0 +1,52 @@
+"""Every ``mocycle`` command prints, with ``--json``, the figures it printed before issue 12's task layer.
+
+``before.json`` was made by ``make_before.py`` from commit 6e2c70a (the code before the change); timing
+fields are left out, numbers are compared with a tolerance (other numpy versions, other BLAS).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from cli_json.cases import CASES, run_all
+
+BEFORE = json.loads((Path(__file__).parent / "before.json").read_text())
+
+
+def _diff(a, b, where: str) -> list[str]:
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = [f"{where}: keys {sorted(set(a) ^ set(b))} differ"] if set(a) != set(b) else []
+        for k in set(a) & set(b):
+            out += _diff(a[k], b[k], f"{where}.{k}")
+        return out
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{where}: length {len(a)} != {len(b)}"]
+        return [d for k, (x, y) in enumerate(zip(a, b, strict=True)) for d in _diff(x, y, f"{where}[{k}]")]
+    if isinstance(a, bool) or isinstance(b, bool) or not isinstance(a, int | float) or not isinstance(b, int | float):
+        return [] if a == b else [f"{where}: {a!r} != {b!r}"]
+    return [] if math.isclose(a, b, rel_tol=1e-5, abs_tol=1e-6) else [f"{where}: {a!r} != {b!r}"]
+
+
+@pytest.fixture(scope="module")
+def after(tmp_path_factory):
+    return run_all(tmp_path_factory.mktemp("cli_json"))
+
+
+def test_the_fixture_covers_every_case():
+    assert set(BEFORE) == set(CASES)
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_same_json_as_before(after, name):
+    diffs = _diff(BEFORE[name], after[name], name)
+    assert not diffs, "\n".join(diffs[:20])
+
+
+def test_the_comparison_can_fail():
+    assert _diff({"a": [1.0, 2.0]}, {"a": [1.0, 2.001]}, "x") == ["x.a[1]: 2.0 != 2.001"]
+    assert _diff({"a": 1}, {"b": 1}, "x")
