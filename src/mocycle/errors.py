@@ -28,6 +28,18 @@ class MotionFileError(MocycleError, ValueError):
         super().__init__(where + message)
 
 
+class OptionError(MocycleError, ValueError):
+    """An argument is out of its allowed values; ``parameter`` names it (the CLI shows the matching flag).
+
+    The message reads ``"<parameter> <what was expected>; got <value>"``; ``reason`` is the part after the name.
+    """
+
+    def __init__(self, parameter: str, reason: str):
+        self.parameter = parameter
+        self.reason = reason
+        super().__init__(f"{parameter} {reason}")
+
+
 class MocycleWarning(UserWarning):
     """Something odd but recoverable in the input (e.g. a wrong ``Frames:`` count)."""
 

@@ -25,11 +25,11 @@ from pathlib import Path
 
 from ..errors import MocycleError, MotionFileError
 from ..motion import Motion
-from .asfamc import read_amc, read_asf, read_asfamc
+from .asfamc import AMC_FPS, read_amc, read_asf, read_asfamc
 from .atomic import atomic_write
 from .bvh import parse_bvh, read_bvh, write_bvh
 
-__all__ = ["READ_SUFFIXES", "WRITE_SUFFIXES", "parse_bvh", "read", "read_amc", "read_asf", "read_asfamc",
+__all__ = ["AMC_FPS", "READ_SUFFIXES", "WRITE_SUFFIXES", "parse_bvh", "read", "read_amc", "read_asf", "read_asfamc",
            "read_bvh", "read_motion", "write", "write_bvh"]
 
 MOTION_SUFFIXES = (".bvh", ".amc")
@@ -48,7 +48,7 @@ def _suffix(p: Path, known: tuple[str, ...], what: str) -> str:
     return suffix
 
 
-def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = 120.0) -> Motion:
+def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = AMC_FPS) -> Motion:
     """Read a motion file (``.bvh``, or ``.amc`` with its ``.asf``) into a :class:`Motion`.
 
     Parameters
@@ -80,7 +80,7 @@ def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None
     return read_asfamc(asf, p, fps=fps)
 
 
-def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = 120.0):
+def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = AMC_FPS):
     """Read any file mocycle writes, chosen by its suffix (table in the module notes).
 
     Parameters

@@ -37,6 +37,9 @@ from ..motion import EndSite, Motion, Skeleton
 
 __all__ = ["AsfSkeleton", "read_amc", "read_asf", "read_asfamc"]
 
+#: Frame rate of AMC files, which do not store it (CMU captured at 120 fps).
+AMC_FPS = 120.0
+
 ROOT = "root"
 ROOT_CHANNELS = ("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")
 BONE_CHANNELS = ("Zrotation", "Yrotation", "Xrotation")
@@ -182,7 +185,7 @@ def read_asf(path: str | os.PathLike) -> AsfSkeleton:
 
 
 def read_amc(path: str | os.PathLike, asf: AsfSkeleton | str | os.PathLike,
-             fps: float = 120.0) -> Motion:
+             fps: float = AMC_FPS) -> Motion:
     """Read an ``.amc`` motion for skeleton ``asf`` (an :class:`AsfSkeleton` or its path).
 
     AMC files do not store the frame rate; ``fps`` gives it (CMU: 120).
@@ -197,7 +200,7 @@ def read_amc(path: str | os.PathLike, asf: AsfSkeleton | str | os.PathLike,
 
 
 def read_asfamc(asf_path: str | os.PathLike, amc_path: str | os.PathLike,
-                fps: float = 120.0) -> Motion:
+                fps: float = AMC_FPS) -> Motion:
     """Read an ASF skeleton and an AMC motion into one :class:`Motion`."""
     return read_amc(amc_path, read_asf(asf_path), fps=fps)
 

@@ -1,0 +1,40 @@
+"""The task layer: one module per user task, the one API every front end calls.
+
+Each task module has an ``Options`` frozen dataclass (defaults, units in the names, one help line per field,
+validation in ``__post_init__``) and ``run(inputs, options) -> Report``. Inputs are :class:`~mocycle.Motion`
+objects or motion file paths. The CLI, the Blender add-on, the web studio and the batch runner call these and
+nothing deeper; :func:`schema` describes an Options class for forms and flags.
+
+    >>> from mocycle import tasks
+    >>> from mocycle.datasets import synthetic_walk
+    >>> report = tasks.info.run(synthetic_walk(n_frames=120).motion)
+    >>> report.facts["frames"], report.task
+    (120, 'info')
+"""
+
+from __future__ import annotations
+
+from . import (
+    blend,
+    compress,
+    decompress,
+    edit,
+    info,
+    loop,
+    phase,
+    project,
+    search,
+    stretch,
+    swings,
+    transition,
+)
+from .fields import AMC_FPS, SWING_THRESHOLD
+from .options import Options, option, schema
+from .report import Report
+
+#: task name -> its module (each has ``Options`` and ``run``)
+TASKS = {m.__name__.rsplit(".", 1)[1]: m for m in (info, phase, loop, blend, transition, stretch, swings, search,
+                                                     edit, compress, decompress, project)}
+
+__all__ = ["AMC_FPS", "SWING_THRESHOLD", "TASKS", "Options", "Report", "blend", "compress", "decompress", "edit",
+           "info", "loop", "option", "phase", "project", "schema", "search", "stretch", "swings", "transition"]

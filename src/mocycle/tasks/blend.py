@@ -1,0 +1,78 @@
+"""``blend``: one new loop from the cycles of several takes (paper 001 §4.5, a convex combination)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ..errors import OptionError
+from . import fields
+from .options import Flag, option
+from .options import Options as _Options
+from .report import Recorder, Report, label_of, load
+
+LABELS = {
+    "weights": ("weights", ""), "input_periods_frames": ("periods", "frames"), "period_frames": ("period", "frames"),
+    "cycle_frames": ("loop", "frames"), "phase_offsets": ("phase offsets", "cycles"),
+    "travel_per_cycle": ("travel per cycle", "file units"), "turn_per_cycle_deg": ("turn per cycle", "deg"),
+    "seam": ("seam jump (pose, velocity)", "× median step"), "frames_out": ("frames written", ""),
+}
+
+
+def _weights(name: str, value):
+    """None, or a tuple of numbers >= 0 (a text such as ``"0.7,0.3"`` is split at the commas)."""
+    if value is None:
+        return None
+    items = value.split(",") if isinstance(value, str) else value
+    try:
+        w = tuple(float(v) for v in items)
+    except (TypeError, ValueError):
+        w = ()
+    if not w or not all(math.isfinite(x) and x >= 0 for x in w):
+        raise OptionError(name, f"must be comma-separated numbers >= 0, one per take (e.g. 0.7,0.3); got {value!r}")
+    return w
+
+
+@dataclass(frozen=True)
+class Options(_Options):
+    """Options of ``blend``."""
+
+    weights: tuple[float, ...] | None = option(
+        None, "One weight >= 0 per take, comma-separated (normalised to sum 1); default equal.", _weights)
+    root: str = fields.root("inplace", "inplace (on the spot) or motion (moves on by the blended stride).")
+    cycles: int = fields.cycles(1, "Repeat the loop this many times in the output.")
+    method: str = fields.method()
+    model: str = fields.model()
+    harmonics: int | str = fields.harmonics()
+    align: bool = option(True, "Search each take's phase offset against the first.", Flag())
+    amc_fps: float = fields.amc_fps()
+
+
+def run(takes: Sequence, options: Options | None = None) -> Report:
+    """Blend the cycles of two or more takes (Motions or files on one skeleton) into one loop;
+    ``motions["loop"]`` is it repeated ``cycles`` times. Raises NoPeriodicMotion when a take has no cycle."""
+    from ..cycle.blend import blend_cycles, check_weights, cycle_seam
+
+    o = options or Options()
+    takes = list(takes)
+    if len(takes) < 2:
+        raise OptionError("takes", f"must be at least two takes to blend; got {len(takes)}")
+    if o.weights is not None:
+        if len(o.weights) != len(takes):
+            raise OptionError("weights", f"needs {len(takes)} numbers, one per take; got {len(o.weights)}")
+        check_weights(o.weights, len(takes))  # refuse bad weights before the (slower) extraction
+    with Recorder() as rec:
+        motions = [load(t, o.amc_fps) for t in takes]
+        result = blend_cycles(motions, o.weights, align=o.align, labels=[label_of(t, k) for k, t in enumerate(takes)],
+                              method=o.method, model=o.model, n_harmonics=o.harmonics)
+        loop = result.repeat(o.cycles, root=o.root)
+        facts = {
+            **result.to_dict(),
+            "frames_out": result.n_frames * o.cycles,
+            "root": o.root,
+            "cycles": o.cycles,
+            "seam": result.seam(),
+            "input_seams": [cycle_seam(c) for c in result.inputs],
+        }
+    return rec.report("blend", facts, {"loop": loop}, result)

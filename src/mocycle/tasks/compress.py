@@ -1,0 +1,56 @@
+"""``compress``: a take as keyframes (and a 2-D trajectory for the spatial scheme), thesis 002."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import fields, keyframe_fields
+from .options import Choice, option
+from .options import Options as _Options
+from .report import Recorder, Report, load
+
+SCHEME_CHOICES = ("linear", "hermite", "slerp", "rbf", "spatial")
+LABELS = {
+    "frames": ("frames", ""), "keyframes": ("keyframes", ""),
+    "error_per_frame_per_joint": ("error per frame per joint (eq. 3.2)", "rad"),
+    "compressed_bytes": ("compressed", "bytes"), "bvh_bytes": ("BVH", "bytes"),
+    "keyframe_ratio": ("keyframes / frames", ""), "real_ratio": ("real ratio", ""),
+    "formula_ratio": ("formula 5.2/5.3 ratio (h = 0)", ""),
+}
+
+
+@dataclass(frozen=True)
+class Options(_Options):
+    """Options of ``compress``."""
+
+    ratio: float = keyframe_fields.ratio()
+    select: str = keyframe_fields.select()
+    scheme: str = option("slerp", "Reconstruction: linear, hermite (Euler angles), slerp (quaternions), rbf (1-D RBF "
+                                  "in time) or spatial (2-D projection + Igarashi back-projection).",
+                         Choice(SCHEME_CHOICES))
+    projection: str = keyframe_fields.projection()
+    seed_projection: str = keyframe_fields.seed_projection()
+    optimize: bool = keyframe_fields.optimize()
+    amc_fps: float = fields.amc_fps()
+
+
+def run(take, options: Options | None = None) -> Report:
+    """Compress a take: ``result`` is the :class:`~mocycle.keyframes.Compressed` (``.save(path)`` writes the
+    ``.mck``), ``motions["decompressed"]`` what it decodes to."""
+    from ..keyframes import compress, error_per_frame_per_joint
+
+    o = options or Options()
+    with Recorder() as rec:
+        motion = load(take, o.amc_fps)
+        packed = compress(motion, ratio=o.ratio, select=o.select, scheme=o.scheme, projection=o.projection,
+                          optimize=o.optimize, seed=o.seed_projection)
+        rebuilt = packed.decompress()
+        is_bvh = not hasattr(take, "skeleton") and Path(take).suffix.lower() == ".bvh"
+        size = packed.size_report(Path(take).stat().st_size if is_bvh else None)
+        facts = {"frames": motion.n_frames, "keyframes": packed.n_keyframes,
+                 "error_per_frame_per_joint": error_per_frame_per_joint(motion, rebuilt),
+                 "compressed_bytes": size["compressed_bytes"], "bvh_bytes": size["bvh_bytes"],
+                 "keyframe_ratio": size["keyframe_ratio"], "real_ratio": size["real_ratio"],
+                 "formula_ratio": size["formula_ratio"]}
+    return rec.report("compress", facts, {"decompressed": rebuilt}, packed)

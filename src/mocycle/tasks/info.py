@@ -1,0 +1,77 @@
+"""``info``: the facts of a take (frames, frame time, joints, channels, root travel, rotation ranges)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..io.bvh import motion_channels
+from ..motion import Motion
+from . import fields
+from .options import Options as _Options
+from .report import Recorder, Report, load
+
+#: key -> (label, unit) of the figures a front end shows.
+LABELS = {
+    "frames": ("frames", ""), "frame_time": ("frame time", "s"), "fps": ("frame rate", "fps"),
+    "duration_s": ("duration", "s"), "joints": ("joints", ""), "channels": ("channels", ""),
+    "end_sites": ("end sites", ""), "travel_joint": ("travel joint", ""),
+    "root_displacement": ("travel, net", "file units"), "root_path_length": ("travel along the path", "file units"),
+    "rotation_spread_deg": ("max angle from mean pose", "deg"),
+    "rotation_range_deg": ("channel ranges (max - min)", "deg"),
+}
+
+
+@dataclass(frozen=True)
+class Options(_Options):
+    """Options of ``info``."""
+
+    amc_fps: float = fields.amc_fps()
+
+
+def motion_info(motion: Motion) -> dict:
+    """The facts of a take, JSON-ready (see :data:`LABELS`)."""
+    skel = motion.skeleton
+    travel = motion.travel_joint
+    root = motion.world_positions()[:, travel]
+    steps = np.linalg.norm(np.diff(root, axis=0), axis=1) if motion.n_frames > 1 else np.zeros(0)
+    values = motion_channels(motion)
+    ranges: dict[str, dict[str, float]] = {}
+    spread: dict[str, float] = {}
+    col = 0
+    for j, name in enumerate(skel.names):
+        per = {}
+        for c in skel.channels[j]:
+            if c.endswith("rotation"):
+                per[c] = float(np.ptp(values[:, col]))
+            col += 1
+        if per:
+            ranges[name] = per
+            r = motion.rotation(j)
+            spread[name] = float(np.degrees((r.mean().inv() * r).magnitude().max()))
+    return {
+        "frames": motion.n_frames,
+        "frame_time": motion.frame_time,
+        "fps": motion.fps,
+        "duration_s": motion.duration,
+        "joints": skel.n_joints,
+        "channels": skel.n_channels,
+        "end_sites": len(skel.end_sites),
+        "travel_joint": skel.names[travel],
+        "root_start": root[0].tolist(),
+        "root_end": root[-1].tolist(),
+        "root_displacement": float(np.linalg.norm(root[-1] - root[0])),
+        "root_path_length": float(steps.sum()),
+        "rotation_range_deg": ranges,
+        "rotation_spread_deg": spread,
+    }
+
+
+def run(take, options: Options | None = None) -> Report:
+    """The facts of one take (a :class:`Motion` or a motion file)."""
+    options = options or Options()
+    with Recorder() as rec:
+        motion = load(take, options.amc_fps)
+        facts = motion_info(motion)
+    return rec.report("info", facts, {"motion": motion})

@@ -1,0 +1,114 @@
+"""``loop``: one seamless typical cycle of a take (paper 001 harmonic regression, centroid or cut)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import OptionError
+from . import fields
+from .options import Choice, Integer, option
+from .options import Options as _Options
+from .report import Recorder, Report, load
+
+#: the loop metrics (``facts["metrics"]``): key -> (label, unit)
+METRIC_LABELS = {
+    "template_error": ("template error", "rad"),
+    "rmse_h": ("RMSE h", "rad"),
+    "rmse_dh": ("RMSE h'", "rad/s"),
+    "rmse_ddh": ("RMSE h''", "rad/s²"),
+    "jerk_ratio": ("jerk, cycle / input", ""),
+    "seam_pose": ("seam jump, pose", "× median step"),
+    "seam_velocity": ("seam jump, velocity", "× median change"),
+    "seam_pose_local": ("seam jump, pose (local)", "× nearby steps"),
+    "seam_velocity_local": ("seam jump, velocity (local)", "× nearby changes"),
+    "foot_sliding": ("foot sliding, cycle", "units/s"),
+    "input_foot_sliding": ("foot sliding, input", "units/s"),
+}
+
+TIME_AXES = ("smooth", "rank", "gmm", "line")
+
+
+def parse_range(text: str | None, n_frames: int) -> tuple[int, int]:
+    """``"START:STOP"`` (frame numbers; negative counts from the end; either may be empty) -> (start, stop)."""
+    if not text:
+        return 0, n_frames
+    try:
+        a, _, b = text.partition(":")
+        start = int(a) if a.strip() else 0
+        stop = int(b) if b.strip() else n_frames
+    except ValueError:
+        raise OptionError("frame_range", f"must look like START:STOP (frame numbers); got {text!r}") from None
+    if start < 0:
+        start += n_frames
+    if stop < 0:
+        stop += n_frames
+    if not 0 <= start < stop <= n_frames:
+        raise OptionError("frame_range", f"{text} is outside the take's {n_frames} frames")
+    return start, stop
+
+
+def _range_text(name: str, value):
+    if value is None or value == "":
+        return None
+    if not isinstance(value, str) or ":" not in value:
+        raise OptionError(name, f"must look like START:STOP (frame numbers); got {value!r}")
+    parse_range(value, 2**62)  # the syntax; the bounds are checked against the take
+    return value
+
+
+_range_text.schema = lambda: {"anyOf": [{"type": "string", "pattern": r"^-?\d*:-?\d*$"}, {"type": "null"}]}
+
+
+@dataclass(frozen=True)
+class Options(_Options):
+    """Options of ``loop``."""
+
+    method: str = fields.method("harmonic (regression), centroid (paper 001) or cut (baseline).")
+    model: str = fields.model("Harmonic model: M1 (FGLS-weighted positions, velocities, accelerations), M2 "
+                              "(positions only; velocity/acceleration off), M3 (unweighted).")
+    harmonics: int | str = fields.harmonics()
+    root: str = fields.root("inplace", "inplace (walks on the spot, facing kept) or motion (moves on).")
+    frame_range: str | None = option(None, "Use frames START:STOP of the take.", _range_text, flag="--range")
+    step: int = option(1, "Find the phase on every STEP-th frame (faster on long takes).", Integer(1))
+    joints: str | None = fields.joints("Joints to find the phase on (names, globs, legs/arms/spine); every joint "
+                                       "is looped.")
+    cycles: int = fields.cycles(1, "Repeat the cycle this many times in the output.")
+    classes: int | str = fields.classes("How many periodic motions to look for: 'auto' or N.")
+    which: int | None = option(None, "Which periodic motion to loop (0-based; default: the one covering most "
+                                     "frames).", Integer(0, optional=True), flag="--class")
+    time_axis: str = option("smooth", "Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) "
+                                      "or line.", Choice(TIME_AXES), flag="--time")
+    amc_fps: float = fields.amc_fps()
+
+
+def run(take, options: Options | None = None) -> Report:
+    """Extract one seamless cycle; ``motions["loop"]`` is it repeated ``cycles`` times with the chosen root.
+
+    Raises :class:`~mocycle.errors.NoPeriodicMotion` when the take holds no periodic motion.
+    """
+    from ..cycle import extract_cycle, loop_metrics
+
+    o = options or Options()
+    with Recorder() as rec:
+        motion = load(take, o.amc_fps)
+        start, stop = parse_range(o.frame_range, motion.n_frames)
+        motion = motion[start:stop]
+        with rec.part("cycle"):
+            cycle = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
+                                  time_axis_method=o.time_axis, joints=o.joints, classes=o.classes, which=o.which,
+                                  phase_step=o.step)
+            result = cycle.repeat(o.cycles, root=o.root)
+        with rec.part("metrics"):
+            metrics = loop_metrics(motion, cycle)
+        facts = {
+            "frames_in": motion.n_frames,
+            "frames_out": result.n_frames,
+            "fps": motion.fps,
+            **cycle.to_dict(),
+            "model": o.model if o.method == "harmonic" else None,
+            "root": o.root,
+            "cycles": o.cycles,
+            "metrics": metrics,
+            "excited_regions": len(cycle.periodic.excitation),
+        }
+    return rec.report("loop", facts, {"loop": result, "input": motion}, cycle)

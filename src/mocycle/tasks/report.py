@@ -1,0 +1,109 @@
+"""What a task returns: a :class:`Report` (figures, warnings, labelled times, output motions) and the
+:class:`Recorder` that times a task and collects its warnings."""
+
+from __future__ import annotations
+
+import os
+import time
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..io import read
+from ..io.asfamc import AMC_FPS
+from ..motion import Motion
+
+__all__ = ["Recorder", "Report", "load", "label_of"]
+
+
+@dataclass(frozen=True)
+class Report:
+    """The outcome of one task run.
+
+    task : the task's name (``"loop"``, ...).
+    facts : the figures a user asks for, JSON-ready (what ``mocycle <task> --json`` prints, timing aside).
+    warnings : the warnings raised while the task ran, as text.
+    timings_s : wall-clock seconds, labelled: ``"total"`` always, parts such as ``"metrics"`` when measured.
+    motions : the output motion(s) by role (``{"loop": Motion}``); not part of :meth:`to_dict` (write them
+        with ``mocycle.write``).
+    result : the library's own result object (e.g. a ``Cycle``), for plots; not part of :meth:`to_dict`.
+    """
+
+    task: str
+    facts: Mapping
+    warnings: tuple[str, ...] = ()
+    timings_s: Mapping[str, float] = field(default_factory=dict)
+    motions: Mapping[str, Motion] = field(default_factory=dict, compare=False, repr=False)
+    result: object = field(default=None, compare=False, repr=False)
+
+    @property
+    def seconds(self) -> float:
+        """Total wall-clock time of the run, seconds."""
+        return float(self.timings_s.get("total", 0.0))
+
+    def to_dict(self) -> dict:
+        """JSON-ready: ``task``, ``facts``, ``warnings``, ``timings_s`` (motions and result excluded)."""
+        return {"task": self.task, "facts": dict(self.facts), "warnings": list(self.warnings),
+                "timings_s": dict(self.timings_s)}
+
+    @classmethod
+    def from_dict(cls, data: Mapping) -> Report:
+        """The inverse of :meth:`to_dict` (the report comes back without motions and result)."""
+        return cls(task=data["task"], facts=dict(data["facts"]), warnings=tuple(data.get("warnings", ())),
+                   timings_s=dict(data.get("timings_s", {})))
+
+
+class Recorder:
+    """``with Recorder() as rec: ...`` times the block and records its warnings; ``rec.part("metrics")``
+    times a part. On an exception the recorded warnings are issued again so the caller still sees them."""
+
+    def __enter__(self) -> Recorder:
+        self._catcher = warnings.catch_warnings(record=True)
+        self._caught = self._catcher.__enter__()
+        warnings.simplefilter("always")
+        self.timings_s: dict[str, float] = {}
+        self._t0 = time.perf_counter()
+        return self
+
+    def __exit__(self, kind, value, traceback) -> bool:
+        self.timings_s["total"] = time.perf_counter() - self._t0
+        self._catcher.__exit__(kind, value, traceback)
+        kept = [w for w in self._caught if not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning))]
+        self.warnings = tuple(str(w.message) for w in kept)
+        if kind is not None:
+            for w in kept:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        return False
+
+    def part(self, label: str) -> _Part:
+        return _Part(self.timings_s, label)
+
+    def report(self, task: str, facts: Mapping, motions: Mapping[str, Motion] | None = None,
+               result: object = None) -> Report:
+        return Report(task=task, facts=facts, warnings=self.warnings, timings_s=dict(self.timings_s),
+                      motions=dict(motions or {}), result=result)
+
+
+class _Part:
+    def __init__(self, timings: dict, label: str):
+        self.timings, self.label = timings, label
+
+    def __enter__(self):
+        self.t0 = time.perf_counter()
+
+    def __exit__(self, *exc):
+        self.timings[self.label] = self.timings.get(self.label, 0.0) + time.perf_counter() - self.t0
+        return False
+
+
+def load(item: Motion | str | os.PathLike, amc_fps: float = AMC_FPS) -> Motion:
+    """A task input: a :class:`Motion` as is, or a motion file read (``amc_fps``: AMC files only)."""
+    if isinstance(item, Motion):
+        return item
+    return read(item, fps=amc_fps)
+
+
+def label_of(item, k: int = 0) -> str:
+    """How messages name an input: its path, or ``take k`` for a motion in memory."""
+    return f"take {k}" if isinstance(item, Motion) else str(Path(item)) if not isinstance(item, str) else item

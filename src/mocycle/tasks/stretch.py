@@ -1,0 +1,39 @@
+"""``stretch``: lengthen a take by time-frequency warping (paper 004), keeping its cycle."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from . import fields
+from .options import Integer, Real, option
+from .options import Options as _Options
+from .report import Recorder, Report, load
+
+LABELS = {
+    "factor": ("length ratio", ""), "frames_in": ("frames in", ""), "frames_out": ("frames out", ""),
+    "windows": ("window per joint group", "frames"), "cycles": ("fundamental cycle per joint group", "frames"),
+    "trend_curves": ("warped as line + residual", ""),
+}
+
+
+@dataclass(frozen=True)
+class Options(_Options):
+    """Options of ``stretch``."""
+
+    factor: float = option(help="Length ratio: 2 doubles the take (frames out = round(frames * F)).",
+                           check=Real(0, low_open=True))
+    window: int | str = option("auto", "Block length in frames: 'auto' (each joint group's largest fundamental "
+                                       "cycle) or N.", Integer(1, words={"auto": "auto"}))
+    amc_fps: float = fields.amc_fps()
+
+
+def run(take, options: Options) -> Report:
+    """The take lengthened by ``options.factor``: ``motions["stretched"]``; the windows used in ``facts``."""
+    from ..warp import stretch_motion
+
+    with Recorder() as rec:
+        motion = load(take, options.amc_fps)
+        result, report = stretch_motion(motion, options.factor, window=options.window)
+        facts = {**report.to_dict(), "fps": motion.fps,
+                 "joints_per_group": {g: len(names) for g, names in report.groups.items()}}
+    return rec.report("stretch", facts, {"stretched": result, "input": motion}, report)

@@ -1,0 +1,45 @@
+"""``transition``: from the first take's cycle to the second's (paper 001 §4.5, a homotopy of loops)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ..errors import OptionError
+from . import fields
+from .options import Options as _Options
+from .report import Recorder, Report, label_of, load
+
+LABELS = {
+    "period_frames_start": ("period at the start", "frames"), "period_frames_end": ("period at the end", "frames"),
+    "phase_offset": ("phase offset of the second", "cycles"),
+    "smoothness": ("largest step / velocity change", "× neighbours' median"), "frames": ("frames", ""),
+}
+
+
+@dataclass(frozen=True)
+class Options(_Options):
+    """Options of ``transition``."""
+
+    cycles: int = fields.cycles(3, "Cycles over which the weight moves from the first to the second.")
+    root: str = fields.root("motion", "motion (travels on) or inplace (on the spot).")
+    method: str = fields.method()
+    model: str = fields.model()
+    harmonics: int | str = fields.harmonics()
+    amc_fps: float = fields.amc_fps()
+
+
+def run(takes: Sequence, options: Options | None = None) -> Report:
+    """A motion that starts as the first take's cycle and ends as the second's (``motions["transition"]``)."""
+    from ..cycle.blend import transition, transition_smoothness
+
+    o = options or Options()
+    takes = list(takes)
+    if len(takes) != 2:
+        raise OptionError("takes", f"must be two takes (first, second); got {len(takes)}")
+    with Recorder() as rec:
+        a, b = (load(t, o.amc_fps) for t in takes)
+        result = transition(a, b, o.cycles, root=o.root, labels=[label_of(t, k) for k, t in enumerate(takes)],
+                            method=o.method, model=o.model, n_harmonics=o.harmonics)
+        facts = {**result.to_dict(), "root": o.root, "smoothness": transition_smoothness(result)}
+    return rec.report("transition", facts, {"transition": result.motion}, result)
