@@ -181,5 +181,6 @@ def schema(options_cls: type[Options]) -> dict:
             required.append(f.name)
         props[f.name] = prop
     doc = (options_cls.__doc__ or "").strip().splitlines()
-    return {"title": f"{options_cls.__module__.rsplit('.', 1)[-1]}.{options_cls.__name__}", "description": doc[0] if doc else "", "type": "object",
+    title = f"{options_cls.__module__.rsplit('.', 1)[-1]}.{options_cls.__name__}"
+    return {"title": title, "description": doc[0] if doc else "", "type": "object",
             "properties": props, "required": required, "additionalProperties": False}
