@@ -9,6 +9,5 @@ Each command lives in its own module here and registers itself on ``app``.
 # Importing a command module registers its command; this order is the order in --help.
 from . import info, convert, phase, loop, blend, stretch, swings, keyframes, demo  # noqa: F401, I001
 from .common import app, main
-from .info import motion_info
 
-__all__ = ["app", "main", "motion_info"]
+__all__ = ["app", "main"]

@@ -2,38 +2,19 @@
 
 from __future__ import annotations
 
-import json
-import time
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 
-from ..errors import MocycleError
-from ..io import read_motion as read
+from .. import tasks
 from ..io import write
-from .common import app, check_suffix, count_option, friendly, out
+from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
 
-METHOD_HELP = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."
-MODEL_HELP = "Harmonic model: M1, M2 or M3 (see mocycle loop)."
-HARMONICS_HELP = "Harmonics K: 'auto' (20, capped by the frames) or a number."
-
-
-def _parse_weights(text: str | None, n: int) -> list[float] | None:
-    if text is None:
-        return None
-    try:
-        values = [float(v) for v in text.split(",")]
-    except ValueError:
-        raise MocycleError(f"--weights must be {n} comma-separated numbers >= 0 (e.g. 0.7,0.3); got {text!r}") \
-            from None
-    if len(values) != n:
-        raise MocycleError(f"--weights needs {n} numbers, one per take; got {len(values)} in {text!r}")
-    return values
-
-
-def _read_all(paths: list[Path], fps: float) -> list:
-    return [read(p, fps=fps) for p in paths]
+B = tasks.blend.Options
+T = tasks.transition.Options
+PLOT_HELP = "Write a PNG: the most moving joint curves of the result and of the inputs' cycles."
 
 
 @app.command()
@@ -41,53 +22,41 @@ def _read_all(paths: list[Path], fps: float) -> list:
 def blend(
     paths: Annotated[list[Path], typer.Argument(help="Two or more .bvh (or .amc) takes on one skeleton.")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The blended loop as a .bvh file.")],
-    weights: Annotated[str | None, typer.Option(
-        help="One weight >= 0 per take, comma-separated (normalised to sum 1); default equal.")] = None,
-    root: Annotated[str, typer.Option(help="inplace (on the spot) or motion (moves on by the blended stride).")]
-    = "inplace",
-    cycles: Annotated[int, typer.Option(help="Repeat the loop this many times in the output.")] = 1,
-    method: Annotated[str, typer.Option(help=METHOD_HELP)] = "harmonic",
-    model: Annotated[str, typer.Option(help=MODEL_HELP)] = "M1",
-    harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
-    align: Annotated[bool, typer.Option(help="Search each take's phase offset against the first.")] = True,
+    weights: Annotated[str | None, flag(B, "weights")] = default(B, "weights"),
+    root: Annotated[str, flag(B, "root")] = default(B, "root"),
+    cycles: Annotated[int, flag(B, "cycles")] = default(B, "cycles"),
+    method: Annotated[str, flag(B, "method")] = default(B, "method"),
+    model: Annotated[str, flag(B, "model")] = default(B, "model"),
+    harmonics: Annotated[str, flag(B, "harmonics")] = default(B, "harmonics"),
+    align: Annotated[bool, flag(B, "align")] = default(B, "align"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    plot: Annotated[Path | None, typer.Option(help=PLOT_HELP)] = None,
+    amc_fps: Annotated[float, flag(B, "amc_fps")] = default(B, "amc_fps"),
 ):
     """Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).
 
     Each take's cycle is extracted, brought to the first one's phase, resampled to the weighted period and
     averaged with the weights in rotation space; root sway and travel per cycle are blended likewise.
-    Exit code 0 on success, 3 when a take holds no periodic motion, 1 for bad input.
+    Exit code 0 on success, 3 when a take holds no periodic motion, 1 for bad input, 2 for a bad option.
     """
-    from ..cycle.blend import blend_cycles, check_weights, cycle_seam
-
-    t0 = time.perf_counter()
-    if len(paths) < 2:
-        raise MocycleError(f"blend needs at least two takes; got {len(paths)}")
     check_suffix(output, ".bvh")
-    if cycles < 1:
-        raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
-    w = _parse_weights(weights, len(paths))
-    if w is not None:
-        check_weights(w, len(paths))  # refuse bad weights before the (slower) extraction
-    motions = _read_all(paths, fps)
-    result = blend_cycles(motions, w, align=align, labels=[str(p) for p in paths], method=method, model=model,
-                          n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
-    write(result.repeat(cycles, root=root), output)
-    seconds = time.perf_counter() - t0
-    facts = {
-        "files": [str(p) for p in paths],
-        "output": str(output),
-        **result.to_dict(),
-        "frames_out": result.n_frames * cycles,
-        "root": root,
-        "cycles": cycles,
-        "seam": result.seam(),
-        "input_seams": [cycle_seam(c) for c in result.inputs],
-        "seconds": seconds,
-    }
+    check_suffix(plot, ".png", "--plot")
+    options = B(weights=weights, root=root, cycles=cycles, method=method, model=model, harmonics=harmonics,
+                align=align, amc_fps=amc_fps)
+    report = tasks.blend.run(paths, options)
+    print_warnings(report)
+    write(report.motions["loop"], output)
+    result = report.result
+    if plot is not None:
+        from ..viz import plot_curves
+
+        loops = [("blend", result.motion("inplace"))] + [(p.name, c.motion("inplace"))
+                                                         for p, c in zip(paths, result.inputs, strict=True)]
+        plot_curves([(label, m, np.arange(m.n_frames) / m.n_frames) for label, m in loops], plot,
+                    title=f"blend of {len(paths)} takes", xlabel="phase (cycles)")
+    facts = {"files": [str(p) for p in paths], "output": str(output), **report.facts, "seconds": report.seconds}
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print_json(facts)
         return
     out.print(f"[bold]blend[/] of {len(paths)} takes, weights "
               + ", ".join(f"{p.name} {x:.3g}" for p, x in zip(paths, result.weights, strict=True)))
@@ -99,7 +68,10 @@ def blend(
               f"turn {facts['turn_per_cycle_deg']:.3g}°")
     seam = facts["seam"]
     out.print(f"  seam jump: pose {seam['seam_pose']:.3g}, velocity {seam['seam_velocity']:.3g} (× median step)")
-    out.print(f"wrote {output}: {facts['frames_out']} frames ({cycles} cycle(s), root {root}) in {seconds:.2f} s")
+    out.print(f"wrote {output}: {facts['frames_out']} frames ({cycles} cycle(s), root {root})")
+    if plot is not None:
+        out.print(f"wrote {plot}")
+    out.print(timing_line(report))
 
 
 @app.command()
@@ -108,42 +80,36 @@ def transition(
     first: Annotated[Path, typer.Argument(help="The take to start as (.bvh or .amc).")],
     second: Annotated[Path, typer.Argument(help="The take to end as, on the same skeleton.")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The transition as a .bvh file.")],
-    cycles: Annotated[int, typer.Option(help="Cycles over which the weight moves from the first to the second.")]
-    = 3,
-    root: Annotated[str, typer.Option(help="motion (travels on) or inplace (on the spot).")] = "motion",
-    method: Annotated[str, typer.Option(help=METHOD_HELP)] = "harmonic",
-    model: Annotated[str, typer.Option(help=MODEL_HELP)] = "M1",
-    harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
+    cycles: Annotated[int, flag(T, "cycles")] = default(T, "cycles"),
+    root: Annotated[str, flag(T, "root")] = default(T, "root"),
+    method: Annotated[str, flag(T, "method")] = default(T, "method"),
+    model: Annotated[str, flag(T, "model")] = default(T, "model"),
+    harmonics: Annotated[str, flag(T, "harmonics")] = default(T, "harmonics"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    plot: Annotated[Path | None, typer.Option(
+        help="Write a PNG: the most moving joint curves over the transition's phase, and the weight.")] = None,
+    amc_fps: Annotated[float, flag(T, "amc_fps")] = default(T, "amc_fps"),
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
     The weight moves by a smoothstep over the cycles; period and phase stay continuous (the phase is
     integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion.
     """
-    from ..cycle.blend import transition as make_transition
-    from ..cycle.blend import transition_smoothness
-
-    t0 = time.perf_counter()
     check_suffix(output, ".bvh")
-    if cycles < 1:
-        raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
-    a, b = _read_all([first, second], fps)
-    result = make_transition(a, b, cycles, root=root, labels=[str(first), str(second)], method=method,
-                             model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
-    write(result.motion, output)
-    seconds = time.perf_counter() - t0
-    facts = {
-        "files": [str(first), str(second)],
-        "output": str(output),
-        **result.to_dict(),
-        "root": root,
-        "smoothness": transition_smoothness(result),
-        "seconds": seconds,
-    }
+    check_suffix(plot, ".png", "--plot")
+    options = T(cycles=cycles, root=root, method=method, model=model, harmonics=harmonics, amc_fps=amc_fps)
+    report = tasks.transition.run([first, second], options)
+    print_warnings(report)
+    write(report.motions["transition"], output)
+    if plot is not None:
+        from ..viz import plot_curves
+
+        tr = report.result
+        plot_curves([("transition", tr.motion, tr.phase)], plot, weights=tr.weights, xlabel="phase (cycles)",
+                    title=f"transition {first.name} -> {second.name} over {cycles} cycle(s)")
+    facts = {"files": [str(first), str(second)], "output": str(output), **report.facts, "seconds": report.seconds}
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print_json(facts)
         return
     out.print(f"[bold]transition[/] {first.name} -> {second.name} over {cycles} cycle(s)")
     out.print(f"  period {facts['period_frames_start']:.2f} -> {facts['period_frames_end']:.2f} frames; "
@@ -151,4 +117,7 @@ def transition(
     sm = facts["smoothness"]
     out.print(f"  largest step {sm['step_local']:.3g} × its neighbours' median (inputs {sm['input_step_local']:.3g}); "
               f"largest velocity change {sm['velocity_local']:.3g} × (inputs {sm['input_velocity_local']:.3g})")
-    out.print(f"wrote {output}: {facts['frames']} frames (root {root}) in {seconds:.2f} s")
+    out.print(f"wrote {output}: {facts['frames']} frames (root {root})")
+    if plot is not None:
+        out.print(f"wrote {plot}")
+    out.print(timing_line(report))

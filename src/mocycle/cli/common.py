@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import sys
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from functools import wraps
 from pathlib import Path
 from typing import Annotated
@@ -13,7 +15,10 @@ import typer
 from rich.console import Console
 
 from .. import __version__
-from ..errors import MocycleError, NoPeriodicMotion
+from ..errors import MocycleError, NoPeriodicMotion, OptionError
+from ..tasks import TASKS
+from ..tasks.loop import parse_range  # noqa: F401  (convert uses it)
+from ..tasks.options import MISSING, flag_of
 
 app = typer.Typer(
     name="mocycle",
@@ -21,17 +26,29 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # plain click help: flags show as `--json`, not `--json <bool>`
 )
 out = Console(highlight=False)
 err = Console(stderr=True, highlight=False)
 
 EXIT_ERROR = 1
+EXIT_USAGE = 2  # a bad option value (typer/click use 2 for usage errors too)
 EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion
+
+#: parameter names of the library -> the CLI flag that sets them (every task option, and a few library names)
+FLAGS = {f.name: flag_of(f) for task in TASKS.values() for f in dataclasses.fields(task.Options)}
+FLAGS.update({"n_harmonics": "--harmonics", "time_axis_method": "--time", "phase_step": "--step",
+              "n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles"})
+
+
+def option_message(exc: OptionError) -> str:
+    """The error with the flag instead of the library's parameter name (``--cycles must be ...``)."""
+    return f"{FLAGS.get(exc.parameter, exc.parameter)} {exc.reason}"
 
 
 def friendly(func: Callable) -> Callable:
-    """Run a command: MocycleError -> one 'error:' line and exit 1 (3 for NoPeriodicMotion); warnings ->
-    'warning:' lines."""
+    """Run a command: MocycleError -> one 'error:' line and exit 1 (2 for a bad option value, 3 for
+    NoPeriodicMotion); warnings (the command's and its reports') -> 'warning:' lines."""
 
     @wraps(func)
     def wrapper(*args, **kwargs):
@@ -39,6 +56,10 @@ def friendly(func: Callable) -> Callable:
             warnings.simplefilter("always")
             try:
                 result = func(*args, **kwargs)
+            except OptionError as exc:
+                _print_warnings(caught)
+                err.print(f"[bold red]error:[/] {option_message(exc)}", markup=True, soft_wrap=True)
+                raise typer.Exit(EXIT_USAGE) from None
             except MocycleError as exc:
                 _print_warnings(caught)
                 err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
@@ -56,6 +77,12 @@ def _print_warnings(caught) -> None:
         err.print(f"[yellow]warning:[/] {w.message}", markup=True, soft_wrap=True)
 
 
+def print_warnings(report) -> None:
+    """The warnings a task recorded in its report, as 'warning:' lines."""
+    for text in report.warnings:
+        err.print(f"[yellow]warning:[/] {text}", markup=True, soft_wrap=True)
+
+
 def _version(value: bool):
     if value:
         out.print(f"mocycle {__version__}")
@@ -71,29 +98,45 @@ def main_options(
 
 
 
+# ------------------------------------------------------------ options derived from the task Options
+def _field(options_cls, name: str) -> dataclasses.Field:
+    for f in dataclasses.fields(options_cls):
+        if f.name == name:
+            return f
+    raise KeyError(f"{options_cls.__module__}.Options has no field {name!r}")
+
+
+def flag(options_cls, name: str, *short: str, **kwargs) -> typer.models.OptionInfo:
+    """The typer option of an Options field: its flag (plus short names) and its help line."""
+    f = _field(options_cls, name)
+    return typer.Option(flag_of(f), *short, help=f.metadata.get("help", ""), **kwargs)
+
+
+def default(options_cls, name: str):
+    """The default of an Options field (what the CLI flag defaults to); ``...`` for a required one."""
+    d = _field(options_cls, name).default
+    return ... if d is MISSING else d
+
+
+def as_flag_text(value) -> str:
+    return value if isinstance(value, str) else str(value)
+
+
+def timing_line(report) -> str:
+    """``time 2.42 s`` (with the labelled parts when there are several)."""
+    parts = [f"{k} {v:.2f} s" for k, v in report.timings_s.items() if k != "total"]
+    return f"  time {report.seconds:.2f} s" + (f" ({', '.join(parts)})" if parts else "")
+
+
+def print_json(facts: Mapping, indent: int | None = 2) -> None:
+    print(json.dumps(facts, indent=indent))
+
+
 # ------------------------------------------------------------ option parsing
 def check_suffix(path: Path | None, suffix: str, option: str = "-o") -> None:
     """Refuse an output path without the expected suffix, before any work is done (nothing gets written)."""
     if path is not None and path.suffix.lower() != suffix:
         raise MocycleError(f"{path}: {option} must name a {suffix} file")
-
-
-def parse_range(text: str | None, n_frames: int) -> tuple[int, int]:
-    if not text:
-        return 0, n_frames
-    try:
-        a, _, b = text.partition(":")
-        start = int(a) if a.strip() else 0
-        stop = int(b) if b.strip() else n_frames
-    except ValueError:
-        raise MocycleError(f"--range must look like START:STOP (frame numbers); got {text!r}") from None
-    if start < 0:
-        start += n_frames
-    if stop < 0:
-        stop += n_frames
-    if not 0 <= start < stop <= n_frames:
-        raise MocycleError(f"--range {text} is outside the take's {n_frames} frames")
-    return start, stop
 
 
 def count_option(text: str, option: str, words: dict[str, object]) -> object:

@@ -8,8 +8,8 @@ from typing import Annotated
 import typer
 
 from ..errors import MocycleError
+from ..io import AMC_FPS, write
 from ..io import read_motion as read
-from ..io import write
 from .common import app, friendly, out, parse_range
 
 
@@ -18,8 +18,10 @@ from .common import app, friendly, out, parse_range
 def convert(
     paths: Annotated[list[Path], typer.Argument(
         help="Input then output: IN.bvh OUT.bvh, or SKELETON.asf MOTION.amc OUT.bvh.")],
-    fps: Annotated[float | None, typer.Option(help="Resample to this frame rate (slerp).")] = None,
-    amc_fps: Annotated[float, typer.Option(help="Frame rate of the AMC input (CMU: 120).")] = 120.0,
+    fps: Annotated[float | None, typer.Option(
+        help="Resample the output to this frame rate (slerp; the first and last frame's times are kept).")] = None,
+    amc_fps: Annotated[float, typer.Option(
+        help="Frame rate of AMC input files, which do not store it (CMU: 120).")] = AMC_FPS,
     frame_range: Annotated[str | None, typer.Option("--range", help="Keep frames START:STOP.")] = None,
 ):
     """Convert ASF/AMC to BVH, or rewrite a BVH (optionally a frame range, another fps)."""

@@ -23,8 +23,8 @@ def demo(
     """Loop the built-in synthetic walk: write the take, its cycle (BVH) and the loop plot."""
     from ..cycle import extract_cycle, loop_metrics
     from ..datasets import synthetic_walk
+    from ..tasks.loop import METRIC_LABELS
     from ..viz import plot_loop
-    from .loop import METRIC_LABELS
 
     t0 = time.perf_counter()
     take = synthetic_walk(seed=seed, noise_deg=1.0, speed_change=0.1)
@@ -45,5 +45,5 @@ def demo(
                 "input_foot_sliding"):
         label, unit = METRIC_LABELS[key]
         out.print(f"  {label:28s} {metrics[key]:8.3f} {unit}")
-    out.print(f"wrote {loop_file} (one cycle, in place), {walk_file} (4 cycles walking on), {plot} "
-              f"in {time.perf_counter() - t0:.2f} s")
+    out.print(f"wrote {loop_file} (one cycle, in place), {walk_file} (4 cycles walking on), {plot}")
+    out.print(f"  time {time.perf_counter() - t0:.2f} s")

@@ -2,21 +2,17 @@
 
 from __future__ import annotations
 
-import json
-import time
 from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.table import Table
 
-from ..io import read_motion as read
+from .. import tasks
 from ..io import write
-from .common import app, check_suffix, friendly, out
+from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
 
-_SELECT_HELP = "Keyframe selection: uniform, scs (curve simplification), pb (position based) or rols."
-_PROJECTION_HELP = "2-D projection of the spatial scheme: pca, mds, isomap, lle, force, tsne, rbfp or lamp."
-_SEED_HELP = "First-step projection of rbfp and lamp (the keyframes' 2-D places): pca, mds, isomap, lle, force, tsne."
+C = tasks.compress.Options
+P = tasks.project.Options
 
 
 @app.command()
@@ -24,50 +20,43 @@ _SEED_HELP = "First-step projection of rbfp and lamp (the keyframes' 2-D places)
 def compress(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="The .mck file to write.")],
-    ratio: Annotated[float, typer.Option(help="Keyframes as a fraction of the frames (thesis: 0.03).")] = 0.03,
-    select: Annotated[str, typer.Option(help=_SELECT_HELP)] = "uniform",
-    scheme: Annotated[str, typer.Option(
-        help="Reconstruction: linear, hermite (Euler angles), slerp (quaternions), rbf (1-D RBF in time) or "
-             "spatial (2-D projection + Igarashi back-projection).")] = "slerp",
-    projection: Annotated[str, typer.Option(help=_PROJECTION_HELP)] = "mds",
-    seed: Annotated[str, typer.Option(help=_SEED_HELP)] = "mds",
-    optimize: Annotated[bool, typer.Option("--optimize", help="Optimise the 2-D trajectory (Algorithm 12).")] = False,
+    ratio: Annotated[float, flag(C, "ratio")] = default(C, "ratio"),
+    select: Annotated[str, flag(C, "select")] = default(C, "select"),
+    scheme: Annotated[str, flag(C, "scheme")] = default(C, "scheme"),
+    projection: Annotated[str, flag(C, "projection")] = default(C, "projection"),
+    seed_projection: Annotated[str, flag(C, "seed_projection")] = default(C, "seed_projection"),
+    optimize: Annotated[bool, flag(C, "optimize")] = default(C, "optimize"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    amc_fps: Annotated[float, flag(C, "amc_fps")] = default(C, "amc_fps"),
 ):
     """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size."""
-    from ..keyframes import compress as compress_motion
-    from ..keyframes import error_per_frame_per_joint
-
     check_suffix(output, ".mck")
-    t0 = time.perf_counter()
-    motion = read(path, fps=fps)
-    packed = compress_motion(motion, ratio=ratio, select=select, scheme=scheme, projection=projection,
-                             optimize=optimize, seed=seed)
-    rebuilt = packed.decompress()
-    packed.save(output)
-    bvh_bytes = path.stat().st_size if path.suffix.lower() == ".bvh" else None
-    size = packed.size_report(bvh_bytes)
-    facts = {"frames": motion.n_frames, "keyframes": packed.n_keyframes,
-             "error_per_frame_per_joint": error_per_frame_per_joint(motion, rebuilt),
-             "compressed_bytes": size["compressed_bytes"], "bvh_bytes": size["bvh_bytes"],
-             "seconds": time.perf_counter() - t0}
+    options = C(ratio=ratio, select=select, scheme=scheme, projection=projection, seed_projection=seed_projection,
+                optimize=optimize, amc_fps=amc_fps)
+    report = tasks.compress.run(path, options)
+    print_warnings(report)
+    report.result.save(output)
+    r = report.facts
+    facts = {k: r[k] for k in ("frames", "keyframes", "error_per_frame_per_joint", "compressed_bytes", "bvh_bytes")}
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print_json({**facts, "seconds": report.seconds})
         return
+    from rich.table import Table
+
     what = scheme if scheme != "spatial" else f"spatial/{projection}" + ("/optimised" if optimize else "")
     table = Table(title=f"{path.name} -> {output.name} ({what}, {select} keyframes)")
     table.add_column("")
     table.add_column("value", justify="right")
-    table.add_row("frames", str(facts["frames"]))
-    table.add_row("keyframes", f"{facts['keyframes']} ({size['keyframe_ratio']:.1%})")
-    table.add_row("error per frame per joint (eq. 3.2, rad)", f"{facts['error_per_frame_per_joint']:.4f}")
-    table.add_row("compressed bytes", f"{facts['compressed_bytes']:,}")
-    table.add_row("BVH bytes", f"{facts['bvh_bytes']:,}")
-    table.add_row("real ratio", f"{size['real_ratio']:.2%}")
-    table.add_row("formula 5.2/5.3 ratio (h = 0)", f"{size['formula_ratio']:.2%}")
-    table.add_row("seconds", f"{facts['seconds']:.2f}")
+    table.add_row("frames", str(r["frames"]))
+    table.add_row("keyframes", f"{r['keyframes']} ({r['keyframe_ratio']:.1%})")
+    table.add_row("error per frame per joint (eq. 3.2, rad)", f"{r['error_per_frame_per_joint']:.4f}")
+    table.add_row("compressed bytes", f"{r['compressed_bytes']:,}")
+    table.add_row("BVH bytes", f"{r['bvh_bytes']:,}" if r["bvh_bytes"] is not None else "-")
+    table.add_row("real ratio", f"{r['real_ratio']:.2%}" if r["real_ratio"] is not None else "-")
+    table.add_row("formula 5.2/5.3 ratio (h = 0)", f"{r['formula_ratio']:.2%}")
+    table.add_row("time (s)", f"{report.seconds:.2f}")
     out.print(table)
+    out.print(f"wrote {output}")
 
 
 @app.command()
@@ -77,58 +66,54 @@ def decompress(
     output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh file to write.")],
 ):
     """Rebuild a take from its keyframes; the keyframes come back exactly."""
-    from ..keyframes import read_compressed
-
     check_suffix(output, ".bvh")
-    packed = read_compressed(path)
-    motion = packed.decompress()
-    write(motion, output)
-    out.print(f"{output}: {motion.n_frames} frames rebuilt from {packed.n_keyframes} keyframes ({packed.scheme})")
+    report = tasks.decompress.run(path)
+    print_warnings(report)
+    write(report.motions["motion"], output)
+    r = report.facts
+    out.print(f"{output}: {r['frames']} frames rebuilt from {r['keyframes']} keyframes ({r['scheme']})")
 
 
 @app.command()
 @friendly
 def project(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
-    projection: Annotated[str, typer.Option(help=_PROJECTION_HELP)] = "mds",
-    select: Annotated[str, typer.Option(help=_SELECT_HELP)] = "uniform",
-    ratio: Annotated[float, typer.Option(help="Keyframes as a fraction of the frames.")] = 0.03,
-    seed: Annotated[str, typer.Option(help=_SEED_HELP)] = "mds",
-    optimize: Annotated[bool, typer.Option("--optimize", help="Also optimise the projection (Algorithm 12) "
-                                                               "and plot both.")] = False,
+    projection: Annotated[str, flag(P, "projection")] = default(P, "projection"),
+    select: Annotated[str, flag(P, "select")] = default(P, "select"),
+    ratio: Annotated[float, flag(P, "ratio")] = default(P, "ratio"),
+    seed_projection: Annotated[str, flag(P, "seed_projection")] = default(P, "seed_projection"),
+    optimize: Annotated[bool, flag(P, "optimize")] = default(P, "optimize"),
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: poses as points coloured by time, keyframes "
                                                    "marked (thesis Figure 6.2).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON (includes the 2-D points).")] = False,
-    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    amc_fps: Annotated[float, flag(P, "amc_fps")] = default(P, "amc_fps"),
 ):
     """Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."""
-    from ..keyframes import PoseSpace, keyframe_count, optimize_projection, spatial_layout, stress
-
-    t0 = time.perf_counter()
-    motion = read(path, fps=fps)
-    space = PoseSpace(motion)
-    k = keyframe_count(motion.n_frames, ratio=ratio)
-    key, points = spatial_layout(space, projection, select, k, seed=seed)
-    opt = optimize_projection(points, key, motion.rotations, space.weights).points if optimize else None
-    facts = {"frames": motion.n_frames, "keyframes": key.tolist(), "projection": projection, "select": select,
-             "stress": stress(space.distances, points) if motion.n_frames > 1 else None}
-    if opt is not None:
-        facts["stress_optimized"] = stress(space.distances, opt)
+    check_suffix(plot, ".png", "--plot")
+    options = P(projection=projection, select=select, ratio=ratio, seed_projection=seed_projection,
+                optimize=optimize, amc_fps=amc_fps)
+    report = tasks.project.run(path, options)
+    print_warnings(report)
+    r, arrays = report.facts, report.result
     if plot is not None:
         from ..viz.keyframes import plot_projection
 
-        name = projection if projection not in ("rbfp", "lamp") else f"{projection} ({seed} seed)"
-        plot_projection(points, key, plot, title=f"{path.name}: {name}, {select} keyframes", optimized=opt,
-                        labels=(name, f"{name}, optimised (Algorithm 12)"))
-    facts["seconds"] = time.perf_counter() - t0
+        name = projection if projection not in ("rbfp", "lamp") else f"{projection} ({seed_projection} seed)"
+        plot_projection(arrays["points"], arrays["keyframes"], plot, title=f"{path.name}: {name}, {select} keyframes",
+                        optimized=arrays["optimized"], labels=(name, f"{name}, optimised (Algorithm 12)"))
     if as_json:
-        facts["points"] = points.round(6).tolist()
-        if opt is not None:
-            facts["points_optimized"] = opt.round(6).tolist()
-        print(json.dumps(facts))
+        facts = {k: v for k, v in r.items() if k not in ("points", "points_optimized")}
+        facts["seconds"] = report.seconds
+        facts["points"] = r["points"]
+        if "points_optimized" in r:
+            facts["points_optimized"] = r["points_optimized"]
+        print_json(facts, indent=None)
         return
-    out.print(f"[bold]{path}[/]: {facts['frames']} frames, {len(key)} keyframes ({select}), projection {projection}")
-    out.print(f"  stress (eq. 4.1): {facts['stress']:.4g}" + (
-        f", optimised {facts['stress_optimized']:.4g}" if opt is not None else ""))
-    out.print(f"  keyframes: {', '.join(map(str, key.tolist()))}", soft_wrap=True)
-    out.print(f"  {facts['seconds']:.2f} s")
+    out.print(f"[bold]{path}[/]: {r['frames']} frames, {len(r['keyframes'])} keyframes ({select}), "
+              f"projection {projection}")
+    out.print(f"  stress (eq. 4.1): {r['stress']:.4g}" + (
+        f", optimised {r['stress_optimized']:.4g}" if "stress_optimized" in r else ""))
+    out.print(f"  keyframes: {', '.join(map(str, r['keyframes']))}", soft_wrap=True)
+    if plot is not None:
+        out.print(f"wrote {plot}")
+    out.print(timing_line(report))

@@ -2,63 +2,58 @@
 
 from __future__ import annotations
 
-import json
-import time
 from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.table import Table
 
-from ..errors import MocycleError
-from ..io import read_motion as read
-from .common import EXIT_NOT_FOUND, app, count_option, err, friendly, out
+from .. import tasks
+from .common import EXIT_NOT_FOUND, app, default, err, flag, friendly, out, print_json, print_warnings, timing_line
+
+O = tasks.phase.Options
 
 
 @app.command()
 @friendly
 def phase(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
-    classes: Annotated[str, typer.Option(help="Number of periodic motions: 'auto' or N.")] = "auto",
-    joints: Annotated[str | None, typer.Option(
-        help="Joints to use: names, glob patterns or groups (legs, arms, spine), comma-separated.")] = None,
-    pca: Annotated[str, typer.Option(help="PCA dimensions before the cohomology: 'auto' (8), N or 'none'.")] = "auto",
-    delay: Annotated[int, typer.Option(help="Delay embedding factor m (KTH thesis eq. 3.26; it used 2).")] = 2,
-    landmarks: Annotated[int, typer.Option(help="Landmarks for the Rips filtration.")] = 120,
+    classes: Annotated[str, flag(O, "classes")] = default(O, "classes"),
+    joints: Annotated[str | None, flag(O, "joints")] = default(O, "joints"),
+    pca: Annotated[str, flag(O, "pca")] = default(O, "pca"),
+    delay: Annotated[int, flag(O, "delay")] = default(O, "delay"),
+    landmarks: Annotated[int, flag(O, "n_landmarks")] = default(O, "n_landmarks"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: diagram, phase per frame, PCA by phase.")] = None,
-    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
 ):
     """Find periodic motions and the phase of every frame (persistent cohomology).
 
     Exit code 0 when at least one periodic motion is found, 3 when none is
-    (the reason is printed), 1 for bad input.
+    (the reason is printed), 1 for bad input, 2 for a bad option.
     """
-    from ..phase import find_phase
-
-    if delay < 0:
-        raise MocycleError(f"--delay must be >= 0; got {delay}")
-    t0 = time.perf_counter()
-    motion = read(path, fps=fps)
-    result = find_phase(motion, classes=count_option(classes, "--classes", {"auto": "auto"}), joints=joints,
-                        pca=count_option(pca, "--pca", {"auto": "auto", "none": None, "0": None}),
-                        delay=delay, n_landmarks=landmarks, keep_features=plot is not None)
+    options = O(classes=classes, joints=joints, pca=pca, delay=delay, n_landmarks=landmarks, amc_fps=amc_fps)
+    report = tasks.phase.run(path, options)
+    print_warnings(report)
     if plot is not None:
         from ..viz import plot_phase
 
-        plot_phase(result, plot, title=path.name)
-    facts = result.to_dict()
-    facts["seconds"] = time.perf_counter() - t0
+        plot_phase(report.result, plot, title=path.name)
+    facts = {**report.facts, "seconds": report.seconds}
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print_json(facts)
     else:
-        _print_phase(path, facts)
-    if not result.classes:
-        err.print(f"no periodic motion found: {result.reason}", soft_wrap=True)
+        _print_phase(path, report)
+        if plot is not None:
+            out.print(f"wrote {plot}")
+    if not report.facts["classes"]:
+        err.print(f"no periodic motion found: {report.facts['reason']}", soft_wrap=True)
         raise typer.Exit(EXIT_NOT_FOUND)
 
 
-def _print_phase(path: Path, facts: dict) -> None:
+def _print_phase(path: Path, report) -> None:
+    from rich.table import Table
+
+    facts = report.facts
     out.print(f"[bold]{path}[/]: {facts['frames']} frames at {facts['fps']:.6g} fps")
     table = Table(title="periodic motions (H1 classes)")
     for col in ("class", "bar [birth, death)", "period frames", "period s", "periods", "excitation frames"):
@@ -72,6 +67,4 @@ def _print_phase(path: Path, facts: dict) -> None:
     acf = facts["autocorrelation_period_frames"]
     out.print(f"  autocorrelation period (cross-check): {'none' if acf is None else f'{acf:.2f} frames'}")
     out.print(f"  why: {facts['reason']}", soft_wrap=True)
-    out.print(f"  {facts['seconds']:.3f} s")
-
-
+    out.print(timing_line(report))

@@ -2,29 +2,31 @@
 
 from __future__ import annotations
 
-import json
-import time
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
-from rich.table import Table
 
-from ..io import read_motion as read
+from .. import tasks
 from ..io import write
-from .common import app, check_suffix, count_option, friendly, out
+from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
+
+O = tasks.stretch.Options
 
 
 @app.command()
 @friendly
 def stretch(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
-    factor: Annotated[float, typer.Option(help="Length ratio: 2 doubles the take (frames out = round(frames * F)).")],
+    factor: Annotated[float, flag(O, "factor")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The .bvh file to write.")],
-    window: Annotated[str, typer.Option(
-        help="Block length in frames: 'auto' (each joint group's largest fundamental cycle) or N.")] = "auto",
+    window: Annotated[str, flag(O, "window")] = default(O, "window"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    plot: Annotated[Path | None, typer.Option(
+        help="Write a PNG: the most moving joint curves of the input and the stretched take over the take's "
+             "length (0-1).")] = None,
+    amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
 
@@ -33,28 +35,36 @@ def stretch(
     uses its own fundamental cycle as the window; the travelling joint keeps
     its mean velocity.
     """
-    from ..warp import stretch_motion
-
     check_suffix(output, ".bvh")
-    win = count_option(window, "--window", {"auto": "auto"})
-    t0 = time.perf_counter()
-    motion = read(path, fps=fps)
-    result, report = stretch_motion(motion, factor, window=win)
-    write(result, output)
-    facts = report.to_dict()
-    facts["seconds"] = time.perf_counter() - t0
+    check_suffix(plot, ".png", "--plot")
+    report = tasks.stretch.run(path, O(factor=factor, window=window, amc_fps=amc_fps))
+    print_warnings(report)
+    write(report.motions["stretched"], output)
+    if plot is not None:
+        from ..viz import plot_curves
+
+        series = [(name, m, np.arange(m.n_frames) / max(m.n_frames - 1, 1))
+                  for name, m in (("stretched", report.motions["stretched"]), ("input", report.motions["input"]))]
+        plot_curves(series, plot, title=f"{path.name} stretched × {factor:g}", xlabel="fraction of the take")
+    facts = {**{k: v for k, v in report.facts.items() if k not in ("fps", "joints_per_group")},
+             "seconds": report.seconds}
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print_json(facts)
         return
-    out.print(f"[bold]{path}[/]: {report.frames_in} frames -> {output}: {report.frames_out} frames "
-              f"(factor {report.factor:g}, {motion.fps:.6g} fps)", soft_wrap=True)
+    from rich.table import Table
+
+    r = report.facts
+    out.print(f"[bold]{path}[/]: {r['frames_in']} frames -> {output}: {r['frames_out']} frames "
+              f"(factor {r['factor']:g}, {r['fps']:.6g} fps)", soft_wrap=True)
     table = Table(title="windows (frames)")
     for col in ("group", "window", "cycle found", "joints"):
         table.add_column(col, justify="left" if col in ("group", "joints") else "right")
-    for g, n in report.windows.items():
-        cycle = report.cycles[g]
-        table.add_row(g, str(n), "given" if cycle is None else f"{cycle:.2f}", str(len(report.groups[g])))
+    for g, n in r["windows"].items():
+        cycle = report.result.cycles[g]
+        table.add_row(g, str(n), "given" if cycle is None else f"{cycle:.2f}", str(r["joints_per_group"][g]))
     out.print(table)
-    if report.trend_curves:
-        out.print(f"  warped as line + residual: {', '.join(report.trend_curves)}", soft_wrap=True)
-    out.print(f"  {facts['seconds']:.3f} s")
+    if r["trend_curves"]:
+        out.print(f"  warped as line + residual: {', '.join(r['trend_curves'])}", soft_wrap=True)
+    if plot is not None:
+        out.print(f"wrote {plot}")
+    out.print(timing_line(report))

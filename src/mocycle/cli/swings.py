@@ -3,101 +3,90 @@
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.table import Table
 
+from .. import tasks
 from ..errors import MocycleError
-from ..io import read_motion as read
 from ..io import write
-from .common import app, check_suffix, friendly, out
+from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
 
-_JOINTS_HELP = "Joints to segment: names, glob patterns or groups (legs, arms, spine), comma-separated " \
-               "(default: the major bones, by name and motion energy)."
-_THRESHOLD_HELP = "Acceptable Swing Error, 0-2 (paper: 0.4; 0 accepts only perfectly geodesic swings)."
-
-
-def _load(path: Path, threshold: float, joints: str | None, fps: float):
-    """(motion or None, segmentation) from a motion file or a .mosw swings file."""
-    from ..swings import read_swings, segment
-
-    if path.suffix.lower() == ".mosw":
-        return None, read_swings(path)
-    motion = read(path, fps=fps)
-    return motion, segment(motion, threshold=threshold, joints=joints)
+S = tasks.swings.Options
+Q = tasks.search.Options
+E = tasks.edit.Options
+_FACT_KEYS = ("joints", "n_swings", "segmentation_error", "per_angle_error_deg", "geodesic_error_deg",
+              "compressed_bytes", "raw_float32_bytes")
 
 
 @app.command()
 @friendly
 def swings(
     path: Annotated[Path, typer.Argument(help="A .bvh or .amc file, or a .mosw swings file to play back.")],
-    threshold: Annotated[float, typer.Option(help=_THRESHOLD_HELP)] = 0.4,
-    joints: Annotated[str | None, typer.Option(help=_JOINTS_HELP)] = None,
+    threshold: Annotated[float, flag(S, "threshold")] = default(S, "threshold"),
+    joints: Annotated[str | None, flag(S, "joints")] = default(S, "joints"),
     output: Annotated[Path | None, typer.Option(
         "-o", "--output", help="Write the swings: .json (records) or .mosw (compact binary file).")] = None,
     playback_path: Annotated[Path | None, typer.Option(
         "--playback", help="Write the motion rebuilt from the swings as BVH.")] = None,
-    plot: Annotated[Path | None, typer.Option(help="Write a PNG: one row per joint, swings as bars in time.")] = None,
+    plot: Annotated[Path | None, typer.Option(
+        help="Write a PNG: one row per joint, swings as numbered bars in time (the numbers edit --swing takes).")]
+    = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    amc_fps: Annotated[float, flag(S, "amc_fps")] = default(S, "amc_fps"),
 ):
-    """Segment a take into joint swings and holds; report playback error and compressed size."""
-    from ..swings import encode, playback, playback_errors, size_report
+    """Segment a take into joint swings and holds; report playback error and compressed size.
 
+    The table lists each joint's swing indices (0-based, in time order): what `mocycle edit --swing` takes.
+    """
     if output is not None and output.suffix.lower() not in (".json", ".mosw"):
         raise MocycleError(f"-o {output}: the swings are written as .json or .mosw")
-    t0 = time.perf_counter()
-    motion, seg = _load(path, threshold, joints, fps)
-    seconds = time.perf_counter() - t0
-    rebuilt = playback(seg)
-    facts = {"joints": [seg.skeleton.names[j] for j in seg.joints], "n_swings": seg.n_swings}
-    if motion is not None:
-        errs = playback_errors(motion, rebuilt)
-        facts.update({k: errs[k] for k in ("segmentation_error", "per_angle_error_deg", "geodesic_error_deg")})
-        size = size_report(seg, motion)
-    else:
-        facts.update(segmentation_error=None, per_angle_error_deg=None, geodesic_error_deg=None)
-        size = size_report(seg)
-    facts.update(compressed_bytes=size["compressed_bytes"], raw_float32_bytes=size["raw_float32_bytes"],
-                 seconds=seconds)
+    check_suffix(playback_path, ".bvh", "--playback")
+    check_suffix(plot, ".png", "--plot")
+    report = tasks.swings.run(path, S(threshold=threshold, joints=joints, amc_fps=amc_fps))
+    print_warnings(report)
+    seg, r = report.result, report.facts
+    written = []
     if output is not None:
         from ..io.atomic import atomic_write
+        from ..swings import encode
 
-        if output.suffix.lower() == ".json":
-            atomic_write(output, json.dumps(seg.to_dict(), indent=1))
-        else:
-            atomic_write(output, encode(seg))
+        atomic_write(output, json.dumps(seg.to_dict(), indent=1) if output.suffix.lower() == ".json" else encode(seg))
+        written.append(f"{output} ({seg.n_swings} swings)")
     if playback_path is not None:
-        write(rebuilt, playback_path)
+        write(report.motions["playback"], playback_path)
+        written.append(f"{playback_path} (motion rebuilt from the swings)")
     if plot is not None:
         from ..viz.swings import plot_swings
 
         plot_swings(seg, plot, title=f"{path.name}: {seg.n_swings} swings (threshold {seg.threshold:g})")
+        written.append(str(plot))
+    facts = {**{k: r[k] for k in _FACT_KEYS}, "swing_indices": {row["joint"]: row["indices"] for row in r["per_joint"]},
+             "seconds": report.seconds}
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print_json(facts)
         return
-    out.print(f"[bold]{path}[/]: {seg.n_frames} frames at {seg.fps:.6g} fps, "
-              f"Acceptable Swing Error {seg.threshold:g}")
+    from rich.table import Table
+
+    out.print(f"[bold]{path}[/]: {r['frames']} frames at {r['fps']:.6g} fps, Acceptable Swing Error {r['threshold']:g}")
     table = Table(title="swings per joint")
-    for col in ("joint", "swings", "mean length s", "mean angle deg", "holds"):
+    for col in ("joint", "swings", "indices (edit --swing)", "mean length s", "mean angle deg", "holds"):
         table.add_column(col, justify="left" if col == "joint" else "right")
-    for j in seg.joints:
-        sw = seg.swings_of(j)
-        mlen = sum(s.end - s.start for s in sw) / len(sw) * seg.frame_time if sw else 0.0
-        mang = sum(abs(s.end_angle - s.start_angle) for s in sw) / len(sw) * 57.29577951308232 if sw else 0.0
-        table.add_row(seg.skeleton.names[j], str(len(sw)), f"{mlen:.3f}", f"{mang:.1f}", str(len(seg.holds_of(j))))
+    for row in r["per_joint"]:
+        table.add_row(row["joint"], str(row["swings"]), row["indices"] or "-", f"{row['mean_length_s']:.3f}",
+                      f"{row['mean_angle_deg']:.1f}", str(row["holds"]))
     out.print(table)
-    if facts["segmentation_error"] is not None:
-        out.print(f"  Segmentation Error {facts['segmentation_error']:.2f} deg "
-                  f"({facts['per_angle_error_deg']:.3f} deg per angle, the paper's measure); "
-                  f"geodesic {facts['geodesic_error_deg']:.2f} deg per joint")
-    out.print(f"  compressed {facts['compressed_bytes']} bytes = {size['ratio_raw']:.3f} of the raw float32 "
-              f"channels ({facts['raw_float32_bytes']} bytes)"
-              + (f", {size['ratio_bvh']:.3f} of the BVH text" if size["ratio_bvh"] else ""))
-    out.print(f"  {seconds:.3f} s")
+    if r["segmentation_error"] is not None:
+        out.print(f"  Segmentation Error {r['segmentation_error']:.2f} deg "
+                  f"({r['per_angle_error_deg']:.3f} deg per angle, the paper's measure); "
+                  f"geodesic {r['geodesic_error_deg']:.2f} deg per joint")
+    out.print(f"  compressed {r['compressed_bytes']} bytes = {r['ratio_raw']:.3f} of the raw float32 "
+              f"channels ({r['raw_float32_bytes']} bytes)"
+              + (f", {r['ratio_bvh']:.3f} of the BVH text" if r["ratio_bvh"] else ""))
+    for line in written:
+        out.print(f"wrote {line}")
+    out.print(timing_line(report))
 
 
 @app.command()
@@ -105,71 +94,56 @@ def swings(
 def search(
     query: Annotated[Path, typer.Argument(help="The example take (.bvh or .amc).")],
     folder: Annotated[Path, typer.Argument(help="Folder of takes to search.")],
-    top: Annotated[int, typer.Option(help="How many matches to print.")] = 10,
-    pattern: Annotated[str, typer.Option(help="File pattern in the folder.")] = "*.bvh",
-    threshold: Annotated[float, typer.Option(help=_THRESHOLD_HELP)] = 0.4,
-    window: Annotated[float, typer.Option(help="Sliding window length, seconds.")] = 1.0,
+    top: Annotated[int, flag(Q, "top")] = default(Q, "top"),
+    pattern: Annotated[str, flag(Q, "pattern")] = default(Q, "pattern"),
+    threshold: Annotated[float, flag(Q, "threshold")] = default(Q, "threshold"),
+    window: Annotated[float, flag(Q, "window_s")] = default(Q, "window_s"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    amc_fps: Annotated[float, flag(Q, "amc_fps")] = default(Q, "amc_fps"),
 ):
     """Rank the takes of a folder by how alike their swings are to an example (query by example)."""
-    from ..swings import build_index
-
-    if top < 1:
-        raise MocycleError(f"--top must be >= 1; got {top}")
-    t0 = time.perf_counter()
-    motion = read(query, fps=fps)
-    index = build_index(folder, pattern=pattern, threshold=threshold, window_s=window)
-    hits = index.query(motion, top=top, exclude=query)
-    seconds = time.perf_counter() - t0
+    options = Q(top=top, pattern=pattern, threshold=threshold, window_s=window, amc_fps=amc_fps)
+    report = tasks.search.run(query, folder, options)
+    print_warnings(report)
     if as_json:
-        print(json.dumps({"query": str(query), "indexed": len(index), "seconds": seconds,
-                          "results": [{"rank": k + 1, "path": str(h.path), "score": h.score,
-                                       "offset_s": h.offset_s} for k, h in enumerate(hits)]}, indent=2))
+        r = report.facts
+        print_json({"query": r["query"], "indexed": r["indexed"], "seconds": report.seconds, "results": r["results"]})
         return
-    table = Table(title=f"{query.name} against {len(index)} takes in {folder}")
+    from rich.table import Table
+
+    table = Table(title=f"{query.name} against {report.facts['indexed']} takes in {folder}")
     for col in ("rank", "score", "offset s", "take"):
         table.add_column(col, justify="left" if col == "take" else "right")
-    for k, h in enumerate(hits):
-        table.add_row(str(k + 1), f"{h.score:.3f}", f"{h.offset_s:+.2f}", h.path.name)
+    for hit in report.facts["results"]:
+        table.add_row(str(hit["rank"]), f"{hit['score']:.3f}", f"{hit['offset_s']:+.2f}", Path(hit["path"]).name)
     out.print(table)
-    out.print(f"  {seconds:.2f} s")
+    out.print(timing_line(report))
 
 
 @app.command()
 @friendly
 def edit(
     path: Annotated[Path, typer.Argument(help="A .bvh or .amc file.")],
-    joint: Annotated[str, typer.Option(help="Joint whose swing to edit (exact name).")],
-    swing: Annotated[int, typer.Option(help="Which swing of the joint, 0-based in time order "
-                                            "(see `mocycle swings IN`).")],
+    joint: Annotated[str, flag(E, "joint")],
+    swing: Annotated[int, flag(E, "swing")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Edited motion (.bvh).")],
-    angle_scale: Annotated[float, typer.Option(help="Scale of the angle the swing turns through (0-10).")] = 1.0,
-    duration_scale: Annotated[float, typer.Option(help="Scale of the swing's length in time (0.05-20).")] = 1.0,
-    threshold: Annotated[float, typer.Option(help=_THRESHOLD_HELP)] = 0.4,
-    joints: Annotated[str | None, typer.Option(help=_JOINTS_HELP)] = None,
+    angle_scale: Annotated[float, flag(E, "angle_scale")] = default(E, "angle_scale"),
+    duration_scale: Annotated[float, flag(E, "duration_scale")] = default(E, "duration_scale"),
+    threshold: Annotated[float, flag(E, "threshold")] = default(E, "threshold"),
+    joints: Annotated[str | None, flag(E, "joints")] = default(E, "joints"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    amc_fps: Annotated[float, flag(E, "amc_fps")] = default(E, "amc_fps"),
 ):
     """Scale the angle or the duration of one swing of one joint and write the edited motion."""
-    from ..swings import edit_swing, segment
-
     check_suffix(output, ".bvh")
-    t0 = time.perf_counter()
-    motion = read(path, fps=fps)
-    seg = segment(motion, threshold=threshold, joints=joints)
-    j = motion.skeleton.index(joint)
-    if j not in seg.joints and joints is None:
-        seg = segment(motion, threshold=threshold, joints=sorted({*(motion.skeleton.names[k] for k in seg.joints),
-                                                                  joint}))
-    edited = edit_swing(motion, seg, joint, swing, angle_scale=angle_scale, duration_scale=duration_scale)
-    write(edited, output)
-    sw = seg.swings_of(joint)[swing]
-    facts = {"joint": joint, "swing": swing, "start": sw.start, "end": sw.end,
-             "angle_deg": abs(sw.end_angle - sw.start_angle) * 57.29577951308232, "angle_scale": angle_scale,
-             "duration_scale": duration_scale, "output": str(output), "seconds": time.perf_counter() - t0}
+    options = E(joint=joint, swing=swing, angle_scale=angle_scale, duration_scale=duration_scale,
+                threshold=threshold, joints=joints, amc_fps=amc_fps)
+    report = tasks.edit.run(path, options)
+    print_warnings(report)
+    write(report.motions["edited"], output)
+    r = report.facts
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print_json({**r, "output": str(output), "seconds": report.seconds})
     else:
-        out.print(f"{joint} swing {swing} (frames {sw.start}-{sw.end}, {facts['angle_deg']:.1f} deg): "
+        out.print(f"{joint} swing {swing} (frames {r['start']}-{r['end']}, {r['angle_deg']:.1f} deg): "
                   f"angle x{angle_scale:g}, duration x{duration_scale:g} -> {output}")
