@@ -60,7 +60,7 @@ def test_convert_range_and_fps(tmp_path):
     assert m.n_frames == 16 and np.isclose(m.fps, 30)
     assert max_angle(m.rotations, read_bvh(src).rotations[10:41:2]) < 1e-6
     bad = runner.invoke(app, ["convert", str(src), str(tmp_path / "o.bvh"), "--range", "50:500"])
-    assert bad.exit_code == 1 and "outside" in bad.stderr
+    assert bad.exit_code == 2 and "--range 50:500 is outside" in bad.stderr
     assert not (tmp_path / "o.bvh").exists()
 
 

@@ -45,7 +45,7 @@ def test_motion_rejects_bad_input():
         Motion(s, np.zeros((5, 3, 4)))
     q = np.zeros((5, 4, 4))
     q[..., 3] = 1
-    with pytest.raises(MocycleError, match="frame time"):
+    with pytest.raises(MocycleError, match="frame_time must be a positive number"):
         Motion(s, q, frame_time=0)
     q[2, 1] = np.nan
     with pytest.raises(MocycleError, match="NaN"):

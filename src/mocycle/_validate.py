@@ -33,10 +33,11 @@ def _describe(low, high, low_open: bool = False, high_open: bool = False) -> str
 
 
 def integer(name: str, value, low: int | None = None, high: int | None = None, *,
-            words: Mapping[str, object] | None = None):
+            words: Mapping[str, object] | None = None, note: str = ""):
     """An ``int`` in ``[low, high]`` (``None``: unbounded); numeric strings such as ``"3"`` are accepted.
 
-    ``words`` maps accepted words to what they stand for (``{"auto": "auto", "none": None}``).
+    ``words`` maps accepted words to what they stand for (``{"auto": "auto", "none": None}``); ``note`` says
+    where the bounds come from (``"half the take"``).
     """
     words = dict(words or {})
     if isinstance(value, str) and value in words:
@@ -57,7 +58,7 @@ def integer(name: str, value, low: int | None = None, high: int | None = None, *
             what = "a positive integer"
         if words:
             what = " or ".join(repr(w) for w in words) + " or " + what
-        raise OptionError(name, f"must be {what}; got {value!r}")
+        raise OptionError(name, f"must be {what}{f' ({note})' if note else ''}; got {value!r}")
     return number
 
 

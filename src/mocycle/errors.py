@@ -40,6 +40,10 @@ class OptionError(MocycleError, ValueError):
         super().__init__(f"{parameter} {reason}")
 
 
+class DataError(MocycleError, ValueError):
+    """Data given as an array is unusable (wrong shape, too few rows): bad input, like a bad file."""
+
+
 class MocycleWarning(UserWarning):
     """Something odd but recoverable in the input (e.g. a wrong ``Frames:`` count)."""
 

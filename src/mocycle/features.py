@@ -30,7 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .errors import MocycleError
+from . import _validate
+from .errors import MocycleError, OptionError
 from .motion import Motion
 from .rotations import continuous_euler, continuous_rotvec, euler_to_quats, mean_rotations, quat_exp
 
@@ -213,7 +214,7 @@ def _joint_weights(motion: Motion, weights, joints) -> np.ndarray:
         if w.shape != (J,):
             raise MocycleError(f"weights must have one value per joint ({J}); got shape {w.shape}")
     if not np.all(np.isfinite(w)) or np.any(w <= 0):
-        raise MocycleError("joint weights must be positive finite numbers")
+        raise OptionError("weights", f"must be positive finite numbers, one per joint; got {w.tolist()}")
     return w
 
 
@@ -246,10 +247,8 @@ def pose_matrix(
     X : ``(T, D)`` float array.
     decoder : :class:`PoseDecoder` (``decoder.decode(X)`` gives the motion back).
     """
-    if rep not in REPS:
-        raise MocycleError(f"rep must be one of {', '.join(REPS)}; got {rep!r}")
-    if root not in ROOTS:
-        raise MocycleError(f"root must be one of {', '.join(ROOTS)}; got {root!r}")
+    _validate.choice("rep", rep, REPS)
+    _validate.choice("root", root, ROOTS)
     if not isinstance(motion, Motion):
         raise MocycleError(f"pose_matrix needs a Motion; got {type(motion).__name__}")
     skel = motion.skeleton

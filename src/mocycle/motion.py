@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from . import _validate
 from .errors import MocycleError
 from .rotations import continuous_quats
 
@@ -230,9 +231,7 @@ class Motion:
             trans[:, 0] = rp
         if not np.all(np.isfinite(trans)):
             raise MocycleError("translations contain NaN or infinite values")
-        frame_time = float(frame_time)
-        if not np.isfinite(frame_time) or frame_time <= 0:
-            raise MocycleError(f"frame time must be a positive number of seconds; got {frame_time}")
+        frame_time = _validate.positive("frame_time", frame_time)
         rot.setflags(write=False)
         trans.setflags(write=False)
         self.skeleton = skeleton
@@ -355,9 +354,7 @@ class Motion:
         Rotations are interpolated by slerp, translations linearly.  The first
         frame is kept; the last new frame is at or before the old last frame.
         """
-        fps = float(fps)
-        if not np.isfinite(fps) or fps <= 0:
-            raise MocycleError(f"fps must be a positive number; got {fps}")
+        fps = _validate.positive("fps", fps)
         new_dt = 1.0 / fps
         if self.n_frames == 1:
             return self.replace(frame_time=new_dt)

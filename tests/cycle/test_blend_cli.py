@@ -66,16 +66,16 @@ def test_transition_json_and_bvh(walks, tmp_path):
     (["--weights", "-1,2"], ">= 0"),
     (["--cycles", "0"], "positive integer"),
 ])
-def test_blend_bad_options_exit_1(walks, tmp_path, args, message):
+def test_blend_bad_options_exit_2(walks, tmp_path, args, message):
     out = tmp_path / "x.bvh"
     result = runner.invoke(app, ["blend", str(walks[0]), str(walks[1]), "-o", str(out), *args])
-    assert result.exit_code == 1 and message in result.output, result.output
+    assert result.exit_code == 2 and message in result.output, result.output
     assert not out.exists()
 
 
 def test_blend_needs_two_takes_and_a_bvh_output(walks, tmp_path):
     result = runner.invoke(app, ["blend", str(walks[0]), "-o", str(tmp_path / "x.bvh")])
-    assert result.exit_code == 1 and "at least two takes" in result.output
+    assert result.exit_code == 2 and "at least two takes" in result.output
     result = runner.invoke(app, ["blend", str(walks[0]), str(walks[1]), "-o", str(tmp_path / "x.txt")])
     assert result.exit_code == 1 and ".bvh" in result.output
 

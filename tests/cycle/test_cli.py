@@ -47,20 +47,21 @@ def test_no_periodic_motion_exits_3_and_writes_nothing(tmp_path):
     assert not out.exists()
 
 
-def test_bad_options_exit_1_with_one_message(tmp_path):
+def test_bad_options_exit_2_with_one_message(tmp_path):
     src = _walk(tmp_path, 200)
-    cases = [
-        (["--harmonics", "80"], "K must be <="),
-        (["--harmonics", "many"], "--harmonics must be"),
-        (["--model", "M7"], "model must be one of"),
-        (["--root", "flying"], "root must be one of"),
-        (["--cycles", "0"], "--cycles must be a positive integer"),
-        (["--range", "150:100"], "outside the take"),
+    cases = [  # a bad value exits 2 (usage); too many harmonics for this take is found on the take: 1
+        (["--harmonics", "80"], "K must be <=", 1),
+        (["--harmonics", "many"], "--harmonics must be", 2),
+        (["--model", "M7"], "--model must be one of", 2),
+        (["--method", "spline"], "--method must be one of harmonic, centroid, cut", 2),
+        (["--root", "flying"], "--root must be one of", 2),
+        (["--cycles", "0"], "--cycles must be a positive integer", 2),
+        (["--range", "150:100"], "outside the take", 2),
     ]
-    for extra, message in cases:
+    for extra, message, code in cases:
         out = tmp_path / "x.bvh"
         result = runner.invoke(app, ["loop", str(src), "-o", str(out)] + extra)
-        assert result.exit_code == 1, (extra, result.output)
+        assert result.exit_code == code, (extra, result.output)
         assert message in result.stderr and result.stderr.count("error:") == 1, (extra, result.stderr)
         assert not out.exists()
     result = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.txt")])

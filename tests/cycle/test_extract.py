@@ -107,7 +107,7 @@ def test_bad_options_are_rejected_with_the_limit(walk):
         extract_cycle(walk.motion, model="M9")
     with pytest.raises(MocycleError, match="class 3 does not exist"):
         extract_cycle(walk.motion, which=3)
-    with pytest.raises(MocycleError, match="phase step"):
+    with pytest.raises(MocycleError, match="phase_step must be a positive integer"):
         extract_cycle(walk.motion, phase_step=0)
     with pytest.raises(MocycleError, match="needs a Motion"):
         extract_cycle("walk.bvh")

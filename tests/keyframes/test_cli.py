@@ -67,7 +67,7 @@ def test_project_plot_and_json(walk_file, tmp_path):
 @pytest.mark.parametrize("args,msg", [
     (["compress", "{f}", "-o", "{d}/x.bvh"], ".mck"),
     (["compress", "{f}", "-o", "{d}/x.mck", "--scheme", "cubic"], "scheme must be"),
-    (["compress", "{f}", "-o", "{d}/x.mck", "--ratio", "0"], "ratio must lie"),
+    (["compress", "{f}", "-o", "{d}/x.mck", "--ratio", "0"], "--ratio must be a number in (0, 1]"),
     (["decompress", "{f}", "-o", "{d}/x.bvh"], "not a mocycle keyframe file"),
     (["decompress", "{d}/none.mck", "-o", "{d}/x.bvh"], "cannot read"),
     (["project", "{f}", "--projection", "umap"], "projection must be"),
@@ -76,5 +76,6 @@ def test_project_plot_and_json(walk_file, tmp_path):
 def test_errors(walk_file, tmp_path, args, msg):
     args = [a.format(f=walk_file, d=tmp_path) for a in args]
     r = runner.invoke(app, args)
-    assert r.exit_code == 1 and msg in r.output
+    usage = "must be" in msg  # a bad option value exits 2, bad input 1
+    assert r.exit_code == (2 if usage else 1) and msg in r.output, r.output
     assert not (tmp_path / "x.bvh").exists() and not (tmp_path / "x.mck").exists()

@@ -56,9 +56,9 @@ def test_damaged_files(walk, tmp_path):
 
 
 def test_bad_options(walk):
-    for kw, msg in (({"scheme": "cubic"}, "scheme must be"), ({"select": "best"}, "selection must be"),
+    for kw, msg in (({"scheme": "cubic"}, "scheme must be"), ({"select": "best"}, "select must be one of"),
                     ({"scheme": "spatial", "projection": "umap"}, "projection must be"),
-                    ({"ratio": 2.0}, "ratio must lie"), ({"seed": "lamp"}, "seed projection")):
+                    ({"ratio": 2.0}, r"ratio must be a number in \(0, 1\]"), ({"seed": "lamp"}, "seed must be one of")):
         with pytest.raises(MocycleError, match=msg):
             compress(walk, **kw)
 

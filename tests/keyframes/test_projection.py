@@ -74,7 +74,7 @@ def test_spatial_layout(space, projection, select):
 def test_bad_names(space):
     with pytest.raises(MocycleError, match="projection must be one of"):
         spatial_layout(space, "umap", "uniform", 5)
-    with pytest.raises(MocycleError, match="seed projection"):
+    with pytest.raises(MocycleError, match="seed must be one of"):
         spatial_layout(space, "rbfp", "uniform", 5, seed="rbfp")
     with pytest.raises(MocycleError, match="PoseSpace"):
         PoseSpace(np.zeros((5, 3, 4)))

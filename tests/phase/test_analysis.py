@@ -82,9 +82,10 @@ def test_cli_phase_exit_codes(tmp_path):
     result = runner.invoke(app, ["phase", str(short)])
     assert result.exit_code == 1 and "at least" in result.stderr
     walk = write_bvh(synthetic_walk(n_frames=300).motion, tmp_path / "walk.bvh")
-    for bad in (["--classes", "zero"], ["--pca", "-3"], ["--delay", "-1"], ["--joints", "Tail"]):
+    for bad, code in ((["--classes", "zero"], 2), (["--pca", "-3"], 2), (["--delay", "-1"], 2),
+                      (["--joints", "Tail"], 1)):
         result = runner.invoke(app, ["phase", str(walk), *bad])
-        assert result.exit_code == 1 and result.stderr.startswith("error:"), bad
+        assert result.exit_code == code and result.stderr.startswith("error:"), bad
     bad_plot = runner.invoke(app, ["phase", str(walk), "--plot", str(tmp_path / "x.jpg")])
     assert bad_plot.exit_code == 1 and ".png" in bad_plot.stderr
 

@@ -2,6 +2,7 @@ import warnings
 
 import numpy as np
 import pytest
+from sklearn.exceptions import NotFittedError
 
 from helpers import circular_error
 from mocycle.datasets import synthetic_nonperiodic, synthetic_still, synthetic_walk, synthetic_walk_then_run
@@ -89,8 +90,10 @@ def test_too_few_frames_and_bad_parameters_are_rejected():
         CircularCoordinates(n_landmarks=1).fit(np.zeros((30, 3)))
     with pytest.raises(MocycleError, match="scale_fraction"):
         CircularCoordinates(scale_fraction=1.5).fit(np.zeros((30, 3)))
-    with pytest.raises(MocycleError, match="not fitted"):
+    with pytest.raises(NotFittedError, match="not fitted"):
         CircularCoordinates().transform(np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="at least 20 frames"):  # argument errors are ValueErrors
+        CircularCoordinates().fit(np.zeros((10, 3)))
 
 
 def test_constant_and_nan_columns_do_not_break_the_fit(walk):
@@ -133,3 +136,32 @@ def test_greedy_permutation_picks_farthest_points_and_reports_distances():
     idx, dist = greedy_permutation(X, 3)
     assert idx.tolist() == [0, 2, 3]  # start, farthest from 0, farthest from {0, 2}
     assert np.allclose(dist, np.abs(X[idx, 0][:, None] - X[:, 0][None, :]))
+
+
+# -- the scikit-learn estimator contract ---------------------------------------------------------------------------
+# CircularCoordinates is a scikit-learn transformer and passes check_estimator except for these documented checks:
+EXPECTED_FAILED_CHECKS = {
+    "check_n_features_in_after_fitting": "fits 15 rows; circular coordinates need at least 20 frames",
+    "check_fit2d_1feature": "fits 10 rows; circular coordinates need at least 20 frames",
+    "check_estimators_pickle": "puts NaN in every column; fit drops NaN columns and refuses when none is left",
+}
+
+
+def _sklearn_checks():
+    try:
+        from sklearn.utils.estimator_checks import parametrize_with_checks
+
+        return parametrize_with_checks([CircularCoordinates(n_landmarks=30)],
+                                       expected_failed_checks=lambda est: EXPECTED_FAILED_CHECKS)
+    except TypeError:  # scikit-learn < 1.6 has no expected_failed_checks
+        skip = pytest.mark.skip(reason="scikit-learn < 1.6: no expected_failed_checks")
+        return pytest.mark.parametrize(("estimator", "check"), [pytest.param(None, None, marks=skip)])
+
+
+@_sklearn_checks()
+def test_scikit_learn_estimator_contract(estimator, check):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        check(estimator)

@@ -29,8 +29,9 @@ def test_swings_json_and_outputs(walk_file, tmp_path):
     assert r.exit_code == 0, r.output
     facts = json.loads(r.stdout)
     assert set(facts) == {"joints", "n_swings", "segmentation_error", "per_angle_error_deg", "geodesic_error_deg",
-                          "compressed_bytes", "raw_float32_bytes", "seconds"}
+                          "compressed_bytes", "raw_float32_bytes", "swing_indices", "seconds"}
     assert facts["n_swings"] > 10 and "LeftUpLeg" in facts["joints"]
+    assert facts["swing_indices"]["LeftUpLeg"].startswith("0-")  # what edit --swing takes
     assert facts["compressed_bytes"] < facts["raw_float32_bytes"] / 4
     assert json.loads((tmp_path / "s.json").read_text())["n_swings"] == facts["n_swings"]
     assert read_bvh(tmp_path / "pb.bvh").n_frames == 240
@@ -41,16 +42,19 @@ def test_swings_mosw_round_trip_and_table(walk_file, tmp_path):
     r = runner.invoke(app, ["swings", str(walk_file), "--threshold", "0.6", "-o", str(tmp_path / "s.mosw")])
     assert r.exit_code == 0, r.output
     assert "Segmentation Error" in r.output and "LeftUpLeg" in r.output
+    assert "indices" in r.output and "edit --swing" in r.output and "wrote " + str(tmp_path / "s.mosw") in r.output
+    assert "time " in r.output
     r = runner.invoke(app, ["swings", str(tmp_path / "s.mosw"), "--json", "--playback", str(tmp_path / "b.bvh")])
     assert r.exit_code == 0, r.output
     assert json.loads(r.stdout)["segmentation_error"] is None and read_bvh(tmp_path / "b.bvh").n_frames == 240
 
 
-@pytest.mark.parametrize("args, word", [(["--threshold", "3"], "0-2"), (["-o", "x.txt"], ".json or .mosw"),
-                                        (["--joints", "Tail"], "Tail")])
-def test_swings_bad_options(walk_file, args, word):
+@pytest.mark.parametrize("args, word, code", [(["--threshold", "3"], "--threshold must be a number in [0, 2]", 2),
+                                              (["-o", "x.txt"], ".json or .mosw", 1),
+                                              (["--joints", "Tail"], "Tail", 1)])
+def test_swings_bad_options(walk_file, args, word, code):
     r = runner.invoke(app, ["swings", str(walk_file), *args])
-    assert r.exit_code == 1 and word in r.output and "error:" in r.output
+    assert r.exit_code == code and word in r.output and "error:" in r.output
 
 
 def test_search_ranks_a_folder(tmp_path):

@@ -70,8 +70,8 @@ def test_identity_edit_changes_nothing():
     (dict(joint="Left Up Leg", swing=5), "has 2 swings"),
     (dict(joint="Spine", swing=0), "no swings"),
     (dict(joint="Nope", swing=0), "no joint named"),
-    (dict(joint="Left Up Leg", swing=0, angle_scale=-1), "0-10"),
-    (dict(joint="Left Up Leg", swing=0, duration_scale=0), "0.05-20"),
+    (dict(joint="Left Up Leg", swing=0, angle_scale=-1), r"angle_scale must be a number in \[0, 10\]"),
+    (dict(joint="Left Up Leg", swing=0, duration_scale=0), r"duration_scale must be a number in \[0.05, 20\]"),
     (dict(joint="Left Up Leg", swing=0, duration_scale=10), "largest scale"),
 ])
 def test_bad_edits_raise_one_clear_error(kwargs, word):

@@ -47,7 +47,7 @@ def test_stretch_errors_are_one_line_and_write_nothing(tmp_path):
         (["--factor", "-2"], "factor must be a positive"),
     ):
         result = runner.invoke(app, ["stretch", str(src), "-o", str(out)] + args)
-        assert result.exit_code == 1, result.output
+        assert result.exit_code == 2, result.output  # a bad option value is a usage error
         lines = [ln for ln in result.stderr.splitlines() if ln.strip()]
         assert len(lines) == 1 and lines[0].startswith("error:") and message in lines[0], lines
         assert not out.exists()

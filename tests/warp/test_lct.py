@@ -79,7 +79,7 @@ def test_block_edges_put_the_remainder_in_the_last_block():
     assert block_edges(5, 5).tolist() == [0, 5]
     with pytest.raises(MocycleError, match="at most the number of frames"):
         block_edges(10, 11)
-    with pytest.raises(MocycleError, match="integer >= 1"):
+    with pytest.raises(MocycleError, match="positive integer"):
         block_edges(10, 0)
 
 

@@ -92,7 +92,7 @@ def test_output_length_is_round_t_times_factor(factor, n_out):
 
 def test_warp_rejects_bad_input():
     x = np.zeros(100)
-    with pytest.raises(MocycleError, match="between 1 and half the take"):
+    with pytest.raises(MocycleError, match="half the take"):
         warp_curves(x, 2.0, 51)
     with pytest.raises(MocycleError, match="positive"):
         warp_curves(x, 0.0, 10)
@@ -223,7 +223,7 @@ def test_stretch_rejects_bad_input():
         stretch_motion(np.zeros((10, 3)), 2.0)
     with pytest.raises(MocycleError, match="at least 8 frames"):
         stretch_motion(take[:5], 2.0)
-    with pytest.raises(MocycleError, match="between 1 and half the take"):
+    with pytest.raises(MocycleError, match="half the take"):
         stretch_motion(take, 2.0, window=61)
     with pytest.raises(MocycleError, match="'auto' or"):
         stretch_motion(take, 2.0, window="big")

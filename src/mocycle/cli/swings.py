@@ -70,8 +70,8 @@ def swings(
     from rich.table import Table
 
     out.print(f"[bold]{path}[/]: {r['frames']} frames at {r['fps']:.6g} fps, Acceptable Swing Error {r['threshold']:g}")
-    table = Table(title="swings per joint")
-    for col in ("joint", "swings", "indices (edit --swing)", "mean length s", "mean angle deg", "holds"):
+    table = Table(title="swings per joint", caption="swing indices: 0-based in time order, what edit --swing takes")
+    for col in ("joint", "swings", "indices", "mean length s", "mean angle deg", "holds"):
         table.add_column(col, justify="left" if col == "joint" else "right")
     for row in r["per_joint"]:
         table.add_row(row["joint"], str(row["swings"]), row["indices"] or "-", f"{row['mean_length_s']:.3f}",
@@ -85,7 +85,7 @@ def swings(
               f"channels ({r['raw_float32_bytes']} bytes)"
               + (f", {r['ratio_bvh']:.3f} of the BVH text" if r["ratio_bvh"] else ""))
     for line in written:
-        out.print(f"wrote {line}")
+        out.print(f"wrote {line}", soft_wrap=True)
     out.print(timing_line(report))
 
 

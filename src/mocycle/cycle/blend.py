@@ -58,7 +58,8 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 from scipy.spatial.transform import Rotation
 
-from ..errors import MocycleError, NoPeriodicMotion
+from .. import _validate
+from ..errors import MocycleError, NoPeriodicMotion, OptionError
 from ..motion import Motion, Skeleton
 from ..rotations import mean_rotations
 from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, metric_features
@@ -113,13 +114,13 @@ def check_weights(weights, n: int) -> np.ndarray:
     try:
         w = np.asarray(weights, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError):
-        raise MocycleError(f"weights must be numbers, one per take; got {weights!r}") from None
+        raise OptionError("weights", f"must be numbers, one per take; got {weights!r}") from None
     if w.size != n:
-        raise MocycleError(f"expected {n} weights, one per take; got {w.size}")
+        raise OptionError("weights", f"must be {n} numbers, one per take; got {w.size}")
     if not np.all(np.isfinite(w)) or np.any(w < 0):
-        raise MocycleError(f"weights must be finite and >= 0; got {w.tolist()}")
+        raise OptionError("weights", f"must be finite and >= 0; got {w.tolist()}")
     if w.sum() <= 0:
-        raise MocycleError("at least one weight must be > 0; got all zero")
+        raise OptionError("weights", "must have at least one weight > 0; got all zero")
     return w / w.sum()
 
 
@@ -314,8 +315,7 @@ def align_phase(reference: Cycle, other: Cycle, n_frames: int | None = None) -> 
     first = _prepare(cycles[0], space, None)
     loops = [first, _prepare(cycles[1], space, first)]
     n = reference.n_frames if n_frames is None else n_frames
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
-        raise MocycleError(f"n_frames must be an integer >= 2; got {n_frames!r}")
+    n = _validate.integer("n_frames", n, 2)
     return float(_align(loops, space, int(n))[1])
 
 
@@ -509,10 +509,8 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     blended with the same weight and integrated along the phase; ``"inplace"``: no travel.
     """
     t0 = time.perf_counter()
-    if root not in ROOT_MODES:
-        raise MocycleError(f"root must be one of {', '.join(ROOT_MODES)}; got {root!r}")
-    if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 1:
-        raise MocycleError(f"the number of cycles must be a positive integer; got {cycles!r}")
+    _validate.choice("root", root, ROOT_MODES)
+    cycles = _validate.integer("cycles", cycles, 1)
     cyc = _cycles([a, b], labels if labels is not None else ["the first take", "the second take"],
                   extract_options)
     space = _common_space(cyc)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _validate
 from ..errors import MocycleError
 
 # Fornberg's 8th-order central stencils for offsets -4..4 (thesis eq. 3.23, 3.24).
@@ -28,8 +29,7 @@ def _stencil(Y: np.ndarray, weights: np.ndarray, step: float, power: int) -> np.
     Y = np.asarray(Y, dtype=np.float64)
     if Y.ndim == 1:
         Y = Y[:, None]
-    if not (np.isfinite(step) and step > 0):
-        raise MocycleError(f"the time step must be a positive number; got {step!r}")
+    step = _validate.positive("step", step)
     rows = Y.shape[0] - (weights.size - 1)
     if rows < 1:
         raise MocycleError(f"differences need at least {weights.size} frames; got {Y.shape[0]}")

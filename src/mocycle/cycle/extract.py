@@ -23,6 +23,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .. import _validate
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
 from ..motion import Motion
@@ -100,8 +101,7 @@ class Cycle:
     def repeat(self, count: int, root: str = "inplace") -> Motion:
         """The cycle ``count`` times, seamlessly; with ``root="motion"`` each repeat starts where the last ends."""
         _check_choice(root, ROOT_MODES, "root")
-        if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
-            raise MocycleError(f"the number of cycles must be a positive integer; got {count!r}")
+        count = _validate.integer("count", count, 1)
         P = np.tile(self.P, (count, 1))
         if root == "inplace":
             return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)))
@@ -133,8 +133,7 @@ class Cycle:
 
 
 def _check_choice(value, choices, name):
-    if value not in choices:
-        raise MocycleError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
+    _validate.choice(name, value, choices)
 
 
 # ------------------------------------------------------------------ harmonic
@@ -163,8 +162,7 @@ def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
         if limit < 1:
             raise MocycleError(f"too few frames for a harmonic fit: {n_rows} frames, {cycle_frames} per cycle")
         return min(DEFAULT_HARMONICS, limit)
-    if isinstance(n_harmonics, bool) or not isinstance(n_harmonics, (int, np.integer)) or n_harmonics < 1:
-        raise MocycleError(f"the number of harmonics must be 'auto' or a positive integer; got {n_harmonics!r}")
+    n_harmonics = _validate.integer("n_harmonics", n_harmonics, 1)
     if n_harmonics > limit:
         raise MocycleError(f"K = {n_harmonics} harmonics is too many for {n_rows} frames with {cycle_frames} "
                            f"frames per cycle: K must be <= {limit} (2K+1 <= frames and K < frames per cycle / 2)")
@@ -355,11 +353,10 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     if not isinstance(motion, Motion):
         raise MocycleError(f"extract_cycle needs a Motion; got {type(motion).__name__}")
     _check_choice(method, METHODS, "method")
-    _check_choice(time_axis_method, TIME_AXES, "the time axis")
+    _check_choice(time_axis_method, TIME_AXES, "time_axis_method")
     if method == "harmonic":
         _check_choice(model, MODELS, "model")
-    if isinstance(phase_step, bool) or not isinstance(phase_step, (int, np.integer)) or phase_step < 1:
-        raise MocycleError(f"the phase step must be a positive integer; got {phase_step!r}")
+    phase_step = _validate.integer("phase_step", phase_step, 1)
     if phase is None:
         if phase_step > 1:
             phase = _phase_at_full_rate(find_phase(motion[::phase_step], classes=classes, joints=joints,

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _validate
 from ..errors import MocycleError
 
 MODELS = ("M1", "M2", "M3")
@@ -89,11 +90,8 @@ class HarmonicRegression:
         self.linear = linear
 
     def _check(self, x, Y, xd, dY, ddY):
-        if self.model not in MODELS:
-            raise MocycleError(f"model must be one of {', '.join(MODELS)}; got {self.model!r}")
-        K = self.n_harmonics
-        if isinstance(K, bool) or not isinstance(K, (int, np.integer)) or K < 1:
-            raise MocycleError(f"the number of harmonics K must be a positive integer; got {K!r}")
+        _validate.choice("model", self.model, MODELS)
+        K = _validate.integer("n_harmonics", self.n_harmonics, 1)
         x = np.asarray(x, dtype=np.float64).reshape(-1)
         Y = np.asarray(Y, dtype=np.float64)
         Y = Y[:, None] if Y.ndim == 1 else Y

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _validate
 from ..errors import MocycleError
 from ..phase.analysis import PeriodicMotion
 from ..phase.period import gmm_cdf_remap, rank_uniform, unwrap_phase
@@ -77,8 +78,7 @@ def _period_average(u: np.ndarray, period: float) -> np.ndarray:
 
 def time_axis(periodic: PeriodicMotion, method: str = "smooth") -> TimeAxis:
     """The time axis of one periodic motion found by :func:`mocycle.phase.find_phase`."""
-    if method not in TIME_AXES:
-        raise MocycleError(f"the time axis must be one of {', '.join(TIME_AXES)}; got {method!r}")
+    _validate.choice("time_axis_method", method, TIME_AXES)
     period = float(periodic.period_frames)
     if not (np.isfinite(period) and period > 1):
         raise MocycleError(f"the periodic motion has no usable period ({period:.4g} frames)")

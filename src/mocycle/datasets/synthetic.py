@@ -22,7 +22,8 @@ import numpy as np
 from scipy.ndimage import gaussian_filter1d
 from scipy.spatial.transform import Rotation
 
-from ..errors import MocycleError
+from .. import _validate
+from ..errors import MocycleError, OptionError
 from ..motion import EndSite, Motion, Skeleton
 from ..rotations import euler_to_quats
 
@@ -386,23 +387,17 @@ def _check(n_frames: int, fps: float) -> tuple[int, float]:
     except (TypeError, ValueError, OverflowError):
         ok = False
     if not ok:
-        raise MocycleError(f"n_frames must be a positive integer; got {n_frames!r}")
-    fps = float(fps)
-    if not np.isfinite(fps) or fps <= 0:
-        raise MocycleError(f"fps must be a positive number; got {fps!r}")
-    return int(n_frames), fps
+        raise OptionError("n_frames", f"must be a positive integer; got {n_frames!r}")
+    return int(n_frames), _validate.positive("fps", fps)
 
 
 def _phase_truth(n_frames: int, fps: float, period_s: float, speed_change: float,
                  phase0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Unwrapped phase, wrapped phase and period in frames for a linear frequency ramp."""
-    if not np.isfinite(period_s) or period_s <= 0:
-        raise MocycleError(f"period_s must be a positive number of seconds; got {period_s!r}")
+    _validate.positive("period_s", period_s)
     if not np.isfinite(phase0):
         raise MocycleError(f"phase0 must be a finite number of cycles; got {phase0!r}")
-    if not np.isfinite(speed_change) or speed_change <= -1.0:
-        raise MocycleError(f"speed_change must be > -1 (the frequency must stay positive); "
-                           f"got {speed_change!r}")
+    _validate.real("speed_change", speed_change, -1.0, low_open=True)  # the frequency must stay positive
     t = np.arange(n_frames) / fps
     span = max((n_frames - 1) / fps, 1.0 / fps)
     f0 = 1.0 / period_s

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .. import _validate
 from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..motion import EndSite, Motion, Skeleton
 
@@ -209,13 +210,7 @@ def read_asfamc(asf_path: str | os.PathLike, amc_path: str | os.PathLike,
 # helpers
 # --------------------------------------------------------------------------
 def _frame_time(fps) -> float:
-    try:
-        fps = float(fps)
-    except (TypeError, ValueError):
-        raise MocycleError(f"fps must be a positive number; got {fps!r}") from None
-    if not math.isfinite(fps) or fps <= 0:
-        raise MocycleError(f"fps must be a positive number; got {fps}")
-    return 1.0 / fps
+    return 1.0 / _validate.positive("fps", fps)
 
 
 def _read_text(path) -> str:

@@ -32,7 +32,8 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..errors import MocycleError, MotionFileError
+from .. import _validate
+from ..errors import MotionFileError
 from ..io.atomic import atomic_write
 from ..io.bvh import format_bvh, parse_bvh
 from ..keyframes.distance import joint_weights
@@ -206,14 +207,11 @@ def compress(motion: Motion, ratio: float | None = 0.03, count: int | None = Non
     optimize : run Algorithm 12 on the 2-D trajectory (spatial scheme).
     space : a :class:`PoseSpace` of ``motion`` whose distances are already computed (saves time).
     """
-    if scheme not in SCHEMES:
-        raise MocycleError(f"scheme must be one of {', '.join(SCHEMES)}; got {scheme!r}")
-    if select not in METHODS:
-        raise MocycleError(f"keyframe selection must be one of {', '.join(METHODS)}; got {select!r}")
-    if scheme == "spatial" and projection not in PROJECTIONS:
-        raise MocycleError(f"projection must be one of {', '.join(PROJECTIONS)}; got {projection!r}")
-    if seed not in ONE_STEP:
-        raise MocycleError(f"the seed projection must be one of {', '.join(ONE_STEP)}; got {seed!r}")
+    _validate.choice("scheme", scheme, SCHEMES)
+    _validate.choice("select", select, METHODS)
+    if scheme == "spatial":
+        _validate.choice("projection", projection, PROJECTIONS)
+    _validate.choice("seed", seed, ONE_STEP)
     n = motion.n_frames
     k = keyframe_count(n, ratio=None if count is not None else ratio, count=count)
     space = PoseSpace(motion.rotations, joint_weights(motion.skeleton)) if space is None else space

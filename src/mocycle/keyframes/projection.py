@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _validate
 from ..errors import MocycleError
 from ..motion import Motion
 from .distance import joint_weights, pose_distance_matrix, pose_vectors
@@ -220,7 +221,7 @@ def project_one_step(name: str, space: PoseSpace, random_state: int = 0) -> np.n
         return project_force(space.distances, random_state=random_state)
     if name == "tsne":
         return project_tsne(space.distances, random_state=random_state)
-    raise MocycleError(f"one-step projection must be one of {', '.join(ONE_STEP)}; got {name!r}")
+    _validate.choice("projection", name, ONE_STEP)
 
 
 # ---------------------------------------------------------------- two-step maps
@@ -294,7 +295,7 @@ def select_keyframes(method: str, space: PoseSpace, k: int, points: np.ndarray |
         sub = space.subset(cand)
         Q = project_pca(sub.vectors, random_state) if points is None else np.asarray(points)[cand]
         return cand[select_rols(sub.distances, Q, min(k, len(cand)))]
-    raise MocycleError(f"keyframe selection must be one of {', '.join(METHODS)}; got {method!r}")
+    _validate.choice("select", method, METHODS)
 
 
 def spatial_layout(space: PoseSpace, projection: str, select: str, k: int, seed: str = "mds",
@@ -306,10 +307,8 @@ def spatial_layout(space: PoseSpace, projection: str, select: str, k: int, seed:
     if projection in ONE_STEP:
         points = project_one_step(projection, space, random_state)
         return select_keyframes(select, space, k, points, random_state=random_state), points
-    if projection not in TWO_STEP:
-        raise MocycleError(f"projection must be one of {', '.join(PROJECTIONS)}; got {projection!r}")
-    if seed not in ONE_STEP:
-        raise MocycleError(f"the seed projection of {projection} must be one of {', '.join(ONE_STEP)}; got {seed!r}")
+    _validate.choice("projection", projection, PROJECTIONS)
+    _validate.choice("seed", seed, ONE_STEP)
     n = space.n
     k = keyframe_count(n, count=k)
     if select == "rols":

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _validate
 from ..errors import MocycleError
 from .distance import pose_distance
 from .temporal import slerp
@@ -29,13 +30,10 @@ def keyframe_count(n_frames: int, ratio: float | None = None, count: int | None 
     if (ratio is None) == (count is None):
         raise MocycleError("give exactly one of a keyframe ratio or a keyframe count")
     if ratio is not None:
-        if not (np.isfinite(ratio) and 0 < ratio <= 1):
-            raise MocycleError(f"the keyframe ratio must lie in (0, 1]; got {ratio}")
+        ratio = _validate.real("ratio", ratio, 0, 1, low_open=True)
         k = int(round(ratio * n_frames))
     else:
-        if int(count) != count or count < 2:
-            raise MocycleError(f"the keyframe count must be an integer >= 2; got {count}")
-        k = int(count)
+        k = _validate.integer("count", count, 2)
     return int(min(max(k, 2), n_frames))
 
 

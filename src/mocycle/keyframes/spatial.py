@@ -25,6 +25,7 @@ import numpy as np
 from scipy.spatial.distance import cdist
 from scipy.spatial.transform import Rotation
 
+from .. import _validate
 from ..errors import MocycleError
 from ..rotations import nearest_rotations
 from .distance import moving_joints
@@ -254,8 +255,8 @@ def optimize_projection(points: np.ndarray, key_idx, quats: np.ndarray, weights:
     idx = np.asarray(key_idx, dtype=np.int64)
     if P.shape != (T, 2) or not np.all(np.isfinite(P)):
         raise MocycleError(f"points must be a finite ({T}, 2) array; got {P.shape}")
-    if not (0 < alpha <= 1 and 0 < delta <= 1):
-        raise MocycleError(f"alpha and delta must lie in (0, 1]; got {alpha}, {delta}")
+    alpha = _validate.real("alpha", alpha, 0, 1, low_open=True)
+    delta = _validate.real("delta", delta, 0, 1, low_open=True)
     free = np.setdiff1d(np.arange(T), idx)
     joints = moving_joints(q[idx], tol=min_spread)
     if free.size == 0 or joints.size == 0:

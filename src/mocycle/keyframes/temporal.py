@@ -21,6 +21,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline, RBFInterpolator, make_interp_spline
 from scipy.spatial.transform import Rotation
 
+from .. import _validate
 from ..errors import MocycleError
 from ..motion import Skeleton
 from ..rotations import continuous_euler, euler_to_quats
@@ -69,8 +70,7 @@ def segments(key_idx: np.ndarray, n_frames: int) -> tuple[np.ndarray, np.ndarray
 def interpolate_rotations(skeleton: Skeleton, key_idx, key_quats: np.ndarray, n_frames: int,
                           scheme: str = "slerp") -> np.ndarray:
     """Local rotations ``(T, J, 4)`` of every frame from the keyframes' ``(K, J, 4)``."""
-    if scheme not in SCHEMES:
-        raise MocycleError(f"temporal scheme must be one of {', '.join(SCHEMES)}; got {scheme!r}")
+    _validate.choice("scheme", scheme, SCHEMES)
     idx = check_keys(key_idx, n_frames)
     kq = np.asarray(key_quats, dtype=np.float64)
     J = skeleton.n_joints

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from sklearn.decomposition import PCA
 
+from .. import _validate
 from ..errors import MocycleError
 from ..features import delay_embed, pose_matrix
 from ..motion import Motion
@@ -52,9 +53,7 @@ def phase_features(motion: Motion, joints: str | Iterable[str] | None = None, pc
     if pca == "auto":
         pca = DEFAULT_PCA
     if pca:
-        pca = int(pca)
-        if pca < 1:
-            raise MocycleError(f"--pca must be a positive number of dimensions; got {pca}")
+        pca = _validate.integer("pca", pca, 1)
         n = min(pca, X.shape[1], X.shape[0])
         X = PCA(n_components=n, svd_solver="full").fit_transform(X)
     if delay:

@@ -45,12 +45,18 @@ from scipy import sparse
 from scipy.sparse.linalg import lsqr
 from scipy.spatial.distance import cdist
 from sklearn.base import BaseEstimator, TransformerMixin
+from sklearn.utils.validation import check_array, check_is_fitted
 
-from ..errors import MocycleError, MocycleWarning
+from .. import _validate
+from ..errors import DataError, MocycleError, MocycleWarning
 from .period import autocorrelation_period
 
 PRIMES = (47, 43, 41, 37, 31, 29, 23, 19, 17, 13)
 MIN_FRAMES = 20
+
+# check_array's keyword for "NaN allowed" was renamed in scikit-learn 1.6 (force_all_finite -> ensure_all_finite)
+_ALLOW_NAN = ({"ensure_all_finite": "allow-nan"} if "ensure_all_finite" in check_array.__code__.co_varnames
+              else {"force_all_finite": "allow-nan"})
 
 
 @dataclass(frozen=True)
@@ -120,9 +126,7 @@ def choose_classes(barcode: np.ndarray, n_classes: int | str = "auto", min_ratio
         return f"[{barcode[i, 0]:.3g}, {barcode[i, 1]:.3g})"
 
     if n_classes != "auto":
-        n = int(n_classes)
-        if n < 1:
-            raise MocycleError(f"n_classes must be 'auto' or a positive integer; got {n_classes!r}")
+        n = _validate.integer("n_classes", n_classes, 1, words={"auto": "auto"})
         chosen = order[:n]
         reason = f"the {len(chosen)} longest H1 bar(s) as asked: " + ", ".join(bar(i) for i in chosen)
         if len(chosen) < n:
@@ -309,24 +313,32 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
         self.max_classes = max_classes
         self.min_cycles = min_cycles
 
+    # -- scikit-learn contract -------------------------------------------------
+    def __sklearn_tags__(self):  # scikit-learn >= 1.6
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = True  # fit drops columns with NaN or inf (with a warning)
+        return tags
+
+    def _more_tags(self):  # scikit-learn < 1.6
+        return {"allow_nan": True}
+
     # -- validation ----------------------------------------------------------
     def _check_X(self, X) -> np.ndarray:
-        X = np.asarray(X, dtype=np.float64)
-        if X.ndim == 1:
-            X = X[:, None]
-        if X.ndim != 2:
-            raise MocycleError(f"X must be a 2-D array (frames × features); got shape {X.shape}")
+        """X as a dense 2-D float array of at least MIN_FRAMES rows (NaN/inf allowed: fit drops those columns).
+
+        scikit-learn's ``check_array`` makes the messages (sparse, complex, 1-D, empty input): ValueErrors.
+        """
+        X = check_array(X, dtype=np.float64, ensure_2d=True, ensure_min_samples=1, **_ALLOW_NAN)
         if X.shape[0] < MIN_FRAMES:
-            raise MocycleError(f"circular coordinates need at least {MIN_FRAMES} frames; got {X.shape[0]}")
+            raise DataError(f"X must hold at least {MIN_FRAMES} frames (rows) for circular coordinates; "
+                            f"got {X.shape[0]} sample(s)")
         return X
 
     def _check_params(self):
-        if not isinstance(self.n_landmarks, (int, np.integer)) or self.n_landmarks < 3:
-            raise MocycleError(f"n_landmarks must be an integer >= 3; got {self.n_landmarks!r}")
-        if not 0 < self.scale_fraction < 1:
-            raise MocycleError(f"scale_fraction must lie in (0, 1); got {self.scale_fraction!r}")
-        if self.scale != "auto" and not (isinstance(self.scale, (int, float)) and self.scale > 0):
-            raise MocycleError(f"scale must be 'auto' or a positive filtration value; got {self.scale!r}")
+        _validate.integer("n_landmarks", self.n_landmarks, 3)
+        _validate.real("scale_fraction", self.scale_fraction, 0, 1, low_open=True, high_open=True)
+        if self.scale != "auto":
+            _validate.positive("scale", self.scale)
 
     # -- fitting ---------------------------------------------------------------
     def fit(self, X, y=None):
@@ -336,7 +348,7 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
         self.n_features_in_ = X.shape[1]
         self.columns_used_ = np.all(np.isfinite(X), axis=0)
         if not self.columns_used_.any():
-            raise MocycleError("every column of X contains NaN or infinite values")
+            raise DataError("X has NaN or infinite values in every column")
         if not self.columns_used_.all():
             warnings.warn(f"dropping {int((~self.columns_used_).sum())} column(s) of X with NaN or infinite "
                           "values", MocycleWarning, stacklevel=2)
@@ -451,12 +463,11 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
 
     def transform(self, X) -> np.ndarray:
         """Coordinates ``(N, k)`` in ``[0, 1)`` of new points from the fitted landmarks."""
-        if not hasattr(self, "classes_"):
-            raise MocycleError("CircularCoordinates is not fitted yet; call fit(X) first")
-        X = np.asarray(X, dtype=np.float64)
-        if X.ndim != 2 or X.shape[1] != self.n_features_in_:
-            raise MocycleError(f"X must have shape (N, {self.n_features_in_}); got {X.shape}")
+        check_is_fitted(self, "classes_")
+        X = check_array(X, dtype=np.float64, ensure_2d=True, **_ALLOW_NAN)
+        if X.shape[1] != self.n_features_in_:
+            raise DataError(f"X must have {self.n_features_in_} columns, as in fit; got shape {X.shape}")
         X = X[:, self.columns_used_]
         if not np.all(np.isfinite(X)):
-            raise MocycleError("X contains NaN or infinite values in the columns used for fitting")
+            raise DataError("X contains NaN or infinite values in the columns used for fitting")
         return self._combine(self._coords(cdist(self.landmark_points_, X), self.cocycle_classes_))

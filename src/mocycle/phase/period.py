@@ -30,6 +30,7 @@ from scipy.stats import norm
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.mixture import GaussianMixture
 
+from .. import _validate
 from ..errors import MocycleError
 
 __all__ = [
@@ -76,11 +77,7 @@ def _wrapped_diff(x: np.ndarray) -> np.ndarray:
 
 
 def _positive_int(value, name: str, minimum: int = 1) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise MocycleError(f"{name} must be an integer >= {minimum}; got {value!r}")
-    if value < minimum:
-        raise MocycleError(f"{name} must be an integer >= {minimum}; got {value}")
-    return int(value)
+    return _validate.integer(name, value, minimum)
 
 
 # -- unwrapping and the least-squares period ---------------------------------------------------------------------
@@ -128,12 +125,7 @@ def fit_period(unwrapped, frame_time: float | None = None, frames=None) -> Perio
     y_all = _series(unwrapped, "unwrapped", min_len=2)
     T = y_all.size
     if frame_time is not None:
-        try:
-            frame_time = float(frame_time)
-        except (TypeError, ValueError):
-            raise MocycleError(f"frame_time must be a positive number of seconds; got {frame_time!r}") from None
-        if not np.isfinite(frame_time) or frame_time <= 0:
-            raise MocycleError(f"frame_time must be a positive number of seconds; got {frame_time!r}")
+        frame_time = _validate.positive("frame_time", frame_time)
     index = np.arange(T)
     if frames is None:
         idx = index

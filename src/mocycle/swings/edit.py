@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from .. import _validate
 from ..errors import MocycleError
 from ..motion import Motion
 from ..rotations import quat_multiply
@@ -53,10 +54,8 @@ def edit_swing(motion: Motion, seg: Segmentation, joint: str | int, swing: int, 
                            f"{', '.join(sorted({s.name for s in seg.swings})) or 'none'}")
     if not 0 <= swing < len(swings):
         raise MocycleError(f"joint {name!r} has {len(swings)} swings (0-{len(swings) - 1}); got --swing {swing}")
-    if not (np.isfinite(angle_scale) and 0.0 <= angle_scale <= 10.0):
-        raise MocycleError(f"angle scale must be within 0-10; got {angle_scale}")
-    if not (np.isfinite(duration_scale) and 0.05 <= duration_scale <= 20.0):
-        raise MocycleError(f"duration scale must be within 0.05-20; got {duration_scale}")
+    angle_scale = _validate.real("angle_scale", angle_scale, 0.0, 10.0)
+    duration_scale = _validate.real("duration_scale", duration_scale, 0.05, 20.0)
     sw = swings[swing]
     nxt = swings[swing + 1] if swing + 1 < len(swings) else None
     T = motion.n_frames

@@ -13,6 +13,7 @@ import warnings
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from .. import _validate
 from ..errors import MocycleError
 from ..io.bvh import _channel_layout, motion_channels
 from ..motion import Motion
@@ -54,8 +55,7 @@ def playback(seg: Segmentation, profile: str = "hermite") -> Motion:
     ``profile``: ``"hermite"`` (angle follows the cubic with the stored end
     speeds) or ``"linear"`` (the paper's start-to-end angle interpolation).
     """
-    if profile not in PROFILES:
-        raise MocycleError(f"profile must be one of {', '.join(PROFILES)}; got {profile!r}")
+    _validate.choice("profile", profile, PROFILES)
     T, J = seg.n_frames, seg.skeleton.n_joints
     quats = np.stack([joint_quats(seg, j, profile) for j in range(J)], axis=1)
     trans = np.empty((T, J, 3))

@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
+from .. import _validate
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
 from ..rotations import quat_log, quat_multiply
@@ -455,12 +456,8 @@ def segment(motion: Motion, threshold: float = DEFAULT_THRESHOLD, joints: str | 
     """
     if not isinstance(motion, Motion):
         raise MocycleError(f"segment() needs a Motion; got {type(motion).__name__}")
-    threshold = float(threshold)
-    if not np.isfinite(threshold) or not 0.0 <= threshold <= 2.0:
-        raise MocycleError(f"the Acceptable Swing Error (threshold) must be within 0-2; got {threshold}")
-    window_s = float(window_s)
-    if not np.isfinite(window_s) or not 0.0 < window_s <= 10.0:
-        raise MocycleError(f"window_s must be within (0, 10] seconds; got {window_s}")
+    threshold = _validate.real("threshold", threshold, 0.0, 2.0)  # the Acceptable Swing Error
+    window_s = _validate.real("window_s", window_s, 0.0, 10.0, low_open=True)
     if still_deg_s < 0 or not np.isfinite(still_deg_s):
         raise MocycleError(f"still_deg_s must be >= 0 degrees per second; got {still_deg_s}")
     if max_hold_s is not None and not max_hold_s > 0:

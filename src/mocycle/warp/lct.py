@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import fft as sp_fft
 
+from .. import _validate
 from ..errors import MocycleError
 
 __all__ = ["bell", "block_edges", "fold", "ilct", "lct", "max_overlap", "unfold"]
@@ -89,11 +90,7 @@ def ilct(C, edges, overlap: int | None = None) -> np.ndarray:
 
 
 def _int_at_least(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise MocycleError(f"{name} must be an integer >= {minimum}; got {value!r}")
-    if value < minimum:
-        raise MocycleError(f"{name} must be an integer >= {minimum}; got {value}")
-    return int(value)
+    return _validate.integer(name, value, minimum)
 
 
 def max_overlap(edges: np.ndarray) -> int:

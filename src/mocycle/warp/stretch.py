@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import _validate
 from ..errors import MocycleError
 from ..features import pose_matrix
 from ..motion import JOINT_GROUPS, Motion, Skeleton
@@ -67,12 +68,7 @@ TREND_DOMINATED = 2.0
 
 
 def _factor(factor) -> float:
-    if isinstance(factor, bool) or not isinstance(factor, (int, float, np.integer, np.floating)):
-        raise MocycleError(f"factor must be a positive number; got {factor!r}")
-    f = float(factor)
-    if not math.isfinite(f) or f <= 0:
-        raise MocycleError(f"factor must be a positive finite number; got {factor!r}")
-    return f
+    return _validate.positive("factor", factor)
 
 
 def _frames_out(n_frames: int, factor: float) -> int:
@@ -85,13 +81,8 @@ def _frames_out(n_frames: int, factor: float) -> int:
 
 
 def _window(window, n_frames: int) -> int:
-    if isinstance(window, bool) or not isinstance(window, (int, np.integer)):
-        raise MocycleError(f"window must be 'auto' or an integer number of frames; got {window!r}")
-    limit = n_frames // 2
-    if not 1 <= window <= limit:
-        raise MocycleError(f"window must be between 1 and half the take ({limit} frames of {n_frames}); "
-                           f"got {window}")
-    return int(window)
+    """A window of 1 to half the take's frames."""
+    return _validate.integer("window", window, 1, max(n_frames // 2, 1), note=f"half the take's {n_frames} frames")
 
 
 def warp_curves(X, factor: float, window: int, overlap: int | None = None) -> np.ndarray:
@@ -119,9 +110,7 @@ def warp_curves(X, factor: float, window: int, overlap: int | None = None) -> np
     n_out = _frames_out(T, factor)
     if overlap is None:
         overlap = N // 2
-    elif isinstance(overlap, bool) or not isinstance(overlap, (int, np.integer)) or not 0 <= overlap <= N // 2:
-        raise MocycleError(f"overlap must be an integer between 0 and window // 2 = {N // 2}; got {overlap!r}")
-    overlap = int(overlap)
+    overlap = _validate.integer("overlap", overlap, 0, N // 2)
 
     edges = block_edges(T, N)
     K = edges.size - 1  # >= 2 since N <= T // 2
@@ -312,9 +301,9 @@ def stretch_motion(motion: Motion, factor: float, window: str | int = "auto") ->
 
     cycles: dict[str, float | None] = {}
     windows: dict[str, int] = {}
-    if isinstance(window, str):
-        if window != "auto":
-            raise MocycleError(f"window must be 'auto' or a number of frames; got {window!r}")
+    window = _validate.integer("window", window, 1, max(T // 2, 1), words={"auto": "auto"},
+                               note=f"half the take's {T} frames")
+    if window == "auto":
         limit = T // 2
         found = {g: group_cycle(X[:, c]) if c.size else float("nan") for g, c in cols.items()}
         for g, c in found.items():
