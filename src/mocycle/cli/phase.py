@@ -32,7 +32,7 @@ def phase(
     (the reason is printed), 1 for bad input, 2 for a bad option.
     """
     options = O(classes=classes, joints=joints, pca=pca, delay=delay, n_landmarks=landmarks, amc_fps=amc_fps)
-    report = tasks.phase.run(path, options)
+    report = tasks.phase.run(path, options, keep_features=plot is not None)
     print_warnings(report)
     if plot is not None:
         from ..viz import plot_phase

@@ -35,15 +35,16 @@ class Options(_Options):
     amc_fps: float = fields.amc_fps()
 
 
-def run(take, options: Options | None = None) -> Report:
+def run(take, options: Options | None = None, *, keep_features: bool = False) -> Report:
     """Find the periodic motions of one take; ``facts["classes"]`` is empty when there is none (with the
-    reason in ``facts["reason"]``)."""
+    reason in ``facts["reason"]``). ``keep_features``: keep the point cloud in ``result.features`` (the phase
+    plot needs it)."""
     from ..phase import find_phase
 
     options = options or Options()
     with Recorder() as rec:
         motion = load(take, options.amc_fps)
         result = find_phase(motion, classes=options.classes, joints=options.joints, pca=options.pca,
-                            delay=options.delay, n_landmarks=options.n_landmarks)
+                            delay=options.delay, n_landmarks=options.n_landmarks, keep_features=keep_features)
         facts = {k: v for k, v in result.to_dict().items() if k != "seconds"}
     return rec.report("phase", facts, {"motion": motion}, result)

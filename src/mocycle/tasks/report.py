@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..io import read
+from ..io import read_motion
 from ..io.asfamc import AMC_FPS
 from ..motion import Motion
 
@@ -101,7 +101,7 @@ def load(item: Motion | str | os.PathLike, amc_fps: float = AMC_FPS) -> Motion:
     """A task input: a :class:`Motion` as is, or a motion file read (``amc_fps``: AMC files only)."""
     if isinstance(item, Motion):
         return item
-    return read(item, fps=amc_fps)
+    return read_motion(item, fps=amc_fps)
 
 
 def label_of(item, k: int = 0) -> str:
