@@ -352,14 +352,17 @@ class Motion:
         """Resample to ``fps`` frames per second over the same duration.
 
         Rotations are interpolated by slerp, translations linearly.  The first
-        frame is kept; the last new frame is at or before the old last frame.
+        frame is kept; the last new frame is the old last frame when the new frame time divides the duration
+        (within 1e-5 of a frame per frame: file frame times are rounded, e.g. ``0.0333333``), else the last
+        new frame before it.  273 frames at 30 fps give 545 at 60 fps.
         """
         fps = _validate.positive("fps", fps)
         new_dt = 1.0 / fps
         if self.n_frames == 1:
             return self.replace(frame_time=new_dt)
         old_t = np.arange(self.n_frames) * self.frame_time
-        n_new = int(np.floor(self.duration / new_dt + 1e-9)) + 1
+        steps = self.duration / new_dt
+        n_new = int(np.floor(steps + max(1e-9, 1e-5 * steps))) + 1
         new_t = np.minimum(np.arange(n_new) * new_dt, old_t[-1])
         rot = np.empty((n_new, self.n_joints, 4))
         for j in range(self.n_joints):

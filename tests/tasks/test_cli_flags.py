@@ -56,5 +56,7 @@ def test_flags_are_flags_not_values():
         for p in _command(name).params:
             if p.param_type_name == "option" and isinstance(p.default, bool):
                 assert p.is_flag, f"{name}: {p.opts} takes a value"
+            if p.default is True:
+                assert p.secondary_opts == ["--no-" + p.opts[0][2:]], p.opts
     text = CliRunner().invoke(app, ["compress", "--help"]).output
     assert "--json" in text and "<bool>" not in text and "BOOLEAN" not in text

@@ -68,9 +68,9 @@ def blend(
               f"turn {facts['turn_per_cycle_deg']:.3g}°")
     seam = facts["seam"]
     out.print(f"  seam jump: pose {seam['seam_pose']:.3g}, velocity {seam['seam_velocity']:.3g} (× median step)")
-    out.print(f"wrote {output}: {facts['frames_out']} frames ({cycles} cycle(s), root {root})")
+    out.print(f"wrote {output}: {facts['frames_out']} frames ({cycles} cycle(s), root {root})", soft_wrap=True)
     if plot is not None:
-        out.print(f"wrote {plot}")
+        out.print(f"wrote {plot}", soft_wrap=True)
     out.print(timing_line(report))
 
 
@@ -117,7 +117,7 @@ def transition(
     sm = facts["smoothness"]
     out.print(f"  largest step {sm['step_local']:.3g} × its neighbours' median (inputs {sm['input_step_local']:.3g}); "
               f"largest velocity change {sm['velocity_local']:.3g} × (inputs {sm['input_velocity_local']:.3g})")
-    out.print(f"wrote {output}: {facts['frames']} frames (root {root})")
+    out.print(f"wrote {output}: {facts['frames']} frames (root {root})", soft_wrap=True)
     if plot is not None:
-        out.print(f"wrote {plot}")
+        out.print(f"wrote {plot}", soft_wrap=True)
     out.print(timing_line(report))

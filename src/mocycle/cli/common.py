@@ -109,7 +109,10 @@ def _field(options_cls, name: str) -> dataclasses.Field:
 def flag(options_cls, name: str, *short: str, **kwargs) -> typer.models.OptionInfo:
     """The typer option of an Options field: its flag (plus short names) and its help line."""
     f = _field(options_cls, name)
-    return typer.Option(flag_of(f), *short, help=f.metadata.get("help", ""), **kwargs)
+    names = flag_of(f)
+    if f.default is True:  # a flag that is on by default also gets its --no- form
+        names = f"{names}/--no-{names[2:]}"
+    return typer.Option(names, *short, help=f.metadata.get("help", ""), **kwargs)
 
 
 def default(options_cls, name: str):

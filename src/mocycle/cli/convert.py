@@ -42,6 +42,7 @@ def convert(
     if fps is not None:
         motion = motion.resample(fps)
     write(motion, target)
-    out.print(f"wrote {target}: {motion.n_frames} frames, {motion.n_joints} joints, {motion.fps:.6g} fps")
+    out.print(f"wrote {target}: {motion.n_frames} frames, {motion.n_joints} joints, {motion.fps:.6g} fps",
+              soft_wrap=True)
 
 

@@ -45,5 +45,5 @@ def demo(
                 "input_foot_sliding"):
         label, unit = METRIC_LABELS[key]
         out.print(f"  {label:28s} {metrics[key]:8.3f} {unit}")
-    out.print(f"wrote {loop_file} (one cycle, in place), {walk_file} (4 cycles walking on), {plot}")
+    out.print(f"wrote {loop_file} (one cycle, in place), {walk_file} (4 cycles walking on), {plot}", soft_wrap=True)
     out.print(f"  time {time.perf_counter() - t0:.2f} s")

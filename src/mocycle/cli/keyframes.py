@@ -56,7 +56,7 @@ def compress(
     table.add_row("formula 5.2/5.3 ratio (h = 0)", f"{r['formula_ratio']:.2%}")
     table.add_row("time (s)", f"{report.seconds:.2f}")
     out.print(table)
-    out.print(f"wrote {output}")
+    out.print(f"wrote {output}", soft_wrap=True)
 
 
 @app.command()
@@ -115,5 +115,5 @@ def project(
         f", optimised {r['stress_optimized']:.4g}" if "stress_optimized" in r else ""))
     out.print(f"  keyframes: {', '.join(map(str, r['keyframes']))}", soft_wrap=True)
     if plot is not None:
-        out.print(f"wrote {plot}")
+        out.print(f"wrote {plot}", soft_wrap=True)
     out.print(timing_line(report))

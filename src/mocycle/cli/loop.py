@@ -59,7 +59,7 @@ def loop(
         return
     _print_loop(facts, report)
     if plot is not None:
-        out.print(f"wrote {plot}")
+        out.print(f"wrote {plot}", soft_wrap=True)
 
 
 def _print_loop(facts: dict, report) -> None:
@@ -80,5 +80,5 @@ def _print_loop(facts: dict, report) -> None:
         table.add_row(label, f"{facts['metrics'][key]:.4g}", unit)
     out.print(table)
     out.print(f"wrote {facts['output']}: {facts['frames_out']} frames ({facts['cycles']} cycle(s), root "
-              f"{facts['root']})")
+              f"{facts['root']})", soft_wrap=True)
     out.print(timing_line(report))

@@ -44,7 +44,7 @@ def phase(
     else:
         _print_phase(path, report)
         if plot is not None:
-            out.print(f"wrote {plot}")
+            out.print(f"wrote {plot}", soft_wrap=True)
     if not report.facts["classes"]:
         err.print(f"no periodic motion found: {report.facts['reason']}", soft_wrap=True)
         raise typer.Exit(EXIT_NOT_FOUND)

@@ -66,5 +66,5 @@ def stretch(
     if r["trend_curves"]:
         out.print(f"  warped as line + residual: {', '.join(r['trend_curves'])}", soft_wrap=True)
     if plot is not None:
-        out.print(f"wrote {plot}")
+        out.print(f"wrote {plot}", soft_wrap=True)
     out.print(timing_line(report))

@@ -11,6 +11,12 @@ from sklearn.decomposition import PCA
 from .figure import save, subplots
 
 
+def _wrap(text: str, width: int = 60) -> str:
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width))
+
+
 def plot_phase(result, path: str | os.PathLike, title: str = "") -> Path:
     """Persistence diagram with the chosen classes, coordinate per frame, PCA projection coloured by phase."""
     fig, (ax_dgm, ax_phase, ax_pca) = subplots(1, 3, figsize=(15, 4.6))
@@ -36,13 +42,21 @@ def plot_phase(result, path: str | os.PathLike, title: str = "") -> Path:
                  title="coordinate per frame (shaded: excitation)")
     if result.classes:
         ax_phase.legend(fontsize=8, loc="upper right")
+    else:
+        ax_phase.set(xlim=(0, max(result.n_frames - 1, 1)), title="no periodic motion found")
+        ax_phase.text(0.5, 0.5, "no periodic motion found:\n" + _wrap(result.reason), ha="center", va="center",
+                      fontsize=8, transform=ax_phase.transAxes)
     X = result.features
     xy = PCA(n_components=2).fit_transform(X) if X.shape[1] >= 2 else np.c_[X[:, 0], np.zeros(len(X))]
-    phase = result.classes[0].coords[: len(xy)] if result.classes else np.zeros(len(xy))
     ax_pca.plot(xy[:, 0], xy[:, 1], "-", color="0.85", lw=0.6, zorder=0)
-    points = ax_pca.scatter(xy[:, 0], xy[:, 1], c=phase, cmap="hsv", s=6, vmin=0, vmax=1)
-    fig.colorbar(points, ax=ax_pca, label="phase of class 0")
-    ax_pca.set(xlabel="PC 1", ylabel="PC 2", title="poses (PCA) coloured by phase")
+    if result.classes:
+        phase = result.classes[0].coords[: len(xy)]
+        points = ax_pca.scatter(xy[:, 0], xy[:, 1], c=phase, cmap="hsv", s=6, vmin=0, vmax=1)
+        fig.colorbar(points, ax=ax_pca, label="phase of class 0")
+        ax_pca.set(xlabel="PC 1", ylabel="PC 2", title="poses (PCA) coloured by phase")
+    else:  # no phase to colour by: poses in time order (grey), no phase colour bar
+        ax_pca.scatter(xy[:, 0], xy[:, 1], c="0.4", s=6)
+        ax_pca.set(xlabel="PC 1", ylabel="PC 2", title="poses (PCA); no phase: no periodic motion")
     if title:
         fig.suptitle(title)
     return save(fig, path)
