@@ -14,7 +14,7 @@ from .common import app, check_suffix, default, flag, friendly, out, print_json,
 
 B = tasks.blend.Options
 T = tasks.transition.Options
-PLOT_HELP = "Write a PNG: the most moving joint curves of the result and of the inputs' cycles."
+PLOT_HELP = "Write a PNG: the most moving joint curves of the blend and of the inputs' cycles, phase-aligned."
 
 
 @app.command()
@@ -48,10 +48,16 @@ def blend(
     write(report.motions["loop"], output)
     result = report.result
     if plot is not None:
+        from ..motion import concatenate
         from ..viz import plot_curves
 
-        loops = [("blend", result.motion("inplace"))] + [(p.name, c.motion("inplace"))
-                                                         for p, c in zip(paths, result.inputs, strict=True)]
+        def from_phase(m, phase):  # the input cycle read from the phase the blend's frame 0 is at
+            s = int(round(phase * m.n_frames)) % m.n_frames
+            return concatenate([m[s:], m[:s]]) if s else m
+
+        loops = [("blend", result.motion("inplace"))] + [
+            (p.name, from_phase(c.motion("inplace"), result.start_phase + off))
+            for p, c, off in zip(paths, result.inputs, result.phase_offsets, strict=True)]
         plot_curves([(label, m, np.arange(m.n_frames) / m.n_frames) for label, m in loops], plot,
                     title=f"blend of {len(paths)} takes", xlabel="phase (cycles)")
     facts = {"files": [str(p) for p in paths], "output": str(output), **report.facts, "seconds": report.seconds}

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from .. import tasks
@@ -24,8 +23,7 @@ def stretch(
     window: Annotated[str, flag(O, "window")] = default(O, "window"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(
-        help="Write a PNG: the most moving joint curves of the input and the stretched take over the take's "
-             "length (0-1).")] = None,
+        help="Write a PNG: the most moving joint curves of the input and the stretched take in seconds.")] = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
@@ -43,9 +41,8 @@ def stretch(
     if plot is not None:
         from ..viz import plot_curves
 
-        series = [(name, m, np.arange(m.n_frames) / max(m.n_frames - 1, 1))
-                  for name, m in (("stretched", report.motions["stretched"]), ("input", report.motions["input"]))]
-        plot_curves(series, plot, title=f"{path.name} stretched × {factor:g}", xlabel="fraction of the take")
+        series = [("stretched", report.motions["stretched"], None), ("input", report.motions["input"], None)]
+        plot_curves(series, plot, title=f"{path.name} stretched × {factor:g}: cycles copied, not slowed down")
     facts = {**{k: v for k, v in report.facts.items() if k not in ("fps", "joints_per_group")},
              "seconds": report.seconds}
     if as_json:
