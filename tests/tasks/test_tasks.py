@@ -157,3 +157,13 @@ def test_recorder_keeps_warnings_and_reissues_them_on_error():
         with Recorder():
             warnings.warn("before the error", stacklevel=1)
             raise MocycleError("boom")
+
+
+def test_the_task_layer_loads_no_front_end_library():
+    import subprocess
+    import sys
+
+    code = ("import sys, mocycle.tasks; print(sorted({m.split('.')[0] for m in sys.modules} & "
+            "{'typer', 'rich', 'click', 'matplotlib', 'dask', 'starlette', 'bpy'}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"

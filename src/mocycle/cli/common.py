@@ -142,21 +142,6 @@ def check_suffix(path: Path | None, suffix: str, option: str = "-o") -> None:
         raise MocycleError(f"{path}: {option} must name a {suffix} file")
 
 
-def count_option(text: str, option: str, words: dict[str, object]) -> object:
-    """A positive integer option that also takes a few words (e.g. 'auto')."""
-    if text in words:
-        return words[text]
-    try:
-        n = int(text)
-    except ValueError:
-        n = 0
-    if n < 1:
-        raise MocycleError(f"{option} must be {' or '.join(repr(w) for w in words)} or a positive integer; "
-                           f"got {text!r}")
-    return n
-
-
-
 def main() -> None:  # the console script
     try:
         app()
