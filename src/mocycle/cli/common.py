@@ -38,7 +38,8 @@ EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion
 #: parameter names of the library -> the CLI flag that sets them (every task option, and a few library names)
 FLAGS = {f.name: flag_of(f) for task in TASKS.values() for f in dataclasses.fields(task.Options)}
 FLAGS.update({"n_harmonics": "--harmonics", "time_axis_method": "--time", "phase_step": "--step",
-              "n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles"})
+              "n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles",
+              "window": "--window"})
 
 
 def option_message(exc: OptionError) -> str:

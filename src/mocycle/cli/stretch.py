@@ -20,7 +20,7 @@ def stretch(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
     factor: Annotated[float, flag(O, "factor")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The .bvh file to write.")],
-    window: Annotated[str, flag(O, "window")] = default(O, "window"),
+    window: Annotated[str, flag(O, "window_frames")] = default(O, "window_frames"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves of the input and the stretched take in seconds.")] = None,
@@ -35,7 +35,7 @@ def stretch(
     """
     check_suffix(output, ".bvh")
     check_suffix(plot, ".png", "--plot")
-    report = tasks.stretch.run(path, O(factor=factor, window=window, amc_fps=amc_fps))
+    report = tasks.stretch.run(path, O(factor=factor, window_frames=window, amc_fps=amc_fps))
     print_warnings(report)
     write(report.motions["stretched"], output)
     if plot is not None:

@@ -22,8 +22,9 @@ class Options(_Options):
 
     factor: float = option(help="Length ratio: 2 doubles the take (frames out = round(frames * F)).",
                            check=Real(0, low_open=True))
-    window: int | str = option("auto", "Block length in frames: 'auto' (each joint group's largest fundamental "
-                                       "cycle) or N.", Integer(1, words={"auto": "auto"}))
+    window_frames: int | str = option("auto", "Block length in frames: 'auto' (each joint group's largest "
+                                              "fundamental cycle) or N.", Integer(1, words={"auto": "auto"}),
+                                      flag="--window")
     amc_fps: float = fields.amc_fps()
 
 
@@ -33,7 +34,7 @@ def run(take, options: Options) -> Report:
 
     with Recorder() as rec:
         motion = load(take, options.amc_fps)
-        result, report = stretch_motion(motion, options.factor, window=options.window)
+        result, report = stretch_motion(motion, options.factor, window=options.window_frames)
         facts = {**report.to_dict(), "fps": motion.fps,
                  "joints_per_group": {g: len(names) for g, names in report.groups.items()}}
     return rec.report("stretch", facts, {"stretched": result, "input": motion}, report)
