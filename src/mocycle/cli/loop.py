@@ -9,7 +9,7 @@ import typer
 
 from .. import tasks
 from ..io import write
-from ..tasks.loop import METRIC_LABELS  # noqa: F401  (kept importable from here)
+from ..tasks.loop import METRIC_LABELS
 from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
 
 O = tasks.loop.Options
