@@ -21,7 +21,7 @@ def demo(
     seed: Annotated[int, typer.Option(help="Random seed of the synthetic take.")] = 0,
 ):
     """Loop the built-in synthetic walk: write the take, its cycle (BVH) and the loop plot."""
-    from ..cycle import extract_cycle, loop_metrics
+    from .. import tasks
     from ..datasets import synthetic_walk
     from ..tasks.loop import METRIC_LABELS
     from ..viz import plot_loop
@@ -34,10 +34,10 @@ def demo(
     true_period = float(np.median(take.period_frames))
     out.print(f"[bold]{source}[/]: synthetic walk, {motion.n_frames} frames at {motion.fps:.6g} fps, 1° noise, "
               f"tempo +10 % over the take; true period {true_period:.1f} frames")
-    cycle = extract_cycle(motion)
+    report = tasks.loop.run(motion, tasks.loop.Options(cycles=4, root="motion"))
+    cycle, metrics = report.result, report.facts["metrics"]
     loop_file = write(cycle.motion("inplace"), out_dir / "walk_cycle.bvh")
-    walk_file = write(cycle.repeat(4, root="motion"), out_dir / "walk_cycle_x4.bvh")
-    metrics = loop_metrics(motion, cycle)
+    walk_file = write(report.motions["loop"], out_dir / "walk_cycle_x4.bvh")
     plot = plot_loop(motion, cycle, out_dir / "walk_cycle.png", title="mocycle demo: synthetic walk")
     out.print(f"  found {cycle.n_periods:.2f} periods of {cycle.period_frames:.2f} frames; cycle of "
               f"{cycle.n_frames} frames by harmonic regression M1, K = {cycle.n_harmonics}")
