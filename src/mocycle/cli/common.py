@@ -18,7 +18,7 @@ from .. import __version__
 from ..errors import MocycleError, NoPeriodicMotion, OptionError
 from ..tasks import TASKS
 from ..tasks.loop import parse_range  # noqa: F401  (convert uses it)
-from ..tasks.options import MISSING, flag_of
+from ..tasks.options import MISSING, Choice, flag_of
 
 app = typer.Typer(
     name="mocycle",
@@ -113,6 +113,9 @@ def flag(options_cls, name: str, *short: str, **kwargs) -> typer.models.OptionIn
     names = flag_of(f)
     if f.default is True:  # a flag that is on by default also gets its --no- form
         names = f"{names}/--no-{names[2:]}"
+    check = f.metadata.get("check")
+    if isinstance(check, Choice) and "metavar" not in kwargs:  # --method <harmonic|centroid|cut>
+        kwargs["metavar"] = f"<{'|'.join(check.choices)}>"
     return typer.Option(names, *short, help=f.metadata.get("help", ""), **kwargs)
 
 
