@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..motion import Motion
 from . import fields, keyframe_fields
 from .options import Choice, option
 from .options import Options as _Options
@@ -46,7 +47,7 @@ def run(take, options: Options | None = None) -> Report:
         packed = compress(motion, ratio=o.ratio, select=o.select, scheme=o.scheme, projection=o.projection,
                           optimize=o.optimize, seed=o.seed_projection)
         rebuilt = packed.decompress()
-        is_bvh = not hasattr(take, "skeleton") and Path(take).suffix.lower() == ".bvh"
+        is_bvh = not isinstance(take, Motion) and Path(take).suffix.lower() == ".bvh"
         size = packed.size_report(Path(take).stat().st_size if is_bvh else None)
         facts = {"frames": motion.n_frames, "keyframes": packed.n_keyframes,
                  "error_per_frame_per_joint": error_per_frame_per_joint(motion, rebuilt),

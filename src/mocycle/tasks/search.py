@@ -6,6 +6,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..motion import Motion
 from . import fields
 from .options import Integer, Real, Text, option
 from .options import Options as _Options
@@ -33,7 +34,7 @@ def run(query, folder: str | os.PathLike, options: Options | None = None) -> Rep
     with Recorder() as rec:
         motion = load(query, o.amc_fps)
         index = build_index(folder, pattern=o.pattern, threshold=o.threshold, window_s=o.window_s)
-        exclude = None if hasattr(query, "skeleton") else Path(query)
+        exclude = None if isinstance(query, Motion) else Path(query)
         hits = index.query(motion, top=o.top, exclude=exclude)
         facts = {"query": label_of(query), "indexed": len(index),
                  "results": [{"rank": k + 1, "path": str(h.path), "score": h.score, "offset_s": h.offset_s}

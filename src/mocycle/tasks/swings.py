@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..motion import Motion
 from . import fields
 from .options import Options as _Options
 from .report import Recorder, Report, load
@@ -54,7 +55,7 @@ def run(source, options: Options | None = None) -> Report:
 
     o = options or Options()
     with Recorder() as rec:
-        if not hasattr(source, "skeleton") and Path(source).suffix.lower() == ".mosw":
+        if not isinstance(source, Motion) and Path(source).suffix.lower() == ".mosw":
             motion, seg = None, read_swings(source)
         else:
             motion = load(source, o.amc_fps)
