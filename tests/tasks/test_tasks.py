@@ -167,3 +167,17 @@ def test_the_task_layer_loads_no_front_end_library():
             "{'typer', 'rich', 'click', 'matplotlib', 'dask', 'starlette', 'bpy'}))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
+
+
+def test_an_option_shared_by_tasks_accepts_the_same_values_everywhere():
+    """(Defaults may differ: transition's --cycles is 3, loop's 1.)"""
+    seen: dict[str, tuple] = {}
+    for name, module in tasks.TASKS.items():
+        for f in dataclasses.fields(module.Options):
+            check = f.metadata["check"]
+            constraint = check.schema() if hasattr(check, "schema") else None
+            key = constraint
+            if f.name in seen:
+                assert seen[f.name][0] == key, f"{name}.{f.name} differs from {seen[f.name][1]}.{f.name}"
+            else:
+                seen[f.name] = (key, name)
