@@ -97,7 +97,7 @@ class PoseDecoder:
             quats = tpl.rotations.copy()
             trans = tpl.translations.copy()
         else:
-            mean_q = np.stack([Rotation.from_quat(tpl.rotations[:, j]).mean().as_quat() for j in range(J)])
+            mean_q = mean_rotations(tpl.rotations)
             quats = np.broadcast_to(mean_q, (T, J, 4)).copy()
             trans = np.broadcast_to(tpl.translations.mean(axis=0), (T, J, 3)).copy()
             trans[:, self.travel] = tpl.translations[0, self.travel]

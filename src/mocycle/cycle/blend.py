@@ -60,9 +60,9 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError, NoPeriodicMotion
 from ..motion import Motion, Skeleton
-from ..rotations import mean_rotations
+from ..rotations import axis_rotations, mean_rotations, nearest_rotations
 from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, metric_features
-from .representation import CycleSpace, axis_rotations, nearest_rotations
+from .representation import CycleSpace
 from .seam import LOCAL, calmest_start, seam_ratios
 from .timeaxis import TimeAxis
 
@@ -336,17 +336,6 @@ def _blend_P(Ps: Sequence[np.ndarray], w: np.ndarray, n_joints: int) -> np.ndarr
     T = P.shape[0]
     P[:, : 9 * n_joints] = nearest_rotations(P[:, : 9 * n_joints].reshape(T, n_joints, 3, 3)).reshape(T, -1)
     return P
-
-
-def weighted_rotation_mean(quats: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """The weighted chordal L2 mean ``(..., 4)`` of rotations ``quats`` ``(K, ..., 4)`` with ``weights (K,)``:
-    the rotation nearest (Frobenius) to ``Σ w_k R_k`` — the mean ``Rotation.mean(weights=)`` computes, for
-    many sets at once."""
-    q = np.asarray(quats, dtype=np.float64)
-    w = check_weights(weights, q.shape[0])
-    R = Rotation.from_quat(q.reshape(-1, 4)).as_matrix().reshape(*q.shape[:-1], 3, 3)
-    M = np.tensordot(w, R, axes=1)
-    return Rotation.from_matrix(nearest_rotations(M).reshape(-1, 3, 3)).as_quat().reshape(*q.shape[1:])
 
 
 def cycle_seam(cycle: Cycle) -> dict[str, float]:

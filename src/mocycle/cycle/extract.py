@@ -28,10 +28,10 @@ from ..features import pose_matrix
 from ..motion import Motion
 from ..phase.analysis import PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
-from ..rotations import mean_rotations
+from ..rotations import axis_rotations, mean_rotations
 from .differences import HALF, central_acceleration, central_velocity
 from .harmonic import MODELS, HarmonicRegression, max_harmonics
-from .representation import CycleSpace, axis_rotations
+from .representation import CycleSpace
 from .seam import calmest_start
 from .timeaxis import TIME_AXES, TimeAxis, time_axis
 

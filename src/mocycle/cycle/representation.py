@@ -23,33 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..axes import heading_angles, horizontal_basis, vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
-from ..rotations import continuous_quats, nearest_rotations
-
-
-def vertical_axis(motion: Motion) -> np.ndarray:
-    """The world up direction ``(3,)`` of a humanoid take (unit vector along +X, +Y or +Z or their negatives).
-
-    The axis along which the mean pose is tallest; its sign puts most joints in
-    the upper half (spine, arms, head and hands outnumber the legs).
-    """
-    step = max(1, motion.n_frames // 50)
-    pose = motion[::step].world_positions(end_sites=True).mean(axis=0)  # (J', 3)
-    extent = np.ptp(pose, axis=0)
-    axis = int(np.argmax(extent))
-    mid = 0.5 * (pose[:, axis].max() + pose[:, axis].min())
-    up = np.zeros(3)
-    up[axis] = 1.0 if np.median(pose[:, axis]) >= mid else -1.0
-    return up
-
-
-def axis_rotations(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Rotation matrices ``(T, 3, 3)`` about the unit ``axis`` ``(3,)`` by ``angles`` ``(T,)`` radians."""
-    u = np.asarray(axis, dtype=np.float64)
-    c, s = np.cos(angles)[:, None, None], np.sin(angles)[:, None, None]
-    K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
-    return c * np.eye(3) + s * K + (1.0 - c) * np.outer(u, u)
+from ..rotations import axis_rotations, continuous_quats, nearest_rotations
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -59,7 +36,8 @@ class CycleSpace:
     It keeps what decoding needs, not the input motion: ``skeleton``; ``frame_time`` (s);
     ``static_translations`` ``(J, 3)``: every joint's translation in the input's first
     frame (what the joints whose translation does not move keep);
-    ``travel``: index of the travel joint; ``up``: the vertical axis in the
+    ``travel``: index of the travel joint; ``world_up``: the vertical axis of the
+    take (:func:`~mocycle.axes.vertical_axis`); ``up``: the same in the
     travel joint's parent frame; ``e1``, ``e2``: a horizontal basis there;
     ``forward``: the vector in the travel joint's own frame whose horizontal
     direction defines the heading; ``moving``: the other joints whose translation moves.
@@ -69,6 +47,7 @@ class CycleSpace:
     frame_time: float
     static_translations: np.ndarray
     travel: int
+    world_up: np.ndarray
     up: np.ndarray
     e1: np.ndarray
     e2: np.ndarray
@@ -76,9 +55,11 @@ class CycleSpace:
     moving: tuple[int, ...]
 
     @classmethod
-    def fit(cls, motion: Motion) -> CycleSpace:
+    def fit(cls, motion: Motion, up=None) -> CycleSpace:
+        """The space of ``motion``; ``up``: the vertical axis (``None``: detected; ``"y"``, ``"-z"`` or a
+        3-vector: see :func:`~mocycle.axes.vertical_axis`)."""
         travel = motion.travel_joint
-        up_world = vertical_axis(motion)
+        up_world = vertical_axis(motion, up)
         parent = int(motion.skeleton.parents[travel])
         if parent >= 0:
             world_rot, _ = motion[:: max(1, motion.n_frames // 50)].world_transforms()
@@ -87,17 +68,14 @@ class CycleSpace:
         else:
             up = up_world
         up = up / np.linalg.norm(up)
-        least = np.eye(3)[int(np.argmin(np.abs(up)))]
-        e1 = least - up * (least @ up)
-        e1 /= np.linalg.norm(e1)
-        e2 = np.cross(up, e1)
+        e1, e2 = horizontal_basis(up)
         mean_rot = motion.rotation(travel).mean().as_matrix()
         forward = mean_rot.T @ e1
         moved = np.ptp(motion.translations, axis=0).max(axis=1) > 1e-9
         moving = tuple(int(j) for j in np.flatnonzero(moved) if j != travel)
         return cls(skeleton=motion.skeleton, frame_time=motion.frame_time,
-                   static_translations=motion.translations[0].copy(), travel=travel, up=up, e1=e1, e2=e2,
-                   forward=forward, moving=moving)
+                   static_translations=motion.translations[0].copy(), travel=travel, world_up=up_world, up=up,
+                   e1=e1, e2=e2, forward=forward, moving=moving)
 
     # -- sizes ----------------------------------------------------------
     @property
@@ -114,8 +92,7 @@ class CycleSpace:
 
     def heading(self, rotations: np.ndarray) -> np.ndarray:
         """Unwrapped heading ``(T,)`` radians of the travel joint's rotation matrices ``(T, 3, 3)``."""
-        f = rotations @ self.forward
-        return np.unwrap(np.arctan2(f @ self.e2, f @ self.e1))
+        return heading_angles(rotations @ self.forward, self.e1, self.e2)
 
     # -- motion -> (P, L) -----------------------------------------------
     def encode(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:

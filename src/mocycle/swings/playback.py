@@ -16,7 +16,8 @@ from scipy.spatial.transform import Rotation, Slerp
 from ..errors import MocycleError
 from ..io.bvh import _channel_layout, motion_channels
 from ..motion import Motion
-from .segment import Segmentation, rotvec_quat
+from ..rotations import rotvec_quat
+from .segment import Segmentation
 
 PROFILES = ("hermite", "linear")
 
