@@ -415,6 +415,15 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     calmest pose, as :func:`extract_cycle` does (off: at the first cycle's frame 0); ``labels``: names for
     messages.  The result has ``round(Σ w_i T_i)`` frames at the first take's frame time, travels (or, on the
     spot, faces) like the first take, and its root drifts by the weighted travel and turn per cycle.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> slow = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> fast = synthetic_walk(n_frames=300, fps=60, period_s=0.8, seed=1).motion
+    >>> blend = blend_cycles([slow, fast], weights=[0.5, 0.5])
+    >>> blend.n_frames, blend.weights.tolist()      # (60 + 48) / 2 frames
+    (54, [0.5, 0.5])
     """
     t0 = time.perf_counter()
     cycles = _cycles(takes, labels, extract_options)
@@ -496,6 +505,15 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     half a frame so that frame ``T`` would be phase ``n`` exactly: the result can be preceded by ``a``'s loop
     and followed by ``b``'s loop read from its phase offset.  ``root="motion"``: travel and turn per cycle
     blended with the same weight and integrated along the phase; ``"inplace"``: no travel.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> slow = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> fast = synthetic_walk(n_frames=300, fps=60, period_s=0.8, seed=1).motion
+    >>> tr = transition(slow, fast, cycles=2)
+    >>> tr.motion.n_frames, round(float(tr.period_frames[0])), round(float(tr.period_frames[-1]))
+    (108, 60, 48)
     """
     t0 = time.perf_counter()
     if root not in ROOT_MODES:

@@ -350,6 +350,22 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     ``phase_step``: find the phase on every ``phase_step``-th frame only (the thesis plugin's subsampling;
     the cycle is still built from every frame at the capture's rate).
     Raises :class:`NoPeriodicMotion` when the take has none; warns below 1.5 periods.
+
+    Returns
+    -------
+    Cycle
+        ``motion("inplace")`` / ``motion("motion")``: the loop as a Motion; ``repeat(k, root)``: ``k``
+        seamless repetitions; ``to_dict()``: period, frames, method, travel and turn per cycle.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> walk = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> cycle = extract_cycle(walk, method="harmonic", model="M1")
+    >>> cycle.n_frames, cycle.n_harmonics
+    (60, 20)
+    >>> cycle.motion("inplace").n_frames, cycle.repeat(3, root="motion").n_frames
+    (60, 180)
     """
     t0 = time.perf_counter()
     if not isinstance(motion, Motion):

@@ -422,6 +422,21 @@ def segment(motion: Motion, threshold: float = DEFAULT_THRESHOLD, joints: str | 
         so slow drifts are kept by interpolation between their means.
     translation_tol : tolerance of the piecewise-linear translation track in file units
         (default 0.1 % of the skeleton's height).
+
+    Returns
+    -------
+    Segmentation
+        ``swings`` and ``holds`` per joint (``swings_of(j)``, ``holds_of(j)``), ``to_records()``,
+        ``to_dict()``; :func:`~mocycle.swings.playback` rebuilds the motion, ``mocycle.write(seg,
+        "take.mosw")`` stores it.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> walk = synthetic_walk(n_frames=300, fps=60).motion
+    >>> seg = segment(walk, threshold=0.4)
+    >>> seg.n_swings, len(seg.joints), seg.swings_of(seg.joints[1])[0].name
+    (205, 20, 'LeftUpLeg')
     """
     if not isinstance(motion, Motion):
         raise MocycleError(f"segment() needs a Motion; got {type(motion).__name__}")

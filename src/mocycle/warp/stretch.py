@@ -293,6 +293,14 @@ def stretch_motion(motion: Motion, factor: float, window: str | int = "auto") ->
     -------
     ``(new motion, StretchReport)``.  Raises MocycleError when ``"auto"`` finds no cycle in any group (the
     take does not look periodic; pass a window).
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> walk = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> longer, report = stretch_motion(walk, factor=1.5)
+    >>> longer.n_frames, report.windows
+    (450, {'legs': 60, 'arms': 60, 'spine': 60})
     """
     if not isinstance(motion, Motion):
         raise MocycleError(f"stretch_motion needs a Motion; got {type(motion).__name__}")
