@@ -39,7 +39,7 @@ ROOTS = ("keep", "velocity", "drop")
 _AXES = ("x", "y", "z")
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class PoseDecoder:
     """Turns pose matrices made by :func:`pose_matrix` back into motions.
 
@@ -294,7 +294,8 @@ def pose_matrix(
     w = _joint_weights(motion, weights, chosen)
     scale = scale / w[owner_arr]
     X = (raw - mean) / scale
-    decoder = PoseDecoder(motion, rep, root, chosen, tuple(columns), owner_arr, mean, scale, ref, travel)
+    decoder = PoseDecoder(template=motion, rep=rep, root=root, joints=chosen, columns=tuple(columns),
+                          dof_joint=owner_arr, mean=mean, scale=scale, reference=ref, travel=travel)
     return X, decoder
 
 

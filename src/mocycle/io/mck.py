@@ -47,7 +47,7 @@ MAGIC = b"MOCK\x01"
 SCHEMES = TEMPORAL_SCHEMES + ("spatial",)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class Compressed:
     """A take reduced to keyframes (and, for the spatial scheme, a 2-D trajectory).
 

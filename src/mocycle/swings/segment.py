@@ -58,7 +58,7 @@ MINOR_JOINT_PATTERNS = (
 
 
 # ---------------------------------------------------------------- records
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Swing:
     """One geodesic swing of one joint: ``q(t) = Rot(axis, θ(t)) ⊗ base`` for frames ``start..end``.
 
@@ -105,7 +105,7 @@ class Swing:
         return quat_multiply(axis_angle_quats(np.asarray(self.axis), theta), rotvec_quat(np.asarray(self.base)))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Hold:
     """A still part of one joint: frames ``start..end`` (inclusive) and their mean rotation (rotation vector, rad)."""
 
@@ -120,7 +120,7 @@ class Hold:
         return self.end - self.start + 1
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Segmentation:
     """Swings and holds of every joint of a take, plus what playback needs to rebuild it.
 

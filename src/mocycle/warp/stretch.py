@@ -233,7 +233,7 @@ def joint_groups(skeleton: Skeleton) -> dict[str, list[int]]:
     return {g: js for g, js in groups.items() if js}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class StretchReport:
     """What :func:`stretch_motion` did.
 
