@@ -10,7 +10,8 @@ Quaternions are ``(x, y, z, w)`` arrays (scipy's order), matrices ``(..., 3, 3)`
 * **Vectorised quaternion algebra** on ``(..., 4)`` arrays: :func:`quat_multiply`
   (about 10× faster than ``Rotation.__mul__`` on 100 000 products), :func:`quat_conj`,
   :func:`quat_log` / :func:`quat_exp`, :func:`euler_to_quats`, :func:`axis_angle_quats`,
-  :func:`twist_angles`, :func:`slerp`; single rotations: :func:`rotvec_quat`, :func:`quat_rotvec`.
+  :func:`twist_angles`, :func:`quat_angles` (geodesic), :func:`slerp`; single rotations:
+  :func:`rotvec_quat`, :func:`quat_rotvec`.
 * **Matrices**: :func:`axis_rotations` (about one axis), :func:`nearest_rotations` (SVD),
   :func:`fast_nearest_rotation` (Newton polar iterations), :func:`angle_to_nearest_rotation`.
 * **Means**: :func:`mean_rotations` (per joint over time, scipy), :func:`weighted_rotation_mean`
@@ -279,6 +280,12 @@ def mean_quat(q: np.ndarray) -> np.ndarray:
 def twist_angles(q: np.ndarray, axis: np.ndarray) -> np.ndarray:
     """Angle (radians, unwrapped in time) of the twist of each quaternion ``(n, 4)`` about ``axis``."""
     return np.unwrap(2.0 * np.arctan2(q[:, :3] @ axis, q[:, 3]))
+
+
+def quat_angles(qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
+    """Geodesic angle (radians, 0..π) between quaternions ``(..., 4)`` → ``(...)``: ``2·arccos|qa·qb|``."""
+    dot = np.abs(np.sum(np.asarray(qa) * np.asarray(qb), axis=-1))
+    return 2.0 * np.arccos(np.minimum(dot, 1.0))
 
 
 def slerp(qa: np.ndarray, qb: np.ndarray, u: np.ndarray) -> np.ndarray:

@@ -16,7 +16,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from ..errors import MocycleError
 from ..io.bvh import _channel_layout, motion_channels
 from ..motion import Motion
-from ..rotations import rotvec_quat
+from ..rotations import quat_angles, rotvec_quat
 from .segment import Segmentation
 
 PROFILES = ("hermite", "linear")
@@ -144,8 +144,7 @@ def geodesic_errors(original: Motion, other: Motion) -> np.ndarray:
     """Mean geodesic angle (degrees) between the local rotations of each joint, ``(J,)``."""
     if not original.skeleton.same_as(other.skeleton) or original.n_frames != other.n_frames:
         raise MocycleError(f"motions differ in skeleton or length ({original!r} vs {other!r})")
-    dots = np.abs(np.sum(original.rotations * other.rotations, axis=-1)).clip(0.0, 1.0)
-    return np.degrees(2.0 * np.arccos(dots)).mean(axis=0)
+    return np.degrees(quat_angles(original.rotations, other.rotations)).mean(axis=0)
 
 
 def playback_errors(original: Motion, other: Motion) -> dict:
