@@ -138,11 +138,13 @@ def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> li
     Y = metric_features(motion[s:e], ref)
     spread = float(np.sqrt(((Y - Y.mean(axis=0)) ** 2).sum(axis=1).mean()))
     if np.isfinite(cut) and not tmpl <= max(MAX_FIT_RATIO * cut, FIT_FLOOR * spread):
+        why = (f"the period found ({cycle.period_frames:.1f} frames) is probably wrong"
+               if abs(cut_period / cycle.period_frames - 1) > CUT_SPAN else
+               "the take's cycles differ too much for one typical cycle (a cut copies one of them)")
         failed.append(FailedCheck(
             "fit", float(tmpl / cut), MAX_FIT_RATIO,
-            f"the cycle fits the take {tmpl / cut:.1f} times worse than a plain cut of {cut_period:.1f} frames "
-            f"(template error {tmpl:.3g} against {cut:.3g} rad; limit {MAX_FIT_RATIO:g}×): the period found "
-            f"({cycle.period_frames:.1f} frames) is probably wrong"))
+            f"the cycle fits the take {tmpl / cut:.1f} times worse than a plain cut of about {cut_period:.1f} "
+            f"frames (template error {tmpl:.3g} against {cut:.3g} rad; limit {MAX_FIT_RATIO:g}×): {why}"))
     if not seam <= MAX_SEAM:
         failed.append(FailedCheck(
             "seam", float(seam), MAX_SEAM,
