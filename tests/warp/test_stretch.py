@@ -325,6 +325,12 @@ def test_a_walk_that_stops_keeps_its_ending_and_walks_further():
     out, report = stretch_motion(ending, 1.5)
     (s, e), = report.regions
     assert s == 0 and e <= ending.n_frames - stand + 30
+    # the walk grows by whole strides (60 frames), so that it ends as captured: about 1.5 times the take
+    assert abs(out.n_frames - 1.5 * ending.n_frames) <= 30 and (out.n_frames - ending.n_frames) % 60 == 0
+    X, _ = pose_matrix(ending, rep="quatlog", root="drop")
+    Y, _ = pose_matrix(out, rep="quatlog", root="drop")
+    assert max_step(Y) <= 1.5 * max_step(X)                                   # no pop where the walk stops
+    assert np.abs(Y).max(axis=0).max() <= 1.05 * np.abs(X).max(axis=0).max()  # and no pose it never had
     n_end = ending.n_frames - e
     # the ending is the captured one, moved on by the longer walk (same poses, same relative path)
     assert max_angle(out.rotations[-n_end:, 1:], ending.rotations[-n_end:, 1:]) < 1e-9

@@ -498,14 +498,15 @@ def stretch_motion(motion: Motion, factor: float, window: str | int = "auto", fo
 
     Only the periodic region(s) are warped (:func:`periodic_regions`: the excitation regions of the take's
     phase); the frames before, between and after them are kept as captured, turned and moved on so that they
-    follow the stretched regions, and each join is faded over a window so that nothing pops.  The output
-    still has ``round(T * factor)`` frames: the regions absorb the whole change, in proportion to their
-    lengths.
+    follow the stretched regions, and each join is faded over a window so that nothing pops.  The regions
+    absorb the whole change, in proportion to their lengths; the output has ``round(T * factor)`` frames,
+    or within half a window of it per region when captured frames follow the last region (a region with
+    frames after it grows by whole windows, so that it ends as captured).
 
     Parameters
     ----------
     motion : the take (at least 8 frames).
-    factor : length ratio (> 0); the result has ``round(T * factor)`` frames at the same frame time.
+    factor : length ratio (> 0); the result has about ``round(T * factor)`` frames at the same frame time.
     window : ``"auto"`` (each joint group's largest fundamental cycle in the region, :func:`group_cycle`) or
         a number of frames used for every group (``1 <= window <= region // 2``).
     force : warp the whole take when it has no periodic motion (a warning) instead of raising
@@ -570,6 +571,20 @@ def stretch_motion(motion: Motion, factor: float, window: str | int = "auto", fo
             raise MocycleError(f"window must be between 1 and half the periodic region {s}:{e} "
                                f"({(e - s) // 2} frames); got {window}")
         warped, rep = _warp_take(motion[s:e], n_seg / (e - s), window, travel)
+        if e < T:
+            # The warp copies whole windows and keeps the last block (one window plus the remainder) last; a
+            # length between two whole numbers of copies would cut that block, and the captured frames after
+            # the region would not follow.  So a region with frames after it grows by whole windows.
+            N = max(rep.windows.values())
+            last = N + (e - s) % N
+            whole = last + max(0, int(round((n_seg - last) / N))) * N
+            if whole != n_seg:
+                n_seg = whole
+                warped, rep = _warp_take(motion[s:e], n_seg / (e - s), window, travel)
+        elif (s, e) == regions[-1]:
+            n_seg = n_out - frames  # the last region ends the take: it takes what is left (cut mid-cycle)
+            warped, rep = _warp_take(motion[s:e], n_seg / (e - s), window, travel) if n_seg != warped.n_frames \
+                else (warped, rep)
         warped = placer.place(warped)
         fade = int(min(max(rep.windows.values()), n_seg // 3))
         if s > 0:
