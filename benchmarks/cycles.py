@@ -162,9 +162,9 @@ def trust_row(motion) -> dict:
             warnings.simplefilter("ignore")
             cycle = extract_cycle(motion)
     except NoPeriodicMotion as exc:
-        return row | {"refused": "no periodic motion: " + str(exc).split(": ", 1)[-1][:70]}
+        return row | {"refused": str(exc), "why": "no periodic motion"}
     except MocycleError as exc:
-        return row | {"refused": str(exc)[:80]}
+        return row | {"refused": str(exc), "why": "error"}
     metrics = loop_metrics(motion, cycle)
     failed = loop_checks(motion, cycle, metrics)
     up = vertical_axis(motion)
@@ -180,7 +180,7 @@ def trust_row(motion) -> dict:
             "turn": float(np.degrees(cycle.drift[3])), "take_turn": float(np.degrees(rate * cycle.period_frames)),
             "creep": float(100 * (height[3 * N] - height[0]) / body), "template": metrics["template_error"],
             "cut": cut, "seam": max(metrics["seam_pose_local"], metrics["seam_velocity_local"]),
-            "refused": "; ".join(f"{f.name}: {f.reason}" for f in failed)}
+            "refused": "; ".join(f"{f.name}: {f.reason}" for f in failed), "why": ", ".join(f.name for f in failed)}
     return row
 
 
@@ -199,12 +199,12 @@ def trust(data: Path, quick: bool) -> None:
         rows[name] = r
         if "cycle" not in r:
             print(f"{name[:30]:30s} {r['frames']:6d} {fmt(r['gait']):>6s} {'-':>6s} {'':6s} {'':6s} {'':6s} "
-                  f"{'':7s} {'':5s} {'':5s}  {r['refused']}")
+                  f"{'':7s} {'':5s} {'':5s}  {r['why']}")
         else:
             off = 100 * (r["cycle"] / r["gait"] - 1) if np.isfinite(r["gait"]) else float("nan")
             print(f"{name[:30]:30s} {r['frames']:6d} {fmt(r['gait']):>6s} {r['cycle']:6d} {off:6.1f} "
                   f"{r['turn']:6.1f} {r['take_turn']:6.1f} {r['creep']:7.3f} {r['template'] / r['cut']:5.2f} "
-                  f"{r['seam']:5.2f}  {r['refused'] or '-'}")
+                  f"{r['seam']:5.2f}  {r['why'] or '-'}")
         sys.stdout.flush()
     made = {n: r for n, r in rows.items() if "cycle" in r}
     ok = {n: r for n, r in made.items() if not r["refused"]}
