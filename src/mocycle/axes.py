@@ -45,7 +45,7 @@ def vertical_axis(motion: Motion, up=None) -> np.ndarray:
     -------
     ``(3,)`` unit vector.  Detected: along +X, +Y or +Z or their negatives, the axis along which the mean
     pose is tallest; its sign puts most joints in the upper half (spine, arms, head and hands outnumber
-    the legs).
+    the legs).  The pose is the travel joint and the joints below it, taken relative to the travel joint.
 
     Examples
     --------
@@ -57,7 +57,22 @@ def vertical_axis(motion: Motion, up=None) -> np.ndarray:
     if up is not None:
         return parse_up(up)
     step = max(1, motion.n_frames // 50)
-    pose = motion[::step].world_positions(end_sites=True).mean(axis=0)  # (J', 3)
+    travel = motion.travel_joint
+    parents = list(motion.skeleton.parents) + [site.parent for site in motion.skeleton.end_sites]
+
+    def below_travel(i: int) -> bool:
+        while i >= 0:
+            if i == travel:
+                return True
+            i = parents[i]
+        return False
+
+    # The travel joint and everything below it, relative to the travel joint frame by frame: joints above
+    # it (Bandai's static joint_Root at the room's origin) and the walk across the room would otherwise
+    # stretch the mean pose along the walking direction.
+    keep = [i for i in range(len(parents)) if below_travel(i)]
+    W = motion[::step].world_positions(end_sites=True)
+    pose = (W[:, keep] - W[:, travel:travel + 1]).mean(axis=0)  # (J', 3)
     extent = np.ptp(pose, axis=0)
     axis = int(np.argmax(extent))
     mid = 0.5 * (pose[:, axis].max() + pose[:, axis].min())

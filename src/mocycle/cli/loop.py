@@ -59,12 +59,17 @@ def loop(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: PCA of input and cycle, phase, joint curves.")]
     = None,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Write the cycle even when it fails a loop check (longer than the take, fits much "
+                        "worse than a plain cut, seam jumps); a warning names the check.")] = False,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
 
-    Exit code 0 on success, 3 when the take holds no periodic motion, 1 for bad input.
+    Exit code 0 on success, 3 when the take holds no periodic motion or its cycle fails a loop check
+    (the reason is printed; --force writes it anyway), 1 for bad input.
     """
     from ..cycle import extract_cycle, loop_metrics
+    from ..cycle.checks import check_loop
 
     check_suffix(output, ".bvh", "--output")
     check_suffix(plot, ".png", "--plot")
@@ -78,12 +83,13 @@ def loop(
         motion, method=method, model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}),
         time_axis_method=time_axis, joints=joints, classes=count_option(classes, "--classes", {"auto": "auto"}),
         which=which, phase_step=step)
-    result = cycle.repeat(cycles, root=root)
-    write(result, output)
-    seconds = time.perf_counter() - t0
     t1 = time.perf_counter()
     metrics = loop_metrics(motion, cycle)
+    failed = check_loop(motion, cycle, metrics, force=force, label=str(path))
     metrics_seconds = time.perf_counter() - t1
+    result = cycle.repeat(cycles, root=root)
+    write(result, output)
+    seconds = time.perf_counter() - t0 - metrics_seconds
     if plot is not None:
         from ..viz import plot_loop
 
@@ -99,6 +105,7 @@ def loop(
         "root": root,
         "cycles": cycles,
         "metrics": metrics,
+        "failed_checks": [f.to_dict() for f in failed],
         "seconds": seconds,
         "metrics_seconds": metrics_seconds,
     }

@@ -14,6 +14,13 @@ A pose is split in two blocks (:class:`CycleSpace`):
   (3, in its parent's frame, file units) and its heading about the vertical
   axis (1, radians, unwrapped).  These get the translation model with a
   linear term (KTH thesis eq. 3.27): walking moves on and turning keeps turning.
+
+A walk along an arc has a path that is not "periodic plus a line", so the
+cycle is fitted on the *straightened* path (:meth:`CycleSpace.straighten`,
+paper 001 §4.1's differenced root: every horizontal step turned into the
+heading frame and summed again), which is, and turned back along the cycle's
+own heading afterwards (:meth:`CycleSpace.bend`).  For a walk whose heading
+does not change the two are the same path.
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import uniform_filter1d
 from scipy.spatial.transform import Rotation
 
 from ..axes import heading_angles, horizontal_basis, vertical_axis
@@ -110,6 +118,59 @@ class CycleSpace:
         P = np.concatenate(parts, axis=1)
         L = np.concatenate([motion.translations[:, self.travel], psi[:, None]], axis=1)
         return P, L
+
+    # -- straight and curved paths ---------------------------------------
+    def _turned(self, V: np.ndarray, angles: np.ndarray) -> np.ndarray:
+        """The vectors ``V (T, 3)`` each turned by ``angles (T,)`` about the vertical."""
+        return np.einsum("tij,tj->ti", axis_rotations(self.up, angles), V)
+
+    @staticmethod
+    def heading_trend(psi: np.ndarray, period: float) -> np.ndarray:
+        """The heading ``psi (T,)`` without its within-cycle sway: its mean over one period about each frame.
+
+        The take's straight line through ``psi`` is taken out first and put back after, so the window's
+        ends (shortened there) do not bend a steady turn.
+        """
+        t = np.arange(psi.size, dtype=np.float64)
+        line = np.polyval(np.polyfit(t, psi, 1), t) if psi.size > 1 else psi.copy()
+        width = int(max(1, min(round(period), psi.size)))
+        return line + uniform_filter1d(psi - line, width, mode="nearest")
+
+    def straighten(self, L: np.ndarray, period: float) -> np.ndarray:
+        """``L (T, 4)`` with its path straightened: step ``t`` turned back by the heading trend's change
+        since the first frame (:meth:`heading_trend`, ``period`` in frames).
+
+        The vertical component and the heading are kept; the first frame stays where it is.  A walk along
+        a circle becomes a straight walk (periodic plus a line), which the cycle models can fit; a walk
+        whose heading only sways about a fixed direction is left as it is.
+        """
+        L = np.asarray(L, dtype=np.float64)
+        if L.shape[0] < 2:
+            return L.copy()
+        trend = self.heading_trend(L[:, 3], period)
+        mid = 0.5 * (trend[1:] + trend[:-1])
+        steps = self._turned(np.diff(L[:, :3], axis=0), trend[0] - mid)
+        out = L.copy()
+        out[1:, :3] = L[0, :3] + np.cumsum(steps, axis=0)
+        return out
+
+    def bend(self, Q: np.ndarray, drift: np.ndarray, reference: float) -> tuple[np.ndarray, np.ndarray]:
+        """The inverse of :meth:`straighten` for one cycle: ``Q (N, 4)`` straightened with heading trend
+        ``reference`` at the first frame of its take, ``drift (4,)`` its change over one cycle.
+
+        The cycle's heading trend is its mean heading plus its turn spread evenly over the cycle.  Returns
+        the cycle's path ``(N, 4)`` turned back along it and the drift ``(4,)`` (travel per cycle now in the
+        file's frame, as the path ends one cycle later; turn unchanged).
+        """
+        N = Q.shape[0]
+        full = np.vstack([Q, Q[:1] + drift])
+        # the trend at frame k is the heading's mean over the cycle centred there: the mean over frames
+        # 0..N-1 (centred at (N-1)/2) moved on by the turn; the steps turn at their middles k + 1/2
+        mid = Q[:, 3].mean() + drift[3] * (np.arange(N) + 1 - 0.5 * N) / N - reference
+        steps = self._turned(np.diff(full[:, :3], axis=0), mid)
+        path = np.vstack([full[:1, :3], full[0, :3] + np.cumsum(steps, axis=0)])
+        L = np.column_stack([path[:-1], Q[:, 3]])
+        return L, np.append(path[-1] - path[0], drift[3])
 
     # -- (P, L) -> motion -----------------------------------------------
     def decode(self, P: np.ndarray, L: np.ndarray) -> Motion:

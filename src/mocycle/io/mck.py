@@ -35,6 +35,7 @@ from scipy.spatial.transform import Rotation
 from ..errors import MocycleError, MotionFileError
 from ..io.atomic import atomic_write
 from ..io.bvh import format_bvh, parse_bvh
+from ..keyframes.density import SPATIAL_MIN_KEYS, keyframe_density
 from ..keyframes.distance import joint_weights
 from ..keyframes.projection import ONE_STEP, PROJECTIONS, PoseSpace, select_keyframes, spatial_layout
 from ..keyframes.select import METHODS, keyframe_count
@@ -202,7 +203,7 @@ def read_compressed(path: str | os.PathLike) -> Compressed:
     return Compressed.from_bytes(data, path)
 
 
-def compress(motion: Motion, ratio: float | None = 0.03, count: int | None = None, select: str = "uniform",
+def compress(motion: Motion, ratio: float | str | None = "auto", count: int | None = None, select: str = "uniform",
              scheme: str = "slerp", projection: str = "mds", optimize: bool = False, seed: str = "mds",
              random_state: int = 0, space: PoseSpace | None = None) -> Compressed:
     """Keyframe-compress a take.
@@ -210,6 +211,8 @@ def compress(motion: Motion, ratio: float | None = 0.03, count: int | None = Non
     Parameters
     ----------
     ratio, count : keyframes as a fraction of the frames (thesis: 3%) or a number (``count`` wins); at least 2.
+        ``ratio="auto"`` (default): enough keys for the take's own rhythm (:mod:`.density`: 4 per period, at
+        least 3% and 6 keys).  The spatial scheme gets at least 6 keys from any ratio.
     select : ``uniform``, ``scs``, ``pb`` or ``rols``.
     scheme : ``linear``, ``hermite``, ``slerp``, ``rbf`` (temporal) or ``spatial``.
     projection : the spatial scheme's projector (:data:`~mocycle.keyframes.projection.PROJECTIONS`);
@@ -240,7 +243,12 @@ def compress(motion: Motion, ratio: float | None = 0.03, count: int | None = Non
     if seed not in ONE_STEP:
         raise MocycleError(f"the seed projection must be one of {', '.join(ONE_STEP)}; got {seed!r}")
     n = motion.n_frames
-    k = keyframe_count(n, ratio=None if count is not None else ratio, count=count)
+    if count is None and isinstance(ratio, str):
+        k = keyframe_density(motion, ratio, scheme).count
+    else:
+        k = keyframe_count(n, ratio=None if count is not None else ratio, count=count)
+        if count is None and scheme == "spatial":
+            k = max(k, min(n, SPATIAL_MIN_KEYS))
     space = PoseSpace(motion.rotations, joint_weights(motion.skeleton)) if space is None else space
     points = None
     if scheme == "spatial":
