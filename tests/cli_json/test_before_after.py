@@ -1,6 +1,8 @@
 """Every ``mocycle`` command prints, with ``--json``, the figures it printed before issue 12's task layer.
 
-``before.json`` was made by ``make_before.py`` from commit 6e2c70a (the code before the change); timing
+``before.json`` was made by ``make_before.py`` from the commit in ``before.commit``: first 6e2c70a (the code
+before the task layer), then, after merging branches that change figures on purpose (issue 11's loop checks,
+root motion on arcs, stretch of periodic regions), from the ``main`` commit merged last; timing
 fields are left out, numbers are compared with a tolerance (other numpy versions, other BLAS). A command may
 print keys it did not print before (e.g. ``swings``' ``swing_indices``); every key it printed must be there
 with the same value.

@@ -32,17 +32,19 @@ def blend(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help=PLOT_HELP)] = None,
     amc_fps: Annotated[float, flag(B, "amc_fps")] = default(B, "amc_fps"),
+    force: Annotated[bool, flag(B, "force")] = default(B, "force"),
 ):
     """Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).
 
     Each take's cycle is extracted, brought to the first one's phase, resampled to the weighted period and
     averaged with the weights in rotation space; root sway and travel per cycle are blended likewise.
-    Exit code 0 on success, 3 when a take holds no periodic motion, 1 for bad input, 2 for a bad option.
+    Exit code 0 on success, 3 when a take holds no periodic motion or its cycle fails a loop check (see
+    mocycle loop; --force uses it anyway), 1 for bad input, 2 for a bad option.
     """
     check_suffix(output, ".bvh")
     check_suffix(plot, ".png", "--plot")
     options = B(weights=weights, root=root, cycles=cycles, method=method, model=model, harmonics=harmonics,
-                align=align, amc_fps=amc_fps)
+                align=align, amc_fps=amc_fps, force=force)
     report = tasks.blend.run(paths, options)
     print_warnings(report)
     write(report.motions["loop"], output)
@@ -95,15 +97,18 @@ def transition(
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves over the transition's phase, and the weight.")] = None,
     amc_fps: Annotated[float, flag(T, "amc_fps")] = default(T, "amc_fps"),
+    force: Annotated[bool, flag(T, "force")] = default(T, "force"),
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
     The weight moves by a smoothstep over the cycles; period and phase stay continuous (the phase is
-    integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion.
+    integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion or its
+    cycle fails a loop check (see mocycle loop), 1 for bad input, 2 for a bad option.
     """
     check_suffix(output, ".bvh")
     check_suffix(plot, ".png", "--plot")
-    options = T(cycles=cycles, root=root, method=method, model=model, harmonics=harmonics, amc_fps=amc_fps)
+    options = T(cycles=cycles, root=root, method=method, model=model, harmonics=harmonics, amc_fps=amc_fps,
+                force=force)
     report = tasks.transition.run([first, second], options)
     print_warnings(report)
     write(report.motions["transition"], output)

@@ -15,7 +15,7 @@ import typer
 from rich.console import Console
 
 from .. import __version__
-from ..errors import MocycleError, NoPeriodicMotion, OptionError
+from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from ..tasks import TASKS
 from ..tasks.loop import parse_range  # noqa: F401  (convert uses it)
 from ..tasks.options import MISSING, Choice, flag_of
@@ -33,7 +33,7 @@ err = Console(stderr=True, highlight=False)
 
 EXIT_ERROR = 1
 EXIT_USAGE = 2  # a bad option value (typer/click use 2 for usage errors too)
-EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion
+EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion, or its cycle is not a loop
 
 #: parameter names of the library -> the CLI flag that sets them (every task option, and a few library names)
 FLAGS = {f.name: flag_of(f) for task in TASKS.values() for f in dataclasses.fields(task.Options)}
@@ -49,7 +49,7 @@ def option_message(exc: OptionError) -> str:
 
 def friendly(func: Callable) -> Callable:
     """Run a command: MocycleError -> one 'error:' line and exit 1 (2 for a bad option value, 3 for
-    NoPeriodicMotion); warnings (the command's and its reports') -> 'warning:' lines."""
+    NoPeriodicMotion and LoopRefused); warnings (the command's and its reports') -> 'warning:' lines."""
 
     @wraps(func)
     def wrapper(*args, **kwargs):
@@ -64,7 +64,8 @@ def friendly(func: Callable) -> Callable:
             except MocycleError as exc:
                 _print_warnings(caught)
                 err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
-                raise typer.Exit(EXIT_NOT_FOUND if isinstance(exc, NoPeriodicMotion) else EXIT_ERROR) from None
+                refused = isinstance(exc, (NoPeriodicMotion, LoopRefused))
+                raise typer.Exit(EXIT_NOT_FOUND if refused else EXIT_ERROR) from None
         _print_warnings(caught)
         return result
 

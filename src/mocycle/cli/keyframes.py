@@ -20,7 +20,7 @@ P = tasks.project.Options
 def compress(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="The .mck file to write.")],
-    ratio: Annotated[float, flag(C, "ratio")] = default(C, "ratio"),
+    ratio: Annotated[str, flag(C, "ratio")] = default(C, "ratio"),
     select: Annotated[str, flag(C, "select")] = default(C, "select"),
     scheme: Annotated[str, flag(C, "scheme")] = default(C, "scheme"),
     projection: Annotated[str, flag(C, "projection")] = default(C, "projection"),
@@ -29,7 +29,11 @@ def compress(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(C, "amc_fps")] = default(C, "amc_fps"),
 ):
-    """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size."""
+    """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size.
+
+    The default ratio 'auto' keeps enough keys for the motion's own rhythm; an explicit ratio that leaves
+    fewer than 4 keys per period gets a warning.
+    """
     check_suffix(output, ".mck")
     options = C(ratio=ratio, select=select, scheme=scheme, projection=projection, seed_projection=seed_projection,
                 optimize=optimize, amc_fps=amc_fps)
@@ -37,7 +41,8 @@ def compress(
     print_warnings(report)
     report.result.save(output)
     r = report.facts
-    facts = {k: r[k] for k in ("frames", "keyframes", "error_per_frame_per_joint", "compressed_bytes", "bvh_bytes")}
+    facts = {k: r[k] for k in ("frames", "keyframes", "ratio", "period_frames", "keys_per_period", "keyframes_set_by",
+                               "error_per_frame_per_joint", "compressed_bytes", "bvh_bytes")}
     if as_json:
         print_json({**facts, "seconds": report.seconds})
         return
@@ -48,7 +53,9 @@ def compress(
     table.add_column("")
     table.add_column("value", justify="right")
     table.add_row("frames", str(r["frames"]))
-    table.add_row("keyframes", f"{r['keyframes']} ({r['keyframe_ratio']:.1%})")
+    table.add_row("keyframes", f"{r['keyframes']} ({r['keyframe_ratio']:.1%}, set by {r['keyframes_set_by']})")
+    if r["period_frames"] is not None:
+        table.add_row("keys per period", f"{r['keys_per_period']:.1f} (period {r['period_frames']:.1f} frames)")
     table.add_row("error per frame per joint (eq. 3.2, rad)", f"{r['error_per_frame_per_joint']:.4f}")
     table.add_row("compressed bytes", f"{r['compressed_bytes']:,}")
     table.add_row("BVH bytes", f"{r['bvh_bytes']:,}" if r["bvh_bytes"] is not None else "-")

@@ -35,15 +35,18 @@ def loop(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: PCA of input and cycle, phase, joint curves.")]
     = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
+    force: Annotated[bool, flag(O, "force")] = default(O, "force"),
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
 
-    Exit code 0 on success, 3 when the take holds no periodic motion, 1 for bad input, 2 for a bad option.
+    Exit code 0 on success, 3 when the take holds no periodic motion or its cycle fails a loop check
+    (the reason is printed; --force writes it anyway), 1 for bad input, 2 for a bad option.
     """
     check_suffix(output, ".bvh", "--output")
     check_suffix(plot, ".png", "--plot")
     options = O(method=method, model=model, harmonics=harmonics, root=root, frame_range=frame_range, step=step,
-                joints=joints, cycles=cycles, classes=classes, which=which, time_axis=time_axis, amc_fps=amc_fps)
+                joints=joints, cycles=cycles, classes=classes, which=which, time_axis=time_axis, amc_fps=amc_fps,
+                force=force)
     report = tasks.loop.run(path, options)
     print_warnings(report)
     write(report.motions["loop"], output)

@@ -25,17 +25,21 @@ def stretch(
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves of the input and the stretched take in seconds.")] = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
+    force: Annotated[bool, flag(O, "force")] = default(O, "force"),
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
 
-    The lapped cosine transform of every joint curve is dilated in time by
-    replicating its atoms (paper 004); each joint group (legs, arms, spine)
-    uses its own fundamental cycle as the window; the travelling joint keeps
-    its mean velocity.
+    Only the periodic region(s) of the take (its phase's excitation regions) are
+    warped; a lead-in, pauses and a lead-out are kept as captured and follow on
+    without a pop. The lapped cosine transform of every joint curve is dilated
+    in time by replicating its atoms (paper 004); each joint group (legs, arms,
+    spine) uses its own fundamental cycle as the window; the travelling joint
+    keeps its mean velocity. Exit code 3 when the take has no periodic motion
+    (--force warps it whole anyway), 1 for bad input, 2 for a bad option.
     """
     check_suffix(output, ".bvh")
     check_suffix(plot, ".png", "--plot")
-    report = tasks.stretch.run(path, O(factor=factor, window_frames=window, amc_fps=amc_fps))
+    report = tasks.stretch.run(path, O(factor=factor, window_frames=window, amc_fps=amc_fps, force=force))
     print_warnings(report)
     write(report.motions["stretched"], output)
     if plot is not None:
@@ -60,6 +64,12 @@ def stretch(
         cycle = report.result.cycles[g]
         table.add_row(g, str(n), "given" if cycle is None else f"{cycle:.2f}", str(r["joints_per_group"][g]))
     out.print(table)
+    if r["periodic_regions"]:
+        kept = r["frames_in"] - sum(e - s for s, e in r["periodic_regions"])
+        out.print("  periodic region(s) warped: " + ", ".join(
+            f"{s}:{e} -> {a}:{b}" for (s, e), (a, b) in zip(r["periodic_regions"], r["periodic_regions_out"],
+                                                             strict=True))
+            + (f"; {kept} frame(s) kept as captured" if kept else ""), soft_wrap=True)
     if r["trend_curves"]:
         out.print(f"  warped as line + residual: {', '.join(r['trend_curves'])}", soft_wrap=True)
     if plot is not None:

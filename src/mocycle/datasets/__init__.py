@@ -3,6 +3,7 @@
 from .synthetic import (
     SyntheticTake,
     humanoid_skeleton,
+    synthetic_gesture,
     synthetic_nonperiodic,
     synthetic_run,
     synthetic_still,
@@ -13,6 +14,7 @@ from .synthetic import (
 __all__ = [
     "SyntheticTake",
     "humanoid_skeleton",
+    "synthetic_gesture",
     "synthetic_nonperiodic",
     "synthetic_run",
     "synthetic_still",

@@ -47,11 +47,13 @@ class Options(_Options):
     harmonics: int | str = fields.harmonics()
     align: bool = option(True, "Search each take's phase offset against the first.", Flag())
     amc_fps: float = fields.amc_fps()
+    force: bool = fields.force_cycle()
 
 
 def run(takes: Sequence, options: Options | None = None) -> Report:
     """Blend the cycles of two or more takes (Motions or files on one skeleton) into one loop;
-    ``motions["loop"]`` is it repeated ``cycles`` times. Raises NoPeriodicMotion when a take has no cycle."""
+    ``motions["loop"]`` is it repeated ``cycles`` times. Raises NoPeriodicMotion when a take has no cycle and
+    LoopRefused when a take's cycle fails a loop check (``force``: a warning instead)."""
     from ..cycle.blend import blend_cycles, check_weights, cycle_seam
 
     o = options or Options()
@@ -65,7 +67,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     with Recorder() as rec:
         motions = [load(t, o.amc_fps) for t in takes]
         result = blend_cycles(motions, o.weights, align=o.align, labels=[label_of(t, k) for k, t in enumerate(takes)],
-                              method=o.method, model=o.model, n_harmonics=o.harmonics)
+                              method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force)
         loop = result.repeat(o.cycles, root=o.root)
         facts = {
             **result.to_dict(),

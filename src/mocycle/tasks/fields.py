@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..io.asfamc import AMC_FPS
 from ..swings.segment import DEFAULT_THRESHOLD as SWING_THRESHOLD
-from .options import Choice, Integer, Real, Text, option
+from .options import Choice, Flag, Integer, Real, Text, option
 
 __all__ = ["AMC_FPS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "harmonics", "joints", "method", "model",
            "root", "swing_joints", "threshold"]
@@ -51,6 +51,11 @@ def joints(help: str = "Joints to use: names, glob patterns or groups (legs, arm
 def threshold():
     return option(SWING_THRESHOLD, "Acceptable Swing Error, 0-2 (paper: 0.4; 0 accepts only perfectly geodesic "
                                    "swings).", Real(0, 2))
+
+
+def force_cycle():
+    return option(False, "Use a take's cycle even when it fails a loop check (a warning names the check).",
+                  Flag())
 
 
 def swing_joints():

@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 from ..errors import OptionError
 from . import fields
-from .options import Choice, Integer, option
+from .options import Choice, Flag, Integer, option
 from .options import Options as _Options
-from .report import Recorder, Report, load
+from .report import Recorder, Report, label_of, load
 
 #: the loop metrics (``facts["metrics"]``): key -> (label, unit)
 METRIC_LABELS = {
@@ -79,14 +79,18 @@ class Options(_Options):
     time_axis: str = option("smooth", "Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) "
                                       "or line.", Choice(TIME_AXES), flag="--time")
     amc_fps: float = fields.amc_fps()
+    force: bool = option(False, "Write the cycle even when it fails a loop check (longer than the take, fits much "
+                                "worse than a plain cut, seam jumps); a warning names the check.", Flag())
 
 
 def run(take, options: Options | None = None) -> Report:
     """Extract one seamless cycle; ``motions["loop"]`` is it repeated ``cycles`` times with the chosen root.
 
-    Raises :class:`~mocycle.errors.NoPeriodicMotion` when the take holds no periodic motion.
+    Raises :class:`~mocycle.errors.NoPeriodicMotion` when the take holds no periodic motion and
+    :class:`~mocycle.errors.LoopRefused` when its cycle fails a loop check (``force``: a warning instead).
     """
     from ..cycle import extract_cycle, loop_metrics
+    from ..cycle.checks import check_loop
 
     o = options or Options()
     with Recorder() as rec:
@@ -100,6 +104,7 @@ def run(take, options: Options | None = None) -> Report:
             result = cycle.repeat(o.cycles, root=o.root)
         with rec.part("metrics"):
             metrics = loop_metrics(motion, cycle)
+            failed = check_loop(motion, cycle, metrics, force=o.force, label=label_of(take))
         facts = {
             "frames_in": motion.n_frames,
             "frames_out": result.n_frames,
@@ -109,6 +114,7 @@ def run(take, options: Options | None = None) -> Report:
             "root": o.root,
             "cycles": o.cycles,
             "metrics": metrics,
+            "failed_checks": [f.to_dict() for f in failed],
             "excited_regions": len(cycle.periodic.excitation),
         }
     return rec.report("loop", facts, {"loop": result, "input": motion}, cycle)

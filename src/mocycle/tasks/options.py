@@ -63,15 +63,25 @@ class Integer:
 
 @dataclass(frozen=True)
 class Real:
-    """A finite number in an interval (``low_open``/``high_open``: the end is excluded)."""
+    """A finite number in an interval (``low_open``/``high_open``: the end is excluded), or one of ``words``."""
 
     low: float | None = None
     high: float | None = None
     low_open: bool = False
     high_open: bool = False
+    words: tuple[str, ...] = ()
 
-    def __call__(self, name: str, value) -> float:
-        return _validate.real(name, value, self.low, self.high, low_open=self.low_open, high_open=self.high_open)
+    def __call__(self, name: str, value):
+        if isinstance(value, str) and value in self.words:
+            return value
+        try:
+            return _validate.real(name, value, self.low, self.high, low_open=self.low_open,
+                                  high_open=self.high_open)
+        except OptionError as exc:
+            if not self.words:
+                raise
+            words = " or ".join(repr(w) for w in self.words)
+            raise OptionError(name, f"must be {words} or {exc.reason.removeprefix('must be ')}") from None
 
     def schema(self) -> dict:
         out: dict = {"type": "number"}
@@ -79,7 +89,7 @@ class Real:
             out["exclusiveMinimum" if self.low_open else "minimum"] = self.low
         if self.high is not None:
             out["exclusiveMaximum" if self.high_open else "maximum"] = self.high
-        return out
+        return {"anyOf": [out, {"type": "string", "enum": list(self.words)}]} if self.words else out
 
 
 @dataclass(frozen=True)

@@ -5,14 +5,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from . import fields
-from .options import Integer, Real, option
+from .options import Flag, Integer, Real, option
 from .options import Options as _Options
 from .report import Recorder, Report, load
 
 LABELS = {
     "factor": ("length ratio", ""), "frames_in": ("frames in", ""), "frames_out": ("frames out", ""),
     "windows": ("window per joint group", "frames"), "cycles": ("fundamental cycle per joint group", "frames"),
-    "trend_curves": ("warped as line + residual", ""),
+    "trend_curves": ("warped as line + residual", ""), "periodic_regions": ("periodic regions warped", "frames"),
+    "periodic_regions_out": ("where they are in the output", "frames"), "forced": ("warped although not periodic", ""),
 }
 
 
@@ -26,15 +27,20 @@ class Options(_Options):
                                               "fundamental cycle) or N.", Integer(1, words={"auto": "auto"}),
                                       flag="--window")
     amc_fps: float = fields.amc_fps()
+    force: bool = option(False, "Warp the whole take even when it has no periodic motion (a warning says so).",
+                         Flag())
 
 
 def run(take, options: Options) -> Report:
-    """The take lengthened by ``options.factor``: ``motions["stretched"]``; the windows used in ``facts``."""
+    """The take lengthened by ``options.factor``: ``motions["stretched"]``; the windows used in ``facts``.
+
+    Only the periodic region(s) are warped; raises NoPeriodicMotion when there is none (``force``: the whole take
+    is warped, with a warning)."""
     from ..warp import stretch_motion
 
     with Recorder() as rec:
         motion = load(take, options.amc_fps)
-        result, report = stretch_motion(motion, options.factor, window=options.window_frames)
+        result, report = stretch_motion(motion, options.factor, window=options.window_frames, force=options.force)
         facts = {**report.to_dict(), "fps": motion.fps,
                  "joints_per_group": {g: len(names) for g, names in report.groups.items()}}
     return rec.report("stretch", facts, {"stretched": result, "input": motion}, report)

@@ -27,6 +27,7 @@ class Options(_Options):
     model: str = fields.model()
     harmonics: int | str = fields.harmonics()
     amc_fps: float = fields.amc_fps()
+    force: bool = fields.force_cycle()
 
 
 def run(takes: Sequence, options: Options | None = None) -> Report:
@@ -40,6 +41,6 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     with Recorder() as rec:
         a, b = (load(t, o.amc_fps) for t in takes)
         result = transition(a, b, o.cycles, root=o.root, labels=[label_of(t, k) for k, t in enumerate(takes)],
-                            method=o.method, model=o.model, n_harmonics=o.harmonics)
+                            method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force)
         facts = {**result.to_dict(), "root": o.root, "smoothness": transition_smoothness(result)}
     return rec.report("transition", facts, {"transition": result.motion}, result)
