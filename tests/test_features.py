@@ -92,7 +92,7 @@ def test_bad_arguments_are_rejected_with_the_choices():
     m = random_motion(10)
     with pytest.raises(MocycleError, match="euler, expmap"):
         pose_matrix(m, rep="quaternion")
-    with pytest.raises(MocycleError, match="keep, velocity, drop"):
+    with pytest.raises(MocycleError, match="keep, velocity, heading, drop"):
         pose_matrix(m, root="fly")
     with pytest.raises(MocycleError, match="no joint matches"):
         pose_matrix(m, joints=["Tail"])

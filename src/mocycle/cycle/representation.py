@@ -32,10 +32,20 @@ def vertical_axis(motion: Motion) -> np.ndarray:
     """The world up direction ``(3,)`` of a humanoid take (unit vector along +X, +Y or +Z or their negatives).
 
     The axis along which the mean pose is tallest; its sign puts most joints in
-    the upper half (spine, arms, head and hands outnumber the legs).
+    the upper half (spine, arms, head and hands outnumber the legs).  Only the
+    body counts: the travel joint, what hangs below it and their End Sites (a
+    static root left at the origin, as in Bandai files, is no part of the pose).
     """
     step = max(1, motion.n_frames // 50)
+    skel = motion.skeleton
+    body = np.zeros(skel.n_joints, dtype=bool)
+    body[motion.travel_joint] = True
+    for j in range(skel.n_joints):  # parents come first
+        if skel.parents[j] >= 0 and body[skel.parents[j]]:
+            body[j] = True
+    body = np.concatenate([body, [body[s.parent] for s in skel.end_sites]]).astype(bool)
     pose = motion[::step].world_positions(end_sites=True).mean(axis=0)  # (J', 3)
+    pose = pose[body[: pose.shape[0]]]
     extent = np.ptp(pose, axis=0)
     axis = int(np.argmax(extent))
     mid = 0.5 * (pose[:, axis].max() + pose[:, axis].min())

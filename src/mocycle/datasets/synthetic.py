@@ -31,9 +31,11 @@ __all__ = [
     "humanoid_skeleton",
     "synthetic_nonperiodic",
     "synthetic_run",
+    "synthetic_circle_walk",
     "synthetic_still",
     "synthetic_walk",
     "synthetic_walk_then_run",
+    "to_z_up",
 ]
 
 _ROOT_CH = ("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")
@@ -633,3 +635,47 @@ def synthetic_walk_then_run(n_walk: int = 600, n_run: int = 600, fps: float = 60
             f"blend {blend_frames} frames, noise {noise_deg:g} deg, seed {seed}")
     return SyntheticTake(Motion(skel, q, None, 1.0 / fps, root_positions=root), phase, u, period,
                          [("walk", 0, n_walk), ("run", n_walk, T)], desc, chan)
+
+
+def to_z_up(motion: Motion) -> Motion:
+    """The same take on a Z-up world: the root's rotation and path turned +90 degrees about X (Y -> Z)."""
+    W = Rotation.from_euler("x", 90.0, degrees=True)
+    q = motion.rotations.copy()
+    q[:, 0] = (W * Rotation.from_quat(q[:, 0])).as_quat()
+    t = motion.translations.copy()
+    t[:, 0] = W.apply(t[:, 0])
+    return Motion(motion.skeleton, q, t, motion.frame_time)
+
+
+def synthetic_circle_walk(n_frames: int = 600, fps: float = 60.0, period_s: float = 1.0,
+                          turn_per_cycle_deg: float = 45.0, noise_deg: float = 0.0, run: bool = False,
+                          up: str = "y", seed: int = 0) -> SyntheticTake:
+    """A walk (or run) along a circle: the body and its path turn ``turn_per_cycle_deg`` degrees per cycle.
+
+    The heading is tied to the phase (``turn_per_cycle_deg * cycles walked``), so the turn per cycle and
+    the period (``period_s``) are exact; the radius is ``stride / turn`` (140 cm per cycle for the walk,
+    250 cm for the run).  ``up="z"`` gives the same take on a Z-up world (:func:`to_z_up`).
+    ``noise_deg``: Gaussian noise on every rotation channel (degrees).
+    """
+    n_frames, fps = _check(n_frames, fps)
+    if not np.isfinite(turn_per_cycle_deg):
+        raise MocycleError(f"turn_per_cycle_deg must be a finite number; got {turn_per_cycle_deg!r}")
+    if not np.isfinite(noise_deg) or noise_deg < 0:
+        raise MocycleError(f"noise_deg must be >= 0; got {noise_deg!r}")
+    if up not in ("y", "z"):
+        raise MocycleError(f"up must be 'y' or 'z'; got {up!r}")
+    style = _RUN if run else _WALK
+    u, phase, period = _phase_truth(n_frames, fps, float(period_s), 0.0, 0.0)
+    skel = humanoid_skeleton()
+    chan = _channels(skel, _gait_angles(style, u))
+    heading = float(turn_per_cycle_deg) * u
+    _turn_root(skel, chan, heading)
+    if noise_deg > 0:
+        chan += np.random.default_rng(seed).normal(0.0, noise_deg, size=chan.shape)
+    motion = Motion(skel, _quats_from_channels(skel, chan), None, 1.0 / fps,
+                    root_positions=_gait_root(style, u, heading))
+    if up == "z":
+        motion = to_z_up(motion)
+    desc = (f"synthetic {style.name} along a circle: {n_frames} frames at {fps:g} fps, period {period_s:g} s, "
+            f"turn {turn_per_cycle_deg:g} deg per cycle, noise {noise_deg:g} deg, {up.upper()} up, seed {seed}")
+    return SyntheticTake(motion, phase, u, period, [(style.name, 0, n_frames)], desc, chan)
