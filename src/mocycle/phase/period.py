@@ -13,7 +13,8 @@ A circular coordinate is one value per frame in *cycles* (the circle is
 
 :func:`autocorrelation_period` is independent of any coordinate: the
 fundamental cycle of a pose matrix from its windowed circular autocorrelation
-(paper 004), used as a cross-check.
+(paper 004), used as a cross-check; :func:`self_similarity` decides between
+period estimates that disagree.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ __all__ = [
     "fit_period",
     "gmm_cdf_remap",
     "rank_uniform",
+    "self_similarity",
     "unwrap_phase",
 ]
 
@@ -370,3 +372,33 @@ def excitation_regions(coords, window: int, threshold: float = 0.3, min_length: 
     cum = np.concatenate([[0.0], np.cumsum(d)])  # cum[i] = unwrapped x[i] - x[0]
     return [(s, e) for s, e in merged
             if e - s >= min_length and abs(cum[e - 1] - cum[s]) >= min_cycles]
+
+
+# -- self-similarity one period apart ----------------------------------------------------------------------------
+
+
+def self_similarity(X, lag: float) -> float:
+    """How unlike itself ``X`` (``(T,)`` or ``(T, D)``) is ``lag`` frames later: 0 identical, about 1 unrelated.
+
+    ``mean_t ||x(t + lag) - x(t)||² / (2 * total variance)``, with ``x(t + lag)`` linearly interpolated for a
+    fractional lag; NaN when fewer than two frames overlap.  A periodic take scores lowest at its period
+    (and its multiples), which decides between two nearby period estimates.
+    """
+    A = np.asarray(X, dtype=np.float64)
+    if A.ndim == 1:
+        A = A[:, None]
+    if A.ndim != 2:
+        raise MocycleError(f"X must be a (T,) or (T, D) array; got shape {A.shape}")
+    lag = float(lag)
+    if not np.isfinite(lag) or lag <= 0:
+        return float("nan")
+    k = int(np.floor(lag))
+    f = lag - k
+    n = A.shape[0] - k - 1
+    if n < 2:
+        return float("nan")
+    later = (1.0 - f) * A[k: k + n] + f * A[k + 1: k + 1 + n]
+    var = float(A.var(axis=0).sum())
+    if not var > 0:
+        return float("nan")
+    return float(np.mean(np.sum((later - A[:n]) ** 2, axis=1)) / (2.0 * var))
