@@ -44,6 +44,7 @@ from .period import (
     fit_period,
     gmm_cdf_remap,
     rank_uniform,
+    repetition_distance,
     self_similarity,
     unwrap_phase,
 )
@@ -206,11 +207,8 @@ def _extend_phase(coords: np.ndarray, n_frames: int, period: float) -> np.ndarra
     return np.mod(np.concatenate([coords, tail]), 1.0)
 
 
-def _periodic_motion(coords: np.ndarray, cls, frame_time: float, n_frames: int) -> PeriodicMotion:
-    unwrapped = unwrap_phase(coords)
-    T = coords.size
-    window = int(np.clip(round(0.5 * T / max(cls.n_cycles, 1.0)), 5, max(5, T // 4)))
-    regions = excitation_regions(coords, window=window) or [(0, T)]
+def _region_period(unwrapped: np.ndarray, regions: list[tuple[int, int]]) -> tuple[float, float]:
+    """Period (frames) from the length-weighted mean slope of lines fitted per region, and periods covered."""
     slopes, weights, n_periods = [], [], 0.0
     for s, e in regions:
         fit = fit_period(unwrapped, frames=np.arange(s, e))
@@ -218,10 +216,72 @@ def _periodic_motion(coords: np.ndarray, cls, frame_time: float, n_frames: int) 
         weights.append(e - s)
         n_periods += fit.n_periods
     slope = float(np.average(slopes, weights=weights))
-    period = 1.0 / slope if slope > 0 else float("inf")
+    return (1.0 / slope if slope > 0 else float("inf")), n_periods
+
+
+def _periodic_motion(coords: np.ndarray, cls, frame_time: float, n_frames: int) -> PeriodicMotion:
+    unwrapped = unwrap_phase(coords)
+    T = coords.size
+    window = int(np.clip(round(0.5 * T / max(cls.n_cycles, 1.0)), 5, max(5, T // 4)))
+    regions = excitation_regions(coords, window=window) or [(0, T)]
+    period, n_periods = _region_period(unwrapped, regions)
     coords = _extend_phase(coords, n_frames, period)
     return PeriodicMotion(cls.birth, cls.death, coords, unwrap_phase(coords), regions, period, n_periods,
                           frame_time, cls.combination)
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist(), strict=True))
+
+
+def _separate(found: list[PeriodicMotion], X: np.ndarray) -> list[PeriodicMotion]:
+    """Excitation regions that do not bleed into each other's motion (paper 001 §4.6 made strict).
+
+    The moving average behind :func:`excitation_regions` widens every region, so near the switch from one
+    periodic motion to another (a walk turning into a run) a region reaches into the other motion.  Near
+    another class's region (within one of its periods) a frame stays with a class only when the take
+    repeats better at this class's period than at the other's there (:func:`repetition_distance`), and
+    not more than twice as badly as it does over the class's own frames (the transition belongs to
+    neither).  Runs shorter than a period are dropped; the periods are refitted on what remains.
+    """
+    if len(found) < 2:
+        return found
+    T, n = found[0].coords.size, X.shape[0]
+
+    def padded(d):
+        return np.concatenate([d, np.full(T - n, np.nan)]) if T > n else d[:T]
+
+    dist = [padded(repetition_distance(X, c.period_frames, smooth=max(3, int(round(c.period_frames / 4)))))
+            for c in found]
+    near = []
+    for c in found:
+        mask = np.zeros(T, dtype=bool)
+        for s, e in c.excitation:
+            pad = int(np.ceil(c.period_frames))
+            mask[max(0, s - pad): min(T, e + pad)] = True
+        near.append(mask)
+    out = []
+    for i, c in enumerate(found):
+        own = np.zeros(T, dtype=bool)
+        for s, e in c.excitation:
+            own[s:e] = True
+        keep = own.copy()
+        typical = float(np.nanmedian(dist[i][own])) if np.isfinite(dist[i][own]).any() else np.nan
+        for j in range(len(found)):
+            if j == i:
+                continue
+            zone = own & near[j] & np.isfinite(dist[i]) & np.isfinite(dist[j])
+            keep[zone & (dist[i] > dist[j])] = False
+            if np.isfinite(typical):
+                keep[zone & (dist[i] > 2.0 * typical)] = False
+        runs = [(s, e) for s, e in _runs(keep) if e - s >= c.period_frames]
+        if not runs or runs == list(c.excitation):
+            out.append(c)
+            continue
+        period, n_periods = _region_period(c.unwrapped, runs)
+        out.append(replace(c, excitation=runs, period_frames=period, n_periods=n_periods))
+    return out
 
 
 def _distinct(found: list[PeriodicMotion]) -> list[PeriodicMotion]:
@@ -347,8 +407,8 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
                            weights=weights)
         estimator = CircularCoordinates(n_landmarks=n_landmarks, scale=scale, n_classes=classes,
                                         min_cycles=float(min_periods)).fit(X)
-        found = _distinct([_periodic_motion(estimator.coords_[:, k], c, motion.frame_time, motion.n_frames)
-                           for k, c in enumerate(estimator.classes_)])
+        found = _separate(_distinct([_periodic_motion(estimator.coords_[:, k], c, motion.frame_time,
+                                                      motion.n_frames) for k, c in enumerate(estimator.classes_)]), X)
         checked = []
         for pm in found:
             pm = replace(pm, joints_used=label, legs_period_frames=legs)
@@ -377,15 +437,16 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
 def _doubt(checked: list[PeriodicMotion], acf: float, legs: float) -> str:
     """Why the periodic motions found on one joint selection are in doubt ('' when they are not).
 
-    They are when none is found, or when the longest one's period is more than 25 % away from every
-    autocorrelation period (of the features, of the legs) while at least one of those exists.
+    They are when none is found, or when no period found is within 25 % of an autocorrelation period
+    (of the features, of the legs) while at least one of those exists.
     """
     if not checked:
         return "; nothing periodic found"
-    main = max(checked, key=lambda c: len(c.frames()))
     checks = [v for v in (acf, legs) if np.isfinite(v)]
-    if checks and not any(0.8 <= v / main.period_frames <= 1.25 for v in checks):
-        return (f"; its period of {main.period_frames:.2f} frames disagrees with the autocorrelation periods ("
+    periods = [c.period_frames for c in checked]
+    if checks and not any(0.8 <= v / p <= 1.25 for v in checks for p in periods):
+        return (f"; its period{'s' if len(periods) > 1 else ''} ("
+                + ", ".join(f"{p:.2f}" for p in periods) + " frames) disagree with the autocorrelation periods ("
                 + ", ".join(f"{v:.2f}" for v in checks) + ")")
     return ""
 
