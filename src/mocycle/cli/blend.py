@@ -11,11 +11,26 @@ import typer
 
 from ..errors import MocycleError
 from ..io import read, write
-from .common import app, check_suffix, count_option, friendly, out
+from .common import (
+    ClassesOption,
+    DelayOption,
+    JointsOption,
+    MinPeriodsOption,
+    PcaOption,
+    app,
+    check_suffix,
+    count_option,
+    friendly,
+    out,
+    phase_options,
+)
 
 METHOD_HELP = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."
 MODEL_HELP = "Harmonic model: M1, M2 or M3 (see mocycle loop)."
 HARMONICS_HELP = "Harmonics K: 'auto' (20, capped by the frames) or a number."
+WhichOption = Annotated[int | None, typer.Option(
+    "--class", min=0, help="Which periodic motion of each take to use (0-based; default: the one covering most "
+                           "frames).")]
 
 
 def _parse_weights(text: str | None, n: int) -> list[float] | None:
@@ -49,6 +64,12 @@ def blend(
     model: Annotated[str, typer.Option(help=MODEL_HELP)] = "M1",
     harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
     align: Annotated[bool, typer.Option(help="Search each take's phase offset against the first.")] = True,
+    joints: JointsOption = None,
+    classes: ClassesOption = "auto",
+    which: WhichOption = None,
+    pca: PcaOption = "auto",
+    delay: DelayOption = 2,
+    min_periods: MinPeriodsOption = 1.2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
 ):
@@ -69,9 +90,11 @@ def blend(
     w = _parse_weights(weights, len(paths))
     if w is not None:
         check_weights(w, len(paths))  # refuse bad weights before the (slower) extraction
+    options = phase_options(joints, classes, pca, delay, min_periods)
     motions = _read_all(paths, fps)
     result = blend_cycles(motions, w, align=align, labels=[str(p) for p in paths], method=method, model=model,
-                          n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
+                          n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}), which=which,
+                          **options)
     write(result.repeat(cycles, root=root), output)
     seconds = time.perf_counter() - t0
     facts = {
@@ -113,6 +136,12 @@ def transition(
     method: Annotated[str, typer.Option(help=METHOD_HELP)] = "harmonic",
     model: Annotated[str, typer.Option(help=MODEL_HELP)] = "M1",
     harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
+    joints: JointsOption = None,
+    classes: ClassesOption = "auto",
+    which: WhichOption = None,
+    pca: PcaOption = "auto",
+    delay: DelayOption = 2,
+    min_periods: MinPeriodsOption = 1.2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
 ):
@@ -128,9 +157,11 @@ def transition(
     check_suffix(output, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
+    options = phase_options(joints, classes, pca, delay, min_periods)
     a, b = _read_all([first, second], fps)
     result = make_transition(a, b, cycles, root=root, labels=[str(first), str(second)], method=method,
-                             model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
+                             model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}),
+                             which=which, **options)
     write(result.motion, output)
     seconds = time.perf_counter() - t0
     facts = {

@@ -118,3 +118,30 @@ def main() -> None:  # the console script
         err.print("interrupted")
         sys.exit(130)
 
+
+
+# ------------------------------------------------------- the phase options
+# What ``phase`` takes to find the periodic motion; ``loop``, ``blend`` and ``transition`` take the same.
+JointsOption = Annotated[str | None, typer.Option(
+    help="Joints to find the phase on: names, glob patterns or groups (legs, arms, spine), comma-separated; "
+         "default the whole body, then legs, then arms until one shows a periodic motion.")]
+ClassesOption = Annotated[str, typer.Option(help="How many periodic motions to look for: 'auto' or N.")]
+PcaOption = Annotated[str, typer.Option(help="PCA dimensions before the cohomology: 'auto' (8), N or 'none'.")]
+DelayOption = Annotated[int, typer.Option(help="Delay embedding factor m (KTH thesis eq. 3.26; it used 2).")]
+MinPeriodsOption = Annotated[float, typer.Option(
+    help="Periods a periodic motion must cover (>= 1); below 1.5 the result is kept with a warning.")]
+
+
+def phase_options(joints: str | None, classes: str, pca: str, delay: int, min_periods: float) -> dict:
+    """The phase options of the command line as keyword arguments of ``find_phase``/``extract_cycle``."""
+    if delay < 0:
+        raise MocycleError(f"--delay must be >= 0; got {delay}")
+    if not min_periods >= 1.0:
+        raise MocycleError(f"--min-periods must be a number >= 1; got {min_periods:g}")
+    return {
+        "joints": joints,
+        "classes": count_option(classes, "--classes", {"auto": "auto"}),
+        "pca": count_option(pca, "--pca", {"auto": "auto", "none": None, "0": None}),
+        "delay": delay,
+        "min_periods": min_periods,
+    }

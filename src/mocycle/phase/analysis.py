@@ -411,10 +411,14 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
                                                       motion.n_frames) for k, c in enumerate(estimator.classes_)]), X)
         checked = []
         for pm in found:
-            pm = replace(pm, joints_used=label, legs_period_frames=legs)
+            own = legs
+            if legs_ids.size and len(found) > 1:  # several motions: the legs' period over this one's frames
+                s, e = _longest(pm, motion.n_frames)
+                own = legs_period(motion, curves[s:e])
+            pm = replace(pm, joints_used=label, legs_period_frames=own)
             if legs_ids.size:
-                pm = _full_cycle(pm, curves, legs)
-            checked.append(_choose_period(pm, X, min_lag, legs))
+                pm = _full_cycle(pm, curves, own)
+            checked.append(_choose_period(pm, X, min_lag, own))
         acf = autocorrelation_period(X, min_lag=min_lag)
         doubt = _doubt(checked, acf, legs)
         tries.append((label, estimator.reason_ + doubt))
