@@ -158,7 +158,8 @@ class HeadingFrame:
 
     ``up``: the vertical axis ``(3,)`` in the travel joint's parent frame; ``e1``, ``e2``: a horizontal
     basis there; ``forward``: the vector in the travel joint's own frame whose horizontal direction is the
-    heading (all as found by :meth:`~mocycle.cycle.representation.CycleSpace.fit`).
+    heading (``up``, ``e1``, ``e2`` as found by :meth:`~mocycle.cycle.representation.CycleSpace.fit`;
+    ``forward`` perpendicular to the joint's mean local up, so it does not depend on the headings).
     """
 
     travel: int
@@ -172,7 +173,16 @@ class HeadingFrame:
         from .cycle.representation import CycleSpace  # the one vertical-axis detection (Y-up, Z-up rigs)
 
         space = CycleSpace.fit(motion)
-        return cls(space.travel, space.up, space.e1, space.e2, space.forward)
+        # Forward: perpendicular to the joint's mean *local* up direction (R^T up does not change when
+        # the walker turns about up), so the tilt is the same whichever way the take faces.
+        R = Rotation.from_quat(motion.rotations[:: max(1, motion.n_frames // 200), space.travel])
+        local_up = R.inv().apply(space.up).mean(axis=0)
+        if not np.linalg.norm(local_up) > 1e-9:
+            return cls(space.travel, space.up, space.e1, space.e2, space.forward)
+        local_up /= np.linalg.norm(local_up)
+        least = np.eye(3)[int(np.argmin(np.abs(local_up)))]
+        forward = least - local_up * (least @ local_up)
+        return cls(space.travel, space.up, space.e1, space.e2, forward / np.linalg.norm(forward))
 
     def _about_up(self, angles: np.ndarray) -> Rotation:
         return Rotation.from_rotvec(np.outer(angles, self.up))
