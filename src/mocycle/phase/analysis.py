@@ -56,6 +56,10 @@ SUBSETS = ("legs", "arms")
 PERIOD_AGREEMENT = 0.04
 #: Weight of the heading-rate column relative to a z-scored joint column of the longest bone.
 HEADING_RATE_WEIGHT = 0.5
+#: Self-similarity one found period apart above this: the coordinate does not follow the take's rhythm.
+UNLIKE = 0.5
+#: A found period is one step of a two-step gait only if the legs' own period is this many times as long.
+HALF_RATIO = (1.8, 2.25)
 #: Default for ``min_periods``: a class must wind at least this often over the take.
 MIN_PERIODS = 1.2
 
@@ -316,7 +320,7 @@ def _full_cycle(pm: PeriodicMotion, curves: np.ndarray, legs: float) -> Periodic
     s, e = _longest(pm, curves.shape[0])
     swap = sides_swap(curves, pm.period_frames, np.arange(s, e))
     ratio = legs / pm.period_frames if np.isfinite(legs) else float("nan")
-    if not swap.swaps or (np.isfinite(ratio) and not 1.6 <= ratio <= 2.4):
+    if not swap.swaps or (np.isfinite(ratio) and not HALF_RATIO[0] <= ratio <= HALF_RATIO[1]):
         return pm
     unwrapped = 0.5 * pm.unwrapped
     reason = (f"half cycle doubled: across one period of {pm.period_frames:.2f} frames the left and right legs "
@@ -420,7 +424,7 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
                 pm = _full_cycle(pm, curves, own)
             checked.append(_choose_period(pm, X, min_lag, own))
         acf = autocorrelation_period(X, min_lag=min_lag)
-        doubt = _doubt(checked, acf, legs)
+        doubt = _doubt(checked, acf, legs, X)
         tries.append((label, estimator.reason_ + doubt))
         if kept is None or (checked and not kept[0]):
             kept = (checked, X, estimator, label, acf)
@@ -438,11 +442,12 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
                        X, estimator, time.perf_counter() - t0, label, legs)
 
 
-def _doubt(checked: list[PeriodicMotion], acf: float, legs: float) -> str:
+def _doubt(checked: list[PeriodicMotion], acf: float, legs: float, X: np.ndarray) -> str:
     """Why the periodic motions found on one joint selection are in doubt ('' when they are not).
 
-    They are when none is found, or when no period found is within 25 % of an autocorrelation period
-    (of the features, of the legs) while at least one of those exists.
+    They are when none is found, when no period found is within 25 % of an autocorrelation period
+    (of the features, of the legs) while at least one of those exists, or when the take is not like
+    itself one period of the main class's coordinate later (:func:`self_similarity` above :data:`UNLIKE`).
     """
     if not checked:
         return "; nothing periodic found"
@@ -452,5 +457,12 @@ def _doubt(checked: list[PeriodicMotion], acf: float, legs: float) -> str:
         return (f"; its period{'s' if len(periods) > 1 else ''} ("
                 + ", ".join(f"{p:.2f}" for p in periods) + " frames) disagree with the autocorrelation periods ("
                 + ", ".join(f"{v:.2f}" for v in checks) + ")")
+    main = max(checked, key=lambda c: len(c.frames()))
+    s, e = _longest(main, X.shape[0])
+    found = main.period_candidates.get("cohomology", main.period_frames)
+    unlike = self_similarity(X[s:e], found)
+    if unlike > UNLIKE:
+        return (f"; the take is not like itself one found period ({found:.2f} frames) later (self-similarity "
+                f"{unlike:.2f} > {UNLIKE:g})")
     return ""
 
