@@ -53,8 +53,9 @@ def test_walk_then_run_excitation_regions_match_the_segments():
     walk, run = by_start
     assert len(walk.excitation) == 1 and len(run.excitation) == 1
     (ws, we), (rs, re) = walk.excitation[0], run.excitation[0]
-    assert abs(ws - w0) <= 10 and abs(we - w1) <= 15  # the blend window is 30 frames
-    assert abs(rs - r0) <= 15 and abs(re - r1) <= 10
+    # the blend window is 30 frames; it belongs to neither motion, and no region reaches past the switch
+    assert abs(ws - w0) <= 10 and w1 - 20 <= we <= w1
+    assert r0 <= rs <= r0 + 20 and abs(re - r1) <= 10
     assert abs(walk.period_frames - 60) < 1.5 and abs(run.period_frames - 42) < 1.5
 
 
@@ -128,11 +129,11 @@ def test_a_walk_along_a_circle_keeps_its_period_and_turn(up):
 
 
 def test_a_phase_that_wraps_once_per_step_is_doubled_to_the_full_cycle():
-    take = synthetic_half_cycle_trap(n_frames=300, fps=30.0, period_s=1.0, noise_deg=0.1)
+    take = synthetic_half_cycle_trap(n_frames=300, fps=30.0, period_s=1.0)  # exact: the trunk alone is faint
     result = find_phase(take.motion, joints="spine")  # the trunk repeats every step
     assert len(result.classes) == 1, result.reason
     c = result.classes[0]
-    assert c.half_cycle and "trade places" in c.period_reason
+    assert c.half_cycle and "across one period of 15.0" in c.period_reason and "trade places" in c.period_reason
     assert abs(c.period_frames / 30.0 - 1) < 0.02 and abs(c.n_periods - 10) < 1.0
     assert c.to_dict()["half_cycle_doubled"] is True
     # left and right trade places within the found cycle, not across it
