@@ -145,7 +145,7 @@ def test_a_phase_that_wraps_once_per_step_is_doubled_to_the_full_cycle():
 
 def test_a_short_take_decides_between_disagreeing_periods_by_self_similarity():
     take = synthetic_run(n_frames=68, fps=30.0, period_s=0.9, noise_deg=1.0, seed=1)  # 2.5 cycles of 27 frames
-    result = find_phase(take.motion)
+    result = find_phase(take.motion, keep_features=True)
     assert len(result.classes) == 1, result.reason
     c = result.classes[0]
     assert abs(c.period_frames / 27.0 - 1) < 0.04

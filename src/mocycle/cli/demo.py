@@ -9,7 +9,8 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from ..io import read, write
+from ..io import read_motion as read
+from ..io import write
 from .common import app, friendly, out
 
 

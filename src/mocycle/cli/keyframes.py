@@ -10,7 +10,8 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from ..io import read, write
+from ..io import read_motion as read
+from ..io import write
 from .common import app, check_suffix, friendly, out
 
 _SELECT_HELP = "Keyframe selection: uniform, scs (curve simplification), pb (position based) or rols."

@@ -11,7 +11,8 @@ import typer
 from rich.table import Table
 
 from ..errors import MocycleError
-from ..io import read, write
+from ..io import read_motion as read
+from ..io import write
 from .common import (
     ClassesOption,
     DelayOption,

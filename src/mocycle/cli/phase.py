@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from ..io import read
+from ..io import read_motion as read
 from .common import (
     EXIT_NOT_FOUND,
     ClassesOption,
@@ -50,7 +50,7 @@ def phase(
     options = phase_options(joints, classes, pca, delay, min_periods)
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
-    result = find_phase(motion, n_landmarks=landmarks, **options)
+    result = find_phase(motion, n_landmarks=landmarks, keep_features=plot is not None, **options)
     if plot is not None:
         from ..viz import plot_phase
 

@@ -138,7 +138,7 @@ def _cycles(takes, labels, extract_options) -> list[Cycle]:
     for take, label in zip(takes, labels, strict=True):
         if not isinstance(take, (Motion, Cycle)):
             raise MocycleError(f"{label}: expected a Motion or a Cycle; got {type(take).__name__}")
-        skeletons.append(take.skeleton if isinstance(take, Motion) else take.space.template.skeleton)
+        skeletons.append(take.skeleton if isinstance(take, Motion) else take.space.skeleton)
     for skel, label in zip(skeletons[1:], labels[1:], strict=True):   # before the (slower) extraction
         problems = skeleton_differences(skeletons[0], skel)
         if problems:
@@ -155,7 +155,7 @@ def _cycles(takes, labels, extract_options) -> list[Cycle]:
     first = cycles[0].space
     for cycle, label in zip(cycles[1:], labels[1:], strict=True):
         if cycle.space.travel != first.travel:
-            names = first.template.skeleton.names
+            names = first.skeleton.names
             raise MocycleError(f"{label} travels on joint {names[cycle.space.travel]!r}, {labels[0]} on "
                                f"{names[first.travel]!r}: the takes cannot be blended")
     return cycles
@@ -223,7 +223,7 @@ def _on(skeleton: Skeleton, motion: Motion) -> Motion:
 
 
 def _prepare(cycle: Cycle, space: CycleSpace, reference: _Loop | None) -> _Loop:
-    skel = space.template.skeleton
+    skel = space.skeleton
     inplace = _on(skel, cycle.motion("inplace"))
     n = cycle.n_frames
     _, L = space.encode(inplace)
@@ -244,7 +244,7 @@ def _prepare(cycle: Cycle, space: CycleSpace, reference: _Loop | None) -> _Loop:
                 turn += extra
     drift = drift.copy()
     drift[:3] = axis_rotations(space.up, np.array([turn]))[0] @ drift[:3]
-    period = _period_frames(cycle) * cycle.space.template.frame_time / space.template.frame_time
+    period = _period_frames(cycle) * cycle.space.frame_time / space.frame_time
     return _Loop(inplace, period, drift, turn, heading, centre, None if travel is None else travel + turn)
 
 
@@ -290,7 +290,7 @@ def _best_shift(A: np.ndarray, B: np.ndarray) -> tuple[float, np.ndarray]:
 
 def _align(loops: list[_Loop], space: CycleSpace, N: int) -> np.ndarray:
     """Phase offsets ``(K,)`` in cycles of every loop against the first (the first gets 0)."""
-    J = space.template.n_joints
+    J = space.n_joints
     grid = np.arange(N) / N
     ref = _rotation_block(_read(loops[0], space, grid)[0], J)
     offsets = [0.0]
@@ -357,7 +357,7 @@ def cycle_seam(cycle: Cycle) -> dict[str, float]:
     return {f"seam_{k}": max(r[k] for r in seams) for k in ("pose", "velocity", "pose_local", "velocity_local")}
 
 
-@dataclass
+@dataclass(kw_only=True)
 class BlendedCycle:
     """A blend of ``K`` cycles (paper 001 §4.5): a loop like :class:`~mocycle.cycle.Cycle`.
 
@@ -439,19 +439,21 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     offsets = _align(loops, space, N) if align else np.zeros(len(loops))
     grid = np.arange(N) / N
     reads = [_read(loop, space, grid + off) for loop, off in zip(loops, offsets, strict=True)]
-    J = space.template.n_joints
+    J = space.n_joints
     P = _blend_P([r[0] for r in reads], w, J)
     L = _blend_L([r[1] for r in reads], w)
     L[:, :3] += first.centre
     drift = w @ np.stack([loop.drift for loop in loops])
     L += np.outer(grid, drift)                       # the Cycle convention: L carries its drift
-    axis = TimeAxis(grid.copy(), ((0, N),), period, "blend")
-    cycle = Cycle(space, P, L, drift, "blend", None, None, axis, np.arange(N, dtype=np.float64), None)
+    axis = TimeAxis(x=grid.copy(), regions=((0, N),), period_frames=period, method="blend")
+    cycle = Cycle(space=space, P=P, L=L, drift=drift, method="blend", model=None, n_harmonics=None, axis=axis,
+                  positions=np.arange(N, dtype=np.float64), periodic=None)
     start = calmest_start(*loop_blocks(cycle, mean_rotations(cycle.motion("inplace").rotations))) if roll else 0
     cycle = cycle.rolled(start)
     cycle.seconds = time.perf_counter() - t0
-    return BlendedCycle(cycle, w, offsets, start / N, periods, np.array([loop.turn_to for loop in loops]),
-                        cycles, cycle.seconds)
+    return BlendedCycle(cycle=cycle, weights=w, phase_offsets=offsets, start_phase=start / N, input_periods=periods,
+                        heading_offsets=np.array([loop.turn_to for loop in loops]), inputs=cycles,
+                        seconds=cycle.seconds)
 
 
 # ---------------------------------------------------------------- transition
@@ -464,7 +466,7 @@ def _smoothstep_integral(x: np.ndarray) -> np.ndarray:
     return x ** 3 - 0.5 * x ** 4
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Transition:
     """A motion that starts as the first cycle and ends as the second (paper 001 §4.5, the homotopy).
 
@@ -529,7 +531,7 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     Pa, La = _read(loops[0], space, phase)
     Pb, Lb = _read(loops[1], space, phase + offset)
     W = np.stack([1 - w, w])
-    P = _blend_P([Pa, Pb], W, space.template.n_joints)
+    P = _blend_P([Pa, Pb], W, space.n_joints)
     L = _blend_L([La, Lb], W)
     if root == "motion":
         drift = np.outer(1 - w, loops[0].drift) + np.outer(w, loops[1].drift)   # (T, 4) per cycle
@@ -541,7 +543,8 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     L[:, :3] += first.centre
     motion = space.decode(P, L)
     seconds = time.perf_counter() - t0
-    return Transition(motion, phase, w, scale * ((1 - w) * pa + w * pb), offset, (pa, pb), n, cyc, seconds)
+    return Transition(motion=motion, phase=phase, weights=w, period_frames=scale * ((1 - w) * pa + w * pb),
+                      phase_offset=offset, periods=(pa, pb), cycles=n, inputs=cyc, seconds=seconds)
 
 
 def _local_ratios(x: np.ndarray, periodic: bool) -> float:

@@ -44,7 +44,7 @@ CENTROID_NEIGHBOURS = 10  # paper 001 §6: 10 nearest neighbours
 SUBFRAMES = 10           # the harmonic cycle's start is chosen to a tenth of a frame
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Cycle:
     """One cycle of ``N`` frames (frame ``N`` would equal frame 0) and how it was made.
 
@@ -194,12 +194,14 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     x0 = float(np.floor(x[0]))
     if reference is not None:  # start where the wrap is the calmest step, choosing between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
-        trial = Cycle(space, fit_p.predict(fine), fit_l.predict(fine), fit_l.drift_, "harmonic", model, K, axis,
-                      np.zeros(0), periodic)
+        trial = Cycle(space=space, P=fit_p.predict(fine), L=fit_l.predict(fine), drift=fit_l.drift_,
+                      method="harmonic", model=model, n_harmonics=K, axis=axis, positions=np.zeros(0),
+                      periodic=periodic)
         x0 += calmest_start(*loop_blocks(trial, reference), stride=SUBFRAMES) / (SUBFRAMES * N)
     xs = x0 + np.arange(N) / N
-    return Cycle(space, fit_p.predict(xs), fit_l.predict(xs), fit_l.drift_, "harmonic", model, K, axis,
-                 np.mod(x - x0, 1.0) * N, periodic, fit_p)
+    return Cycle(space=space, P=fit_p.predict(xs), L=fit_l.predict(xs), drift=fit_l.drift_, method="harmonic",
+                 model=model, n_harmonics=K, axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic,
+                 regression=fit_p)
 
 
 # ------------------------------------------------------------------ centroid
@@ -240,7 +242,8 @@ def centroid_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     Pn = _circular_resample(P[frames][nearest].mean(axis=1), N, shift=-0.5)
     Ln = _circular_resample(flat[nearest].mean(axis=1), N, shift=-0.5) + np.outer(np.arange(N) / N, drift)
     positions = np.mod((cdf(phi) * n_samples - 0.5) * N / n_samples, N)
-    return Cycle(space, Pn, Ln, drift, "centroid", None, None, axis, positions, periodic)
+    return Cycle(space=space, P=Pn, L=Ln, drift=drift, method="centroid", model=None, n_harmonics=None, axis=axis,
+                 positions=positions, periodic=periodic)
 
 
 # ----------------------------------------------------------------------- cut
@@ -290,7 +293,8 @@ def cut_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, p
         Lc[k] = (1 - t) * L[a + k] + t * (L[src] + drift)
     x = axis.x[axis.frames()]
     positions = np.mod(x - axis.x[a], 1.0) * lag
-    return Cycle(space, Pc, Lc, drift, "cut", None, None, axis, positions, periodic)
+    return Cycle(space=space, P=Pc, L=Lc, drift=drift, method="cut", model=None, n_harmonics=None, axis=axis,
+                 positions=positions, periodic=periodic)
 
 
 # ------------------------------------------------------------------ pipeline

@@ -24,7 +24,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError
-from ..motion import Motion
+from ..motion import Motion, Skeleton
 from ..rotations import continuous_quats, nearest_rotations
 
 
@@ -62,18 +62,22 @@ def axis_rotations(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
     return c * np.eye(3) + s * K + (1.0 - c) * np.outer(u, u)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class CycleSpace:
     """How a motion maps to ``(P, L)`` and back (see the module docstring).
 
-    ``template``: the input motion (skeleton, frame time, constant translations);
+    It keeps what decoding needs, not the input motion: ``skeleton``; ``frame_time`` (s);
+    ``static_translations`` ``(J, 3)``: every joint's translation in the input's first
+    frame (what the joints whose translation does not move keep);
     ``travel``: index of the travel joint; ``up``: the vertical axis in the
     travel joint's parent frame; ``e1``, ``e2``: a horizontal basis there;
     ``forward``: the vector in the travel joint's own frame whose horizontal
     direction defines the heading; ``moving``: the other joints whose translation moves.
     """
 
-    template: Motion
+    skeleton: Skeleton
+    frame_time: float
+    static_translations: np.ndarray
     travel: int
     up: np.ndarray
     e1: np.ndarray
@@ -101,12 +105,18 @@ class CycleSpace:
         forward = mean_rot.T @ e1
         moved = np.ptp(motion.translations, axis=0).max(axis=1) > 1e-9
         moving = tuple(int(j) for j in np.flatnonzero(moved) if j != travel)
-        return cls(motion, travel, up, e1, e2, forward, moving)
+        return cls(skeleton=motion.skeleton, frame_time=motion.frame_time,
+                   static_translations=motion.translations[0].copy(), travel=travel, up=up, e1=e1, e2=e2,
+                   forward=forward, moving=moving)
 
     # -- sizes ----------------------------------------------------------
     @property
+    def n_joints(self) -> int:
+        return self.skeleton.n_joints
+
+    @property
     def n_periodic(self) -> int:
-        return 9 * self.template.n_joints + 3 * len(self.moving)
+        return 9 * self.n_joints + 3 * len(self.moving)
 
     @property
     def n_drifting(self) -> int:
@@ -119,8 +129,8 @@ class CycleSpace:
 
     # -- motion -> (P, L) -----------------------------------------------
     def encode(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
-        """``P (T, n_periodic)`` and ``L (T, 4)`` of a motion with the template's skeleton."""
-        if not motion.skeleton.same_as(self.template.skeleton):
+        """``P (T, n_periodic)`` and ``L (T, 4)`` of a motion with the space's skeleton."""
+        if not motion.skeleton.same_as(self.skeleton):
             raise MocycleError("this motion's skeleton differs from the one the cycle space was made for")
         R = motion.rotation_matrices()  # (T, J, 3, 3)
         psi = self.heading(R[:, self.travel])
@@ -136,16 +146,16 @@ class CycleSpace:
 
     # -- (P, L) -> motion -----------------------------------------------
     def decode(self, P: np.ndarray, L: np.ndarray) -> Motion:
-        """A Motion on the template's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``."""
+        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``."""
         P, L = np.asarray(P, dtype=np.float64), np.asarray(L, dtype=np.float64)
-        N, J = P.shape[0], self.template.n_joints
+        N, J = P.shape[0], self.n_joints
         if P.shape != (N, self.n_periodic) or L.shape != (N, self.n_drifting):
             raise MocycleError(f"expected P ({N}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
         R = nearest_rotations(P[:, : 9 * J].reshape(N, J, 3, 3))
         R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
         quats = continuous_quats(Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat().reshape(N, J, 4))
-        trans = np.broadcast_to(self.template.translations[0], (N, J, 3)).copy()
+        trans = np.broadcast_to(self.static_translations, (N, J, 3)).copy()
         if self.moving:
             trans[:, list(self.moving)] = P[:, 9 * J:].reshape(N, len(self.moving), 3)
         trans[:, self.travel] = L[:, :3]
-        return Motion(self.template.skeleton, quats, trans, self.template.frame_time)
+        return Motion(self.skeleton, quats, trans, self.frame_time)

@@ -2,11 +2,10 @@
 
 Pose distance and errors (:mod:`.distance`), keyframe selection (:mod:`.select`),
 temporal reconstruction (:mod:`.temporal`), projections to 2-D (:mod:`.projection`),
-Igarashi back-projection and Algorithm 12 (:mod:`.spatial`), and the ``.mck``
-codec (:mod:`.codec`).
+Igarashi back-projection and Algorithm 12 (:mod:`.spatial`); ``compress``, ``Compressed``
+and the ``.mck`` file are in :mod:`mocycle.io.mck`.
 """
 
-from .codec import SCHEMES, Compressed, compress, read_compressed
 from .distance import (
     error_per_frame_per_joint,
     frame_errors,
@@ -28,3 +27,15 @@ __all__ = [
     "pose_vectors", "project_one_step", "read_compressed", "reconstruct_spatial", "select_keyframes", "select_pb",
     "select_rols", "select_scs", "select_uniform", "slerp", "spatial_layout", "stress",
 ]
+
+# compress/Compressed live in mocycle.io.mck, which itself imports this package's modules:
+# resolved on first use so that importing either package first works.
+_CODEC = ("SCHEMES", "Compressed", "compress", "read_compressed")
+
+
+def __getattr__(name: str):
+    if name in _CODEC:
+        from ..io import mck
+
+        return getattr(mck, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

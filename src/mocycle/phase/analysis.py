@@ -99,7 +99,7 @@ def phase_features(motion: Motion, *, joints: str | Iterable[str] | None = None,
     return X
 
 
-@dataclass
+@dataclass(kw_only=True)
 class PeriodicMotion:
     """One periodic motion found in a take.
 
@@ -170,9 +170,14 @@ class PeriodicMotion:
         }
 
 
-@dataclass
+@dataclass(kw_only=True)
 class PhaseResult:
-    """What ``find_phase`` found: zero or more periodic motions and how it decided."""
+    """What ``find_phase`` found: zero or more periodic motions and how it decided.
+
+    ``barcode``: ``(B, 2)`` H1 bars (birth, death); ``features``: the point cloud the coordinates were
+    computed on, ``(T - delay, D)``, only when ``find_phase(keep_features=True)`` asked for it (``None``
+    otherwise: a result stays about the size of its own per-frame numbers).
+    """
 
     classes: list[PeriodicMotion]
     barcode: np.ndarray
@@ -180,8 +185,7 @@ class PhaseResult:
     autocorrelation_period_frames: float
     n_frames: int
     frame_time: float
-    features: np.ndarray = field(repr=False)
-    estimator: CircularCoordinates = field(repr=False)
+    features: np.ndarray | None = field(default=None, repr=False)
     seconds: float = 0.0
     joints_used: str = "all"
     legs_period_frames: float = float("nan")
@@ -230,8 +234,9 @@ def _periodic_motion(coords: np.ndarray, cls, frame_time: float, n_frames: int) 
     regions = excitation_regions(coords, window=window) or [(0, T)]
     period, n_periods = _region_period(unwrapped, regions)
     coords = _extend_phase(coords, n_frames, period)
-    return PeriodicMotion(cls.birth, cls.death, coords, unwrap_phase(coords), regions, period, n_periods,
-                          frame_time, cls.combination)
+    return PeriodicMotion(birth=cls.birth, death=cls.death, coords=coords, unwrapped=unwrap_phase(coords),
+                          excitation=regions, period_frames=period, n_periods=n_periods, frame_time=frame_time,
+                          combination=cls.combination)
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -382,13 +387,16 @@ def _subsets(motion: Motion, joints) -> list[tuple[str | Iterable[str] | None, s
 def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Iterable[str] | None = None,
                pca: int | str | None = "auto", delay: int = 2, n_landmarks: int = 120,
                scale: str | float = "auto", min_periods: float = MIN_PERIODS, rep: str = "expmap",
-               root: str = "heading", normalize: bool = True, weights: str | None = "bone") -> PhaseResult:
+               root: str = "heading", normalize: bool = True, weights: str | None = "bone",
+               keep_features: bool = False) -> PhaseResult:
     """Periodic motions of ``motion`` with their phase per frame and their periods.
 
     ``classes``: ``"auto"`` or how many; ``joints`` (``None``: the whole body, then legs, then arms until
     one shows a periodic motion), ``pca``, ``delay``, ``rep``, ``root``, ``normalize`` and ``weights``
     shape the input (:func:`phase_features`); ``n_landmarks``, ``scale`` and ``min_periods`` (how often a
-    coordinate must wind over the take to count, >= 1) go to :class:`CircularCoordinates`.  An empty
+    coordinate must wind over the take to count, >= 1) go to :class:`CircularCoordinates`;
+    ``keep_features`` keeps the point cloud in ``result.features`` (for plots; off by default so results
+    stay small).  An empty
     ``result.classes`` means no periodic motion; ``result.reason`` says why.
     """
     t0 = time.perf_counter()
@@ -438,8 +446,10 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
         used = next(r for k, r in tries if k == label)
         others = "; ".join(f"{k}: {r}" for k, r in tries if k != label)
         reason = f"{label}: {used} (also tried {others})"
-    return PhaseResult(checked, estimator.barcode_, reason, acf, motion.n_frames, motion.frame_time,
-                       X, estimator, time.perf_counter() - t0, label, legs)
+    return PhaseResult(classes=checked, barcode=estimator.barcode_, reason=reason,
+                       autocorrelation_period_frames=acf, n_frames=motion.n_frames, frame_time=motion.frame_time,
+                       features=X if keep_features else None, seconds=time.perf_counter() - t0,
+                       joints_used=label, legs_period_frames=legs)
 
 
 def _doubt(checked: list[PeriodicMotion], acf: float, legs: float, X: np.ndarray) -> str:
@@ -465,4 +475,3 @@ def _doubt(checked: list[PeriodicMotion], acf: float, legs: float, X: np.ndarray
         return (f"; the take is not like itself one found period ({found:.2f} frames) later (self-similarity "
                 f"{unlike:.2f} > {UNLIKE:g})")
     return ""
-

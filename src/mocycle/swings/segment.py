@@ -167,7 +167,7 @@ class Segmentation:
 
     def to_dict(self) -> dict:
         """Everything as JSON-ready values (read back with :meth:`from_dict`)."""
-        from .codec import skeleton_text
+        from ..io.mosw import skeleton_text
 
         return dict(
             frames=self.n_frames, frame_time=self.frame_time, fps=self.fps, threshold=self.threshold,
@@ -182,7 +182,7 @@ class Segmentation:
 
     @classmethod
     def from_dict(cls, d: dict) -> Segmentation:
-        from .codec import skeleton_from_text
+        from ..io.mosw import skeleton_from_text
 
         try:
             skel = skeleton_from_text(d["skeleton_bvh"])

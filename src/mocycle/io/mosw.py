@@ -29,7 +29,7 @@ from ..errors import MocycleError, MotionFileError
 from ..io.atomic import atomic_write
 from ..io.bvh import format_bvh, parse_bvh
 from ..motion import Motion, Skeleton
-from .segment import Hold, Segmentation, Swing
+from ..swings.segment import Hold, Segmentation, Swing
 
 MAGIC = b"MOSW\x01"
 _PI_Q = 32767.0 / np.pi  # int16 steps per radian for angles within [-π, π]

@@ -35,13 +35,13 @@ from scipy.spatial.transform import Rotation
 from ..errors import MocycleError, MotionFileError
 from ..io.atomic import atomic_write
 from ..io.bvh import format_bvh, parse_bvh
+from ..keyframes.distance import joint_weights
+from ..keyframes.projection import ONE_STEP, PROJECTIONS, PoseSpace, select_keyframes, spatial_layout
+from ..keyframes.select import METHODS, keyframe_count
+from ..keyframes.spatial import optimize_projection, reconstruct_spatial
+from ..keyframes.temporal import SCHEMES as TEMPORAL_SCHEMES
+from ..keyframes.temporal import check_keys, interpolate_rotations
 from ..motion import Motion, Skeleton
-from .distance import joint_weights
-from .projection import ONE_STEP, PROJECTIONS, PoseSpace, select_keyframes, spatial_layout
-from .select import METHODS, keyframe_count
-from .spatial import optimize_projection, reconstruct_spatial
-from .temporal import SCHEMES as TEMPORAL_SCHEMES
-from .temporal import check_keys, interpolate_rotations
 
 MAGIC = b"MOCK\x01"
 SCHEMES = TEMPORAL_SCHEMES + ("spatial",)
