@@ -364,7 +364,8 @@ def _choose_period(pm: PeriodicMotion, X: np.ndarray, min_lag: int, legs: float)
     scores = {k: self_similarity(X[s:e], v) for k, v in near.items()}
     best = min(scores, key=lambda k: scores[k] if np.isfinite(scores[k]) else np.inf)
     reason = (f"estimates differ by more than {PERIOD_AGREEMENT:.0%}; {best} makes the take most like itself "
-              "one period later (self-similarity " + ", ".join(f"{k} {v:.3g}" for k, v in scores.items()) + ")")
+              "one period later (self-similarity " + ", ".join(f"{k} {near[k]:.2f} frames: {v:.3g}"
+                                                              for k, v in scores.items()) + ")")
     new = near[best]
     return replace(pm, period_frames=float(new), n_periods=pm.n_periods * P / new, period_source=best,
                    period_candidates=cands, period_reason=reason + note)
