@@ -32,6 +32,7 @@ HARMONICS_HELP = "Harmonics K: 'auto' (20, capped by the frames) or a number."
 WhichOption = Annotated[int | None, typer.Option(
     "--class", min=0, help="Which periodic motion of each take to use (0-based; default: the one covering most "
                            "frames).")]
+FORCE_HELP = "Use a take's cycle even when it fails a loop check (a warning names the check)."
 
 
 def _parse_weights(text: str | None, n: int) -> list[float] | None:
@@ -73,12 +74,14 @@ def blend(
     min_periods: MinPeriodsOption = 1.2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).
 
     Each take's cycle is extracted, brought to the first one's phase, resampled to the weighted period and
     averaged with the weights in rotation space; root sway and travel per cycle are blended likewise.
-    Exit code 0 on success, 3 when a take holds no periodic motion, 1 for bad input.
+    Exit code 0 on success, 3 when a take holds no periodic motion or its cycle fails a loop check (see
+    mocycle loop), 1 for bad input.
     """
     from ..cycle.blend import blend_cycles, check_weights, cycle_seam
 
@@ -95,7 +98,7 @@ def blend(
     motions = _read_all(paths, fps)
     result = blend_cycles(motions, w, align=align, labels=[str(p) for p in paths], method=method, model=model,
                           n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}), which=which,
-                          **options)
+                          force=force, **options)
     write(result.repeat(cycles, root=root), output)
     seconds = time.perf_counter() - t0
     facts = {
@@ -145,11 +148,13 @@ def transition(
     min_periods: MinPeriodsOption = 1.2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
     The weight moves by a smoothstep over the cycles; period and phase stay continuous (the phase is
-    integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion.
+    integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion or its
+    cycle fails a loop check (see mocycle loop).
     """
     from ..cycle.blend import transition as make_transition
     from ..cycle.blend import transition_smoothness
@@ -162,7 +167,7 @@ def transition(
     a, b = _read_all([first, second], fps)
     result = make_transition(a, b, cycles, root=root, labels=[str(first), str(second)], method=method,
                              model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}),
-                             which=which, **options)
+                             which=which, force=force, **options)
     write(result.motion, output)
     seconds = time.perf_counter() - t0
     facts = {

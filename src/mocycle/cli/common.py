@@ -13,7 +13,7 @@ import typer
 from rich.console import Console
 
 from .. import __version__
-from ..errors import MocycleError, NoPeriodicMotion
+from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 
 app = typer.Typer(
     name="mocycle",
@@ -26,12 +26,12 @@ out = Console(highlight=False)
 err = Console(stderr=True, highlight=False)
 
 EXIT_ERROR = 1
-EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion
+EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion, or its cycle is not a loop
 
 
 def friendly(func: Callable) -> Callable:
-    """Run a command: MocycleError -> one 'error:' line and exit 1 (3 for NoPeriodicMotion); warnings ->
-    'warning:' lines."""
+    """Run a command: MocycleError -> one 'error:' line and exit 1 (3 for NoPeriodicMotion and LoopRefused);
+    warnings -> 'warning:' lines."""
 
     @wraps(func)
     def wrapper(*args, **kwargs):
@@ -42,7 +42,8 @@ def friendly(func: Callable) -> Callable:
             except MocycleError as exc:
                 _print_warnings(caught)
                 err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
-                raise typer.Exit(EXIT_NOT_FOUND if isinstance(exc, NoPeriodicMotion) else EXIT_ERROR) from None
+                refused = isinstance(exc, (NoPeriodicMotion, LoopRefused))
+                raise typer.Exit(EXIT_NOT_FOUND if refused else EXIT_ERROR) from None
         _print_warnings(caught)
         return result
 

@@ -75,12 +75,17 @@ def loop(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: PCA of input and cycle, phase, joint curves.")]
     = None,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Write the cycle even when it fails a loop check (longer than the take, fits much "
+                        "worse than a plain cut, seam jumps); a warning names the check.")] = False,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
 
-    Exit code 0 on success, 3 when the take holds no periodic motion, 1 for bad input.
+    Exit code 0 on success, 3 when the take holds no periodic motion or its cycle fails a loop check
+    (the reason is printed; --force writes it anyway), 1 for bad input.
     """
     from ..cycle import cycle_phase, extract_cycle, loop_metrics
+    from ..cycle.checks import check_loop
 
     check_suffix(output, ".bvh", "--output")
     check_suffix(plot, ".png", "--plot")
@@ -98,21 +103,23 @@ def loop(
         else [(chosen, output)]
     if everything and not targets:
         targets = [(None, output)]  # extract_cycle says why there is nothing to loop
-    results = []
-    for k, target in targets:
+    made, metrics_seconds = [], 0.0
+    for k, target in targets:  # every cycle is made and checked before any file is written
         cycle = extract_cycle(
             motion, method=method, model=model,
             n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}), time_axis_method=time_axis,
             which=k, phase=phase)
-        result = cycle.repeat(cycles, root=root)
-        results.append((k, target, cycle, result))
-    seconds = time.perf_counter() - t0
-    reports = []
-    for k, target, cycle, result in results:  # every cycle is made before any file is written
-        write(result, target)
         t1 = time.perf_counter()
         metrics = loop_metrics(motion, cycle)
-        metrics_seconds = time.perf_counter() - t1
+        label = f"{path} class {k}" if everything else str(path)
+        failed = check_loop(motion, cycle, metrics, force=force, label=label)
+        metrics_seconds += time.perf_counter() - t1
+        made.append((target, cycle, cycle.repeat(cycles, root=root), metrics, failed))
+    seconds = time.perf_counter() - t0 - metrics_seconds
+    reports = []
+    for target, cycle, result, metrics, failed in made:
+        write(result, target)
+        k = next(i for i, c in enumerate(phase.classes) if c is cycle.periodic)
         if plot is not None:
             from ..viz import plot_loop
 
@@ -122,7 +129,7 @@ def loop(
         reports.append({
             "file": str(path),
             "output": str(target),
-            "class": next(i for i, c in enumerate(phase.classes) if c is cycle.periodic),
+            "class": k,
             "frames_in": motion.n_frames,
             "frames_out": result.n_frames,
             "fps": motion.fps,
@@ -132,13 +139,14 @@ def loop(
             "root": root,
             "cycles": cycles,
             "metrics": metrics,
+            "failed_checks": [f.to_dict() for f in failed],
             "seconds": seconds,
             "metrics_seconds": metrics_seconds,
         })
     if as_json:
         print(json.dumps({"file": str(path), "loops": reports} if everything else reports[0], indent=2))
         return
-    for facts, (_, _, cycle, _) in zip(reports, results, strict=True):
+    for facts, (_, cycle, *_) in zip(reports, made, strict=True):
         _print_loop(facts, len(cycle.periodic.excitation), which)
 
 
