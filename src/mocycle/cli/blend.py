@@ -29,6 +29,12 @@ def blend(
     model: Annotated[str, flag(B, "model")] = default(B, "model"),
     harmonics: Annotated[str, flag(B, "harmonics")] = default(B, "harmonics"),
     align: Annotated[bool, flag(B, "align")] = default(B, "align"),
+    joints: Annotated[str | None, flag(B, "joints")] = default(B, "joints"),
+    classes: Annotated[str, flag(B, "classes")] = default(B, "classes"),
+    which: Annotated[int | None, flag(B, "which")] = default(B, "which"),
+    pca: Annotated[str, flag(B, "pca")] = default(B, "pca"),
+    delay: Annotated[int, flag(B, "delay")] = default(B, "delay"),
+    min_periods: Annotated[float, flag(B, "min_periods")] = default(B, "min_periods"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help=PLOT_HELP)] = None,
     amc_fps: Annotated[float, flag(B, "amc_fps")] = default(B, "amc_fps"),
@@ -44,7 +50,8 @@ def blend(
     check_suffix(output, ".bvh")
     check_suffix(plot, ".png", "--plot")
     options = B(weights=weights, root=root, cycles=cycles, method=method, model=model, harmonics=harmonics,
-                align=align, amc_fps=amc_fps, force=force)
+                align=align, joints=joints, classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods,
+                amc_fps=amc_fps, force=force)
     report = tasks.blend.run(paths, options)
     print_warnings(report)
     write(report.motions["loop"], output)
@@ -93,6 +100,12 @@ def transition(
     method: Annotated[str, flag(T, "method")] = default(T, "method"),
     model: Annotated[str, flag(T, "model")] = default(T, "model"),
     harmonics: Annotated[str, flag(T, "harmonics")] = default(T, "harmonics"),
+    joints: Annotated[str | None, flag(T, "joints")] = default(T, "joints"),
+    classes: Annotated[str, flag(T, "classes")] = default(T, "classes"),
+    which: Annotated[int | None, flag(T, "which")] = default(T, "which"),
+    pca: Annotated[str, flag(T, "pca")] = default(T, "pca"),
+    delay: Annotated[int, flag(T, "delay")] = default(T, "delay"),
+    min_periods: Annotated[float, flag(T, "min_periods")] = default(T, "min_periods"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves over the transition's phase, and the weight.")] = None,
@@ -107,7 +120,8 @@ def transition(
     """
     check_suffix(output, ".bvh")
     check_suffix(plot, ".png", "--plot")
-    options = T(cycles=cycles, root=root, method=method, model=model, harmonics=harmonics, amc_fps=amc_fps,
+    options = T(cycles=cycles, root=root, method=method, model=model, harmonics=harmonics, joints=joints,
+                classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods, amc_fps=amc_fps,
                 force=force)
     report = tasks.transition.run([first, second], options)
     print_warnings(report)

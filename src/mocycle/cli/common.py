@@ -153,4 +153,3 @@ def main() -> None:  # the console script
     except KeyboardInterrupt:  # pragma: no cover
         err.print("interrupted")
         sys.exit(130)
-

@@ -29,10 +29,14 @@ def loop(
     joints: Annotated[str | None, flag(O, "joints")] = default(O, "joints"),
     cycles: Annotated[int, flag(O, "cycles")] = default(O, "cycles"),
     classes: Annotated[str, flag(O, "classes")] = default(O, "classes"),
-    which: Annotated[int | None, flag(O, "which")] = default(O, "which"),
+    which: Annotated[str | None, flag(O, "which")] = default(O, "which"),
+    pca: Annotated[str, flag(O, "pca")] = default(O, "pca"),
+    delay: Annotated[int, flag(O, "delay")] = default(O, "delay"),
+    min_periods: Annotated[float, flag(O, "min_periods")] = default(O, "min_periods"),
     time_axis: Annotated[str, flag(O, "time_axis")] = default(O, "time_axis"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    plot: Annotated[Path | None, typer.Option(help="Write a PNG: PCA of input and cycle, phase, joint curves.")]
+    plot: Annotated[Path | None, typer.Option(
+        help="Write a PNG: PCA of input and cycle, phase, joint curves (with --class all: OUT.classK.png).")]
     = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
     force: Annotated[bool, flag(O, "force")] = default(O, "force"),
@@ -45,33 +49,46 @@ def loop(
     check_suffix(output, ".bvh", "--output")
     check_suffix(plot, ".png", "--plot")
     options = O(method=method, model=model, harmonics=harmonics, root=root, frame_range=frame_range, step=step,
-                joints=joints, cycles=cycles, classes=classes, which=which, time_axis=time_axis, amc_fps=amc_fps,
-                force=force)
+                joints=joints, cycles=cycles, classes=classes, which=which, pca=pca, delay=delay,
+                min_periods=min_periods, time_axis=time_axis, amc_fps=amc_fps, force=force)
     report = tasks.loop.run(path, options)
     print_warnings(report)
-    write(report.motions["loop"], output)
-    if plot is not None:
-        from ..viz import plot_loop
+    everything = options.which == "all"
+    loops = report.facts["loops"] if everything else [report.facts]
+    cycles_made = report.result if everything else [report.result]
+    shown = []
+    for facts, cycle in zip(loops, cycles_made, strict=True):  # every cycle was made and checked before writing
+        k = facts["class"]
+        target = output.with_suffix(f".class{k}.bvh") if everything else output
+        write(report.motions[f"loop.class{k}" if everything else "loop"], target)
+        image = None
+        if plot is not None:
+            from ..viz import plot_loop
 
-        plot_loop(report.motions["input"], report.result, plot,
-                  title=f"{path.name}: {method}{' ' + model if method == 'harmonic' else ''}")
-    facts = {"file": str(path), "output": str(output), **report.facts, "seconds": report.seconds,
-             "metrics_seconds": report.timings_s["metrics"]}
+            image = plot.with_suffix(f".class{k}.png") if everything else plot
+            plot_loop(report.motions["input"], cycle, image,
+                      title=f"{path.name}: {method}{' ' + model if method == 'harmonic' else ''}")
+        shown.append(({"file": str(path), "output": str(target), **facts, "seconds": report.seconds,
+                       "metrics_seconds": report.timings_s["metrics"]}, image))
     if as_json:
-        print_json(facts)
+        print_json({"file": str(path), "loops": [f for f, _ in shown]} if everything else shown[0][0])
         return
-    _print_loop(facts, report)
-    if plot is not None:
-        out.print(f"wrote {plot}", soft_wrap=True)
+    for facts, image in shown:
+        _print_loop(facts)
+        if image is not None:
+            out.print(f"wrote {image}", soft_wrap=True)
+    out.print(timing_line(report))
 
 
-def _print_loop(facts: dict, report) -> None:
+def _print_loop(facts: dict) -> None:
     from rich.table import Table
 
     kind = facts["method"] + (f" {facts['model']}, K = {facts['harmonics']}" if facts["method"] == "harmonic" else "")
     out.print(f"[bold]{facts['file']}[/]: {facts['frames_in']} frames at {facts['fps']:.6g} fps")
-    out.print(f"  {facts['n_periods']:.2f} periods of {facts['period_frames']:.2f} frames "
-              f"(time axis: {facts['time_axis']}, {facts['excited_regions']} excited region(s))")
+    out.print(f"  class {facts['class']}: {facts['n_periods']:.2f} periods of {facts['period_frames']:.2f} frames "
+              f"(time axis: {facts['time_axis']}, {facts['excited_regions']} excited region(s): "
+              + ", ".join(f"{s}-{e}" for s, e in facts["excitation"]) + f"; joints used: {facts['joints_used']})")
+    out.print(f"  period: {facts['period_reason']}", soft_wrap=True)
     move = facts["travel_per_cycle"]
     out.print(f"  cycle: {facts['cycle_frames']} frames by {kind}; travel per cycle "
               f"({move[0]:.3g}, {move[1]:.3g}, {move[2]:.3g}), turn {facts['turn_per_cycle_deg']:.3g}°")
@@ -84,4 +101,3 @@ def _print_loop(facts: dict, report) -> None:
     out.print(table)
     out.print(f"wrote {facts['output']}: {facts['frames_out']} frames ({facts['cycles']} cycle(s), root "
               f"{facts['root']})", soft_wrap=True)
-    out.print(timing_line(report))

@@ -21,6 +21,7 @@ def phase(
     joints: Annotated[str | None, flag(O, "joints")] = default(O, "joints"),
     pca: Annotated[str, flag(O, "pca")] = default(O, "pca"),
     delay: Annotated[int, flag(O, "delay")] = default(O, "delay"),
+    min_periods: Annotated[float, flag(O, "min_periods")] = default(O, "min_periods"),
     landmarks: Annotated[int, flag(O, "n_landmarks")] = default(O, "n_landmarks"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: diagram, phase per frame, PCA by phase.")] = None,
@@ -31,7 +32,8 @@ def phase(
     Exit code 0 when at least one periodic motion is found, 3 when none is
     (the reason is printed), 1 for bad input, 2 for a bad option.
     """
-    options = O(classes=classes, joints=joints, pca=pca, delay=delay, n_landmarks=landmarks, amc_fps=amc_fps)
+    options = O(classes=classes, joints=joints, pca=pca, delay=delay, min_periods=min_periods, n_landmarks=landmarks,
+                amc_fps=amc_fps)
     report = tasks.phase.run(path, options, keep_features=plot is not None)
     print_warnings(report)
     if plot is not None:
@@ -66,5 +68,10 @@ def _print_phase(path: Path, report) -> None:
         out.print(table)
     acf = facts["autocorrelation_period_frames"]
     out.print(f"  autocorrelation period (cross-check): {'none' if acf is None else f'{acf:.2f} frames'}")
+    legs = facts["legs_period_frames"]
+    out.print(f"  legs' autocorrelation period: {'none' if legs is None else f'{legs:.2f} frames'}; "
+              f"joints used: {facts['joints_used']}")
+    for k, c in enumerate(facts["classes"]):
+        out.print(f"  class {k} period: {c['period_reason']}", soft_wrap=True)
     out.print(f"  why: {facts['reason']}", soft_wrap=True)
     out.print(timing_line(report))

@@ -27,7 +27,7 @@ from .. import _validate
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
 from ..motion import Motion
-from ..phase.analysis import PeriodicMotion, PhaseResult, find_phase
+from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
 from ..rotations import axis_rotations, mean_rotations
 from .differences import HALF, central_acceleration, central_velocity
@@ -149,6 +149,7 @@ class Cycle:
             "time_axis": self.axis.method,
             "travel_per_cycle": self.drift[:3].tolist(),
             "turn_per_cycle_deg": float(np.degrees(self.drift[3])),
+            **self.periodic.provenance(),
         }
 
 
@@ -354,19 +355,34 @@ def _phase_at_full_rate(result: PhaseResult, step: int, n_frames: int) -> PhaseR
                    autocorrelation_period_frames=result.autocorrelation_period_frames * step)
 
 
+def cycle_phase(motion: Motion, *, joints: str | Iterable[str] | None = None, classes: int | str = "auto",
+                pca: int | str | None = "auto", delay: int = 2, min_periods: float = MIN_PERIODS,
+                phase_step: int = 1) -> PhaseResult:
+    """:func:`~mocycle.phase.find_phase` as the cycle extraction calls it, optionally on every
+    ``phase_step``-th frame only (the thesis plugin's subsampling), brought back to every frame."""
+    phase_step = _validate.integer("phase_step", phase_step, 1)
+    options = dict(classes=classes, joints=joints, pca=pca, delay=delay, min_periods=min_periods)
+    if phase_step > 1:
+        return _phase_at_full_rate(find_phase(motion[::phase_step], **options), phase_step, motion.n_frames)
+    return find_phase(motion, **options)
+
+
 def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n_harmonics: int | str = "auto",
-                  time_axis_method: str = "smooth", joints: str | Iterable[str] | None = None,
-                  classes: int | str = "auto", which: int | None = None, phase: PhaseResult | None = None,
-                  phase_step: int = 1, **phase_options) -> Cycle:
+                  time_axis_method: str = "smooth", *, joints: str | Iterable[str] | None = None,
+                  classes: int | str = "auto", which: int | None = None, pca: int | str | None = "auto",
+                  delay: int = 2, min_periods: float = MIN_PERIODS, phase: PhaseResult | None = None,
+                  phase_step: int = 1) -> Cycle:
     """One seamless cycle of ``motion``.
 
     ``method``: ``harmonic`` | ``centroid`` | ``cut``; ``model``: M1 | M2 | M3 (harmonic only);
     ``n_harmonics``: K or ``"auto"`` (20, capped by the frames); ``time_axis_method``: see
-    :mod:`~mocycle.cycle.timeaxis`; ``joints``: the joints the *phase* is found on (every joint is
-    looped); ``classes``/``which``: how many periodic motions to look for and which to loop;
+    :mod:`~mocycle.cycle.timeaxis`.  The phase options go to :func:`~mocycle.phase.find_phase`:
+    ``joints`` (the joints the *phase* is found on; every joint is looped; default the whole body, then
+    legs, then arms), ``classes`` (how many periodic motions to look for), ``pca``, ``delay`` and
+    ``min_periods``; ``which``: the periodic motion to loop (0-based; default the one covering most frames);
     ``phase``: a :class:`PhaseResult` already computed for this motion (skips :func:`find_phase`);
-    ``phase_step``: find the phase on every ``phase_step``-th frame only (the thesis plugin's subsampling;
-    the cycle is still built from every frame at the capture's rate).
+    ``phase_step``: find the phase on every ``phase_step``-th frame only (the cycle is still built from
+    every frame at the capture's rate).
     Raises :class:`NoPeriodicMotion` when the take has none; warns below 1.5 periods.
 
     Returns
@@ -392,13 +408,9 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     _check_choice(time_axis_method, TIME_AXES, "time_axis_method")
     if method == "harmonic":
         _check_choice(model, MODELS, "model")
-    phase_step = _validate.integer("phase_step", phase_step, 1)
     if phase is None:
-        if phase_step > 1:
-            phase = _phase_at_full_rate(find_phase(motion[::phase_step], classes=classes, joints=joints,
-                                                   **phase_options), phase_step, motion.n_frames)
-        else:
-            phase = find_phase(motion, classes=classes, joints=joints, **phase_options)
+        phase = cycle_phase(motion, joints=joints, classes=classes, pca=pca, delay=delay, min_periods=min_periods,
+                            phase_step=phase_step)
     periodic = choose_periodic(phase, which)
     axis = time_axis(periodic, time_axis_method)
     if axis.n_periods < FEW_PERIODS:

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 from ..errors import OptionError
 from . import fields
+from .fields import phase_options
 from .options import Flag, option
 from .options import Options as _Options
 from .report import Recorder, Report, label_of, load
@@ -46,6 +47,12 @@ class Options(_Options):
     model: str = fields.model()
     harmonics: int | str = fields.harmonics()
     align: bool = option(True, "Search each take's phase offset against the first.", Flag())
+    joints: str | None = fields.phase_joints()
+    classes: int | str = fields.classes()
+    which: int | None = fields.which()
+    pca: int | str | None = fields.pca()
+    delay: int = fields.delay()
+    min_periods: float = fields.min_periods()
     amc_fps: float = fields.amc_fps()
     force: bool = fields.force_cycle()
 
@@ -67,7 +74,8 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     with Recorder() as rec:
         motions = [load(t, o.amc_fps) for t in takes]
         result = blend_cycles(motions, o.weights, align=o.align, labels=[label_of(t, k) for k, t in enumerate(takes)],
-                              method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force)
+                              method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force,
+                              **phase_options(o))
         loop = result.repeat(o.cycles, root=o.root)
         facts = {
             **result.to_dict(),

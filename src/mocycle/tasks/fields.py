@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 from ..io.asfamc import AMC_FPS
+from ..phase.analysis import MIN_PERIODS
 from ..swings.segment import DEFAULT_THRESHOLD as SWING_THRESHOLD
 from .options import Choice, Flag, Integer, Real, Text, option
 
-__all__ = ["AMC_FPS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "harmonics", "joints", "method", "model",
-           "root", "swing_joints", "threshold"]
+__all__ = ["AMC_FPS", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay", "force_cycle",
+           "harmonics", "joints", "method", "min_periods", "model", "pca", "phase_joints", "root", "swing_joints",
+           "threshold", "which"]
 
 METHODS = ("harmonic", "centroid", "cut")
 MODELS = ("M1", "M2", "M3")
@@ -40,8 +42,33 @@ def cycles(default: int, help: str):
     return option(default, help, Integer(1))
 
 
-def classes(help: str = "Number of periodic motions: 'auto' or N."):
+def classes(help: str = "How many periodic motions to look for: 'auto' or N."):
     return option("auto", help, Integer(1, words={"auto": "auto"}))
+
+
+# -- the phase options: what ``phase`` takes to find the periodic motion; loop, blend and transition take the same
+def phase_joints():
+    return joints("Joints to find the phase on: names, glob patterns or groups (legs, arms, spine), comma-separated; "
+                  "default the whole body, then legs, then arms until one shows a periodic motion.")
+
+
+def pca():
+    return option("auto", "PCA dimensions before the cohomology: 'auto' (8), N or 'none'.",
+                  Integer(1, words={"auto": "auto", "none": None, "0": None}, optional=True))
+
+
+def delay():
+    return option(2, "Delay embedding factor m (KTH thesis eq. 3.26; it used 2).", Integer(0))
+
+
+def min_periods():
+    return option(MIN_PERIODS, "Periods a periodic motion must cover (>= 1); below 1.5 the result is kept with a "
+                               "warning.", Real(1.0))
+
+
+def which(help: str = "Which periodic motion of each take to use (0-based; default: the one covering most "
+                      "frames).", words: tuple[str, ...] = ()):
+    return option(None, help, Integer(0, words={w: w for w in words}, optional=True), flag="--class")
 
 
 def joints(help: str = "Joints to use: names, glob patterns or groups (legs, arms, spine), comma-separated."):
@@ -56,6 +83,12 @@ def threshold():
 def force_cycle():
     return option(False, "Use a take's cycle even when it fails a loop check (a warning names the check).",
                   Flag())
+
+
+def phase_options(options) -> dict:
+    """The phase options of an Options object as keyword arguments of ``extract_cycle``/``blend_cycles``."""
+    return {"joints": options.joints, "classes": options.classes, "which": options.which, "pca": options.pca,
+            "delay": options.delay, "min_periods": options.min_periods}
 
 
 def swing_joints():

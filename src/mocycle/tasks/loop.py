@@ -70,12 +70,15 @@ class Options(_Options):
     root: str = fields.root("inplace", "inplace (walks on the spot, facing kept) or motion (moves on).")
     frame_range: str | None = option(None, "Use frames START:STOP of the take.", _range_text, flag="--range")
     step: int = option(1, "Find the phase on every STEP-th frame (faster on long takes).", Integer(1))
-    joints: str | None = fields.joints("Joints to find the phase on (names, globs, legs/arms/spine); every joint "
-                                       "is looped.")
+    joints: str | None = fields.phase_joints()
     cycles: int = fields.cycles(1, "Repeat the cycle this many times in the output.")
-    classes: int | str = fields.classes("How many periodic motions to look for: 'auto' or N.")
-    which: int | None = option(None, "Which periodic motion to loop (0-based; default: the one covering most "
-                                     "frames).", Integer(0, optional=True), flag="--class")
+    classes: int | str = fields.classes()
+    which: int | str | None = fields.which("Which periodic motion to loop (0-based; default: the one covering most "
+                                           "frames), or 'all': one file per periodic motion, OUT.class0.bvh, "
+                                           "OUT.class1.bvh, ...", words=("all",))
+    pca: int | str | None = fields.pca()
+    delay: int = fields.delay()
+    min_periods: float = fields.min_periods()
     time_axis: str = option("smooth", "Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) "
                                       "or line.", Choice(TIME_AXES), flag="--time")
     amc_fps: float = fields.amc_fps()
@@ -86,35 +89,53 @@ class Options(_Options):
 def run(take, options: Options | None = None) -> Report:
     """Extract one seamless cycle; ``motions["loop"]`` is it repeated ``cycles`` times with the chosen root.
 
+    With ``which="all"``: one loop per periodic motion, ``motions["loop.class<k>"]``, and ``facts["loops"]``
+    holds the figures of each (every cycle is made and checked before the report is returned).
     Raises :class:`~mocycle.errors.NoPeriodicMotion` when the take holds no periodic motion and
-    :class:`~mocycle.errors.LoopRefused` when its cycle fails a loop check (``force``: a warning instead).
+    :class:`~mocycle.errors.LoopRefused` when a cycle fails a loop check (``force``: a warning instead).
     """
-    from ..cycle import extract_cycle, loop_metrics
+    from ..cycle import cycle_phase, extract_cycle, loop_metrics
     from ..cycle.checks import check_loop
 
     o = options or Options()
+    everything = o.which == "all"
     with Recorder() as rec:
         motion = load(take, o.amc_fps)
         start, stop = parse_range(o.frame_range, motion.n_frames)
         motion = motion[start:stop]
         with rec.part("cycle"):
-            cycle = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
-                                  time_axis_method=o.time_axis, joints=o.joints, classes=o.classes, which=o.which,
-                                  phase_step=o.step)
-            result = cycle.repeat(o.cycles, root=o.root)
-        with rec.part("metrics"):
-            metrics = loop_metrics(motion, cycle)
-            failed = check_loop(motion, cycle, metrics, force=o.force, label=label_of(take))
-        facts = {
-            "frames_in": motion.n_frames,
-            "frames_out": result.n_frames,
-            "fps": motion.fps,
-            **cycle.to_dict(),
-            "model": o.model if o.method == "harmonic" else None,
-            "root": o.root,
-            "cycles": o.cycles,
-            "metrics": metrics,
-            "failed_checks": [f.to_dict() for f in failed],
-            "excited_regions": len(cycle.periodic.excitation),
-        }
-    return rec.report("loop", facts, {"loop": result, "input": motion}, cycle)
+            phase = cycle_phase(motion, phase_step=o.step, joints=o.joints, classes=o.classes, pca=o.pca,
+                                delay=o.delay, min_periods=o.min_periods)
+        targets = list(range(len(phase.classes))) if everything else [o.which]
+        if everything and not targets:
+            targets = [None]  # extract_cycle says why there is nothing to loop
+        loops, motions, cycles = [], {}, []
+        for k in targets:
+            with rec.part("cycle"):
+                cycle = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
+                                      time_axis_method=o.time_axis, which=k, phase=phase)
+                result = cycle.repeat(o.cycles, root=o.root)
+            with rec.part("metrics"):
+                metrics = loop_metrics(motion, cycle)
+                label = f"{label_of(take)} class {k}" if everything else label_of(take)
+                failed = check_loop(motion, cycle, metrics, force=o.force, label=label)
+            index = next(i for i, c in enumerate(phase.classes) if c is cycle.periodic)
+            loops.append({
+                "class": index,
+                "frames_in": motion.n_frames,
+                "frames_out": result.n_frames,
+                "fps": motion.fps,
+                **cycle.to_dict(),
+                "excitation": [[int(s), int(e)] for s, e in cycle.axis.regions],
+                "model": o.model if o.method == "harmonic" else None,
+                "root": o.root,
+                "cycles": o.cycles,
+                "metrics": metrics,
+                "failed_checks": [f.to_dict() for f in failed],
+                "excited_regions": len(cycle.periodic.excitation),
+            })
+            motions[f"loop.class{index}" if everything else "loop"] = result
+            cycles.append(cycle)
+    motions["input"] = motion
+    facts = {"loops": loops} if everything else loops[0]
+    return rec.report("loop", facts, motions, cycles if everything else cycles[0])

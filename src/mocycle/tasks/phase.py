@@ -27,10 +27,10 @@ class Options(_Options):
     """Options of ``phase``."""
 
     classes: int | str = fields.classes()
-    joints: str | None = fields.joints()
-    pca: int | str | None = option("auto", "PCA dimensions before the cohomology: 'auto' (8), N or 'none'.",
-                                   Integer(1, words={"auto": "auto", "none": None, "0": None}, optional=True))
-    delay: int = option(2, "Delay embedding factor m (KTH thesis eq. 3.26; it used 2).", Integer(0))
+    joints: str | None = fields.phase_joints()
+    pca: int | str | None = fields.pca()
+    delay: int = fields.delay()
+    min_periods: float = fields.min_periods()
     n_landmarks: int = option(120, "Landmarks for the Rips filtration.", Integer(3), flag="--landmarks")
     amc_fps: float = fields.amc_fps()
 
@@ -45,6 +45,7 @@ def run(take, options: Options | None = None, *, keep_features: bool = False) ->
     with Recorder() as rec:
         motion = load(take, options.amc_fps)
         result = find_phase(motion, classes=options.classes, joints=options.joints, pca=options.pca,
-                            delay=options.delay, n_landmarks=options.n_landmarks, keep_features=keep_features)
+                            delay=options.delay, min_periods=options.min_periods, n_landmarks=options.n_landmarks,
+                            keep_features=keep_features)
         facts = {k: v for k, v in result.to_dict().items() if k != "seconds"}
     return rec.report("phase", facts, {"motion": motion}, result)

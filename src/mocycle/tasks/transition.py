@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 from ..errors import OptionError
 from . import fields
+from .fields import phase_options
 from .options import Options as _Options
 from .report import Recorder, Report, label_of, load
 
@@ -26,6 +27,12 @@ class Options(_Options):
     method: str = fields.method()
     model: str = fields.model()
     harmonics: int | str = fields.harmonics()
+    joints: str | None = fields.phase_joints()
+    classes: int | str = fields.classes()
+    which: int | None = fields.which()
+    pca: int | str | None = fields.pca()
+    delay: int = fields.delay()
+    min_periods: float = fields.min_periods()
     amc_fps: float = fields.amc_fps()
     force: bool = fields.force_cycle()
 
@@ -41,6 +48,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     with Recorder() as rec:
         a, b = (load(t, o.amc_fps) for t in takes)
         result = transition(a, b, o.cycles, root=o.root, labels=[label_of(t, k) for k, t in enumerate(takes)],
-                            method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force)
+                            method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force,
+                            **phase_options(o))
         facts = {**result.to_dict(), "root": o.root, "smoothness": transition_smoothness(result)}
     return rec.report("transition", facts, {"transition": result.motion}, result)
