@@ -18,7 +18,7 @@ def test_parse_up(name, vector):
 
 @pytest.mark.parametrize("bad", ["up", [0, 0, 0], [1, 2], [np.nan, 1, 0]])
 def test_parse_up_refuses_what_is_not_an_axis(bad):
-    with pytest.raises(MocycleError, match="up axis"):
+    with pytest.raises(MocycleError, match="up must be one of"):
         parse_up(bad)
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import MocycleError
+from .errors import OptionError
 from .motion import Motion
 
 AXIS_NAMES = ("x", "y", "z", "+x", "+y", "+z", "-x", "-y", "-z")
@@ -22,14 +22,14 @@ def parse_up(up) -> np.ndarray:
     if isinstance(up, str):
         name = up.strip().lower()
         if name not in AXIS_NAMES:
-            raise MocycleError(f"the up axis must be one of {', '.join(AXIS_NAMES)} or a 3-vector; got {up!r}")
+            raise OptionError("up", f"must be one of {', '.join(AXIS_NAMES)} or a 3-vector; got {up!r}")
         v = np.zeros(3)
         v["xyz".index(name[-1])] = -1.0 if name.startswith("-") else 1.0
         return v
     v = np.asarray(up, dtype=np.float64).reshape(-1)
     norm = float(np.linalg.norm(v)) if v.shape == (3,) and np.all(np.isfinite(v)) else 0.0
     if norm == 0.0:
-        raise MocycleError(f"the up axis must be one of {', '.join(AXIS_NAMES)} or a non-zero 3-vector; got {up!r}")
+        raise OptionError("up", f"must be one of {', '.join(AXIS_NAMES)} or a non-zero 3-vector; got {up!r}")
     return v / norm
 
 

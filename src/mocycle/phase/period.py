@@ -209,12 +209,7 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
         raise MocycleError(f"max_lag must be at most T - 2 = {T - 2} frames; got {max_lag}")
     if max_lag < min_lag:
         raise MocycleError(f"max_lag ({max_lag}) must not be smaller than min_lag ({min_lag})")
-    try:
-        min_strength = float(min_strength)
-    except (TypeError, ValueError):
-        raise MocycleError(f"min_strength must be a number in [0, 1); got {min_strength!r}") from None
-    if not 0.0 <= min_strength < 1.0:
-        raise MocycleError(f"min_strength must be a number in [0, 1); got {min_strength!r}")
+    min_strength = _validate.real("min_strength", min_strength, 0.0, 1.0, high_open=True)
 
     A = A[:, np.all(np.isfinite(A), axis=0)]
     if A.shape[1] == 0:

@@ -523,10 +523,8 @@ def stretch_motion(motion: Motion, factor: float, window: str | int = "auto", fo
         raise MocycleError(f"stretching needs a take of at least 8 frames; got {T}")
     factor = _factor(factor)
     n_out = _frames_out(T, factor)
-    if isinstance(window, str) and window != "auto":
-        raise MocycleError(f"window must be 'auto' or a number of frames; got {window!r}")
-    if not isinstance(window, str):
-        _window(window, T)
+    window = _validate.integer("window", window, 1, max(T // 2, 1), words={"auto": "auto"},
+                               note=f"half the take's {T} frames")
     try:
         regions, period, reason = periodic_regions(motion, phase)
     except MocycleError as exc:  # too short for a phase
