@@ -70,7 +70,7 @@ def test_project_plot_and_json(walk_file, tmp_path):
 @pytest.mark.parametrize("args,msg", [
     (["compress", "{f}", "-o", "{d}/x.bvh"], ".mck"),
     (["compress", "{f}", "-o", "{d}/x.mck", "--scheme", "cubic"], "scheme must be"),
-    (["compress", "{f}", "-o", "{d}/x.mck", "--ratio", "0"], "--ratio must be a number in (0, 1]"),
+    (["compress", "{f}", "-o", "{d}/x.mck", "--ratio", "0"], "--ratio must be 'auto' or a number in (0, 1]"),
     (["decompress", "{f}", "-o", "{d}/x.bvh"], "not a mocycle keyframe file"),
     (["decompress", "{d}/none.mck", "-o", "{d}/x.bvh"], "cannot read"),
     (["project", "{f}", "--projection", "umap"], "projection must be"),
@@ -89,4 +89,4 @@ def test_an_explicit_ratio_that_aliases_the_gait_warns(walk_file, tmp_path):
     assert r.exit_code == 0, r.output
     assert "warning:" in r.output and "per period" in r.output and "--ratio auto" in r.output
     bad = runner.invoke(app, ["compress", str(walk_file), "-o", str(tmp_path / "w.mck"), "--ratio", "x"])
-    assert bad.exit_code == 1 and "'auto' or a number" in bad.output
+    assert bad.exit_code == 2 and "'auto' or a number" in bad.output  # a bad option value: usage error
