@@ -27,8 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate
-from ..errors import MocycleError, MocycleWarning
+from ..errors import MocycleError, MocycleWarning, OptionError
 from ..motion import Motion
 from .select import keyframe_count
 
@@ -83,8 +82,8 @@ def keyframe_density(motion: Motion, ratio: float | str = "auto", scheme: str = 
         period = rhythm_period(motion)
         return KeyDensity(k, period, None if period is None else k * period / n, "count")
     auto = isinstance(ratio, str)
-    if auto:
-        _validate.choice("ratio", ratio, ("auto",))
+    if auto and ratio != "auto":
+        raise OptionError("ratio", f"must be 'auto' or a number in (0, 1]; got {ratio!r}")
     k = keyframe_count(n, ratio=THESIS_RATIO if auto else ratio)
     rule = "ratio"
     period = rhythm_period(motion)
