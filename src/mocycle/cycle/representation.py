@@ -28,14 +28,32 @@ from ..motion import Motion, Skeleton
 from ..rotations import continuous_quats, nearest_rotations
 
 
+def body_pose(motion: Motion) -> np.ndarray:
+    """Mean world positions ``(J', 3)`` of the travel joint, the joints below it and their End Sites
+    (about 50 frames of the take)."""
+    step = max(1, motion.n_frames // 50)
+    pose = motion[::step].world_positions(end_sites=True).mean(axis=0)
+    skel, travel = motion.skeleton, motion.travel_joint
+    above = set()
+    j = int(skel.parents[travel])
+    while j >= 0:
+        above.add(j)
+        j = int(skel.parents[j])
+    keep = [j for j in range(skel.n_joints) if j not in above] + [
+        skel.n_joints + i for i, s in enumerate(skel.end_sites) if s.parent not in above]
+    return pose[keep]
+
+
 def vertical_axis(motion: Motion) -> np.ndarray:
     """The world up direction ``(3,)`` of a humanoid take (unit vector along +X, +Y or +Z or their negatives).
 
     The axis along which the mean pose is tallest; its sign puts most joints in
-    the upper half (spine, arms, head and hands outnumber the legs).
+    the upper half (spine, arms, head and hands outnumber the legs).  Only the
+    body is measured: joints above the travel joint (a static ``joint_Root`` on
+    the floor while the hips are 1.3 m away, as in the Bandai Namco dashes) are
+    left out, so they cannot make a horizontal axis look tallest.
     """
-    step = max(1, motion.n_frames // 50)
-    pose = motion[::step].world_positions(end_sites=True).mean(axis=0)  # (J', 3)
+    pose = body_pose(motion)
     extent = np.ptp(pose, axis=0)
     axis = int(np.argmax(extent))
     mid = 0.5 * (pose[:, axis].max() + pose[:, axis].min())
