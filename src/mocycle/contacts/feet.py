@@ -53,7 +53,9 @@ class Foot:
         return (self.ankle,) if self.toe is None else (self.ankle, self.toe)
 
     def names(self, skeleton: Skeleton) -> dict[str, str | None]:
-        n = skeleton.names
+        return self.names_of(skeleton.names)
+
+    def names_of(self, n: Sequence[str]) -> dict[str, str | None]:
         return {"hip": n[self.hip], "knee": n[self.knee], "ankle": n[self.ankle],
                 "toe": None if self.toe is None else n[self.toe]}
 

@@ -1,0 +1,268 @@
+"""Foot locking (Kovar, Schreiner and Gleicher 2002, "Footskate cleanup for motion capture editing").
+
+During each contact of a contact joint its position is held at one point in
+world space (at the joint's lowest height during the contact, horizontally at
+its mean position, or nearer the hip where the leg would otherwise be too short); just before and
+after, over ``blend`` seconds (at most half the gap to the next contact), the
+held point is cross-faded with the joint's own path by a smoothstep, so the
+correction grows and fades without a pop.  Per foot:
+
+* the **ankle goal** is the held ankle, or, while only the toe is held, the
+  ankle moved with the toe (the foot keeps its orientation and pivots on the
+  ball); the toe of a foot whose ankle and toe are both held is held at the
+  ankle's point plus the foot vector in the middle of their overlap, so both
+  holds can be met exactly by a rigid foot;
+* the **root is lowered** (along the vertical, smoothed over the blend window
+  so it never jumps) on frames where an ankle goal is farther from its hip
+  than ``reach`` of the leg's length;
+* the leg is solved by **analytic two-bone IK**: the knee bends about the
+  normal of the hip-knee-ankle plane until the hip-ankle distance is right,
+  then the thigh swings by the smallest rotation that puts the ankle on its
+  goal (the knee stays in the leg's plane, only turned with it);
+* the **foot** keeps its world orientation, turned by the smallest rotation
+  that points it at the toe goal.
+
+Only local rotations change (and the travel joint's translation when the root
+is lowered), so every bone keeps its length exactly; frames outside the
+contacts, their blend windows and the lowering are left untouched.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.ndimage import maximum_filter1d, uniform_filter1d
+from scipy.spatial.transform import Rotation
+
+from ..motion import Motion
+from .detect import Contacts, ranges
+
+BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
+REACH = 0.995        # of hip-knee plus knee-ankle: farther goals lower the root
+DISTANCE_WEIGHT = 3.0  # a hold this much farther from the mean weighs like the same lowering of the root
+
+
+def _smoothstep(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def _holds(mask: np.ndarray, targets: list[np.ndarray], n_blend: int) -> tuple[np.ndarray, np.ndarray]:
+    """Weights ``(T,)`` and held points ``(T, 3)`` of one contact joint: 1 inside each contact, smoothstep
+    ramps of ``n_blend`` frames (at most half the gap to the neighbour contact) outside."""
+    T = mask.shape[0]
+    rs = ranges(mask)
+    w = np.zeros(T)
+    hold = np.zeros((T, 3))
+    for k, ((a, b), target) in enumerate(zip(rs, targets, strict=True)):
+        before = a - (rs[k - 1][1] if k else -n_blend * 2)
+        after = (rs[k + 1][0] if k + 1 < len(rs) else T + n_blend * 2) - b
+        r_in, r_out = min(n_blend, before // 2), min(n_blend, after // 2)
+        w[a:b] = 1.0
+        hold[a:b] = target
+        if r_in > 0:
+            t = np.arange(max(0, a - r_in), a)
+            w[t] = _smoothstep((t - (a - r_in - 1)) / (r_in + 1))
+            hold[t] = target
+        if r_out > 0:
+            t = np.arange(b, min(T, b + r_out))
+            w[t] = _smoothstep((b + r_out - t) / (r_out + 1))
+            hold[t] = target
+    return w, hold
+
+
+def _normalize(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.maximum(n, 1e-300)
+
+
+def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The smallest rotations ``(T, 3, 3)`` turning the directions of ``a`` into those of ``b`` ``(T, 3)``."""
+    a, b = _normalize(a), _normalize(b)
+    axis = np.cross(a, b)
+    s = np.linalg.norm(axis, axis=-1)
+    angle = np.arctan2(s, np.sum(a * b, axis=-1))
+    rotvec = _normalize(axis) * angle[:, None]
+    return Rotation.from_rotvec(rotvec).as_matrix()
+
+
+def _reach(W: np.ndarray, foot, reach: float) -> np.ndarray:
+    """How far ``(T,)`` the ankle may be from the hip: ``reach`` of the leg's length, or the capture's own
+    stretch where that is more."""
+    H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
+    legs = np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
+    return np.maximum(reach * legs, np.linalg.norm(A - H, axis=1))
+
+
+def _need(goals: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """Smallest lowering ``delta >= 0`` of the hips along ``-up`` putting each goal within ``R`` of its hip
+    (as close as it gets when the goal is too far sideways); broadcasts over leading axes."""
+    d = goals - hips
+    du = d @ up
+    disc = du ** 2 - np.sum(d * d, axis=-1) + R ** 2
+    return np.maximum(np.where(disc >= 0, -du - np.sqrt(np.maximum(disc, 0.0)), -du), 0.0)
+
+
+def _best_hold(path: np.ndarray, offsets: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray,
+               body: float) -> np.ndarray:
+    """Where to hold a contact: at the joint's lowest height during the contact, and horizontally at one of
+    its positions during the contact or their mean: the one whose
+    ankle goals (hold + ``offsets``, ``(m, 3)``) need the least lowering of the root, then the one nearest
+    the mean (``DISTANCE_WEIGHT`` × the distance to the mean weighs like the same lowering)."""
+    floor = (path @ up).min()
+    mean = path.mean(axis=0)
+    cands = np.vstack([mean, path])                                   # (n, 3)
+    cands = cands + np.outer(floor - cands @ up, up)                  # planted at the contact's lowest point
+    mean = cands[0]
+    need = _need(cands[:, None, :] + offsets[None], hips[None], R[None], up).max(axis=1)
+    cost = need + DISTANCE_WEIGHT * np.linalg.norm(cands - mean, axis=1)
+    k = int(np.argmin(cost))
+    return cands[0] if need[0] <= need[k] + 1e-6 * body else cands[k]
+
+
+def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: float):
+    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and the frames with any correction ``(T,)``."""
+    foot = contacts.feet[f]
+    up, body = contacts.up, contacts.body
+    cols = {contacts.joints[c]: c for c, g in enumerate(contacts.foot_of) if g == f}
+    a, hips, R = W[:, foot.ankle], W[:, foot.hip], _reach(W, foot, reach)
+    ma = contacts.mask[:, cols[foot.ankle]]
+    ra = ranges(ma)
+    mt = contacts.mask[:, cols[foot.toe]] if foot.toe is not None else np.zeros_like(ma)
+    rt = ranges(mt)
+    t = W[:, foot.toe] if foot.toe is not None else a
+    # each ankle contact with the toe contacts it overlaps most: one rigid-foot hold
+    partner = {}
+    for i, (s, e) in enumerate(rt):
+        overlaps = [min(e, y) - max(s, x) for x, y in ra]
+        k = int(np.argmax(overlaps)) if overlaps else -1
+        if k >= 0 and overlaps[k] > 0:
+            partner[i] = (k, (max(s, ra[k][0]) + min(e, ra[k][1]) - 1) // 2)
+    held_a = []
+    for k, (s, e) in enumerate(ra):
+        frames = [np.arange(s, e)]
+        offsets = [np.zeros((e - s, 3))]
+        for i, (k2, mid) in partner.items():
+            if k2 == k:  # toe-only frames of the partner contact: the ankle follows the held toe
+                only = np.array([x for x in range(*rt[i]) if not ma[x]], dtype=int)
+                frames.append(only)
+                offsets.append((t[mid] - a[mid]) - (t[only] - a[only]))
+        fr, off = np.concatenate(frames), np.concatenate(offsets)
+        held_a.append(_best_hold(a[s:e], off, hips[fr], R[fr], up, body)
+                      if fr.size else a[s:e].mean(axis=0))
+    w_a, hold_a = _holds(ma, held_a, n_blend)
+    if foot.toe is None:
+        return a + w_a[:, None] * (hold_a - a), None, w_a > 0
+    held_t = []
+    for i, (s, e) in enumerate(rt):
+        if i in partner:  # a rigid foot can meet both holds: toe = held ankle + foot vector
+            k, mid = partner[i]
+            held_t.append(held_a[k] + (t[mid] - a[mid]))
+        else:
+            fr = np.arange(s, e)
+            held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
+    w_t, hold_t = _holds(mt, held_t, n_blend)
+    wa, wt = w_a[:, None], w_t[:, None]
+    goal_a = a + wa * (hold_a - a) + (1.0 - wa) * wt * (hold_t - t)
+    goal_t = (1.0 - wt) * (goal_a + t - a) + wt * hold_t
+    # while the toe is held harder than the ankle, put the ankle on the sphere of foot length around the toe
+    length = np.linalg.norm(t - a, axis=1, keepdims=True)
+    on_sphere = goal_t - length * _normalize(goal_t - goal_a)
+    den = 1.0 - wa * wt
+    lam = np.where(den > 1e-12, wt * (1.0 - wa) / np.maximum(den, 1e-12), 0.0)
+    goal_a = goal_a + lam * (on_sphere - goal_a)
+    return goal_a, goal_t, (w_a > 0) | (w_t > 0)
+
+
+def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], reach: float, n_blend: int) -> np.ndarray:
+    """How far ``(T,)`` the root must go down so every ankle goal is within reach, smoothed so it is never less."""
+    need = np.zeros(W.shape[0])
+    for foot, g in zip(contacts.feet, goals, strict=True):
+        need = np.maximum(need, _need(g, W[:, foot.hip], _reach(W, foot, reach), contacts.up))
+    if not need.any():
+        return need
+    width = 2 * max(1, n_blend) + 1
+    return uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
+
+
+def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+    """Unit normals ``(T, 3)`` of the hip-knee-ankle plane; a straight leg takes the mean normal in its
+    thigh's frame over the frames where the knee is bent."""
+    n = np.cross(u1, u2)
+    s = np.linalg.norm(n, axis=1)
+    ok = s > 1e-4
+    n = np.where(ok[:, None], n / np.maximum(s, 1e-300)[:, None], 0.0)
+    if not ok.all():
+        if ok.any():
+            local = np.einsum("tji,tj->ti", Rw_hip[ok], n[ok]).mean(axis=0)
+        else:  # never bent: any axis across the leg
+            local = np.cross(np.einsum("tji,tj->ti", Rw_hip, u1).mean(axis=0), [0.0, 0.0, 1.0])
+            if np.linalg.norm(local) < 1e-9:
+                local = np.array([1.0, 0.0, 0.0])
+        local = local / np.linalg.norm(local)
+        n[~ok] = np.einsum("tij,j->ti", Rw_hip[~ok], local)
+    return n
+
+
+def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH) -> Motion:
+    """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
+
+    ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
+    beyond which the root is lowered.  Returns a new Motion with the same skeleton and frame time.
+    """
+    if contacts.n_frames != motion.n_frames:
+        raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
+    n_blend = max(1, int(round(blend / motion.frame_time)))
+    skel = motion.skeleton
+    Rw, W = motion.world_transforms()
+    goals, toe_goals, active = [], [], []
+    for f in range(len(contacts.feet)):
+        g, gt, act = _foot_goals(W, contacts, f, n_blend, reach)
+        goals.append(g)
+        toe_goals.append(gt)
+        active.append(act)
+    trans = motion.translations.copy()
+    delta = _lowering(W, contacts, goals, reach, n_blend)
+    lowered = delta > 0
+    if lowered.any():
+        travel = motion.travel_joint
+        parent = int(skel.parents[travel])
+        step = np.outer(delta, contacts.up)
+        if parent >= 0:
+            step = np.einsum("tji,tj->ti", Rw[:, parent], step)
+        trans[:, travel] -= step
+        motion = motion.replace(translations=trans)
+        Rw, W = motion.world_transforms()
+    local = motion.rotation_matrices().copy()
+    for foot, g, gt, act in zip(contacts.feet, goals, toe_goals, active, strict=True):
+        t = np.flatnonzero(act | lowered)
+        if t.size == 0:
+            continue
+        H, K, A, G = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle], g[t]
+        l1 = np.linalg.norm(K - H, axis=1)
+        l2 = np.linalg.norm(A - K, axis=1)
+        u1, u2 = (K - H) / l1[:, None], (A - K) / l2[:, None]
+        n = _bend_normals(Rw[t, foot.hip], u1, u2)
+        beta0 = np.arctan2(np.sum(np.cross(u1, u2) * n, axis=1), np.sum(u1 * u2, axis=1))
+        d = np.clip(np.linalg.norm(G - H, axis=1), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
+        beta1 = np.pi - np.arccos(np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0))
+        R1 = Rotation.from_rotvec(n * (beta1 - beta0)[:, None]).as_matrix()     # knee bend, world frame
+        A1 = K + np.einsum("tij,tj->ti", R1, A - K)
+        R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
+        hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
+        Rp_hip = Rw[t, hp] if hp >= 0 else np.broadcast_to(np.eye(3), (t.size, 3, 3))
+        local[t, foot.hip] = np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rw[t, foot.hip]
+        local[t, foot.knee] = np.swapaxes(Rw[t, kp], 1, 2) @ R1 @ Rw[t, foot.knee]
+        aim = np.broadcast_to(np.eye(3), (t.size, 3, 3))
+        if gt is not None:
+            aim = _swing(W[t, foot.toe] - A, gt[t] - G)
+        new_parent = R2 @ R1 @ Rw[t, ap]
+        local[t, foot.ankle] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
+    T, J = motion.n_frames, motion.n_joints
+    quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, J, 4)
+    # frames and joints not touched keep their exact quaternions
+    touched = np.zeros((T, J), bool)
+    for foot, act in zip(contacts.feet, active, strict=True):
+        touched[np.ix_(act | lowered, [foot.hip, foot.knee, foot.ankle])] = True
+    quats = np.where(touched[..., None], quats, motion.rotations)
+    sign = np.where(np.sum(quats * motion.rotations, axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    return motion.replace(rotations=quats * sign)
