@@ -27,7 +27,10 @@ METRIC_LABELS = {
     "seam_velocity_local": ("seam jump, velocity (local)", "× nearby changes"),
     "foot_sliding": ("foot sliding, cycle", "units/s"),
     "input_foot_sliding": ("foot sliding, input", "units/s"),
+    "skate": ("foot skate, cycle", "units/s"),
+    "input_skate": ("foot skate, input", "units/s"),
 }
+FEET_MODES = ("auto", "lock", "keep")
 
 
 @app.command()
@@ -59,6 +62,13 @@ def loop(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: PCA of input and cycle, phase, joint curves.")]
     = None,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    feet: Annotated[str, typer.Option(
+        help="lock (feet held still on the floor during each contact; in place they slide back at the "
+             "treadmill speed), keep (as fitted) or auto (lock with --root motion when feet are found, else "
+             "keep).")] = "auto",
+    foot_joints: Annotated[str | None, typer.Option(
+        help="Name the feet when the name patterns fail: ANKLE[:TOE],ANKLE[:TOE] (e.g. lfoot:ltoes,rfoot:rtoes).")]
+    = None,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
 
@@ -70,6 +80,8 @@ def loop(
     check_suffix(plot, ".png", "--plot")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
+    if feet not in FEET_MODES:
+        raise MocycleError(f"--feet must be one of {', '.join(FEET_MODES)}; got {feet!r}")
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     start, stop = parse_range(frame_range, motion.n_frames)
@@ -78,12 +90,15 @@ def loop(
         motion, method=method, model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}),
         time_axis_method=time_axis, joints=joints, classes=count_option(classes, "--classes", {"auto": "auto"}),
         which=which, phase_step=step)
+    cycle, feet_facts = _clean_feet(cycle, feet, root, foot_joints)
     result = cycle.repeat(cycles, root=root)
     write(result, output)
     seconds = time.perf_counter() - t0
     t1 = time.perf_counter()
     metrics = loop_metrics(motion, cycle)
     metrics_seconds = time.perf_counter() - t1
+    if feet_facts["skate_before"] is not None:
+        feet_facts["skate_after"] = metrics["skate"]
     if plot is not None:
         from ..viz import plot_loop
 
@@ -99,6 +114,7 @@ def loop(
         "root": root,
         "cycles": cycles,
         "metrics": metrics,
+        "feet": feet_facts,
         "seconds": seconds,
         "metrics_seconds": metrics_seconds,
     }
@@ -106,6 +122,36 @@ def loop(
         print(json.dumps(facts, indent=2))
         return
     _print_loop(facts, len(cycle.periodic.excitation), which)
+
+
+def _clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
+    """The cycle with its feet locked (or not), and what the JSON says about it."""
+    import warnings
+
+    from ..contacts import find_feet, largest_leg_step, lock_cycle, skate
+    from ..errors import MocycleWarning
+
+    if mode == "auto":
+        try:
+            find_feet(cycle.space.template.skeleton, foot_joints)
+            mode = "lock" if root == "motion" else "keep"
+        except MocycleError as exc:
+            if root == "motion":
+                warnings.warn(f"feet not locked: {exc}", MocycleWarning, stacklevel=2)
+            mode = "keep"
+    facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
+             "largest_leg_step_before": None, "largest_leg_step_after": None, "seconds": 0.0}
+    if mode == "keep":
+        return cycle, facts
+    t0 = time.perf_counter()
+    cleaned, contacts = lock_cycle(cycle, foot_joints)
+    facts["seconds"] = time.perf_counter() - t0
+    before, after = cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
+    names = cycle.space.template.skeleton.names
+    facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=skate(before, contacts.feet),
+                 largest_leg_step_before=largest_leg_step(before, contacts.feet),
+                 largest_leg_step_after=largest_leg_step(after, contacts.feet))
+    return cleaned, facts
 
 
 def _print_loop(facts: dict, n_regions: int, which: int | None) -> None:
@@ -123,5 +169,11 @@ def _print_loop(facts: dict, n_regions: int, which: int | None) -> None:
     for key, (label, unit) in METRIC_LABELS.items():
         table.add_row(label, f"{facts['metrics'][key]:.4g}", unit)
     out.print(table)
+    f = facts["feet"]
+    if f["mode"] == "lock":
+        spans = "; ".join(f"{side} {' '.join(f'{a}-{b}' for a, b in v['contacts'])}" for side, v in
+                          f["contacts"].items())
+        out.print(f"  feet locked (contacts, cycle frames: {spans}); skate {f['skate_before']:.4g} -> "
+                  f"{f['skate_after']:.4g} units/s in {f['seconds']:.2f} s")
     out.print(f"wrote {facts['output']}: {facts['frames_out']} frames ({facts['cycles']} cycle(s), root "
               f"{facts['root']}) in {facts['seconds']:.2f} s")

@@ -14,7 +14,9 @@ correction grows and fades without a pop.  Per foot:
   holds can be met exactly by a rigid foot;
 * the **root is lowered** (along the vertical, smoothed over the blend window
   so it never jumps) on frames where an ankle goal is farther from its hip
-  than ``reach`` of the leg's length;
+  than ``reach`` of the leg's length; a leg without a contact there rides
+  down with it unchanged (bending a straight swing leg to keep its foot up
+  would make the knee pop);
 * the leg is solved by **analytic two-bone IK**: the knee bends about the
   normal of the hip-knee-ankle plane until the hip-ankle distance is right,
   then the thigh swings by the smallest rotation that puts the ankle on its
@@ -36,8 +38,8 @@ from scipy.spatial.transform import Rotation
 from ..motion import Motion
 from .detect import Contacts, ranges
 
-BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
-REACH = 0.995        # of hip-knee plus knee-ankle: farther goals lower the root
+BLEND_SECONDS = 0.2  # cross-fade in and out of each contact
+REACH = 1.0        # of hip-knee plus knee-ankle: farther goals lower the root
 DISTANCE_WEIGHT = 3.0  # a hold this much farther from the mean weighs like the same lowering of the root
 
 
@@ -234,7 +236,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         Rw, W = motion.world_transforms()
     local = motion.rotation_matrices().copy()
     for foot, g, gt, act in zip(contacts.feet, goals, toe_goals, active, strict=True):
-        t = np.flatnonzero(act | lowered)
+        t = np.flatnonzero(act)  # a free leg rides down with the root (bending it from straight would pop)
         if t.size == 0:
             continue
         H, K, A, G = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle], g[t]
@@ -262,7 +264,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     # frames and joints not touched keep their exact quaternions
     touched = np.zeros((T, J), bool)
     for foot, act in zip(contacts.feet, active, strict=True):
-        touched[np.ix_(act | lowered, [foot.hip, foot.knee, foot.ankle])] = True
+        touched[np.ix_(act, [foot.hip, foot.knee, foot.ankle])] = True
     quats = np.where(touched[..., None], quats, motion.rotations)
     sign = np.where(np.sum(quats * motion.rotations, axis=-1, keepdims=True) < 0, -1.0, 1.0)
     return motion.replace(rotations=quats * sign)

@@ -24,6 +24,11 @@ vector of each joint relative to the input's mean rotation of that joint
 * ``foot_sliding`` and ``input_foot_sliding`` — mean horizontal speed (file
   units/s) of each foot while it is within 2 % of the body height of its
   floor, for the cycle repeated twice with its root motion and for the input.
+* ``skate`` and ``input_skate`` — the foot-skate measure of
+  :func:`mocycle.contacts.skate` (units/s: horizontal speed of each ankle and
+  toe weighted by ``2 - 2**(h/H)`` below ``H`` = 2.5 % of the body height,
+  averaged over frames) for the same two motions; ``nan`` when the rig's feet
+  are not found by name.
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from ..errors import MocycleError
 from ..motion import Motion
 from ..rotations import mean_rotations
 from .differences import HALF, central_acceleration, central_velocity, forward_jerk
@@ -144,6 +150,15 @@ def foot_sliding(motion: Motion) -> float:
     return float(speeds.mean()) if speeds.size else float("nan")
 
 
+def _skate(motion: Motion) -> float:
+    from ..contacts.skate import skate
+
+    try:
+        return skate(motion)
+    except MocycleError:  # no feet found by name
+        return float("nan")
+
+
 def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
     """Every metric of the module docstring for ``cycle`` extracted from ``motion``."""
     ref = mean_rotations(motion.rotations)
@@ -157,6 +172,7 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
     tmpl, offset = template_error(Y[s:e], C)
     seams = [seam_ratios(C), seam_ratios(root)]
     travelling = cycle.repeat(2, root="motion")
+    captured = motion[frames[0]:frames[-1] + 1]
     return {
         "rmse_h": rmse_h,
         "rmse_dh": rmse_dh,
@@ -169,5 +185,7 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
         "seam_pose_local": max(r["pose_local"] for r in seams),
         "seam_velocity_local": max(r["velocity_local"] for r in seams),
         "foot_sliding": foot_sliding(travelling),
-        "input_foot_sliding": foot_sliding(motion[frames[0]:frames[-1] + 1]),
+        "input_foot_sliding": foot_sliding(captured),
+        "skate": _skate(travelling),
+        "input_skate": _skate(captured),
     }
