@@ -38,7 +38,7 @@ from scipy.spatial.transform import Rotation
 from ..motion import Motion
 from .detect import Contacts, ranges
 
-BLEND_SECONDS = 0.2  # cross-fade in and out of each contact
+BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
 REACH = 1.0        # of hip-knee plus knee-ankle: farther goals lower the root
 DISTANCE_WEIGHT = 3.0  # a hold this much farther from the mean weighs like the same lowering of the root
 
