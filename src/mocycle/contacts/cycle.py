@@ -32,9 +32,9 @@ def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend:
     """The cycle with its feet locked, and its contacts over its ``N`` frames (a contact running over the
     last frame continues at frame 0)."""
     N = cycle.n_frames
-    ext = cycle.repeat(3, root="motion")
+    ext = cycle.repeat(4, root="motion")
     contacts = detect_contacts(ext, feet, **detect_options)
-    locked = lock_feet(ext, contacts, blend=blend, reach=reach)[N:2 * N]
+    locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N)[N:2 * N]
     P, L = cycle.space.encode(locked)
     turn, move = cycle.drift[3], cycle.drift[:3]
     R = axis_rotations(cycle.space.up, np.array([turn]))[0]

@@ -40,6 +40,8 @@ from .detect import Contacts, ranges
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
 REACH = 1.0        # of hip-knee plus knee-ankle: farther goals lower the root
+HORIZONTAL = True
+STRAIGHT, BENT = 0.99, 0.95  # hip-ankle over leg length: a free leg rides down above STRAIGHT, keeps its foot below BENT
 DISTANCE_WEIGHT = 3.0  # a hold this much farther from the mean weighs like the same lowering of the root
 
 
@@ -122,7 +124,7 @@ def _best_hold(path: np.ndarray, offsets: np.ndarray, hips: np.ndarray, R: np.nd
 
 
 def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: float):
-    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and the frames with any correction ``(T,)``."""
+    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and the foot's hold weight ``(T,)`` (0: free)."""
     foot = contacts.feet[f]
     up, body = contacts.up, contacts.body
     cols = {contacts.joints[c]: c for c, g in enumerate(contacts.foot_of) if g == f}
@@ -152,8 +154,10 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
         held_a.append(_best_hold(a[s:e], off, hips[fr], R[fr], up, body)
                       if fr.size else a[s:e].mean(axis=0))
     w_a, hold_a = _holds(ma, held_a, n_blend)
+    if HORIZONTAL:
+        hold_a = hold_a + np.outer((a - hold_a) @ up, up)
     if foot.toe is None:
-        return a + w_a[:, None] * (hold_a - a), None, w_a > 0
+        return a + w_a[:, None] * (hold_a - a), None, w_a
     held_t = []
     for i, (s, e) in enumerate(rt):
         if i in partner:  # a rigid foot can meet both holds: toe = held ankle + foot vector
@@ -163,6 +167,8 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
             fr = np.arange(s, e)
             held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
     w_t, hold_t = _holds(mt, held_t, n_blend)
+    if HORIZONTAL:
+        hold_t = hold_t + np.outer((t - hold_t) @ up, up)
     wa, wt = w_a[:, None], w_t[:, None]
     goal_a = a + wa * (hold_a - a) + (1.0 - wa) * wt * (hold_t - t)
     goal_t = (1.0 - wt) * (goal_a + t - a) + wt * hold_t
@@ -172,7 +178,30 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
     den = 1.0 - wa * wt
     lam = np.where(den > 1e-12, wt * (1.0 - wa) / np.maximum(den, 1e-12), 0.0)
     goal_a = goal_a + lam * (on_sphere - goal_a)
-    return goal_a, goal_t, (w_a > 0) | (w_t > 0)
+    # a held toe with the ankle out of the leg's reach: the heel lifts (the foot turns about the toe) until
+    # the ankle is back within reach, rather than the root going down
+    lifted = _within_reach(goal_a, goal_t, length[:, 0], hips, R)
+    goal_a = goal_a + lam * (lifted - goal_a)
+    return goal_a, goal_t, np.maximum(w_a, w_t)
+
+
+def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray, r2: np.ndarray) -> np.ndarray:
+    """``p`` on the sphere ``(c1, r1)`` moved along it to the nearest point within ``r2`` of ``c2`` (where
+    it is out of reach and the spheres meet; unchanged elsewhere).  All ``(T, 3)`` / ``(T,)``."""
+    out = p.copy()
+    far = np.linalg.norm(p - c2, axis=1) > r2
+    axis = c2 - c1
+    d = np.linalg.norm(axis, axis=1)
+    a = (d ** 2 + r1 ** 2 - r2 ** 2) / (2 * np.maximum(d, 1e-300))
+    meet = far & (d > 1e-12) & (np.abs(a) <= r1)
+    if meet.any():
+        n = axis[meet] / d[meet, None]
+        centre = c1[meet] + a[meet, None] * n
+        radius = np.sqrt(np.maximum(r1[meet] ** 2 - a[meet] ** 2, 0.0))
+        q = p[meet] - centre
+        q = q - np.sum(q * n, axis=1, keepdims=True) * n
+        out[meet] = centre + radius[:, None] * _normalize(q)
+    return out
 
 
 def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], reach: float, n_blend: int) -> np.ndarray:
@@ -205,38 +234,83 @@ def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndar
     return n
 
 
-def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH) -> Motion:
+def _weights(contacts: Contacts, n_blend: int) -> np.ndarray:
+    """Hold weights ``(T, C)`` of every contact joint: 1 in contact, smoothstep ramps around."""
+    T, C = contacts.mask.shape
+    w = np.zeros((T, C))
+    for c in range(C):
+        n = len(ranges(contacts.mask[:, c]))
+        w[:, c] = _holds(contacts.mask[:, c], [np.zeros(3)] * n, n_blend)[0]
+    return w
+
+
+def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | None) -> np.ndarray:
+    """Horizontal world displacement ``(T, 3)`` of the root that cancels the hold-weighted mean horizontal
+    velocity of the planted contact joints (the hips follow the planted foot, as in a real stance), less
+    its mean over a period (or the take) so the travel is kept."""
+    T = W.shape[0]
+    if T < 2:
+        return np.zeros((T, 3))
+    up = contacts.up
+    w = _weights(contacts, n_blend)
+    v = np.diff(W[:, list(contacts.joints)], axis=0)                  # (T-1, C, 3)
+    v = v - (v @ up)[..., None] * up
+    ws = 0.5 * (w[1:] + w[:-1])
+    u = -np.einsum("tc,tci->ti", ws, v) / np.maximum(ws.sum(axis=1), 1.0)[:, None]
+    u -= u[period:2 * period].mean(axis=0) if period and T >= 3 * period else u.mean(axis=0)
+    shift = np.vstack([np.zeros(3), np.cumsum(u, axis=0)])
+    return shift - shift.mean(axis=0)
+
+
+def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
+    """``motion`` with its travel joint moved by ``world`` ``(T, 3)`` (world frame)."""
+    travel = motion.travel_joint
+    parent = int(motion.skeleton.parents[travel])
+    step = np.einsum("tji,tj->ti", Rw[:, parent], world) if parent >= 0 else world
+    trans = motion.translations.copy()
+    trans[:, travel] += step
+    return motion.replace(translations=trans)
+
+
+def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
+              follow: bool = True, period: int | None = None) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
 
     ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
-    beyond which the root is lowered.  Returns a new Motion with the same skeleton and frame time.
+    beyond which the root is lowered; ``follow``: first move the root horizontally with the planted feet;
+    ``period``: the motion is a loop repeated every ``period`` frames (at least three times), so the root
+    correction keeps the travel of each period.  Returns a new Motion with the same skeleton and frame time.
     """
     if contacts.n_frames != motion.n_frames:
         raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
     n_blend = max(1, int(round(blend / motion.frame_time)))
     skel = motion.skeleton
     Rw, W = motion.world_transforms()
+    if follow:
+        shift = _root_shift(W, contacts, n_blend, period)
+        if np.abs(shift).max() > 0:
+            motion = _move_travel(motion, Rw, shift)
+            Rw, W = motion.world_transforms()
     goals, toe_goals, active = [], [], []
     for f in range(len(contacts.feet)):
         g, gt, act = _foot_goals(W, contacts, f, n_blend, reach)
         goals.append(g)
         toe_goals.append(gt)
         active.append(act)
-    trans = motion.translations.copy()
     delta = _lowering(W, contacts, goals, reach, n_blend)
     lowered = delta > 0
     if lowered.any():
-        travel = motion.travel_joint
-        parent = int(skel.parents[travel])
-        step = np.outer(delta, contacts.up)
-        if parent >= 0:
-            step = np.einsum("tji,tj->ti", Rw[:, parent], step)
-        trans[:, travel] -= step
-        motion = motion.replace(translations=trans)
+        # a free leg that is bent keeps its foot where it was; a straight one rides down with the root
+        for f, foot in enumerate(contacts.feet):
+            H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
+            stretch = np.linalg.norm(A - H, axis=1) / (np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1))
+            keep = _smoothstep((STRAIGHT - stretch) / (STRAIGHT - BENT))
+            goals[f] = goals[f] - ((1.0 - active[f]) * (1.0 - keep) * delta)[:, None] * contacts.up
+        motion = _move_travel(motion, Rw, -np.outer(delta, contacts.up))
         Rw, W = motion.world_transforms()
     local = motion.rotation_matrices().copy()
     for foot, g, gt, act in zip(contacts.feet, goals, toe_goals, active, strict=True):
-        t = np.flatnonzero(act)  # a free leg rides down with the root (bending it from straight would pop)
+        t = np.flatnonzero((act > 0) | lowered)
         if t.size == 0:
             continue
         H, K, A, G = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle], g[t]
@@ -264,7 +338,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     # frames and joints not touched keep their exact quaternions
     touched = np.zeros((T, J), bool)
     for foot, act in zip(contacts.feet, active, strict=True):
-        touched[np.ix_(act, [foot.hip, foot.knee, foot.ankle])] = True
+        touched[np.ix_((act > 0) | lowered, [foot.hip, foot.knee, foot.ankle])] = True
     quats = np.where(touched[..., None], quats, motion.rotations)
     sign = np.where(np.sum(quats * motion.rotations, axis=-1, keepdims=True) < 0, -1.0, 1.0)
     return motion.replace(rotations=quats * sign)

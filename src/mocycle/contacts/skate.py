@@ -17,7 +17,7 @@ import numpy as np
 from ..motion import Motion
 from .feet import Foot, body_height, find_feet, up_axis
 
-SKATE_HEIGHT = 0.025  # H, of the body height
+SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual absolute H
 
 
 def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = SKATE_HEIGHT,
