@@ -73,9 +73,12 @@ def test_locking_holds_the_feet_still_and_leaves_the_rest_alone():
         leg = [foot.hip, foot.knee, foot.ankle]
         assert np.array_equal(out.rotations[free][:, leg], m.rotations[free][:, leg])
         checked += free.sum()
-    # the root only ever goes down, along the vertical
+    # only the root's translation changes; vertically it only ever goes down; without the horizontal
+    # follow step the root keeps its path horizontally
     moved = out.translations - m.translations
-    assert np.abs(moved[..., [0, 2]]).max() < 1e-12 and (moved[..., 1] <= 1e-12).all()
+    assert np.abs(moved[:, 1:]).max() == 0.0 and (moved[:, 0, 1] <= 1e-12).all()
+    fixed = lock_feet(m, con, follow=False).translations - m.translations
+    assert np.abs(fixed[..., [0, 2]]).max() < 1e-12
     # the non-leg joints keep their local rotations everywhere
     legs = {j for f in con.feet for j in (f.hip, f.knee, f.ankle)}
     others = [j for j in range(m.n_joints) if j not in legs]

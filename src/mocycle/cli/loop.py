@@ -7,6 +7,7 @@ import time
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 from rich.table import Table
 
@@ -66,6 +67,9 @@ def loop(
         help="lock (feet held still on the floor during each contact; in place they slide back at the "
              "treadmill speed), keep (as fitted) or auto (lock with --root motion when feet are found, else "
              "keep).")] = "auto",
+    feet_plot: Annotated[Path | None, typer.Option(
+        help="Write a PNG of the contacts: each ankle and toe's height and speed over two cycles, before (dashed) "
+             "and after locking.")] = None,
     foot_joints: Annotated[str | None, typer.Option(
         help="Name the feet when the name patterns fail: ANKLE[:TOE],ANKLE[:TOE] (e.g. lfoot:ltoes,rfoot:rtoes).")]
     = None,
@@ -78,6 +82,7 @@ def loop(
 
     check_suffix(output, ".bvh", "--output")
     check_suffix(plot, ".png", "--plot")
+    check_suffix(feet_plot, ".png", "--feet-plot")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     if feet not in FEET_MODES:
@@ -90,7 +95,8 @@ def loop(
         motion, method=method, model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}),
         time_axis_method=time_axis, joints=joints, classes=count_option(classes, "--classes", {"auto": "auto"}),
         which=which, phase_step=step)
-    cycle, feet_facts = _clean_feet(cycle, feet, root, foot_joints)
+    fitted = cycle
+    cycle, feet_facts, contacts = _clean_feet(cycle, feet, root, foot_joints)
     result = cycle.repeat(cycles, root=root)
     write(result, output)
     seconds = time.perf_counter() - t0
@@ -99,6 +105,16 @@ def loop(
     metrics_seconds = time.perf_counter() - t1
     if feet_facts["skate_before"] is not None:
         feet_facts["skate_after"] = metrics["skate"]
+    if feet_plot is not None:
+        if contacts is None:
+            raise MocycleError("--feet-plot needs locked feet (--feet lock, or auto with --root motion)")
+        from ..contacts import Contacts
+        from ..viz import plot_contacts
+
+        twice = Contacts(contacts.feet, contacts.joints, contacts.foot_of, np.tile(contacts.mask, (2, 1)),
+                         contacts.up, contacts.body, contacts.frame_time)
+        plot_contacts(cycle.repeat(2, root="motion"), twice, feet_plot, title=f"{path.name}: feet locked",
+                      before=fitted.repeat(2, root="motion"))
     if plot is not None:
         from ..viz import plot_loop
 
@@ -142,7 +158,7 @@ def _clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
     facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
              "largest_leg_step_before": None, "largest_leg_step_after": None, "seconds": 0.0}
     if mode == "keep":
-        return cycle, facts
+        return cycle, facts, None
     t0 = time.perf_counter()
     cleaned, contacts = lock_cycle(cycle, foot_joints)
     facts["seconds"] = time.perf_counter() - t0
@@ -151,7 +167,7 @@ def _clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
     facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=skate(before, contacts.feet),
                  largest_leg_step_before=largest_leg_step(before, contacts.feet),
                  largest_leg_step_after=largest_leg_step(after, contacts.feet))
-    return cleaned, facts
+    return cleaned, facts, contacts
 
 
 def _print_loop(facts: dict, n_regions: int, which: int | None) -> None:

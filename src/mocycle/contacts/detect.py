@@ -1,8 +1,9 @@
 """Foot contacts: when each contact joint (ankle, toe) is planted.
 
 A contact joint is planted while it is **near its floor and slow**: its height
-above its lowest level is under ``height`` and its speed (horizontal and
-vertical: a heel that starts to rise is no longer planted) under ``speed``.
+above its lowest level is under ``height``, its horizontal speed under
+``speed`` and its vertical speed under ``rise`` (a heel that starts to lift or
+is still coming down is not planted).
 Both are fractions of the body height (and body heights per second), so the
 same numbers work for centimetres, metres or inches, and the
 speed is measured on positions smoothed over a fixed time (not a fixed number
@@ -30,7 +31,8 @@ from ..motion import Motion
 from .feet import Foot, body_height, find_feet, up_axis
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
-CONTACT_SPEED = 0.15     # body heights per second
+CONTACT_SPEED = 0.15    # body heights per second, horizontal
+CONTACT_RISE = 0.05     # body heights per second, vertical: a heel that lifts faster is not planted
 RELEASE = 1.5           # a contact ends above RELEASE × the thresholds
 SMOOTH_SECONDS = 1 / 60  # std of the Gaussian the positions are smoothed with before differencing
 MIN_CONTACT = 0.06      # seconds
@@ -131,9 +133,9 @@ def _durations(mask: np.ndarray, min_contact: int, min_gap: int) -> np.ndarray:
 
 
 def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, smooth: float = SMOOTH_SECONDS,
-                       positions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Height above the lowest level ``(T, C)`` and speed ``(T, C)`` (units/s, vertical included: a heel
-    that rises is no longer planted) of ``joints``.
+                       positions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Height above the lowest level ``(T, C)``, horizontal speed ``(T, C)`` and vertical speed ``(T, C)``
+    (units/s) of ``joints``.
 
     Speeds are central differences of positions smoothed by a Gaussian of ``smooth`` seconds.
     """
@@ -144,20 +146,23 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
     sigma = smooth / motion.frame_time
     Ps = gaussian_filter1d(P, sigma, axis=0, mode="nearest") if sigma >= 0.3 else P
     if motion.n_frames < 2:
-        return h, np.zeros_like(h)
+        return h, np.zeros_like(h), np.zeros_like(h)
     v = np.gradient(Ps, motion.frame_time, axis=0)
-    return h, np.linalg.norm(v, axis=-1)
+    vu = v @ up
+    return h, np.linalg.norm(v - vu[..., None] * up, axis=-1), np.abs(vu)
 
 
 def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = CONTACT_HEIGHT,
-                    speed: float = CONTACT_SPEED, release: float = RELEASE, min_contact: float = MIN_CONTACT,
+                    speed: float = CONTACT_SPEED, rise: float = CONTACT_RISE, release: float = RELEASE,
+                    min_contact: float = MIN_CONTACT,
                     min_gap: float = MIN_GAP, up: np.ndarray | None = None) -> Contacts:
     """Contacts of every contact joint of ``feet`` (default: :func:`find_feet`; a string names them).
 
     ``height``: fraction of the body height above the joint's lowest level; ``speed``: body heights per
-    second; ``release``: hysteresis factor (> 1); ``min_contact``, ``min_gap``: seconds.
+    second (horizontal), ``rise``: body heights per second (vertical); ``release``: hysteresis factor (> 1);
+    ``min_contact``, ``min_gap``: seconds.
     """
-    if not (height > 0 and speed > 0 and release >= 1 and min_contact >= 0 and min_gap >= 0):
+    if not (height > 0 and speed > 0 and rise > 0 and release >= 1 and min_contact >= 0 and min_gap >= 0):
         raise MocycleError(f"contact thresholds must be positive (height {height}, speed {speed}, release "
                            f"{release} >= 1, durations {min_contact}, {min_gap} >= 0)")
     if feet is None or isinstance(feet, str):
@@ -167,14 +172,14 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
     body = body_height(motion, up)
     joints = tuple(j for f in feet for j in f.contact_joints)
     foot_of = tuple(i for i, f in enumerate(feet) for _ in f.contact_joints)
-    h, v = heights_and_speeds(motion, joints, up)
-    h, v = h / body, v / body
+    h, v, vu = heights_and_speeds(motion, joints, up)
+    h, v, vu = h / body, v / body, vu / body
     fps = motion.fps
     n_contact = max(1, int(round(min_contact * fps)))
     n_gap = max(1, int(round(min_gap * fps)))
     mask = np.zeros(h.shape, bool)
     for c in range(len(joints)):
-        on = (h[:, c] < height) & (v[:, c] < speed)
-        keep = (h[:, c] < release * height) & (v[:, c] < release * speed)
+        on = (h[:, c] < height) & (v[:, c] < speed) & (vu[:, c] < rise)
+        keep = (h[:, c] < release * height) & (v[:, c] < release * speed) & (vu[:, c] < release * rise)
         mask[:, c] = _durations(_hysteresis(on, keep), n_contact, n_gap)
     return Contacts(feet, joints, foot_of, mask, up, body, motion.frame_time)

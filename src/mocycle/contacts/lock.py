@@ -1,32 +1,37 @@
 """Foot locking (Kovar, Schreiner and Gleicher 2002, "Footskate cleanup for motion capture editing").
 
-During each contact of a contact joint its position is held at one point in
-world space (at the joint's lowest height during the contact, horizontally at
-its mean position, or nearer the hip where the leg would otherwise be too short); just before and
-after, over ``blend`` seconds (at most half the gap to the next contact), the
-held point is cross-faded with the joint's own path by a smoothstep, so the
-correction grows and fades without a pop.  Per foot:
+1. **Hips follow the planted feet.** The root is first moved horizontally by
+   the opposite of the hold-weighted mean horizontal velocity of the planted
+   contact joints (less its mean over the take, or over one period of a
+   repeated loop, so the travel is kept): in single support the stance foot
+   then stands still with no change to the legs at all.
+2. **Holds.** Each contact of a contact joint is held at one point in world
+   space: at the joint's lowest height during the contact (so its lowest
+   level does not change) and horizontally at its mean position, or at one of
+   its positions during the contact when that needs less lowering of the root.
+   The toe of a foot whose ankle and toe are both held is held at the ankle's
+   point plus the foot vector in the middle of their overlap, so a rigid foot
+   meets both holds exactly.  Over ``blend`` seconds before and after each
+   contact (at most half the gap to the next) the hold is cross-faded with
+   the joint's own path by a smoothstep, so corrections grow and fade.
+3. **Ankle goals.** The held ankle; while only the toe is held, the ankle
+   moved with the toe (the foot keeps its orientation and pivots on the
+   ball), and where that is beyond the leg's reach the heel lifts (the foot
+   turns about the held toe) until it is within reach.
+4. **Root lowering.** Where an ankle goal is still farther from its hip than
+   ``reach`` of the leg's length, the root goes down along the vertical
+   (smoothed over the blend window so it never jumps and is never less than
+   needed); a free leg that is bent keeps its foot where it was, a straight
+   one rides down with the root (bending a straight leg by a few millimetres
+   takes a large knee angle: a pop).
+5. **Two-bone IK.** The knee bends about the normal of the hip-knee-ankle
+   plane until the hip-ankle distance is right, then the thigh swings by the
+   smallest rotation that puts the ankle on its goal (the knee stays in the
+   leg's plane, only turned with it); the foot keeps its world orientation,
+   turned by the smallest rotation that points it at the toe goal.
 
-* the **ankle goal** is the held ankle, or, while only the toe is held, the
-  ankle moved with the toe (the foot keeps its orientation and pivots on the
-  ball); the toe of a foot whose ankle and toe are both held is held at the
-  ankle's point plus the foot vector in the middle of their overlap, so both
-  holds can be met exactly by a rigid foot;
-* the **root is lowered** (along the vertical, smoothed over the blend window
-  so it never jumps) on frames where an ankle goal is farther from its hip
-  than ``reach`` of the leg's length; a leg without a contact there rides
-  down with it unchanged (bending a straight swing leg to keep its foot up
-  would make the knee pop);
-* the leg is solved by **analytic two-bone IK**: the knee bends about the
-  normal of the hip-knee-ankle plane until the hip-ankle distance is right,
-  then the thigh swings by the smallest rotation that puts the ankle on its
-  goal (the knee stays in the leg's plane, only turned with it);
-* the **foot** keeps its world orientation, turned by the smallest rotation
-  that points it at the toe goal.
-
-Only local rotations change (and the travel joint's translation when the root
-is lowered), so every bone keeps its length exactly; frames outside the
-contacts, their blend windows and the lowering are left untouched.
+Only local rotations of hips, knees and ankles change, and the travel
+joint's translation, so every bone keeps its length exactly.
 """
 
 from __future__ import annotations
@@ -40,8 +45,8 @@ from .detect import Contacts, ranges
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
 REACH = 1.0        # of hip-knee plus knee-ankle: farther goals lower the root
-HORIZONTAL = True
-STRAIGHT, BENT = 0.99, 0.95  # hip-ankle over leg length: a free leg rides down above STRAIGHT, keeps its foot below BENT
+# hip-ankle distance over leg length: a free leg rides down with the root above STRAIGHT, keeps its foot below BENT
+STRAIGHT, BENT = 0.99, 0.95
 DISTANCE_WEIGHT = 3.0  # a hold this much farther from the mean weighs like the same lowering of the root
 
 
@@ -154,8 +159,6 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
         held_a.append(_best_hold(a[s:e], off, hips[fr], R[fr], up, body)
                       if fr.size else a[s:e].mean(axis=0))
     w_a, hold_a = _holds(ma, held_a, n_blend)
-    if HORIZONTAL:
-        hold_a = hold_a + np.outer((a - hold_a) @ up, up)
     if foot.toe is None:
         return a + w_a[:, None] * (hold_a - a), None, w_a
     held_t = []
@@ -167,8 +170,6 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
             fr = np.arange(s, e)
             held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
     w_t, hold_t = _holds(mt, held_t, n_blend)
-    if HORIZONTAL:
-        hold_t = hold_t + np.outer((t - hold_t) @ up, up)
     wa, wt = w_a[:, None], w_t[:, None]
     goal_a = a + wa * (hold_a - a) + (1.0 - wa) * wt * (hold_t - t)
     goal_t = (1.0 - wt) * (goal_a + t - a) + wt * hold_t
