@@ -44,10 +44,10 @@ from ..motion import Motion
 from .detect import Contacts, ranges
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
-REACH = 1.0        # of hip-knee plus knee-ankle: farther goals lower the root
+REACH = 0.995        # of hip-knee plus knee-ankle: farther goals lower the root
 # hip-ankle distance over leg length: a free leg rides down with the root above STRAIGHT, keeps its foot below BENT
-STRAIGHT, BENT = 0.99, 0.95
-DISTANCE_WEIGHT = 3.0  # a hold this much farther from the mean weighs like the same lowering of the root
+STRAIGHT, BENT = 0.999, 0.98
+DISTANCE_WEIGHT = 1.0  # a hold this much farther from the mean weighs like the same lowering of the root
 
 
 def _smoothstep(x: np.ndarray) -> np.ndarray:
@@ -95,8 +95,8 @@ def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _reach(W: np.ndarray, foot, reach: float) -> np.ndarray:
-    """How far ``(T,)`` the ankle may be from the hip: ``reach`` of the leg's length, or the capture's own
-    stretch where that is more."""
+    """How far ``(T,)`` a held ankle may be from its hip: ``reach`` of the leg's length (a held knee never
+    goes fully straight, where a millimetre of length takes a large knee angle)."""
     H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
     legs = np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
     return np.maximum(reach * legs, np.linalg.norm(A - H, axis=1))
@@ -126,6 +126,14 @@ def _best_hold(path: np.ndarray, offsets: np.ndarray, hips: np.ndarray, R: np.nd
     cost = need + DISTANCE_WEIGHT * np.linalg.norm(cands - mean, axis=1)
     k = int(np.argmin(cost))
     return cands[0] if need[0] <= need[k] + 1e-6 * body else cands[k]
+
+
+def _toward(correction: np.ndarray, w: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """``correction`` ``(T, 3)`` scaled by the hold weight ``w`` ``(T,)``; a downward part by ``w**3``, so a
+    heel still coming down (or already lifting) is not pulled to the floor while it moves fast."""
+    vert = correction @ up
+    wv = np.where(vert < 0, w ** 3, w)
+    return w[:, None] * (correction - np.outer(vert, up)) + np.outer(wv * vert, up)
 
 
 def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: float):
@@ -160,7 +168,7 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
                       if fr.size else a[s:e].mean(axis=0))
     w_a, hold_a = _holds(ma, held_a, n_blend)
     if foot.toe is None:
-        return a + w_a[:, None] * (hold_a - a), None, w_a
+        return a + _toward(hold_a - a, w_a, up), None, w_a
     held_t = []
     for i, (s, e) in enumerate(rt):
         if i in partner:  # a rigid foot can meet both holds: toe = held ankle + foot vector
@@ -171,8 +179,8 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
             held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
     w_t, hold_t = _holds(mt, held_t, n_blend)
     wa, wt = w_a[:, None], w_t[:, None]
-    goal_a = a + wa * (hold_a - a) + (1.0 - wa) * wt * (hold_t - t)
-    goal_t = (1.0 - wt) * (goal_a + t - a) + wt * hold_t
+    goal_a = a + _toward(hold_a - a, w_a, up) + (1.0 - wa) * _toward(hold_t - t, w_t, up)
+    goal_t = goal_a + t - a + _toward(hold_t - (goal_a + t - a), w_t, up)
     # while the toe is held harder than the ankle, put the ankle on the sphere of foot length around the toe
     length = np.linalg.norm(t - a, axis=1, keepdims=True)
     on_sphere = goal_t - length * _normalize(goal_t - goal_a)
@@ -205,11 +213,13 @@ def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray,
     return out
 
 
-def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], reach: float, n_blend: int) -> np.ndarray:
-    """How far ``(T,)`` the root must go down so every ankle goal is within reach, smoothed so it is never less."""
+def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray], reach: float,
+              n_blend: int) -> np.ndarray:
+    """How far ``(T,)`` the root must go down so every held ankle goal (weight > 0) is within reach, smoothed
+    so it is never less."""
     need = np.zeros(W.shape[0])
-    for foot, g in zip(contacts.feet, goals, strict=True):
-        need = np.maximum(need, _need(g, W[:, foot.hip], _reach(W, foot, reach), contacts.up))
+    for foot, g, w in zip(contacts.feet, goals, weights, strict=True):
+        need = np.maximum(need, np.where(w > 0, _need(g, W[:, foot.hip], _reach(W, foot, reach), contacts.up), 0.0))
     if not need.any():
         return need
     width = 2 * max(1, n_blend) + 1
@@ -298,7 +308,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         goals.append(g)
         toe_goals.append(gt)
         active.append(act)
-    delta = _lowering(W, contacts, goals, reach, n_blend)
+    delta = _lowering(W, contacts, goals, active, reach, n_blend)
     lowered = delta > 0
     if lowered.any():
         # a free leg that is bent keeps its foot where it was; a straight one rides down with the root
