@@ -149,7 +149,7 @@ def _clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
 
     if mode == "auto":
         try:
-            find_feet(cycle.space.template.skeleton, foot_joints)
+            find_feet(cycle.space.skeleton, foot_joints)
             mode = "lock" if root == "motion" else "keep"
         except MocycleError as exc:
             if root == "motion":
@@ -163,7 +163,7 @@ def _clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
     cleaned, contacts = lock_cycle(cycle, foot_joints)
     facts["seconds"] = time.perf_counter() - t0
     before, after = cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
-    names = cycle.space.template.skeleton.names
+    names = cycle.space.skeleton.names
     facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=skate(before, contacts.feet),
                  largest_leg_step_before=largest_leg_step(before, contacts.feet),
                  largest_leg_step_after=largest_leg_step(after, contacts.feet))
