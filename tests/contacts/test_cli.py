@@ -43,3 +43,16 @@ def test_loop_feet_options(tmp_path):
                                  "--foot-joints", "LeftFoot:LeftToeBase,RightFoot:RightToeBase"])
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout)["feet"]["contacts"]["left"]["joints"]["toe"] == "LeftToeBase"
+
+
+def test_blend_locks_the_feet_of_a_travelling_blend(tmp_path):
+    a = _walk(tmp_path)
+    b = write(_planted_walk(n_frames=300, fps=60.0, noise_deg=0.3, period_s=1.1)[1], tmp_path / "slow.bvh")
+    out = tmp_path / "blend.bvh"
+    result = runner.invoke(app, ["blend", str(a), str(b), "-o", str(out), "--root", "motion", "--json"])
+    assert result.exit_code == 0, result.output
+    facts = json.loads(result.stdout)
+    assert facts["feet"]["mode"] == "lock" and facts["feet"]["contacts"]["right"]["contacts"]
+    assert facts["seam"]["seam_pose"] < 2.0
+    result = runner.invoke(app, ["blend", str(a), str(b), "-o", str(out), "--json"])
+    assert json.loads(result.stdout)["feet"]["mode"] == "keep"

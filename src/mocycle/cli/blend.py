@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import time
+from dataclasses import replace as dc_replace
 from pathlib import Path
 from typing import Annotated
 
@@ -13,6 +14,7 @@ from ..errors import MocycleError
 from ..io import read_motion as read
 from ..io import write
 from .common import app, check_suffix, count_option, friendly, out
+from .feet import FEET_HELP, FOOT_JOINTS_HELP, check_feet_mode, clean_feet
 
 METHOD_HELP = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."
 MODEL_HELP = "Harmonic model: M1, M2 or M3 (see mocycle loop)."
@@ -52,6 +54,8 @@ def blend(
     align: Annotated[bool, typer.Option(help="Search each take's phase offset against the first.")] = True,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    feet: Annotated[str, typer.Option(help=FEET_HELP)] = "auto",
+    foot_joints: Annotated[str | None, typer.Option(help=FOOT_JOINTS_HELP)] = None,
 ):
     """Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).
 
@@ -67,12 +71,15 @@ def blend(
     check_suffix(output, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
+    check_feet_mode(feet)
     w = _parse_weights(weights, len(paths))
     if w is not None:
         check_weights(w, len(paths))  # refuse bad weights before the (slower) extraction
     motions = _read_all(paths, fps)
     result = blend_cycles(motions, w, align=align, labels=[str(p) for p in paths], method=method, model=model,
                           n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
+    cleaned, feet_facts, _ = clean_feet(result.cycle, feet, root, foot_joints)
+    result = dc_replace(result, cycle=cleaned)
     write(result.repeat(cycles, root=root), output)
     seconds = time.perf_counter() - t0
     facts = {
@@ -84,6 +91,7 @@ def blend(
         "cycles": cycles,
         "seam": result.seam(),
         "input_seams": [cycle_seam(c) for c in result.inputs],
+        "feet": feet_facts,
         "seconds": seconds,
     }
     if as_json:
@@ -99,6 +107,8 @@ def blend(
               f"turn {facts['turn_per_cycle_deg']:.3g}°")
     seam = facts["seam"]
     out.print(f"  seam jump: pose {seam['seam_pose']:.3g}, velocity {seam['seam_velocity']:.3g} (× median step)")
+    if feet_facts["mode"] == "lock":
+        out.print(f"  feet locked: skate {feet_facts['skate_before']:.4g} -> {feet_facts['skate_after']:.4g} units/s")
     out.print(f"wrote {output}: {facts['frames_out']} frames ({cycles} cycle(s), root {root}) in {seconds:.2f} s")
 
 

@@ -15,6 +15,7 @@ from ..errors import MocycleError
 from ..io import read_motion as read
 from ..io import write
 from .common import app, check_suffix, count_option, friendly, out, parse_range
+from .feet import FEET_HELP, FOOT_JOINTS_HELP, check_feet_mode, clean_feet
 
 METRIC_LABELS = {
     "template_error": ("template error", "rad"),
@@ -31,7 +32,7 @@ METRIC_LABELS = {
     "skate": ("foot skate, cycle", "units/s"),
     "input_skate": ("foot skate, input", "units/s"),
 }
-FEET_MODES = ("auto", "lock", "keep")
+
 
 
 @app.command()
@@ -63,16 +64,11 @@ def loop(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: PCA of input and cycle, phase, joint curves.")]
     = None,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
-    feet: Annotated[str, typer.Option(
-        help="lock (feet held still on the floor during each contact; in place they slide back at the "
-             "treadmill speed), keep (as fitted) or auto (lock with --root motion when feet are found, else "
-             "keep).")] = "auto",
+    feet: Annotated[str, typer.Option(help=FEET_HELP)] = "auto",
     feet_plot: Annotated[Path | None, typer.Option(
         help="Write a PNG of the contacts: each ankle and toe's height and speed over two cycles, before (dashed) "
              "and after locking.")] = None,
-    foot_joints: Annotated[str | None, typer.Option(
-        help="Name the feet when the name patterns fail: ANKLE[:TOE],ANKLE[:TOE] (e.g. lfoot:ltoes,rfoot:rtoes).")]
-    = None,
+    foot_joints: Annotated[str | None, typer.Option(help=FOOT_JOINTS_HELP)] = None,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
 
@@ -85,8 +81,7 @@ def loop(
     check_suffix(feet_plot, ".png", "--feet-plot")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
-    if feet not in FEET_MODES:
-        raise MocycleError(f"--feet must be one of {', '.join(FEET_MODES)}; got {feet!r}")
+    check_feet_mode(feet)
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     start, stop = parse_range(frame_range, motion.n_frames)
@@ -96,15 +91,13 @@ def loop(
         time_axis_method=time_axis, joints=joints, classes=count_option(classes, "--classes", {"auto": "auto"}),
         which=which, phase_step=step)
     fitted = cycle
-    cycle, feet_facts, contacts = _clean_feet(cycle, feet, root, foot_joints)
+    cycle, feet_facts, contacts = clean_feet(cycle, feet, root, foot_joints)
     result = cycle.repeat(cycles, root=root)
     write(result, output)
     seconds = time.perf_counter() - t0
     t1 = time.perf_counter()
     metrics = loop_metrics(motion, cycle)
     metrics_seconds = time.perf_counter() - t1
-    if feet_facts["skate_before"] is not None:
-        feet_facts["skate_after"] = metrics["skate"]
     if feet_plot is not None:
         if contacts is None:
             raise MocycleError("--feet-plot needs locked feet (--feet lock, or auto with --root motion)")
@@ -138,36 +131,6 @@ def loop(
         print(json.dumps(facts, indent=2))
         return
     _print_loop(facts, len(cycle.periodic.excitation), which)
-
-
-def _clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
-    """The cycle with its feet locked (or not), and what the JSON says about it."""
-    import warnings
-
-    from ..contacts import find_feet, largest_leg_step, lock_cycle, skate
-    from ..errors import MocycleWarning
-
-    if mode == "auto":
-        try:
-            find_feet(cycle.space.skeleton, foot_joints)
-            mode = "lock" if root == "motion" else "keep"
-        except MocycleError as exc:
-            if root == "motion":
-                warnings.warn(f"feet not locked: {exc}", MocycleWarning, stacklevel=2)
-            mode = "keep"
-    facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
-             "largest_leg_step_before": None, "largest_leg_step_after": None, "seconds": 0.0}
-    if mode == "keep":
-        return cycle, facts, None
-    t0 = time.perf_counter()
-    cleaned, contacts = lock_cycle(cycle, foot_joints)
-    facts["seconds"] = time.perf_counter() - t0
-    before, after = cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
-    names = cycle.space.skeleton.names
-    facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=skate(before, contacts.feet),
-                 largest_leg_step_before=largest_leg_step(before, contacts.feet),
-                 largest_leg_step_after=largest_leg_step(after, contacts.feet))
-    return cleaned, facts, contacts
 
 
 def _print_loop(facts: dict, n_regions: int, which: int | None) -> None:

@@ -1,0 +1,47 @@
+"""The ``--feet`` options every command that writes a loop shares: foot locking (``mocycle.contacts``)."""
+
+from __future__ import annotations
+
+import time
+import warnings
+
+from ..errors import MocycleError, MocycleWarning
+
+FEET_MODES = ("auto", "lock", "keep")
+FEET_HELP = ("lock (feet held still on the floor during each contact; in place they slide back at the treadmill "
+             "speed), keep (as fitted) or auto (lock with --root motion when feet are found, else keep).")
+FOOT_JOINTS_HELP = ("Name the feet when the name patterns fail: ANKLE[:TOE],ANKLE[:TOE] (e.g. "
+                    "lfoot:ltoes,rfoot:rtoes).")
+
+
+def check_feet_mode(mode: str) -> None:
+    if mode not in FEET_MODES:
+        raise MocycleError(f"--feet must be one of {', '.join(FEET_MODES)}; got {mode!r}")
+
+
+def clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
+    """The cycle with its feet locked (or not), and what the JSON says about it."""
+    from ..contacts import find_feet, largest_leg_step, lock_cycle, skate
+
+    if mode == "auto":
+        try:
+            find_feet(cycle.space.skeleton, foot_joints)
+            mode = "lock" if root == "motion" else "keep"
+        except MocycleError as exc:
+            if root == "motion":
+                warnings.warn(f"feet not locked: {exc}", MocycleWarning, stacklevel=2)
+            mode = "keep"
+    facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
+             "largest_leg_step_before": None, "largest_leg_step_after": None, "seconds": 0.0}
+    if mode == "keep":
+        return cycle, facts, None
+    t0 = time.perf_counter()
+    cleaned, contacts = lock_cycle(cycle, foot_joints)
+    facts["seconds"] = time.perf_counter() - t0
+    before, after = cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
+    names = cycle.space.skeleton.names
+    facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=skate(before, contacts.feet),
+                 skate_after=skate(after, contacts.feet),
+                 largest_leg_step_before=largest_leg_step(before, contacts.feet),
+                 largest_leg_step_after=largest_leg_step(after, contacts.feet))
+    return cleaned, facts, contacts
