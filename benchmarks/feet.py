@@ -19,6 +19,10 @@ input vs output:
   over the largest step inside it, for the fitted and the cleaned loop;
 * seconds: ``extract_cycle`` and ``lock_cycle``.
 
+Then blends (``blend_cycles`` of the Bandai normal walk with each other Bandai
+walk, equal weights, locked as ``mocycle blend --root motion`` does): skate of
+the two captured takes (mean), of the blend and of the locked blend; leg steps.
+
 Goals (issue 13): median skate of the cleaned loops <= 0.5x the input's and no
 take worse than its input; leg step after <= 1.5x before; bone lengths exact
 (1e-9); clean-up <= 20 % of the loop job.
@@ -79,6 +83,43 @@ def seam_ratio(cycle, feet) -> float:
     return float(steps[n - 1] / max(np.delete(steps, n - 1).max(), 1e-12))
 
 
+def blends(data: Path, quick: bool) -> list[dict]:
+    from mocycle.cycle import blend_cycles
+
+    walks = sorted((data / "bandai").glob("dataset-1_walk_*.bvh"))
+    base = data / "bandai" / "dataset-1_walk_normal_001.bvh"
+    others = [p for p in walks if p != base][:: 4 if quick else 1]
+    if not base.exists():
+        return []
+    rows = []
+    print(f"\n{'blend of walk_normal with':34s} {'skate in':>8s} {'blend':>7s} {'locked':>7s} {'lock/in':>7s} "
+          f"{'step before':>11s} {'after':>6s} {'lock s':>7s}")
+    a = read(base)
+    for path in others:
+        b = read(path)
+        try:
+            blend = blend_cycles([a, b])
+        except MocycleError as exc:
+            print(f"{path.name:34s} no blend: {exc}")
+            continue
+        t0 = time.perf_counter()
+        cleaned, _ = lock_cycle(blend.cycle)
+        t_lock = time.perf_counter() - t0
+        s_in = float(np.mean([skate(a), skate(b)]))  # the two captures
+        before, after = blend.cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
+        row = dict(take=path.name, s_in=s_in, s_fit=skate(before), s_out=skate(after),
+                   step_before=largest_leg_step(before), step_after=largest_leg_step(after))
+        row["ratio"] = row["s_out"] / s_in
+        rows.append(row)
+        print(f"{path.name:34s} {s_in:8.2f} {row['s_fit']:7.2f} {row['s_out']:7.2f} {row['ratio']:7.2f} "
+              f"{row['step_before']:11.3f} {row['step_after']:6.3f} {t_lock:7.3f}")
+    if rows:
+        print(f"blends: median locked/input {statistics.median(r['ratio'] for r in rows):.2f} (goal <= 0.5); "
+              f"locked above input: {sum(r['s_out'] > r['s_in'] for r in rows)} of {len(rows)}; leg step > 1.5x "
+              f"before: {sum(r['step_after'] > 1.5 * r['step_before'] for r in rows)}")
+    return rows
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
@@ -134,6 +175,7 @@ def main() -> None:
           f"{max(r['seam_fit'] for r in rows):.2f}; cleaned above 1.1x its fitted loop's: "
           f"{sum(r['seam'] > 1.1 * max(r['seam_fit'], 1.0) for r in rows)}")
     print(f"clean-up time / loop job time: {share:.1%} (goal <= 20%)")
+    blends(args.data, args.quick)
 
 
 if __name__ == "__main__":
