@@ -23,6 +23,10 @@ Then blends (``blend_cycles`` of the Bandai normal walk with each other Bandai
 walk, equal weights, locked as ``mocycle blend --root motion`` does): skate of
 the two captured takes (mean), of the blend and of the locked blend; leg steps.
 
+Then stretched takes (``stretch_motion`` by 2 of every Bandai walk and the
+cmu-iclone walks, locked as ``mocycle stretch`` does): skate of the take, of
+the stretched take and of the locked one; leg steps.
+
 Goals (issue 13): median skate of the cleaned loops <= 0.5x the input's and no
 take worse than its input; leg step after <= 1.5x before; bone lengths exact
 (1e-9); clean-up <= 20 % of the loop job.
@@ -120,12 +124,52 @@ def blends(data: Path, quick: bool) -> list[dict]:
     return rows
 
 
+def stretched(data: Path, quick: bool) -> list[dict]:
+    from mocycle.warp import stretch_motion
+
+    files = [p for p in takes(data, quick) if "_walk_" in p.name or p.name.startswith("07_")]
+    rows = []
+    print(f"\n{'stretched x2':34s} {'skate in':>8s} {'stretch':>7s} {'locked':>7s} {'lock/in':>7s} "
+          f"{'step before':>11s} {'after':>6s} {'lock s':>7s}")
+    for path in files:
+        motion = read(path)
+        try:
+            long, _ = stretch_motion(motion, 2.0)
+        except MocycleError as exc:
+            print(f"{path.name:34s} no stretch: {exc}")
+            continue
+        t0 = time.perf_counter()
+        locked = lock_feet(long, detect_contacts(long))
+        t_lock = time.perf_counter() - t0
+        row = dict(take=path.name, s_in=skate(motion), s_fit=skate(long), s_out=skate(locked),
+                   step_before=largest_leg_step(long), step_after=largest_leg_step(locked))
+        row["ratio"] = row["s_out"] / row["s_in"]
+        rows.append(row)
+        print(f"{path.name:34s} {row['s_in']:8.2f} {row['s_fit']:7.2f} {row['s_out']:7.2f} {row['ratio']:7.2f} "
+              f"{row['step_before']:11.3f} {row['step_after']:6.3f} {t_lock:7.3f}")
+    if rows:
+        print(f"stretched: median locked/input {statistics.median(r['ratio'] for r in rows):.2f} (goal <= 0.5); "
+              f"locked above input: {sum(r['s_out'] > r['s_in'] for r in rows)} of {len(rows)}; leg step > 1.5x "
+              f"before: {sum(r['step_after'] > 1.5 * r['step_before'] for r in rows)}")
+    return rows
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--part", choices=("all", "loops", "blends", "stretch"), default="all")
     ap.add_argument("--data", type=Path, default=Path(__file__).resolve().parents[1].parent / "shared" / "data")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
+    if args.part in ("all", "loops"):
+        loops(args)
+    if args.part in ("all", "blends"):
+        blends(args.data, args.quick)
+    if args.part in ("all", "stretch"):
+        stretched(args.data, args.quick)
+
+
+def loops(args) -> None:
     rows = []
     print(f"{'take':34s} {'skate in':>8s} {'fitted':>7s} {'locked':>7s} {'lock/in':>7s} {'step before':>11s} "
           f"{'after':>6s} {'bones':>8s} {'planted':>8s} {'seam':>5s} {'fit':>5s} {'loop s':>7s} {'lock s':>7s}")
@@ -175,7 +219,6 @@ def main() -> None:
           f"{max(r['seam_fit'] for r in rows):.2f}; cleaned above 1.1x its fitted loop's: "
           f"{sum(r['seam'] > 1.1 * max(r['seam_fit'], 1.0) for r in rows)}")
     print(f"clean-up time / loop job time: {share:.1%} (goal <= 20%)")
-    blends(args.data, args.quick)
 
 
 if __name__ == "__main__":

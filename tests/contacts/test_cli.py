@@ -56,3 +56,18 @@ def test_blend_locks_the_feet_of_a_travelling_blend(tmp_path):
     assert facts["seam"]["seam_pose"] < 2.0
     result = runner.invoke(app, ["blend", str(a), str(b), "-o", str(out), "--json"])
     assert json.loads(result.stdout)["feet"]["mode"] == "keep"
+
+
+def test_stretch_and_transition_lock_travelling_output(tmp_path):
+    a = _walk(tmp_path)
+    out = tmp_path / "long.bvh"
+    result = runner.invoke(app, ["stretch", str(a), "--factor", "1.5", "-o", str(out), "--json"])
+    assert result.exit_code == 0, result.output
+    feet = json.loads(result.stdout)["feet"]
+    assert feet["mode"] == "lock" and feet["contacts"]["left"]["contacts"]
+    result = runner.invoke(app, ["stretch", str(a), "--factor", "1.5", "-o", str(out), "--json", "--feet", "keep"])
+    assert json.loads(result.stdout)["feet"]["mode"] == "keep"
+    b = write(_planted_walk(n_frames=300, fps=60.0, noise_deg=0.3, period_s=1.1)[1], tmp_path / "slow.bvh")
+    result = runner.invoke(app, ["transition", str(a), str(b), "-o", str(out), "--cycles", "2", "--json"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["feet"]["mode"] == "lock"

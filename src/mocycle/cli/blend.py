@@ -14,7 +14,7 @@ from ..errors import MocycleError
 from ..io import read_motion as read
 from ..io import write
 from .common import app, check_suffix, count_option, friendly, out
-from .feet import FEET_HELP, FOOT_JOINTS_HELP, check_feet_mode, clean_feet
+from .feet import FEET_HELP, FOOT_JOINTS_HELP, check_feet_mode, clean_feet, lock_motion
 
 METHOD_HELP = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."
 MODEL_HELP = "Harmonic model: M1, M2 or M3 (see mocycle loop)."
@@ -126,6 +126,8 @@ def transition(
     harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    feet: Annotated[str, typer.Option(help=FEET_HELP)] = "auto",
+    foot_joints: Annotated[str | None, typer.Option(help=FOOT_JOINTS_HELP)] = None,
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
@@ -139,10 +141,12 @@ def transition(
     check_suffix(output, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
+    check_feet_mode(feet)
     a, b = _read_all([first, second], fps)
     result = make_transition(a, b, cycles, root=root, labels=[str(first), str(second)], method=method,
                              model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
-    write(result.motion, output)
+    written, feet_facts = lock_motion(result.motion, feet, foot_joints, root == "motion")
+    write(written, output)
     seconds = time.perf_counter() - t0
     facts = {
         "files": [str(first), str(second)],
@@ -150,6 +154,7 @@ def transition(
         **result.to_dict(),
         "root": root,
         "smoothness": transition_smoothness(result),
+        "feet": feet_facts,
         "seconds": seconds,
     }
     if as_json:

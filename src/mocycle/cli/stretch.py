@@ -13,6 +13,7 @@ from rich.table import Table
 from ..io import read_motion as read
 from ..io import write
 from .common import app, check_suffix, count_option, friendly, out
+from .feet import FEET_HELP, FOOT_JOINTS_HELP, check_feet_mode, lock_motion, travels
 
 
 @app.command()
@@ -25,6 +26,9 @@ def stretch(
         help="Block length in frames: 'auto' (each joint group's largest fundamental cycle) or N.")] = "auto",
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    feet: Annotated[str, typer.Option(help=FEET_HELP.replace("with --root motion", "when the take travels"))]
+    = "auto",
+    foot_joints: Annotated[str | None, typer.Option(help=FOOT_JOINTS_HELP)] = None,
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
 
@@ -37,11 +41,14 @@ def stretch(
 
     check_suffix(output, ".bvh")
     win = count_option(window, "--window", {"auto": "auto"})
+    check_feet_mode(feet)
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     result, report = stretch_motion(motion, factor, window=win)
+    result, feet_facts = lock_motion(result, feet, foot_joints, travels(motion))
     write(result, output)
     facts = report.to_dict()
+    facts["feet"] = feet_facts
     facts["seconds"] = time.perf_counter() - t0
     if as_json:
         print(json.dumps(facts, indent=2))
@@ -57,4 +64,6 @@ def stretch(
     out.print(table)
     if report.trend_curves:
         out.print(f"  warped as line + residual: {', '.join(report.trend_curves)}", soft_wrap=True)
+    if feet_facts["mode"] == "lock":
+        out.print(f"  feet locked: skate {feet_facts['skate_before']:.4g} -> {feet_facts['skate_after']:.4g} units/s")
     out.print(f"  {facts['seconds']:.3f} s")
