@@ -13,12 +13,28 @@ import typer
 from ..errors import MocycleError
 from ..io import read_motion as read
 from ..io import write
-from .common import app, check_suffix, count_option, friendly, out
+from .common import (
+    ClassesOption,
+    DelayOption,
+    JointsOption,
+    MinPeriodsOption,
+    PcaOption,
+    app,
+    check_suffix,
+    count_option,
+    friendly,
+    out,
+    phase_options,
+)
 from .feet import FEET_HELP, FOOT_JOINTS_HELP, check_feet_mode, clean_feet, lock_motion
 
 METHOD_HELP = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."
 MODEL_HELP = "Harmonic model: M1, M2 or M3 (see mocycle loop)."
 HARMONICS_HELP = "Harmonics K: 'auto' (20, capped by the frames) or a number."
+WhichOption = Annotated[int | None, typer.Option(
+    "--class", min=0, help="Which periodic motion of each take to use (0-based; default: the one covering most "
+                           "frames).")]
+FORCE_HELP = "Use a take's cycle even when it fails a loop check (a warning names the check)."
 
 
 def _parse_weights(text: str | None, n: int) -> list[float] | None:
@@ -52,8 +68,15 @@ def blend(
     model: Annotated[str, typer.Option(help=MODEL_HELP)] = "M1",
     harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
     align: Annotated[bool, typer.Option(help="Search each take's phase offset against the first.")] = True,
+    joints: JointsOption = None,
+    classes: ClassesOption = "auto",
+    which: WhichOption = None,
+    pca: PcaOption = "auto",
+    delay: DelayOption = 2,
+    min_periods: MinPeriodsOption = 1.2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
     feet: Annotated[str, typer.Option(help=FEET_HELP)] = "auto",
     foot_joints: Annotated[str | None, typer.Option(help=FOOT_JOINTS_HELP)] = None,
 ):
@@ -61,7 +84,8 @@ def blend(
 
     Each take's cycle is extracted, brought to the first one's phase, resampled to the weighted period and
     averaged with the weights in rotation space; root sway and travel per cycle are blended likewise.
-    Exit code 0 on success, 3 when a take holds no periodic motion, 1 for bad input.
+    Exit code 0 on success, 3 when a take holds no periodic motion or its cycle fails a loop check (see
+    mocycle loop), 1 for bad input.
     """
     from ..cycle.blend import blend_cycles, check_weights, cycle_seam
 
@@ -75,9 +99,11 @@ def blend(
     w = _parse_weights(weights, len(paths))
     if w is not None:
         check_weights(w, len(paths))  # refuse bad weights before the (slower) extraction
+    options = phase_options(joints, classes, pca, delay, min_periods)
     motions = _read_all(paths, fps)
     result = blend_cycles(motions, w, align=align, labels=[str(p) for p in paths], method=method, model=model,
-                          n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
+                          n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}), which=which,
+                          force=force, **options)
     cleaned, feet_facts, _ = clean_feet(result.cycle, feet, root, foot_joints)
     result = dc_replace(result, cycle=cleaned)
     write(result.repeat(cycles, root=root), output)
@@ -124,15 +150,23 @@ def transition(
     method: Annotated[str, typer.Option(help=METHOD_HELP)] = "harmonic",
     model: Annotated[str, typer.Option(help=MODEL_HELP)] = "M1",
     harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
+    joints: JointsOption = None,
+    classes: ClassesOption = "auto",
+    which: WhichOption = None,
+    pca: PcaOption = "auto",
+    delay: DelayOption = 2,
+    min_periods: MinPeriodsOption = 1.2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
     feet: Annotated[str, typer.Option(help=FEET_HELP)] = "auto",
     foot_joints: Annotated[str | None, typer.Option(help=FOOT_JOINTS_HELP)] = None,
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
     The weight moves by a smoothstep over the cycles; period and phase stay continuous (the phase is
-    integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion.
+    integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion or its
+    cycle fails a loop check (see mocycle loop).
     """
     from ..cycle.blend import transition as make_transition
     from ..cycle.blend import transition_smoothness
@@ -142,9 +176,11 @@ def transition(
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     check_feet_mode(feet)
+    options = phase_options(joints, classes, pca, delay, min_periods)
     a, b = _read_all([first, second], fps)
     result = make_transition(a, b, cycles, root=root, labels=[str(first), str(second)], method=method,
-                             model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
+                             model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}),
+                             which=which, force=force, **options)
     written, feet_facts = lock_motion(result.motion, feet, foot_joints, root == "motion")
     write(written, output)
     seconds = time.perf_counter() - t0

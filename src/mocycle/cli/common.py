@@ -13,7 +13,7 @@ import typer
 from rich.console import Console
 
 from .. import __version__
-from ..errors import MocycleError, NoPeriodicMotion
+from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 
 app = typer.Typer(
     name="mocycle",
@@ -26,12 +26,12 @@ out = Console(highlight=False)
 err = Console(stderr=True, highlight=False)
 
 EXIT_ERROR = 1
-EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion
+EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion, or its cycle is not a loop
 
 
 def friendly(func: Callable) -> Callable:
-    """Run a command: MocycleError -> one 'error:' line and exit 1 (3 for NoPeriodicMotion); warnings ->
-    'warning:' lines."""
+    """Run a command: MocycleError -> one 'error:' line and exit 1 (3 for NoPeriodicMotion and LoopRefused);
+    warnings -> 'warning:' lines."""
 
     @wraps(func)
     def wrapper(*args, **kwargs):
@@ -42,7 +42,8 @@ def friendly(func: Callable) -> Callable:
             except MocycleError as exc:
                 _print_warnings(caught)
                 err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
-                raise typer.Exit(EXIT_NOT_FOUND if isinstance(exc, NoPeriodicMotion) else EXIT_ERROR) from None
+                refused = isinstance(exc, (NoPeriodicMotion, LoopRefused))
+                raise typer.Exit(EXIT_NOT_FOUND if refused else EXIT_ERROR) from None
         _print_warnings(caught)
         return result
 
@@ -118,3 +119,30 @@ def main() -> None:  # the console script
         err.print("interrupted")
         sys.exit(130)
 
+
+
+# ------------------------------------------------------- the phase options
+# What ``phase`` takes to find the periodic motion; ``loop``, ``blend`` and ``transition`` take the same.
+JointsOption = Annotated[str | None, typer.Option(
+    help="Joints to find the phase on: names, glob patterns or groups (legs, arms, spine), comma-separated; "
+         "default the whole body, then legs, then arms until one shows a periodic motion.")]
+ClassesOption = Annotated[str, typer.Option(help="How many periodic motions to look for: 'auto' or N.")]
+PcaOption = Annotated[str, typer.Option(help="PCA dimensions before the cohomology: 'auto' (8), N or 'none'.")]
+DelayOption = Annotated[int, typer.Option(help="Delay embedding factor m (KTH thesis eq. 3.26; it used 2).")]
+MinPeriodsOption = Annotated[float, typer.Option(
+    help="Periods a periodic motion must cover (>= 1); below 1.5 the result is kept with a warning.")]
+
+
+def phase_options(joints: str | None, classes: str, pca: str, delay: int, min_periods: float) -> dict:
+    """The phase options of the command line as keyword arguments of ``find_phase``/``extract_cycle``."""
+    if delay < 0:
+        raise MocycleError(f"--delay must be >= 0; got {delay}")
+    if not min_periods >= 1.0:
+        raise MocycleError(f"--min-periods must be a number >= 1; got {min_periods:g}")
+    return {
+        "joints": joints,
+        "classes": count_option(classes, "--classes", {"auto": "auto"}),
+        "pca": count_option(pca, "--pca", {"auto": "auto", "none": None, "0": None}),
+        "delay": delay,
+        "min_periods": min_periods,
+    }

@@ -21,7 +21,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..cycle.extract import Cycle
-from ..cycle.representation import axis_rotations
+from ..rotations import axis_rotations
 from .detect import Contacts, detect_contacts
 from .feet import Foot
 from .lock import BLEND_SECONDS, REACH, lock_feet

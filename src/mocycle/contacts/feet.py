@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..axes import vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
 
@@ -192,17 +193,22 @@ def find_feet(skeleton: Skeleton, names: str | Sequence[str] | None = None) -> l
     return [feet["left"], feet["right"]]
 
 
-def up_axis(motion: Motion) -> np.ndarray:
-    """The world up direction ``(3,)`` of ``motion`` (the cycle module's vertical-axis detection)."""
-    from ..cycle.representation import vertical_axis
-
-    return vertical_axis(motion)
+def up_axis(motion: Motion, up=None) -> np.ndarray:
+    """The world up direction ``(3,)`` of ``motion`` (:func:`mocycle.axes.vertical_axis`; ``up`` overrides)."""
+    return vertical_axis(motion, up)
 
 
 def body_height(motion: Motion, up: np.ndarray | None = None) -> float:
-    """The body's height along ``up`` in file units: the extent of the mean pose (End Sites included, joints
-    above the travel joint left out)."""
-    from ..cycle.representation import body_pose
-
-    up = up_axis(motion) if up is None else up
-    return float(np.ptp(body_pose(motion) @ up)) or 1.0
+    """The body's height along ``up`` in file units: the extent of the mean pose of the travel joint, the
+    joints below it and their End Sites, each frame taken relative to the travel joint (about 50 frames)."""
+    up = up_axis(motion) if up is None else np.asarray(up, dtype=np.float64)
+    skel, travel = motion.skeleton, motion.travel_joint
+    above, j = set(), int(skel.parents[travel])
+    while j >= 0:
+        above.add(j)
+        j = int(skel.parents[j])
+    keep = [j for j in range(skel.n_joints) if j not in above] + [
+        skel.n_joints + i for i, site in enumerate(skel.end_sites) if site.parent not in above]
+    W = motion[::max(1, motion.n_frames // 50)].world_positions(end_sites=True)
+    pose = (W[:, keep] - W[:, travel:travel + 1]).mean(axis=0)
+    return float(np.ptp(pose @ up)) or 1.0

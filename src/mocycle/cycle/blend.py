@@ -60,9 +60,10 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError, NoPeriodicMotion
 from ..motion import Motion, Skeleton
-from ..rotations import mean_rotations
+from ..rotations import axis_rotations, mean_rotations, nearest_rotations
+from .checks import check_loop
 from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, metric_features
-from .representation import CycleSpace, axis_rotations, nearest_rotations
+from .representation import CycleSpace
 from .seam import LOCAL, calmest_start, seam_ratios
 from .timeaxis import TimeAxis
 
@@ -128,7 +129,9 @@ def _period_frames(cycle: Cycle) -> float:
     return float(cycle.n_frames if cycle.method == "cut" else cycle.period_frames)
 
 
-def _cycles(takes, labels, extract_options) -> list[Cycle]:
+def _cycles(takes, labels, extract_options, force: bool = False) -> list[Cycle]:
+    """The takes' cycles (Motions are extracted, then checked as loops: :func:`~mocycle.cycle.checks.check_loop`
+    raises LoopRefused, or warns with ``force``)."""
     if isinstance(takes, (Motion, Cycle)) or not isinstance(takes, Sequence) or len(takes) == 0:
         raise MocycleError("expected a non-empty list of takes (Motion or Cycle objects)")
     labels = list(labels) if labels is not None else [f"take {i + 1}" for i in range(len(takes))]
@@ -149,9 +152,11 @@ def _cycles(takes, labels, extract_options) -> list[Cycle]:
             cycles.append(take)
             continue
         try:
-            cycles.append(extract_cycle(take, **extract_options))
+            cycle = extract_cycle(take, **extract_options)
         except NoPeriodicMotion as exc:
             raise NoPeriodicMotion(f"{label}: {exc}") from None
+        check_loop(take, cycle, force=force, label=label)
+        cycles.append(cycle)
     first = cycles[0].space
     for cycle, label in zip(cycles[1:], labels[1:], strict=True):
         if cycle.space.travel != first.travel:
@@ -338,17 +343,6 @@ def _blend_P(Ps: Sequence[np.ndarray], w: np.ndarray, n_joints: int) -> np.ndarr
     return P
 
 
-def weighted_rotation_mean(quats: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """The weighted chordal L2 mean ``(..., 4)`` of rotations ``quats`` ``(K, ..., 4)`` with ``weights (K,)``:
-    the rotation nearest (Frobenius) to ``Σ w_k R_k`` — the mean ``Rotation.mean(weights=)`` computes, for
-    many sets at once."""
-    q = np.asarray(quats, dtype=np.float64)
-    w = check_weights(weights, q.shape[0])
-    R = Rotation.from_quat(q.reshape(-1, 4)).as_matrix().reshape(*q.shape[:-1], 3, 3)
-    M = np.tensordot(w, R, axes=1)
-    return Rotation.from_matrix(nearest_rotations(M).reshape(-1, 3, 3)).as_quat().reshape(*q.shape[1:])
-
-
 def cycle_seam(cycle: Cycle) -> dict[str, float]:
     """Seam ratios of a loop as :func:`~mocycle.cycle.loop_metrics` measures them (rotations relative to the
     loop's own mean rotations, and the travel joint's in-place path; the larger of the two)."""
@@ -416,7 +410,7 @@ class BlendedCycle:
 
 
 def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool = True, roll: bool = True,
-                 labels: Sequence[str] | None = None, **extract_options) -> BlendedCycle:
+                 labels: Sequence[str] | None = None, force: bool = False, **extract_options) -> BlendedCycle:
     """Paper 001 §4.5: the convex combination of the takes' cycles, a new loop.
 
     ``takes``: Motions (their cycle is extracted with ``extract_cycle(**extract_options)``, e.g.
@@ -424,11 +418,22 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     one per take, ``>= 0``, normalised to sum 1 (default equal); ``align``: search each take's phase offset
     against the first (off: every loop is read from its own frame 0); ``roll``: start the blend at its
     calmest pose, as :func:`extract_cycle` does (off: at the first cycle's frame 0); ``labels``: names for
-    messages.  The result has ``round(Σ w_i T_i)`` frames at the first take's frame time, travels (or, on the
-    spot, faces) like the first take, and its root drifts by the weighted travel and turn per cycle.
+    messages; ``force``: blend a take's cycle that fails a loop check (with a warning) instead of raising
+    :class:`~mocycle.errors.LoopRefused`.  The result has ``round(Σ w_i T_i)`` frames at the first take's
+    frame time, travels (or, on the spot, faces) like the first take, and its root drifts by the weighted
+    travel and turn per cycle.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> slow = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> fast = synthetic_walk(n_frames=300, fps=60, period_s=0.8, seed=1).motion
+    >>> blend = blend_cycles([slow, fast], weights=[0.5, 0.5])
+    >>> blend.n_frames, blend.weights.tolist()      # (60 + 48) / 2 frames
+    (54, [0.5, 0.5])
     """
     t0 = time.perf_counter()
-    cycles = _cycles(takes, labels, extract_options)
+    cycles = _cycles(takes, labels, extract_options, force)
     w = check_weights(weights, len(cycles))
     space = _common_space(cycles)
     first = _prepare(cycles[0], space, None)
@@ -498,7 +503,8 @@ class Transition:
 
 
 def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str = "motion", *,
-               align: bool = True, labels: Sequence[str] | None = None, **extract_options) -> Transition:
+               align: bool = True, labels: Sequence[str] | None = None, force: bool = False,
+               **extract_options) -> Transition:
     """Over ``cycles`` cycles, move from ``a``'s cycle to ``b``'s (paper 001 §4.5: a homotopy of loops).
 
     The weight of ``b`` is ``smoothstep(φ / cycles)`` of the unwrapped phase ``φ``; the local period
@@ -506,7 +512,17 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     (``t(φ) = T_a φ + (T_b - T_a) n (x³ - x⁴/2)``, ``x = φ / n``), and the time axis is scaled by less than
     half a frame so that frame ``T`` would be phase ``n`` exactly: the result can be preceded by ``a``'s loop
     and followed by ``b``'s loop read from its phase offset.  ``root="motion"``: travel and turn per cycle
-    blended with the same weight and integrated along the phase; ``"inplace"``: no travel.
+    blended with the same weight and integrated along the phase; ``"inplace"``: no travel.  A take whose
+    cycle fails a loop check raises :class:`~mocycle.errors.LoopRefused` (``force``: a warning instead).
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> slow = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> fast = synthetic_walk(n_frames=300, fps=60, period_s=0.8, seed=1).motion
+    >>> tr = transition(slow, fast, cycles=2)
+    >>> tr.motion.n_frames, round(float(tr.period_frames[0])), round(float(tr.period_frames[-1]))
+    (108, 60, 48)
     """
     t0 = time.perf_counter()
     if root not in ROOT_MODES:
@@ -514,7 +530,7 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 1:
         raise MocycleError(f"the number of cycles must be a positive integer; got {cycles!r}")
     cyc = _cycles([a, b], labels if labels is not None else ["the first take", "the second take"],
-                  extract_options)
+                  extract_options, force)
     space = _common_space(cyc)
     first = _prepare(cyc[0], space, None)
     loops = [first, _prepare(cyc[1], space, first)]
