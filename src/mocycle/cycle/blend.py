@@ -62,7 +62,7 @@ from ..errors import MocycleError, NoPeriodicMotion
 from ..motion import Motion, Skeleton
 from ..rotations import axis_rotations, mean_rotations, nearest_rotations
 from .checks import check_loop
-from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, metric_features
+from .extract import ROOT_MODES, Cycle, drifting_L, extract_cycle, loop_blocks, metric_features
 from .representation import CycleSpace
 from .seam import LOCAL, calmest_start, seam_ratios
 from .timeaxis import TimeAxis
@@ -449,7 +449,7 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     L = _blend_L([r[1] for r in reads], w)
     L[:, :3] += first.centre
     drift = w @ np.stack([loop.drift for loop in loops])
-    L += np.outer(grid, drift)                       # the Cycle convention: L carries its drift
+    L = drifting_L(space.up, L, drift)               # the Cycle convention: L carries its drift
     axis = TimeAxis(x=grid.copy(), regions=((0, N),), period_frames=period, method="blend")
     cycle = Cycle(space=space, P=P, L=L, drift=drift, method="blend", model=None, n_harmonics=None, axis=axis,
                   positions=np.arange(N, dtype=np.float64), periodic=None)
