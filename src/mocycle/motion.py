@@ -24,6 +24,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from .errors import MocycleError
+from .limits import check_frames
 from .rotations import continuous_quats
 
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
@@ -362,7 +363,8 @@ class Motion:
         if self.n_frames == 1:
             return self.replace(frame_time=new_dt)
         old_t = np.arange(self.n_frames) * self.frame_time
-        n_new = int(np.floor(self.duration / new_dt + 1e-9)) + 1
+        n_new = check_frames(np.floor(self.duration / new_dt + 1e-9) + 1, self.n_joints,
+                             f"resampling {self.n_frames} frames to {fps:g} fps")
         new_t = np.minimum(np.arange(n_new) * new_dt, old_t[-1])
         rot = np.empty((n_new, self.n_joints, 4))
         for j in range(self.n_joints):

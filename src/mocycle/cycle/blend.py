@@ -59,6 +59,7 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError, NoPeriodicMotion
+from ..limits import check_frames
 from ..motion import Motion, Skeleton
 from ..rotations import mean_rotations
 from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, metric_features
@@ -520,6 +521,8 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     offset = float(_align(loops, space, max(2, int(round(0.5 * (pa + pb)))))[1]) if align else 0.0
     n = int(cycles)
     total = n * 0.5 * (pa + pb)                       # t(n): frames over the n cycles
+    check_frames(round(total), space.template.n_joints,
+                 f"a transition over {n} cycles")
     T = max(2, int(round(total)))
     scale = T / total
     grid = np.linspace(0.0, n, 256 * n + 1)

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import MocycleError, MocycleWarning, MotionFileError
+from ..limits import check_frames
 from ..motion import POSITION_CHANNELS, ROTATION_CHANNELS, EndSite, Motion, Skeleton
 from ..rotations import continuous_euler, euler_to_quats
 from .atomic import atomic_write
@@ -309,6 +310,8 @@ def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motio
         if not frames or frames < 1:
             raise MotionFileError("the hierarchy declares no channels and 'Frames:' gives no count", path,
                                   data_start)
+        # no row holds data, so the count is only a claim: bound it like a size asked for by an option
+        check_frames(frames, skel.n_joints, f"'Frames: {frames}' with no channels", path, data_start - 1)
         return _motion_from_channels(skel, np.zeros((frames, 0)), frame_time)
     values = _parse_rows(lines, data_start, skel.n_channels, path)
     T = values.shape[0]
