@@ -134,8 +134,9 @@ class Compressed:
         (n,) = z.unpack("<I", "the header length")
         if n > MAX_HEADER_BYTES:
             raise z.error(f"its header claims {n:,} bytes (at most {MAX_HEADER_BYTES:,} expected)")
+        text = z.take(n, "the header")
         try:
-            header = json.loads(z.take(n, "the header").decode("utf-8"), parse_constant=_no_constant)
+            header = json.loads(text.decode("utf-8"), parse_constant=_no_constant)
         except (ValueError, RecursionError) as exc:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
             raise z.error(f"its header is not valid UTF-8 JSON ({type(exc).__name__})") from None
         h = _check_header(header, z)

@@ -172,7 +172,8 @@ def decode(data: bytes, path: str | os.PathLike | None = None) -> Segmentation:
     keys = {}
     for j in tj.tolist():
         f = r.array("u4", T, "translation key frames").astype(np.int64)
-        v = r.array("f4", 3 * f.size, "translation key values").astype(np.float64)
+        with np.errstate(invalid="ignore"):  # a signalling NaN in the file: refused below
+            v = r.array("f4", 3 * f.size, "translation key values").astype(np.float64)
         keys[int(j)] = (f, v)
     r.z.finish()
     sizes = {"swing": (sj, ss, sl, az, el, a0, rng, v0, v1, errs), "hold": (hj, hs, hl)}
@@ -183,6 +184,8 @@ def decode(data: bytes, path: str | os.PathLike | None = None) -> Segmentation:
         raise r.error("its swing bases or hold rotations differ in length from the swings or holds")
     _check_events(r, "swing", sj, ss, sl, T, J, min_length=1)
     _check_events(r, "hold", hj, hs, hl, T, J, min_length=0)
+    _check_cover(r, np.concatenate([sj, hj]).astype(np.int64), np.concatenate([ss, hs]).astype(np.int64),
+                 np.concatenate([ss + sl, hs + hl]).astype(np.int64), T)
     if len(set(joints)) != len(joints) or any(j >= J for j in joints):
         raise r.error(f"its segmented joints repeat or exceed the skeleton's {J} joints")
     if not (np.all(np.isfinite(v0)) and np.all(np.isfinite(v1))):
@@ -192,8 +195,8 @@ def decode(data: bytes, path: str | os.PathLike | None = None) -> Segmentation:
     for j, (f, v) in keys.items():
         if v.size != 3 * f.size or f.size == 0:
             raise r.error(f"joint {j}'s translation keys: {f.size} frames but {v.size} values")
-        if f[0] < 0 or f[-1] >= T or np.any(np.diff(f) <= 0):
-            raise r.error(f"joint {j}'s translation key frames must increase within 0..{T - 1}")
+        if f[0] != 0 or f[-1] >= T or np.any(np.diff(f) <= 0) or (f.size > 1 and f[-1] != T - 1):
+            raise r.error(f"joint {j}'s translation key frames must increase from 0 (to {T - 1} when they move)")
         if not np.all(np.isfinite(v)) or np.abs(v).max() > MAX_VALUE:
             raise r.error(f"joint {j}'s translation values are not finite numbers within ±{MAX_VALUE:g}")
         keys[j] = (f, v.reshape(-1, 3))
@@ -213,6 +216,20 @@ def decode(data: bytes, path: str | os.PathLike | None = None) -> Segmentation:
 
 #: The largest translation a swings file may hold (file units): far above any take, far below overflow.
 MAX_VALUE = 1e12
+
+
+def _check_cover(r: _Reader, joint: np.ndarray, start: np.ndarray, end: np.ndarray, T: int) -> None:
+    """The swings and holds of every joint that has any run from frame 0 to the last frame (what
+    :func:`~mocycle.swings.segment` writes): a frame count that no record reaches is damage."""
+    if not joint.size:
+        return
+    first = np.full(joint.max() + 1, T, dtype=np.int64)
+    last = np.full(joint.max() + 1, -1, dtype=np.int64)
+    np.minimum.at(first, joint, start)
+    np.maximum.at(last, joint, end)
+    used = np.unique(joint)
+    if np.any(first[used] != 0) or np.any(last[used] != T - 1):
+        raise r.error(f"its swings and holds do not span the take's {T} frames (from 0 to {T - 1})")
 
 
 def _check_events(r: _Reader, what: str, joint, start, length, T: int, J: int, min_length: int) -> None:
