@@ -56,7 +56,8 @@ def check_frames(n_frames: float, n_joints: int = 1, what: str = "the result", p
     frames = f"{n_frames:,.0f}" if n_frames < 1e18 else f"{n_frames:.3g}"
     bound = (f"the limit is {limit:,} frames" if too_long
              else f"the limit is {limit * JOINTS_BUDGET:,} joint-frames")
-    message = (f"{what} would hold {frames} frames × {joints} joint{'s' if joints != 1 else ''} (about {size:,.3g} GiB in memory); "
+    plural = "s" if joints != 1 else ""
+    message = (f"{what} would hold {frames} frames × {joints} joint{plural} (about {size:,.3g} GiB in memory); "
                f"{bound} (set {ENV_MAX_FRAMES} to raise it)")
     if path is not None:
         raise MotionFileError(message, path, line)
