@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -550,7 +551,8 @@ def _parse_amc(text: str, path, asf: AsfSkeleton) -> tuple[list[np.ndarray], str
     labels = (asf.root_order,) + asf.dofs
     lookup = {n: j for j, n in enumerate(names)}
     lower = [n.lower() for n in names]
-    lookup_lower = {n: j for j, n in enumerate(lower) if lower.count(n) == 1}
+    counts = Counter(lower)
+    lookup_lower = {n: j for j, n in enumerate(lower) if counts[n] == 1}
     J = len(names)
     rows: list[list[list[str]]] = [[] for _ in range(J)]
     frames: list[list[int]] = [[] for _ in range(J)]

@@ -60,6 +60,7 @@ class _Header:
     def __init__(self, path):
         self.path = path
         self.names: list[str] = []
+        self.known: set[str] = set()
         self.parents: list[int] = []
         self.offsets: list[tuple[float, float, float] | None] = []
         self.channels: list[tuple[str, ...]] = []
@@ -135,8 +136,9 @@ class _Header:
                 raise self.error(lineno, "found a second ROOT; only one skeleton per file is supported")
             if key == "JOINT" and not (self.stack and self.stack[-1][0] == "joint"):
                 raise self.error(lineno, "JOINT outside of a ROOT or JOINT block")
-            if name in self.names:
+            if name in self.known:
                 raise self.error(lineno, f"joint name {name!r} is used twice")
+            self.known.add(name)
             parent = self.stack[-1][1] if self.stack else -1
             self.pending = ("joint", parent, name)
         elif key == "END" and len(words) >= 2 and words[1].upper() == "SITE":
@@ -366,28 +368,36 @@ def _fmt(x: float) -> str:
 
 
 def format_bvh(motion: Motion) -> str:
-    """The BVH text of ``motion``."""
+    """The BVH text of ``motion`` (written without recursion: any depth of hierarchy)."""
     skel = motion.skeleton
     out = io.StringIO()
     out.write("HIERARCHY\n")
-    children = [skel.children(j) for j in range(skel.n_joints)]
-    sites = [[s for s in skel.end_sites if s.parent == j] for j in range(skel.n_joints)]
-
-    def joint(j: int, depth: int):
+    children: list[list[int]] = [[] for _ in range(skel.n_joints)]
+    for j, p in enumerate(skel.parents.tolist()):
+        if p >= 0:
+            children[p].append(j)
+    sites: list[list[EndSite]] = [[] for _ in range(skel.n_joints)]
+    for site in skel.end_sites:
+        sites[site.parent].append(site)
+    # A stack of ("open", joint, depth) and ("close", joint, depth): depth-first, children in order.
+    stack = [("close", 0, 0), ("open", 0, 0)]
+    while stack:
+        what, j, depth = stack.pop()
         tab = "\t" * depth
+        if what == "close":
+            for s in sites[j]:
+                label = "End Site" + (f" {s.name}" if s.name else "")
+                out.write(f"{tab}\t{label}\n{tab}\t{{\n")
+                out.write(f"{tab}\t\tOFFSET {' '.join(_fmt(v) for v in s.offset)}\n{tab}\t}}\n")
+            out.write(f"{tab}}}\n")
+            continue
         out.write(f"{tab}{'ROOT' if j == 0 else 'JOINT'} {skel.names[j]}\n{tab}{{\n")
         out.write(f"{tab}\tOFFSET {' '.join(_fmt(v) for v in skel.offsets[j])}\n")
         chans = skel.channels[j]
         out.write(f"{tab}\tCHANNELS {len(chans)}{''.join(' ' + c for c in chans)}\n")
-        for c in children[j]:
-            joint(c, depth + 1)
-        for s in sites[j]:
-            label = "End Site" + (f" {s.name}" if s.name else "")
-            out.write(f"{tab}\t{label}\n{tab}\t{{\n")
-            out.write(f"{tab}\t\tOFFSET {' '.join(_fmt(v) for v in s.offset)}\n{tab}\t}}\n")
-        out.write(f"{tab}}}\n")
+        for c in reversed(children[j]):
+            stack += [("close", c, depth + 1), ("open", c, depth + 1)]
 
-    joint(0, 0)
     out.write(f"MOTION\nFrames: {motion.n_frames}\nFrame Time: {motion.frame_time!r}\n")
     values = motion_channels(motion)
     if values.shape[1]:
