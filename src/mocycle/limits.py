@@ -62,3 +62,18 @@ def check_frames(n_frames: float, n_joints: int = 1, what: str = "the result", p
     if path is not None:
         raise MotionFileError(message, path, line)
     raise MocycleError(message)
+
+
+#: The largest magnitude a coordinate, offset or angle may have: far beyond any capture in any unit, and
+#: far below where squares (and squares of sums of squares) overflow float64.
+MAX_MAGNITUDE = 1e30
+#: Frame times outside this range (seconds) are refused: 1 MHz to one frame in about three hours.
+FRAME_TIME_RANGE = (1e-6, 1e4)
+
+
+def frame_time_problem(frame_time: float) -> str | None:
+    """Why ``frame_time`` (seconds) is unusable, or ``None`` when it is fine."""
+    lo, hi = FRAME_TIME_RANGE
+    if not lo <= frame_time <= hi:  # also NaN
+        return f"the frame time must lie within [{lo:g}, {hi:g}] s; got {frame_time!r}"
+    return None

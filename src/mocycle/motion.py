@@ -24,7 +24,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from .errors import MocycleError
-from .limits import check_frames
+from .limits import MAX_MAGNITUDE, check_frames, frame_time_problem
 from .rotations import continuous_quats
 
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
@@ -231,9 +231,13 @@ class Motion:
             trans[:, 0] = rp
         if not np.all(np.isfinite(trans)):
             raise MocycleError("translations contain NaN or infinite values")
+        if trans.size and np.abs(trans).max() > MAX_MAGNITUDE:
+            raise MocycleError(f"translations reach {np.abs(trans).max():.3g}, beyond ±{MAX_MAGNITUDE:g}")
         frame_time = float(frame_time)
         if not np.isfinite(frame_time) or frame_time <= 0:
             raise MocycleError(f"frame time must be a positive number of seconds; got {frame_time}")
+        if frame_time_problem(frame_time):
+            raise MocycleError(frame_time_problem(frame_time))
         rot.setflags(write=False)
         trans.setflags(write=False)
         self.skeleton = skeleton
@@ -357,8 +361,8 @@ class Motion:
         frame is kept; the last new frame is at or before the old last frame.
         """
         fps = float(fps)
-        if not np.isfinite(fps) or fps <= 0:
-            raise MocycleError(f"fps must be a positive number; got {fps}")
+        if not np.isfinite(fps) or fps <= 0 or frame_time_problem(1.0 / fps):
+            raise MocycleError(f"fps must be a positive number within [1e-4, 1e6]; got {fps:g}")
         new_dt = 1.0 / fps
         if self.n_frames == 1:
             return self.replace(frame_time=new_dt)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -11,7 +10,7 @@ import typer
 
 from ..errors import MocycleError
 from ..io import read, write
-from .common import app, check_suffix, count_option, friendly, out
+from .common import FORCE_HELP, app, check_output, count_option, friendly, json_text, out
 
 METHOD_HELP = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."
 MODEL_HELP = "Harmonic model: M1, M2 or M3 (see mocycle loop)."
@@ -51,6 +50,7 @@ def blend(
     align: Annotated[bool, typer.Option(help="Search each take's phase offset against the first.")] = True,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).
 
@@ -63,7 +63,7 @@ def blend(
     t0 = time.perf_counter()
     if len(paths) < 2:
         raise MocycleError(f"blend needs at least two takes; got {len(paths)}")
-    check_suffix(output, ".bvh")
+    check_output(output, paths, force, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     w = _parse_weights(weights, len(paths))
@@ -86,7 +86,7 @@ def blend(
         "seconds": seconds,
     }
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     out.print(f"[bold]blend[/] of {len(paths)} takes, weights "
               + ", ".join(f"{p.name} {x:.3g}" for p, x in zip(paths, result.weights, strict=True)))
@@ -115,6 +115,7 @@ def transition(
     harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
@@ -125,7 +126,7 @@ def transition(
     from ..cycle.blend import transition_smoothness
 
     t0 = time.perf_counter()
-    check_suffix(output, ".bvh")
+    check_output(output, [first, second], force, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     a, b = _read_all([first, second], fps)
@@ -142,7 +143,7 @@ def transition(
         "seconds": seconds,
     }
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     out.print(f"[bold]transition[/] {first.name} -> {second.name} over {cycles} cycle(s)")
     out.print(f"  period {facts['period_frames_start']:.2f} -> {facts['period_frames_end']:.2f} frames; "

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -11,7 +10,7 @@ import typer
 from rich.table import Table
 
 from ..io import read, write
-from .common import app, check_suffix, friendly, out
+from .common import FORCE_HELP, app, check_output, friendly, json_text, out
 
 _SELECT_HELP = "Keyframe selection: uniform, scs (curve simplification), pb (position based) or rols."
 _PROJECTION_HELP = "2-D projection of the spatial scheme: pca, mds, isomap, lle, force, tsne, rbfp or lamp."
@@ -33,12 +32,13 @@ def compress(
     optimize: Annotated[bool, typer.Option("--optimize", help="Optimise the 2-D trajectory (Algorithm 12).")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size."""
     from ..keyframes import compress as compress_motion
     from ..keyframes import error_per_frame_per_joint
 
-    check_suffix(output, ".mck")
+    check_output(output, [path], force, ".mck")
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     packed = compress_motion(motion, ratio=ratio, select=select, scheme=scheme, projection=projection,
@@ -52,7 +52,7 @@ def compress(
              "compressed_bytes": size["compressed_bytes"], "bvh_bytes": size["bvh_bytes"],
              "seconds": time.perf_counter() - t0}
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     what = scheme if scheme != "spatial" else f"spatial/{projection}" + ("/optimised" if optimize else "")
     table = Table(title=f"{path.name} -> {output.name} ({what}, {select} keyframes)")
@@ -74,11 +74,12 @@ def compress(
 def decompress(
     path: Annotated[Path, typer.Argument(help="A .mck file written by 'mocycle compress'.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh file to write.")],
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Rebuild a take from its keyframes; the keyframes come back exactly."""
     from ..keyframes import read_compressed
 
-    check_suffix(output, ".bvh")
+    check_output(output, [path], force, ".bvh")
     packed = read_compressed(path)
     motion = packed.decompress()
     write(motion, output)
@@ -99,10 +100,12 @@ def project(
                                                    "marked (thesis Figure 6.2).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON (includes the 2-D points).")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."""
     from ..keyframes import PoseSpace, keyframe_count, optimize_projection, spatial_layout, stress
 
+    check_output(plot, [path], force, ".png", "--plot")
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     space = PoseSpace(motion)
@@ -124,7 +127,7 @@ def project(
         facts["points"] = points.round(6).tolist()
         if opt is not None:
             facts["points_optimized"] = opt.round(6).tolist()
-        print(json.dumps(facts))
+        print(json_text(facts, indent=None))
         return
     out.print(f"[bold]{path}[/]: {facts['frames']} frames, {len(key)} keyframes ({select}), projection {projection}")
     out.print(f"  stress (eq. 4.1): {facts['stress']:.4g}" + (

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -12,7 +11,7 @@ from rich.table import Table
 
 from ..errors import MocycleError
 from ..io import read, write
-from .common import app, check_suffix, count_option, friendly, out, parse_range
+from .common import FORCE_HELP, app, check_output, count_option, friendly, json_text, out, parse_range
 
 METRIC_LABELS = {
     "template_error": ("template error", "rad"),
@@ -58,6 +57,7 @@ def loop(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: PCA of input and cycle, phase, joint curves.")]
     = None,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
 
@@ -65,8 +65,8 @@ def loop(
     """
     from ..cycle import extract_cycle, loop_metrics
 
-    check_suffix(output, ".bvh", "--output")
-    check_suffix(plot, ".png", "--plot")
+    check_output(output, [path], force, ".bvh", "--output")
+    check_output(plot, [path], force, ".png", "--plot")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     t0 = time.perf_counter()
@@ -102,7 +102,7 @@ def loop(
         "metrics_seconds": metrics_seconds,
     }
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     _print_loop(facts, len(cycle.periodic.excitation), which)
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -12,7 +11,7 @@ from rich.table import Table
 
 from ..errors import MocycleError
 from ..io import read
-from .common import EXIT_NOT_FOUND, app, count_option, err, friendly, out
+from .common import EXIT_NOT_FOUND, FORCE_HELP, app, check_output, count_option, err, friendly, json_text, out
 
 
 @app.command()
@@ -27,6 +26,7 @@ def phase(
     landmarks: Annotated[int, typer.Option(help="Landmarks for the Rips filtration.")] = 120,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: diagram, phase per frame, PCA by phase.")] = None,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
 ):
     """Find periodic motions and the phase of every frame (persistent cohomology).
@@ -36,6 +36,7 @@ def phase(
     """
     from ..phase import find_phase
 
+    check_output(plot, [path], force, ".png", "--plot")
     if delay < 0:
         raise MocycleError(f"--delay must be >= 0; got {delay}")
     t0 = time.perf_counter()
@@ -50,7 +51,7 @@ def phase(
     facts = result.to_dict()
     facts["seconds"] = time.perf_counter() - t0
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
     else:
         _print_phase(path, facts)
     if not result.classes:

@@ -34,6 +34,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError, MocycleWarning, MotionFileError
+from ..limits import MAX_MAGNITUDE, frame_time_problem
 from ..motion import EndSite, Motion, Skeleton
 
 __all__ = ["AsfSkeleton", "read_amc", "read_asf", "read_asfamc"]
@@ -211,8 +212,8 @@ def _frame_time(fps) -> float:
         fps = float(fps)
     except (TypeError, ValueError):
         raise MocycleError(f"fps must be a positive number; got {fps!r}") from None
-    if not math.isfinite(fps) or fps <= 0:
-        raise MocycleError(f"fps must be a positive number; got {fps}")
+    if not math.isfinite(fps) or fps <= 0 or frame_time_problem(1.0 / fps):
+        raise MocycleError(f"fps must be a positive number within [1e-4, 1e6]; got {fps}")
     return 1.0 / fps
 
 
@@ -241,8 +242,9 @@ def _numbers(tokens, count, path, line, what, allow_inf=False) -> list[float]:
             v = float(tok)
         except ValueError:
             raise MotionFileError(f"{what}: expected a number, got {tok!r}", path, line) from None
-        if math.isnan(v) or (math.isinf(v) and not allow_inf):
-            raise MotionFileError(f"{what}: expected a finite number, got {tok!r}", path, line)
+        if math.isnan(v) or (math.isinf(v) and not allow_inf) or (math.isfinite(v) and abs(v) > MAX_MAGNITUDE):
+            raise MotionFileError(f"{what}: expected a finite number within ±{MAX_MAGNITUDE:g}, got {tok!r}",
+                                  path, line)
         out.append(v)
     return out
 
@@ -629,12 +631,13 @@ def _parse_amc(text: str, path, asf: AsfSkeleton) -> tuple[list[np.ndarray], str
                 arr = np.array(rows[j], dtype=np.float64)
             except ValueError:
                 arr = None
-            bad = (np.flatnonzero(~np.all(np.isfinite(arr), axis=1)) if arr is not None
+            bad = (np.flatnonzero(~np.all(np.isfinite(arr) & (np.abs(arr) <= MAX_MAGNITUDE), axis=1))
+                   if arr is not None
                    else [_first_bad_row(rows[j])])
             if len(bad):
                 k = int(bad[0])
                 raise MotionFileError(
-                    f"bone {names[j]!r}: expected {expected[j]} finite numbers "
+                    f"bone {names[j]!r}: expected {expected[j]} finite numbers within ±{MAX_MAGNITUDE:g} "
                     f"({' '.join(labels[j])}), got {' '.join(rows[j][k])!r}", path, lines[j][k])
             data[frames[j]] = arr
         values.append(data)

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import MocycleError, MocycleWarning, MotionFileError
-from ..limits import check_frames
+from ..limits import MAX_MAGNITUDE, check_frames, frame_time_problem
 from ..motion import POSITION_CHANNELS, ROTATION_CHANNELS, EndSite, Motion, Skeleton
 from ..rotations import continuous_euler, euler_to_quats
 from .atomic import atomic_write
@@ -79,8 +79,9 @@ class _Header:
             vals = tuple(float(w) for w in words)
         except ValueError:
             raise self.error(lineno, f"expected {n} numbers after {what}, found {' '.join(words)!r}") from None
-        if not all(np.isfinite(vals)):
-            raise self.error(lineno, f"{what} values must be finite, found {' '.join(words)!r}")
+        if not all(np.isfinite(vals)) or max(map(abs, vals)) > MAX_MAGNITUDE:
+            raise self.error(lineno, f"{what} values must be finite numbers within ±{MAX_MAGNITUDE:g}, "
+                                     f"found {' '.join(words)!r}")
         return vals
 
     def open_node(self, lineno: int):
@@ -222,6 +223,9 @@ def _motion_header(lines: list[str], first: int, path) -> tuple[int | None, floa
         raise MotionFileError(f"expected 'Frame Time: <seconds>', found {lines[i].strip()!r}", path, i + 1) from None
     if not np.isfinite(frame_time) or frame_time <= 0:
         raise MotionFileError(f"Frame Time must be a positive number of seconds, found {val.strip()!r}", path, i + 1)
+    problem = frame_time_problem(frame_time)
+    if problem:
+        raise MotionFileError(f"{problem} (Frame Time: {val.strip()})", path, i + 1)
     return frames, frame_time, i + 1
 
 
@@ -240,7 +244,8 @@ def _parse_rows(lines: list[str], start: int, n_channels: int, path) -> np.ndarr
                 values = np.loadtxt(body, dtype=np.float64, ndmin=2, comments=None)
         except ValueError:
             values = None
-    if values is None or values.shape[1] != n_channels or not np.all(np.isfinite(values)):
+    if (values is None or values.shape[1] != n_channels or not np.all(np.isfinite(values))
+            or (values.size and np.abs(values).max() > MAX_MAGNITUDE)):
         _find_bad_row(body, start, n_channels, path)
     if values.shape[0] == 0:
         raise MotionFileError("no frame rows after 'Frame Time:'; expected at least one", path, len(lines))
@@ -263,8 +268,9 @@ def _find_bad_row(body: list[str], start: int, n_channels: int, path) -> None:
                 v = float(word) if word.isascii() and "_" not in word else np.nan
             except ValueError:
                 v = np.nan
-            if not np.isfinite(v):
-                raise MotionFileError(f"expected a finite number, found {word!r}", path, start + k + 1)
+            if not np.isfinite(v) or abs(v) > MAX_MAGNITUDE:
+                raise MotionFileError(f"expected a finite number within ±{MAX_MAGNITUDE:g}, found {word!r}",
+                                      path, start + k + 1)
     if n_channels == 0:
         raise MotionFileError("the hierarchy declares no channels; nothing to read", path, start)
     raise MotionFileError("no frame rows after 'Frame Time:'; expected at least one", path, start)
