@@ -14,6 +14,7 @@ from typing import Annotated
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 
 from .. import __version__
 from ..errors import MocycleError, NoPeriodicMotion
@@ -46,7 +47,8 @@ def friendly(func: Callable) -> Callable:
                 result = func(*args, **kwargs)
             except MocycleError as exc:
                 _print_warnings(caught)
-                err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
+                message = _naming_the_input(str(exc), kwargs)
+                err.print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
                 raise typer.Exit(EXIT_NOT_FOUND if isinstance(exc, NoPeriodicMotion) else EXIT_ERROR) from None
         _print_warnings(caught)
         return result
@@ -54,11 +56,28 @@ def friendly(func: Callable) -> Callable:
     return wrapper
 
 
+#: The command arguments that name input files.
+INPUT_ARGUMENTS = ("path", "query", "first", "second", "paths")
+
+
+def _naming_the_input(message: str, kwargs: dict) -> str:
+    """``message`` with the input file in front when it names none of the command's files (so that in
+    ``blend`` or ``transition`` the user can tell which take is meant).  Option errors stay as they are."""
+    inputs = []
+    for key in INPUT_ARGUMENTS:
+        value = kwargs.get(key)
+        inputs += [str(v) for v in value] if isinstance(value, (list, tuple)) else [str(value)] if value else []
+    files = inputs + [str(v) for v in kwargs.values() if isinstance(v, Path)]
+    if len(inputs) != 1 or any(f in message for f in files) or message.startswith("-") or " --" in message:
+        return message
+    return f"{inputs[0]}: {message}"
+
+
 def _print_warnings(caught) -> None:
     for w in caught:
         if issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)):
             continue
-        err.print(f"[yellow]warning:[/] {w.message}", markup=True, soft_wrap=True)
+        err.print(f"[yellow]warning:[/] {escape(str(w.message))}", markup=True, soft_wrap=True)
 
 
 def _version(value: bool):

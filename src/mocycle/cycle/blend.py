@@ -153,6 +153,8 @@ def _cycles(takes, labels, extract_options) -> list[Cycle]:
             cycles.append(extract_cycle(take, **extract_options))
         except NoPeriodicMotion as exc:
             raise NoPeriodicMotion(f"{label}: {exc}") from None
+        except MocycleError as exc:  # say which take: the user gave several
+            raise MocycleError(f"{label}: {exc}") from None
     first = cycles[0].space
     for cycle, label in zip(cycles[1:], labels[1:], strict=True):
         if cycle.space.travel != first.travel:

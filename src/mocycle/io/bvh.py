@@ -320,7 +320,7 @@ def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motio
                                   data_start)
         # no row holds data, so the count is only a claim: bound it like a size asked for by an option
         check_frames(frames, skel.n_joints, f"'Frames: {frames}' with no channels", path, data_start - 1)
-        return _motion_from_channels(skel, np.zeros((frames, 0)), frame_time)
+        return _motion_from_channels(skel, np.zeros((frames, 0)), frame_time, path)
     values = _parse_rows(lines, data_start, skel.n_channels, path)
     T = values.shape[0]
     if frames is not None and frames != T:
@@ -328,10 +328,10 @@ def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motio
             f"{path or 'BVH'}: 'Frames: {frames}' but {T} frame rows follow; using the {T} rows",
             MocycleWarning, stacklevel=2,
         )
-    return _motion_from_channels(skel, values, frame_time)
+    return _motion_from_channels(skel, values, frame_time, path)
 
 
-def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float) -> Motion:
+def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float, path=None) -> Motion:
     T, J = values.shape[0], skel.n_joints
     quats = np.zeros((T, J, 4))
     quats[..., 3] = 1.0
@@ -347,7 +347,10 @@ def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float)
         cols = [c for _, cs in items for c in cs]
         angles = values[:, cols].reshape(T, len(joints), len(order))
         quats[:, joints] = euler_to_quats(angles, order, degrees=True)
-    return Motion(skel, quats, trans, frame_time)
+    try:
+        return Motion(skel, quats, trans, frame_time)
+    except MocycleError as exc:
+        raise MotionFileError(f"cannot build a motion from this file: {exc}", path) from None
 
 
 def motion_channels(motion: Motion) -> np.ndarray:
