@@ -118,3 +118,35 @@ def mutated_zlib_file(draw, magic: bytes, payload: bytes) -> bytes:
     if draw(st.integers(0, 3)) == 0:
         return draw(mutated(zlib_file(magic, payload)))
     return zlib_file(magic, draw(mutated(payload)))
+
+
+@st.composite
+def edited_text(draw, base: str, vocab: list[str], max_edits: int = 6) -> str:
+    """``base`` after 1-``max_edits`` edits of characters, words (from ``vocab`` or absurd numbers) or lines."""
+    text = base
+    word = st.one_of(st.sampled_from(vocab), st.sampled_from(["nan", "inf", "-inf", "1e308", "-1e400", "0", "",
+                                                              "1e-320", "99999999999999999999", "#", ":"]),
+                     st.floats().map(repr), st.integers(-3, 10**12).map(str), st.characters().map(str))
+    for _ in range(draw(st.integers(1, max_edits))):
+        lines = text.split("\n")
+        i = draw(st.integers(0, len(lines) - 1))
+        op = draw(st.sampled_from(["word", "word", "char", "dup_line", "drop_line", "swap_lines", "truncate"]))
+        if op == "word":
+            words = lines[i].split(" ")
+            k = draw(st.integers(0, len(words)))
+            words[k:k + draw(st.integers(0, 1))] = [draw(word)] if draw(st.booleans()) else []
+            lines[i] = " ".join(words)
+        elif op == "char":
+            pos = draw(st.integers(0, len(lines[i])))
+            lines[i] = lines[i][:pos] + draw(st.characters()) + lines[i][pos + draw(st.integers(0, 1)):]
+        elif op == "dup_line":
+            lines[i:i + 1] = [lines[i]] * draw(st.integers(2, 4))
+        elif op == "drop_line":
+            del lines[i]
+        elif op == "swap_lines":
+            j = draw(st.integers(0, len(lines) - 1))
+            lines[i], lines[j] = lines[j], lines[i]
+        else:
+            del lines[i:]
+        text = "\n".join(lines)
+    return text

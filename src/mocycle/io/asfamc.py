@@ -37,7 +37,7 @@ from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..limits import MAX_MAGNITUDE, frame_time_problem
 from ..motion import EndSite, Motion, Skeleton
 
-__all__ = ["AsfSkeleton", "read_amc", "read_asf", "read_asfamc"]
+__all__ = ["AsfSkeleton", "parse_amc", "parse_asf", "read_amc", "read_asf", "read_asfamc"]
 
 ROOT = "root"
 ROOT_CHANNELS = ("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")
@@ -181,6 +181,18 @@ class AsfSkeleton:
 def read_asf(path: str | os.PathLike) -> AsfSkeleton:
     """Read an ``.asf`` skeleton file."""
     return _parse_asf(_read_text(path), path)
+
+
+def parse_asf(text: str, path: str | os.PathLike | None = None) -> AsfSkeleton:
+    """Parse ASF text (``path`` only names errors)."""
+    return _parse_asf(text.replace("\r\n", "\n").replace("\r", "\n"), path)
+
+
+def parse_amc(text: str, asf: AsfSkeleton, path: str | os.PathLike | None = None, fps: float = 120.0) -> Motion:
+    """Parse AMC text for skeleton ``asf`` (``path`` only names errors)."""
+    frame_time = _frame_time(fps)
+    values, unit = _parse_amc(text.replace("\r\n", "\n").replace("\r", "\n"), path, asf)
+    return _to_motion(asf, values, unit or asf.angle_unit, frame_time)
 
 
 def read_amc(path: str | os.PathLike, asf: AsfSkeleton | str | os.PathLike,
