@@ -96,7 +96,7 @@ SKELETON = parse_asf(ASF, "fuzz.asf")
 
 
 def _lines(text: str) -> int:
-    return text.count("\n") + 1
+    return text.replace("\r\n", "\n").replace("\r", "\n").count("\n") + 1
 
 
 def check_error(exc: MotionFileError, names: str, text: str) -> None:

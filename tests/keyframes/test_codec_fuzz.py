@@ -97,6 +97,8 @@ def test_absurd_array_shapes(payload, data):
         shape[data.draw(st.integers(0, len(shape) - 1))] = data.draw(st.sampled_from([0, 1, 3, 10**9, 2**32 + 5]))
     if data.draw(st.booleans()):
         entry[1] = data.draw(st.sampled_from(["<f8", "<u4", "|O", "<U9", "V1000000000", ">f8"]))
+    if data.draw(st.booleans()):
+        entry[0] = data.draw(st.sampled_from(["key_idx", "track", "points", "other", ""]))
     check(_join(header, arrays))
 
 

@@ -37,7 +37,7 @@ from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..io.atomic import atomic_write
 from ..io.bvh import format_bvh, parse_bvh
 from ..io.inflate import Inflater
-from ..limits import check_frames
+from ..limits import check_frames, frame_time_problem
 from ..motion import Motion, Skeleton
 from .distance import joint_weights
 from .projection import ONE_STEP, PROJECTIONS, PoseSpace, select_keyframes, spatial_layout
@@ -143,8 +143,9 @@ class Compressed:
         skeleton = h["skeleton"]
         T, J = h["n_frames"], skeleton.n_joints
         shapes = dict(header_shapes(header, z))
-        K = shapes["key_idx"][1][0] if len(shapes["key_idx"][1]) == 1 else -1
-        M = shapes["track_joints"][1][0] if len(shapes["track_joints"][1]) == 1 else -1
+        key_shape, track_shape = shapes.get("key_idx", ("", ()))[1], shapes.get("track_joints", ("", ()))[1]
+        K = key_shape[0] if len(key_shape) == 1 else -1
+        M = track_shape[0] if len(track_shape) == 1 else -1
         expected = {"key_idx": ("<u4", (K,)), "key_rotvec": ("<f8", (K, J, 3)), "track_joints": ("<u2", (M,)),
                     "key_track": ("<f8", (K, M, 3)), "track": ("<f4", (T, M, 3)), "static": ("<f8", (J, 3))}
         if h["scheme"] == "spatial":
@@ -246,8 +247,10 @@ def _check_header(header, z: Inflater) -> dict:
     n_frames, frame_time = header["n_frames"], header["frame_time"]
     if type(n_frames) is not int or n_frames < 2:
         raise z.error(f"n_frames must be a whole number >= 2; found {str(n_frames)[:40]!r}")
-    if type(frame_time) not in (int, float) or not 0 < frame_time < 1e6 or not np.isfinite(1 / frame_time):
-        raise z.error(f"frame_time must be a positive number of seconds; found {str(frame_time)[:40]!r}")
+    if type(frame_time) not in (int, float):
+        raise z.error(f"frame_time must be a number of seconds; found {str(frame_time)[:40]!r}")
+    if frame_time_problem(frame_time):
+        raise z.error(frame_time_problem(frame_time))
     scheme = header["scheme"]
     if scheme not in SCHEMES:
         raise z.error(f"unknown scheme {str(scheme)[:40]!r}; expected one of {', '.join(SCHEMES)}")

@@ -30,7 +30,7 @@ from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..io.atomic import atomic_write
 from ..io.bvh import format_bvh, parse_bvh
 from ..io.inflate import Inflater
-from ..limits import check_frames
+from ..limits import check_frames, frame_time_problem
 from ..motion import Motion, Skeleton
 from .segment import Hold, Segmentation, Swing
 
@@ -149,7 +149,7 @@ def decode(data: bytes, path: str | os.PathLike | None = None) -> Segmentation:
         raise r.error(f"its skeleton does not read as BVH ({exc})") from None
     J = skel.n_joints
     n_frames, frame_time, threshold, window_s = r.unpack("<Idff", "the frame count and time")
-    if n_frames < 1 or not (np.isfinite(frame_time) and 0 < frame_time < 1e6 and np.isfinite(1 / frame_time)):
+    if n_frames < 1 or frame_time_problem(frame_time):
         raise r.error(f"{n_frames} frames of {frame_time!r} s (expected >= 1 frame and a positive frame time)")
     if not (np.isfinite(threshold) and np.isfinite(window_s)):
         raise r.error("its threshold or window is not a finite number")
