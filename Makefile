@@ -1,5 +1,7 @@
 # Two commands on a fresh machine with Python 3.11 and pip:
 #   make demo   set up .venv and run the main job on the built-in synthetic walk
+#               (the core needs numpy, scipy, scikit-learn, ripser; ".[test]" also pulls the
+#               cli and plot extras, typer/rich and matplotlib, which the demo and the tests use)
 #   make test   lint with ruff, run the whole suite with numpy 2.x (.venv) and again
 #               with numpy 1.26 (.venv-numpy1, the line Blender bundles)
 PYTHON ?= $(shell command -v python3.11 || command -v python3)

@@ -1,6 +1,17 @@
-"""Cycle extraction: every method on the walks and runs of ../shared/data, in one table.
+"""Cycle extraction on the walks, runs and dashes of ../shared/data: can the loops be trusted, and every method.
 
-    python benchmarks/cycles.py [--quick] [--data DIR]
+    python benchmarks/cycles.py [--quick] [--data DIR] [--only trust|methods]
+
+**Trust** (issue 11), the ``mocycle loop`` defaults (harmonic M1, the library's loop checks) on every
+Bandai walk, run and dash (45 takes) and the cmu-iclone walks and run: per take the cycle length against
+the legs' own autocorrelation period (paper 004 eq. 1 on the legs' rotations: the gait period), the turn
+per cycle against the take's turn rate (its heading trend's slope times the period), the root's height
+change over 3 cycles of ``--root motion`` (% of the body height), and whether the take was refused and
+why.  Then the goal lines: cycle within 5 % of the gait period; turn within max(10°, 25 %); height creep
+under 1 % of the body height over 3 cycles; no exit-0 cycle longer than the take or fitting worse than
+twice the best plain cut (:mod:`mocycle.cycle.checks`).
+
+**Methods**:
 
 Methods: harmonic regression M1 (FGLS-weighted), M2 (positions only), M3
 (unweighted), all with K = 20 capped by the frames (``"auto"``); the centroid
@@ -37,10 +48,14 @@ from pathlib import Path
 import numpy as np
 
 from mocycle.cycle import extract_cycle, loop_metrics
+from mocycle.cycle.checks import MAX_FIT_RATIO, best_cut_error, loop_checks
+from mocycle.cycle.representation import vertical_axis
 from mocycle.datasets import synthetic_walk
-from mocycle.errors import MocycleError
+from mocycle.errors import MocycleError, NoPeriodicMotion
+from mocycle.features import pose_matrix
 from mocycle.io import read, write
 from mocycle.phase import find_phase
+from mocycle.phase.period import autocorrelation_period
 
 DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 METHODS = (("harmonic", "M1"), ("harmonic", "M2"), ("harmonic", "M3"), ("centroid", None), ("cut", None))
@@ -115,11 +130,116 @@ def speed(runs: int = 5) -> None:
                   f"of 3: {statistics.median(walls):.2f} s")
 
 
+# ------------------------------------------------------------------------------------------------ trust (issue 11)
+TRUST_QUICK = QUICK + ["bandai/dataset-1_dash_happy_001.bvh", "bandai/dataset-1_run_chimpira_001.bvh"]
+PERIOD_GOAL = 0.05      # cycle within 5 % of the gait period
+TURN_GOAL = (10.0, 0.25)  # turn per cycle within max(10 degrees, 25 %) of the take's
+CREEP_GOAL = 1.0        # % of the body height over 3 cycles
+
+
+def trust_inputs(data: Path, quick: bool) -> list[Path]:
+    if not data.is_dir():
+        return []
+    if quick:
+        return [data / p for p in TRUST_QUICK if (data / p).exists()]
+    bandai = sorted((data / "bandai").glob("dataset-1_*.bvh"))
+    return bandai + [data / "cmu-iclone" / f"{n}.bvh" for n in ICLONE if (data / "cmu-iclone" / f"{n}.bvh").exists()]
+
+
+def gait_period(motion) -> float:
+    """The legs' own period (frames): windowed circular autocorrelation of the legs' rotations, lags >= 0.25 s."""
+    X, _ = pose_matrix(motion, rep="quatlog", root="drop", joints="legs")
+    if X.shape[0] < 8:
+        return float("nan")
+    return autocorrelation_period(X, min_lag=max(2, int(round(0.25 / motion.frame_time))))
+
+
+def trust_row(motion) -> dict:
+    """One take through the ``mocycle loop`` defaults: the issue-11 figures, refused or not and why."""
+    row = {"frames": motion.n_frames, "gait": gait_period(motion)}
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            cycle = extract_cycle(motion)
+    except NoPeriodicMotion as exc:
+        return row | {"refused": str(exc), "why": "no periodic motion"}
+    except MocycleError as exc:
+        return row | {"refused": str(exc), "why": "error"}
+    metrics = loop_metrics(motion, cycle)
+    failed = loop_checks(motion, cycle, metrics)
+    up = vertical_axis(motion)
+    W = motion[:: max(1, motion.n_frames // 50)].world_positions(end_sites=True) @ up
+    body = float(np.median(np.ptp(W, axis=1)))
+    N = cycle.n_frames
+    height = cycle.repeat(4, root="motion").world_positions()[:, cycle.space.travel] @ up
+    space = cycle.space
+    psi = space.heading_trend(space.heading(motion.rotation_matrices()[:, space.travel]), cycle.period_frames)
+    rate = np.polyfit(np.arange(motion.n_frames), psi, 1)[0] if motion.n_frames > 1 else 0.0
+    cut, _ = best_cut_error(motion, cycle)
+    row |= {"cycle": N, "period": cycle.period_frames, "periods": cycle.n_periods,
+            "turn": float(np.degrees(cycle.drift[3])), "take_turn": float(np.degrees(rate * cycle.period_frames)),
+            "creep": float(100 * (height[3 * N] - height[0]) / body), "template": metrics["template_error"],
+            "cut": cut, "seam": max(metrics["seam_pose_local"], metrics["seam_velocity_local"]),
+            "refused": "; ".join(f"{f.name}: {f.reason}" for f in failed), "why": ", ".join(f.name for f in failed)}
+    return row
+
+
+def trust(data: Path, quick: bool) -> None:
+    paths = trust_inputs(data, quick)
+    print("## loops you can trust (issue 11): mocycle loop defaults (harmonic M1 + loop checks)")
+    print("gait: the legs' autocorrelation period (frames); cycle: the loop's frames; turn: degrees per cycle, the")
+    print("loop's and the take's (heading trend x period); creep: root height change over 3 cycles of --root motion,")
+    print("% of the body height; fit: template error over the best plain cut's; seam: local seam ratio")
+    print(f"{'take':30s} {'frames':>6s} {'gait':>6s} {'cycle':>6s} {'off%':>6s} {'turn':>6s} {'take':>6s} "
+          f"{'creep%':>7s} {'fit':>5s} {'seam':>5s}  refused")
+    rows = {}
+    for p in paths:
+        name = f"{p.parent.name}/{p.stem.replace('dataset-1_', '').replace('_001', '')}"
+        r = trust_row(read(p))
+        rows[name] = r
+        if "cycle" not in r:
+            print(f"{name[:30]:30s} {r['frames']:6d} {fmt(r['gait']):>6s} {'-':>6s} {'':6s} {'':6s} {'':6s} "
+                  f"{'':7s} {'':5s} {'':5s}  {r['why']}")
+        else:
+            off = 100 * (r["cycle"] / r["gait"] - 1) if np.isfinite(r["gait"]) else float("nan")
+            print(f"{name[:30]:30s} {r['frames']:6d} {fmt(r['gait']):>6s} {r['cycle']:6d} {off:6.1f} "
+                  f"{r['turn']:6.1f} {r['take_turn']:6.1f} {r['creep']:7.3f} {r['template'] / r['cut']:5.2f} "
+                  f"{r['seam']:5.2f}  {r['why'] or '-'}")
+        sys.stdout.flush()
+    made = {n: r for n, r in rows.items() if "cycle" in r}
+    ok = {n: r for n, r in made.items() if not r["refused"]}
+    print(f"\n## goals (trust): {len(rows)} takes, {len(ok)} loops written with exit 0, "
+          f"{len(rows) - len(ok)} refused (exit 3)")
+    period_off = [n for n, r in ok.items() if not abs(r["cycle"] / r["gait"] - 1) <= PERIOD_GOAL]
+    listed = ", ".join(f"{n} ({made[n]['cycle']} vs {made[n]['gait']:.1f})" for n in period_off)
+    print(f"cycle within {PERIOD_GOAL:.0%} of the gait period: {len(ok) - len(period_off)}/{len(ok)}"
+          + (f"; off: {listed}" if period_off else ""))
+    turn_off = [n for n, r in ok.items()
+                if not abs(r["turn"] - r["take_turn"]) <= max(TURN_GOAL[0], TURN_GOAL[1] * abs(r["take_turn"]))]
+    print(f"turn within max({TURN_GOAL[0]:g} deg, {TURN_GOAL[1]:.0%}) of the take's: "
+          f"{len(ok) - len(turn_off)}/{len(ok)}"
+          + (f"; off: {', '.join(turn_off)}" if turn_off else ""))
+    creep = [abs(r["creep"]) for r in made.values()]
+    print(f"height creep < {CREEP_GOAL:g}% of the body height over 3 cycles: "
+          f"{sum(c < CREEP_GOAL for c in creep)}/{len(creep)} (largest {max(creep, default=0):.2g}%)")
+    bad = [n for n, r in ok.items() if r["cycle"] > r["frames"] or r["template"] > MAX_FIT_RATIO * r["cut"]]
+    print(f"exit-0 loops longer than the take or fitting worse than {MAX_FIT_RATIO:g}x the best plain cut: {len(bad)}"
+          + (f" ({', '.join(bad)}; under the fit floor)" if bad else ""))
+    refused = {n: r["refused"] for n, r in rows.items() if r["refused"]}
+    print(f"refused: {len(refused)}" + "".join(f"\n  {n}: {why}" for n, why in refused.items()))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="the synthetic walk and five real takes")
+    parser.add_argument("--quick", action="store_true", help="the synthetic walk and a few real takes")
     parser.add_argument("--data", type=Path, default=DEFAULT_DATA)
+    parser.add_argument("--only", choices=("trust", "methods"), help="run one part only")
     args = parser.parse_args()
+    if args.only != "methods":
+        trust(args.data, args.quick)
+        if args.only == "trust":
+            return
+        print()
     results: dict[str, list[dict]] = {f"{m} {k or ''}".strip(): [] for m, k in METHODS}
     per_file: dict[str, dict[str, dict]] = {}
     head = f"{'file':32s} {'method':11s} " + " ".join(f"{c:>8s}" for c in COLUMNS)

@@ -92,7 +92,7 @@ def test_bad_arguments_are_rejected_with_the_choices():
     m = random_motion(10)
     with pytest.raises(MocycleError, match="euler, expmap"):
         pose_matrix(m, rep="quaternion")
-    with pytest.raises(MocycleError, match="keep, velocity, drop"):
+    with pytest.raises(MocycleError, match="keep, velocity, heading, drop"):
         pose_matrix(m, root="fly")
     with pytest.raises(MocycleError, match="no joint matches"):
         pose_matrix(m, joints=["Tail"])
@@ -126,3 +126,22 @@ def test_root_columns_follow_the_travel_joint_when_the_root_is_static():
     X, dec = pose_matrix(bandai_like, rep="expmap", root="velocity")
     assert np.allclose(X[1:, -3:], np.diff(trans[:, 1], axis=0))
     assert np.allclose(dec.decode(X).translations, trans)
+
+
+@pytest.mark.parametrize("up", ["y", "z"])
+def test_heading_root_features_do_not_depend_on_where_the_walker_faces(up):
+    # paper 001 §4.1: root position and orientation as first differences
+    from mocycle.datasets import synthetic_circle_walk
+
+    straight = synthetic_circle_walk(n_frames=90, fps=30.0, turn_per_cycle_deg=0.0, up=up).motion
+    circle = synthetic_circle_walk(n_frames=90, fps=30.0, turn_per_cycle_deg=90.0, up=up).motion
+    Xs, dec = pose_matrix(straight, rep="expmap", root="heading")
+    Xc, _ = pose_matrix(circle, rep="expmap", root="heading")
+    assert dec.columns[-4:] == ("root:hx", "root:hy", "root:hz", "root:dheading")
+    assert np.allclose(Xc[:, :-4], Xs[:, :-4], atol=1e-9)          # rotations, the root's tilt included
+    turn = np.diff(Xc[:, -1] - Xs[:, -1])
+    assert np.allclose(Xc[1:, -1] - Xs[1:, -1], np.radians(90.0) / 30.0, rtol=1e-6) and np.allclose(turn, 0)
+    speed = np.linalg.norm(Xs[:, -4:-1], axis=1).max()
+    assert np.abs(Xc[:, -4:-1] - Xs[:, -4:-1]).max() < 0.05 * speed  # velocity in the heading frame
+    Xv, _ = pose_matrix(circle, rep="expmap", root="velocity")      # world axes: they turn with the walker
+    assert np.abs(Xv[:, -3:] - Xs[:, -4:-1]).max() > 0.5 * speed

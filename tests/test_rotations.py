@@ -73,3 +73,28 @@ def test_continuous_rotvec_follows_several_full_turns():
     v = continuous_rotvec(r.as_quat()[:, None])[:, 0]
     assert np.allclose(v[:, 1], angle, atol=1e-9)
     assert (Rotation.from_rotvec(v).inv() * r).magnitude().max() < 1e-9
+
+
+def test_small_quaternion_helpers_agree_with_scipy():
+    from mocycle.rotations import axis_angle_quats, quat_conj, quat_multiply, quat_rotvec, rotvec_quat, twist_angles
+
+    axis = np.array([0.0, 0.6, 0.8])
+    theta = np.linspace(-3.0, 3.0, 7)
+    q = axis_angle_quats(axis, theta)
+    assert np.allclose(q, Rotation.from_rotvec(np.outer(theta, axis)).as_quat() * np.sign(np.cos(theta / 2))[:, None])
+    v = np.array([0.3, -0.2, 1.1])
+    assert np.allclose(rotvec_quat(v), Rotation.from_rotvec(v).as_quat())
+    assert np.allclose(quat_rotvec(-rotvec_quat(v)), v)
+    assert np.allclose(quat_multiply(q, quat_conj(q)), [0, 0, 0, 1])
+    assert np.allclose(twist_angles(q, axis), theta)
+
+
+def test_weighted_rotation_mean_checks_its_weights():
+    from mocycle.errors import MocycleError
+    from mocycle.rotations import weighted_rotation_mean
+
+    q = Rotation.random(4, random_state=0).as_quat().reshape(2, 2, 4)
+    with pytest.raises(MocycleError, match="weights"):
+        weighted_rotation_mean(q, [1.0, -1.0])
+    with pytest.raises(MocycleError, match="weights"):
+        weighted_rotation_mean(q, [1.0])

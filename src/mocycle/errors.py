@@ -34,3 +34,12 @@ class MocycleWarning(UserWarning):
 
 class NoPeriodicMotion(MocycleError):
     """The input is fine but holds no periodic motion (the CLI exits with code 3)."""
+
+
+class LoopRefused(MocycleError):
+    """A cycle was made but fails the checks of a loop (:mod:`mocycle.cycle.checks`); the CLI exits with
+    code 3 and ``--force`` writes it anyway.  ``failed``: the failed checks, each with its reason."""
+
+    def __init__(self, message: str, failed=()):
+        super().__init__(message)
+        self.failed = list(failed)

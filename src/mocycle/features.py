@@ -14,7 +14,15 @@ Representations of the joint rotations (``rep``):
               the nearest rotation)
 
 Root translation (``root``): ``keep`` (positions), ``velocity`` (first
-differences per frame, as paper 001 does; row 0 repeats row 1) or ``drop``.
+differences per frame; row 0 repeats row 1), ``heading`` or ``drop``.
+``heading`` is paper 001 §4.1 in full: root position *and orientation* as
+first differences, so nothing depends on where the actor faces.  The root's
+rotation is split into its heading about the vertical axis and its tilt
+(:class:`~mocycle.cycle.representation.CycleSpace` finds the vertical, Y-up
+or Z-up); the tilt replaces the root's rotation columns, and four columns
+follow: the root velocity in the root's own heading frame (3, file units per
+frame) and the heading rate (1, radians per frame).  A walk along a circle
+then gives the same features as a straight one.
 "Root" means ``motion.travel_joint``: the root, or the first joint whose
 translation moves when the root is static (Bandai files move ``Hips``).
 
@@ -35,11 +43,11 @@ from .motion import Motion
 from .rotations import continuous_euler, continuous_rotvec, euler_to_quats, mean_rotations, quat_exp
 
 REPS = ("euler", "expmap", "quatlog", "rotmat")
-ROOTS = ("keep", "velocity", "drop")
+ROOTS = ("keep", "velocity", "heading", "drop")
 _AXES = ("x", "y", "z")
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class PoseDecoder:
     """Turns pose matrices made by :func:`pose_matrix` back into motions.
 
@@ -54,6 +62,7 @@ class PoseDecoder:
     mean, scale : ``(D,)``: ``X = (raw - mean) / scale``.
     reference : ``(J, 4)`` reference quaternions of the ``quatlog`` rep.
     travel : the joint whose translation the root columns hold.
+    frame : with ``root="heading"``, the :class:`HeadingFrame` used.
     """
 
     template: Motion
@@ -66,6 +75,7 @@ class PoseDecoder:
     scale: np.ndarray
     reference: np.ndarray
     travel: int = 0
+    frame: HeadingFrame | None = None
 
     @property
     def n_features(self) -> int:
@@ -75,7 +85,7 @@ class PoseDecoder:
         """The pose matrix of another motion with the same skeleton, same transform."""
         if not motion.skeleton.same_as(self.template.skeleton):
             raise MocycleError("cannot encode a motion whose skeleton differs from the template's")
-        raw = _raw_features(motion, self.rep, self.root, self.joints, self.reference, self.travel)
+        raw = _raw_features(motion, self.rep, self.root, self.joints, self.reference, self.travel, self.frame)
         return (raw - self.mean) / self.scale
 
     def decode(self, X: np.ndarray, frame_time: float | None = None) -> Motion:
@@ -97,12 +107,15 @@ class PoseDecoder:
             quats = tpl.rotations.copy()
             trans = tpl.translations.copy()
         else:
-            mean_q = np.stack([Rotation.from_quat(tpl.rotations[:, j]).mean().as_quat() for j in range(J)])
+            mean_q = mean_rotations(tpl.rotations)
             quats = np.broadcast_to(mean_q, (T, J, 4)).copy()
             trans = np.broadcast_to(tpl.translations.mean(axis=0), (T, J, 3)).copy()
             trans[:, self.travel] = tpl.translations[0, self.travel]
         col = 0
         skel = tpl.skeleton
+        if self.root == "heading":  # the travel joint's columns hold its tilt: start from the template's
+            tilt = self.frame.tilt(tpl)[0]
+            quats[:, self.travel] = tilt if same_length else Rotation.from_quat(tilt).mean().as_quat()
         if self.rep == "euler":
             for order, joints in _joints_by_order(skel, self.joints).items():
                 k = len(order)
@@ -129,7 +142,69 @@ class PoseDecoder:
             v = raw[:, col: col + 3]
             start = tpl.translations[0, self.travel]
             trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
+        elif self.root == "heading":
+            _, psi = self.frame.tilt(tpl[:1])
+            psi = psi[0] + np.concatenate([[0.0], np.cumsum(raw[1:, col + 3])])
+            quats[:, self.travel] = self.frame.turn(quats[:, self.travel], psi)
+            v = self.frame.to_world(raw[1:, col: col + 3], 0.5 * (psi[1:] + psi[:-1]))
+            start = tpl.translations[0, self.travel]
+            trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v, axis=0)])
         return Motion(skel, quats, trans, tpl.frame_time if frame_time is None else frame_time)
+
+
+@dataclass(frozen=True, eq=False)
+class HeadingFrame:
+    """The travel joint's heading about the vertical and the frame it defines (``root="heading"``).
+
+    ``up``: the vertical axis ``(3,)`` in the travel joint's parent frame; ``e1``, ``e2``: a horizontal
+    basis there; ``forward``: the vector in the travel joint's own frame whose horizontal direction is the
+    heading (``up``, ``e1``, ``e2`` as found by :meth:`~mocycle.cycle.representation.CycleSpace.fit`;
+    ``forward`` perpendicular to the joint's mean local up, so it does not depend on the headings).
+    """
+
+    travel: int
+    up: np.ndarray
+    e1: np.ndarray
+    e2: np.ndarray
+    forward: np.ndarray
+
+    @classmethod
+    def fit(cls, motion: Motion) -> HeadingFrame:
+        from .cycle.representation import CycleSpace  # the one vertical-axis detection (Y-up, Z-up rigs)
+
+        space = CycleSpace.fit(motion)
+        # Forward: perpendicular to the joint's mean *local* up direction (R^T up does not change when
+        # the walker turns about up), so the tilt is the same whichever way the take faces.
+        R = Rotation.from_quat(motion.rotations[:: max(1, motion.n_frames // 200), space.travel])
+        local_up = R.inv().apply(space.up).mean(axis=0)
+        if not np.linalg.norm(local_up) > 1e-9:
+            return cls(space.travel, space.up, space.e1, space.e2, space.forward)
+        local_up /= np.linalg.norm(local_up)
+        least = np.eye(3)[int(np.argmin(np.abs(local_up)))]
+        forward = least - local_up * (least @ local_up)
+        return cls(space.travel, space.up, space.e1, space.e2, forward / np.linalg.norm(forward))
+
+    def _about_up(self, angles: np.ndarray) -> Rotation:
+        return Rotation.from_rotvec(np.outer(angles, self.up))
+
+    def tilt(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+        """The travel joint's rotation without its heading ``(T, 4)`` and the unwrapped heading ``(T,)`` rad."""
+        R = Rotation.from_quat(motion.rotations[:, self.travel])
+        f = R.apply(self.forward)
+        psi = np.unwrap(np.arctan2(f @ self.e2, f @ self.e1))
+        return (self._about_up(-psi) * R).as_quat(), psi
+
+    def turn(self, quats: np.ndarray, angles: np.ndarray) -> np.ndarray:
+        """Tilt quaternions ``(T, 4)`` turned to the headings ``angles`` ``(T,)`` rad."""
+        return (self._about_up(angles) * Rotation.from_quat(quats)).as_quat()
+
+    def to_local(self, v: np.ndarray, angles: np.ndarray) -> np.ndarray:
+        """Vectors ``(T, 3)`` of the parent frame in the heading frames at ``angles`` ``(T,)``."""
+        return self._about_up(-angles).apply(v)
+
+    def to_world(self, v: np.ndarray, angles: np.ndarray) -> np.ndarray:
+        """Inverse of :meth:`to_local`."""
+        return self._about_up(angles).apply(v)
 
 
 def _joints_by_order(skel, joints: Iterable[int]) -> dict[str, list[int]]:
@@ -140,10 +215,15 @@ def _joints_by_order(skel, joints: Iterable[int]) -> dict[str, list[int]]:
 
 
 def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
-                  reference: np.ndarray, travel: int) -> np.ndarray:
+                  reference: np.ndarray, travel: int, frame: HeadingFrame | None = None) -> np.ndarray:
     T = motion.n_frames
     js = list(joints)
     parts = []
+    if root == "heading":
+        tilt, psi = frame.tilt(motion)
+        rotations = motion.rotations.copy()
+        rotations[:, travel] = tilt
+        motion = Motion(motion.skeleton, rotations, motion.translations, motion.frame_time)
     if rep == "euler":
         for order, group in _joints_by_order(motion.skeleton, js).items():
             parts.append(continuous_euler(motion.rotations[:, group], order).reshape(T, -1))
@@ -163,6 +243,14 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
         p = motion.translations[:, travel]
         v = np.diff(p, axis=0) if T > 1 else np.zeros((1, 3))
         parts.append(np.concatenate([v[:1], v]) if T > 1 else v)
+    elif root == "heading":
+        if T > 1:
+            mid = 0.5 * (psi[1:] + psi[:-1])
+            v = np.c_[frame.to_local(np.diff(motion.translations[:, travel], axis=0), mid), np.diff(psi)]
+            v = np.concatenate([v[:1], v])
+        else:
+            v = np.zeros((1, 4))
+        parts.append(v)
     return np.concatenate(parts, axis=1) if parts else np.zeros((T, 0))
 
 
@@ -181,7 +269,10 @@ def _columns(motion: Motion, rep: str, root: str, joints) -> tuple[list[str], li
         for j in joints:
             names += [f"{skel.names[j]}:{lab}" for lab in labels]
             owner += [j] * len(labels)
-    if root != "drop":
+    if root == "heading":  # velocity in the heading frame, heading rate
+        names += [f"root:h{a}" for a in _AXES] + ["root:dheading"]
+        owner += [0, 0, 0, 0]
+    elif root != "drop":
         prefix = "v" if root == "velocity" else ""
         names += [f"root:{prefix}{a}" for a in _AXES]
         owner += [0, 0, 0]
@@ -231,7 +322,7 @@ def pose_matrix(
     Parameters
     ----------
     rep : ``"euler"``, ``"expmap"``, ``"quatlog"`` or ``"rotmat"`` (module notes).
-    root : ``"keep"``, ``"velocity"`` or ``"drop"`` for the root translation.
+    root : ``"keep"``, ``"velocity"``, ``"heading"`` or ``"drop"`` for the root (module notes).
     joints : joint names, glob patterns or group names (``"legs"``, ``"arms"``,
         ``"spine"``), a comma-separated string or a list; ``None``: every joint
         with rotation channels.
@@ -245,6 +336,18 @@ def pose_matrix(
     -------
     X : ``(T, D)`` float array.
     decoder : :class:`PoseDecoder` (``decoder.decode(X)`` gives the motion back).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mocycle.datasets import synthetic_walk
+    >>> walk = synthetic_walk(n_frames=300, fps=60).motion
+    >>> X, decoder = pose_matrix(walk, rep="expmap", root="velocity", joints="legs")
+    >>> X.shape, decoder.columns[:2]
+    ((300, 27), ('LeftUpLeg:rx', 'LeftUpLeg:ry'))
+    >>> back = decoder.decode(X)                   # the motion again
+    >>> bool(np.allclose(back.rotations, walk.rotations))
+    True
     """
     if rep not in REPS:
         raise MocycleError(f"rep must be one of {', '.join(REPS)}; got {rep!r}")
@@ -257,9 +360,13 @@ def pose_matrix(
     chosen = tuple(j for j in chosen if skel.euler_order(j))
     if not chosen and root == "drop":
         raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
+    travel = motion.travel_joint
+    frame = HeadingFrame.fit(motion) if root == "heading" else None
     if rep == "quatlog":
         if reference is None:
             ref = mean_rotations(motion.rotations)
+            if frame is not None:  # the travel joint's columns are its tilt: about the mean tilt
+                ref[travel] = mean_rotations(frame.tilt(motion)[0][:, None])[0]
         elif isinstance(reference, Motion):
             ref = reference.rotations[0]
         else:
@@ -268,8 +375,7 @@ def pose_matrix(
                 raise MocycleError(f"reference must be a Motion or ({skel.n_joints}, 4) quaternions")
     else:
         ref = np.tile([0.0, 0.0, 0.0, 1.0], (skel.n_joints, 1))
-    travel = motion.travel_joint
-    raw = _raw_features(motion, rep, root, chosen, ref, travel)
+    raw = _raw_features(motion, rep, root, chosen, ref, travel, frame)
     columns, owner = _columns(motion, rep, root, chosen)
     owner_arr = np.asarray(owner, dtype=np.int64)
     D = raw.shape[1]
@@ -282,7 +388,9 @@ def pose_matrix(
     w = _joint_weights(motion, weights, chosen)
     scale = scale / w[owner_arr]
     X = (raw - mean) / scale
-    decoder = PoseDecoder(motion, rep, root, chosen, tuple(columns), owner_arr, mean, scale, ref, travel)
+    decoder = PoseDecoder(template=motion, rep=rep, root=root, joints=chosen, columns=tuple(columns),
+                          dof_joint=owner_arr, mean=mean, scale=scale, reference=ref, travel=travel,
+                          frame=frame)
     return X, decoder
 
 

@@ -317,7 +317,20 @@ class Motion:
     def world_positions(self, end_sites: bool = False) -> np.ndarray:
         """Forward kinematics: world joint positions ``(T, J, 3)`` in file units.
 
-        With ``end_sites=True`` the End Site points are appended: ``(T, J + E, 3)``.
+        Parameters
+        ----------
+        end_sites : append the End Site points: ``(T, J + E, 3)``.
+
+        Returns
+        -------
+        ``(T, J, 3)`` (or ``(T, J + E, 3)``) float array, joints in skeleton order.
+
+        Examples
+        --------
+        >>> from mocycle.datasets import synthetic_walk
+        >>> walk = synthetic_walk(n_frames=300, fps=60).motion
+        >>> walk.world_positions().shape, walk.world_positions(end_sites=True).shape
+        ((300, 22, 3), (300, 27, 3))
         """
         world_r, world_p = self.world_transforms()
         if not end_sites or not self.skeleton.end_sites:

@@ -1,9 +1,21 @@
-"""Rotation curves that stay continuous in time.
+"""Every rotation helper of the project, in one place.
 
-scipy's ``Rotation`` gives each rotation one canonical Euler triple or rotation
-vector; along a motion those jump by ±360° or switch to the other Euler
-solution.  These helpers pick, frame by frame, the equivalent value closest to
-the previous frame, so curves written to BVH or fed to regressions are smooth.
+Quaternions are ``(x, y, z, w)`` arrays (scipy's order), matrices ``(..., 3, 3)``.
+
+* **Curves continuous in time.**  scipy's ``Rotation`` gives each rotation one canonical
+  Euler triple or rotation vector; along a motion those jump by ±360° or switch to the
+  other Euler solution.  :func:`continuous_euler`, :func:`continuous_rotvec` and
+  :func:`continuous_quats` pick, frame by frame, the equivalent value closest to the
+  previous frame, so curves written to BVH or fed to regressions are smooth.
+* **Vectorised quaternion algebra** on ``(..., 4)`` arrays: :func:`quat_multiply`
+  (about 10× faster than ``Rotation.__mul__`` on 100 000 products), :func:`quat_conj`,
+  :func:`quat_log` / :func:`quat_exp`, :func:`euler_to_quats`, :func:`axis_angle_quats`,
+  :func:`twist_angles`, :func:`quat_angles` (geodesic), :func:`slerp`; single rotations:
+  :func:`rotvec_quat`, :func:`quat_rotvec`.
+* **Matrices**: :func:`axis_rotations` (about one axis), :func:`nearest_rotations` (SVD),
+  :func:`fast_nearest_rotation` (Newton polar iterations), :func:`angle_to_nearest_rotation`.
+* **Means**: :func:`mean_rotations` (per joint over time, scipy), :func:`weighted_rotation_mean`
+  (weighted chordal mean of many sets at once), :func:`mean_quat` (nearby quaternions).
 """
 
 from __future__ import annotations
@@ -12,6 +24,8 @@ import warnings
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from .errors import MocycleError
 
 TWO_PI = 2.0 * np.pi
 
@@ -202,3 +216,169 @@ def mean_rotations(quats: np.ndarray) -> np.ndarray:
     """Mean rotation of each joint over time: ``(T, J, 4)`` -> ``(J, 4)`` (scipy's ``Rotation.mean``)."""
     q = np.asarray(quats, dtype=np.float64)
     return np.stack([Rotation.from_quat(q[:, j]).mean().as_quat() for j in range(q.shape[1])])
+
+
+def weighted_rotation_mean(quats: np.ndarray, weights) -> np.ndarray:
+    """The weighted chordal L2 mean ``(..., 4)`` of rotations ``quats`` ``(K, ..., 4)`` with ``weights (K,)``:
+    the rotation nearest (Frobenius) to ``Σ w_k R_k`` — the mean ``Rotation.mean(weights=)`` computes, for
+    many sets at once.  ``weights``: ``>= 0``, not all zero (normalised here)."""
+    q = np.asarray(quats, dtype=np.float64)
+    try:
+        w = np.asarray(weights, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise MocycleError(f"weights must be numbers, one per rotation set; got {weights!r}") from None
+    if w.size != q.shape[0] or not np.all(np.isfinite(w)) or np.any(w < 0) or w.sum() <= 0:
+        raise MocycleError(f"expected {q.shape[0]} finite weights >= 0, not all zero; got {w.tolist()}")
+    w = w / w.sum()
+    R = Rotation.from_quat(q.reshape(-1, 4)).as_matrix().reshape(*q.shape[:-1], 3, 3)
+    M = np.tensordot(w, R, axes=1)
+    return Rotation.from_matrix(nearest_rotations(M).reshape(-1, 3, 3)).as_quat().reshape(*q.shape[1:])
+
+
+def axis_rotations(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Rotation matrices ``(T, 3, 3)`` about the unit ``axis`` ``(3,)`` by ``angles`` ``(T,)`` radians."""
+    u = np.asarray(axis, dtype=np.float64)
+    c, s = np.cos(angles)[:, None, None], np.sin(angles)[:, None, None]
+    K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
+    return c * np.eye(3) + s * K + (1.0 - c) * np.outer(u, u)
+
+
+def axis_angle_quats(axis: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """Quaternions ``(n, 4)`` of rotations by ``theta`` (n,) radians about one unit ``axis``."""
+    half = 0.5 * np.asarray(theta, dtype=np.float64)
+    return np.concatenate([np.sin(half)[:, None] * np.asarray(axis)[None, :], np.cos(half)[:, None]], axis=1)
+
+
+def rotvec_quat(v: np.ndarray) -> np.ndarray:
+    """Quaternion ``(4,)`` of a rotation vector ``(3,)`` (radians)."""
+    v = np.asarray(v, dtype=np.float64)
+    angle = float(np.linalg.norm(v))
+    if angle < 1e-12:
+        return np.array([0.5 * v[0], 0.5 * v[1], 0.5 * v[2], 1.0]) / np.sqrt(1 + 0.25 * angle**2)
+    return np.concatenate([np.sin(angle / 2) * v / angle, [np.cos(angle / 2)]])
+
+
+def quat_rotvec(q: np.ndarray) -> np.ndarray:
+    """Rotation vector ``(3,)`` (angle ≤ π) of a quaternion ``(4,)``."""
+    q = np.asarray(q, dtype=np.float64)
+    return quat_log(q if q[3] >= 0 else -q)
+
+
+def quat_conj(q: np.ndarray) -> np.ndarray:
+    """Conjugate (the inverse of a unit quaternion) of ``(..., 4)`` quaternions."""
+    return np.asarray(q) * np.array([-1.0, -1.0, -1.0, 1.0])
+
+
+def mean_quat(q: np.ndarray) -> np.ndarray:
+    """Mean ``(4,)`` of nearby quaternions ``(n, 4)``: the sign-aligned normalised sum (chordal mean)."""
+    q = np.asarray(q, dtype=np.float64)
+    q = q * np.where(q @ q[0] < 0, -1.0, 1.0)[:, None]
+    s = q.sum(axis=0)
+    return s / np.linalg.norm(s)
+
+
+def twist_angles(q: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """Angle (radians, unwrapped in time) of the twist of each quaternion ``(n, 4)`` about ``axis``."""
+    return np.unwrap(2.0 * np.arctan2(q[:, :3] @ axis, q[:, 3]))
+
+
+def quat_angles(qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
+    """Geodesic angle (radians, 0..π) between quaternions ``(..., 4)`` → ``(...)``: ``2·arccos|qa·qb|``."""
+    dot = np.abs(np.sum(np.asarray(qa) * np.asarray(qb), axis=-1))
+    return 2.0 * np.arccos(np.minimum(dot, 1.0))
+
+
+def slerp(qa: np.ndarray, qb: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Spherical linear interpolation of quaternions ``(..., 4)`` at fractions ``u`` ``(...)`` (shortest arc)."""
+    qa = np.asarray(qa, dtype=np.float64)
+    qb = np.asarray(qb, dtype=np.float64)
+    u = np.asarray(u, dtype=np.float64)[..., None]
+    dot = np.sum(qa * qb, axis=-1, keepdims=True)
+    qb = np.where(dot < 0, -qb, qb)
+    dot = np.abs(dot)
+    theta = np.arccos(np.minimum(dot, 1.0))
+    s = np.sin(theta)
+    small = s < 1e-9
+    safe = np.where(small, 1.0, s)
+    wa = np.where(small, 1.0 - u, np.sin((1.0 - u) * theta) / safe)
+    wb = np.where(small, u, np.sin(u * theta) / safe)
+    q = wa * qa + wb * qb
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def fast_nearest_rotation(M: np.ndarray, iterations: int = 8) -> np.ndarray:
+    """Same result as :func:`nearest_rotations`, by scaled Newton polar iterations ``X ← (γX + X⁻ᵀ/γ) / 2``.
+
+    Written on the nine matrix entries as separate arrays (closed-form 3×3 inverse),
+    several times faster than batched SVD; matrices with ``det <= 0`` or that do not
+    converge go to the SVD.
+    """
+    M = np.asarray(M, dtype=np.float64)
+    shape = M.shape
+    flat = M.reshape(-1, 9)
+    scale = np.linalg.norm(flat, axis=1) / np.sqrt(3.0)
+    x = flat / np.where(scale > 0, scale, 1.0)[:, None]
+    bad = ~(np.linalg.det(x.reshape(-1, 3, 3)) > 1e-6)
+    x[bad] = np.eye(3).ravel()  # these go to the SVD below
+    x = list(x.T)  # 9 arrays (N,)
+    for _ in range(iterations):
+        a, b, c, d, e, f, g, h, i = x
+        # cofactor matrix (= det · X⁻ᵀ)
+        C = [e * i - f * h, f * g - d * i, d * h - e * g,
+             c * h - b * i, a * i - c * g, b * g - a * h,
+             b * f - c * e, c * d - a * f, a * e - b * d]
+        det = np.maximum(a * C[0] + b * C[1] + c * C[2], 1e-300)
+        gam = det ** (-1.0 / 3.0)
+        k = 1.0 / (gam * det)
+        x = [0.5 * (gam * xv + k * cv) for xv, cv in zip(x, C, strict=True)]
+    X = np.stack(x, axis=1).reshape(-1, 3, 3)
+    err = np.abs(np.einsum("nji,njk->nik", X, X) - np.eye(3)).max(axis=(1, 2))
+    bad |= ~(err < 1e-9)
+    if np.any(bad):
+        X[bad] = nearest_rotations(flat[bad].reshape(-1, 3, 3))
+    return X.reshape(shape)
+
+
+def angle_to_nearest_rotation(N: np.ndarray, iterations: int = 4) -> np.ndarray:
+    """Rotation angle (radians) of the pure rotation nearest to each ``(..., 3, 3)`` matrix ``N``.
+
+    With ``N = R_targetᵀ·M`` this is the geodesic error of the orthonormalised ``M``
+    without forming it: the nearest rotation's quaternion is the top eigenvector of
+    Bar-Itzhack's symmetric 4×4 matrix of ``N``, found by a few power iterations from
+    the column Shepperd's method would pick (exact for a pure rotation; within about
+    1e-4 rad of the SVD answer for the near-rotations RBF interpolation gives).
+    """
+    N = np.asarray(N, dtype=np.float64)
+    shape = N.shape[:-2]
+    return nearest_rotation_angle_entries(list(N.reshape(-1, 9).T), iterations).reshape(shape)
+
+
+def nearest_rotation_angle_entries(n: list, iterations: int = 4) -> np.ndarray:
+    """:func:`angle_to_nearest_rotation` on the nine entries of ``N`` given as separate arrays (row-major)."""
+    norm2 = n[0] * n[0]
+    for v in n[1:]:
+        norm2 = norm2 + v * v
+    s = np.sqrt(3.0) / np.maximum(np.sqrt(norm2), 1e-300)
+    a, b, c, d, e, f, g, h, i = (v * s for v in n)
+    third = 1.0 / 3.0
+    # Bar-Itzhack's matrix (quaternion order x, y, z, w), shifted by 1/3: a rotation's eigenvalues
+    # 1, -1/3, -1/3, -1/3 become 4/3, 0, 0, 0
+    k00, k11, k22, k33 = (a - e - i + 1) * third, (e - a - i + 1) * third, (i - a - e + 1) * third, \
+        (a + e + i + 1) * third
+    k01, k02, k03 = (b + d) * third, (c + g) * third, (h - f) * third
+    k12, k13, k23 = (f + h) * third, (c - g) * third, (d - b) * third
+    # start from the column of the largest diagonal entry (Shepperd): exact for a pure rotation
+    pick = np.argmax(np.stack([k00, k11, k22, k33]), axis=0)
+    p0, p1, p2 = pick == 0, pick == 1, pick == 2
+    x = np.where(p0, k00, np.where(p1, k01, np.where(p2, k02, k03)))
+    y = np.where(p0, k01, np.where(p1, k11, np.where(p2, k12, k13)))
+    z = np.where(p0, k02, np.where(p1, k12, np.where(p2, k22, k23)))
+    w = np.where(p0, k03, np.where(p1, k13, np.where(p2, k23, k33)))
+    for _ in range(iterations):
+        x, y, z, w = (k00 * x + k01 * y + k02 * z + k03 * w, k01 * x + k11 * y + k12 * z + k13 * w,
+                      k02 * x + k12 * y + k22 * z + k23 * w, k03 * x + k13 * y + k23 * z + k33 * w)
+        norm = np.sqrt(x * x + y * y + z * z + w * w)
+        norm = np.where(norm > 0, norm, 1.0)
+        x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    vec = np.sqrt(x * x + y * y + z * z)
+    return 2.0 * np.arctan2(vec, np.abs(w))

@@ -13,7 +13,6 @@ from mocycle.cycle.blend import (
     resample_cycle,
     transition,
     transition_smoothness,
-    weighted_rotation_mean,
 )
 from mocycle.cycle.extract import metric_features
 from mocycle.cycle.metrics import template_error
@@ -21,7 +20,7 @@ from mocycle.datasets import humanoid_skeleton, synthetic_walk
 from mocycle.errors import MocycleError
 from mocycle.io import read
 from mocycle.motion import Motion, Skeleton
-from mocycle.rotations import mean_rotations
+from mocycle.rotations import mean_rotations, weighted_rotation_mean
 
 
 @pytest.fixture(scope="module")

@@ -75,3 +75,43 @@ def test_demo_writes_the_take_the_cycle_and_the_plot(tmp_path):
     for name in ("synthetic_walk.bvh", "walk_cycle.bvh", "walk_cycle_x4.bvh", "walk_cycle.png"):
         assert (tmp_path / name).exists(), name
     assert "periods of" in result.output
+
+
+def test_loop_class_all_writes_one_file_per_periodic_motion(tmp_path):
+    from mocycle.datasets import synthetic_walk_then_run
+
+    take = synthetic_walk_then_run(n_walk=150, n_run=150, fps=30.0, noise_deg=1.0, seed=1)
+    src = write(take.motion, tmp_path / "walk_run.bvh")
+    out = tmp_path / "loop.bvh"
+    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--class", "all", "--json"])
+    assert result.exit_code == 0, result.output
+    loops = json.loads(result.stdout)["loops"]
+    assert [f["output"] for f in loops] == [str(tmp_path / "loop.class0.bvh"), str(tmp_path / "loop.class1.bvh")]
+    assert not out.exists()
+    walk, run = loops
+    assert abs(walk["period_frames"] - 30) < 1 and abs(run["period_frames"] - 21) < 1
+    assert walk["excitation"][-1][1] <= 150 <= run["excitation"][0][0]  # each from its own region
+    assert read(tmp_path / "loop.class1.bvh").n_frames == run["cycle_frames"]
+    for f in loops:
+        assert f["joints_used"] == "all" and f["period_source"] in f["period_candidates"]
+    text = runner.invoke(app, ["loop", str(src), "-o", str(out), "--class", "1"])
+    assert text.exit_code == 0 and "class 1:" in text.output and out.exists()
+    for bad in ("two", "-1"):
+        refused = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.bvh"), "--class", bad])
+        assert refused.exit_code == 1 and "--class" in refused.stderr
+
+
+def test_loop_takes_the_phase_options_and_reports_the_period_decision(tmp_path):
+    src = _walk(tmp_path, 300)
+    out = tmp_path / "cycle.bvh"
+    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--json", "--pca", "6", "--delay", "1",
+                                 "--joints", "legs", "--classes", "1", "--min-periods", "1.5"])
+    assert result.exit_code == 0, result.output
+    facts = json.loads(result.stdout)
+    assert facts["joints_used"] == "legs" and abs(facts["legs_period_frames"] - 60) < 1.5
+    assert facts["half_cycle_doubled"] is False and "cohomology" in facts["period_candidates"]
+    for bad, message in ((["--min-periods", "0.5"], "--min-periods"), (["--delay", "-1"], "--delay")):
+        refused = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.bvh"), *bad])
+        assert refused.exit_code == 1 and message in refused.stderr
+    too_many = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "y.bvh"), "--min-periods", "9"])
+    assert too_many.exit_code == 3 and not (tmp_path / "y.bvh").exists()

@@ -2,9 +2,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from helpers import max_angle, random_motion
-from mocycle.cycle.representation import CycleSpace, axis_rotations, nearest_rotations, vertical_axis
+from mocycle.axes import vertical_axis
+from mocycle.cycle.representation import CycleSpace
 from mocycle.datasets import synthetic_walk
 from mocycle.motion import Motion
+from mocycle.rotations import axis_rotations, nearest_rotations
 
 
 def _rotate_world(motion: Motion, rot: Rotation) -> Motion:

@@ -449,3 +449,39 @@ def _timed(fn) -> float:
     t0 = time.perf_counter()
     fn()
     return time.perf_counter() - t0
+
+
+def test_circle_walk_turns_by_its_turn_per_cycle_on_both_up_axes():
+    from mocycle.cycle.representation import CycleSpace
+    from mocycle.datasets import synthetic_circle_walk
+
+    for up, axis in (("y", 1), ("z", 2)):
+        take = synthetic_circle_walk(n_frames=120, fps=30.0, period_s=1.0, turn_per_cycle_deg=45.0, up=up)
+        space = CycleSpace.fit(take.motion)
+        _, L = space.encode(take.motion)
+        assert np.isclose(np.degrees(L[-1, 3] - L[0, 3]), 45.0 * 119 / 30, atol=1.0)
+        height = take.motion.world_positions()[:, 0, axis]
+        assert 80 < height.mean() < 100  # the hips stay up along the vertical axis
+        path = take.motion.root_positions
+        assert np.linalg.norm(np.diff(path, axis=0), axis=1).max() < 10.0  # continuous
+
+
+def test_walk_then_run_root_path_is_continuous():
+    from mocycle.datasets import synthetic_walk_then_run
+
+    take = synthetic_walk_then_run(n_walk=150, n_run=150, fps=30.0)
+    step = np.linalg.norm(np.diff(take.motion.root_positions, axis=0), axis=1)
+    assert step.max() < 1.2 * np.percentile(step, 99)  # no jump at the switch
+
+
+def test_half_cycle_trap_is_left_right_symmetric():
+    from mocycle.datasets import synthetic_half_cycle_trap
+
+    take = synthetic_half_cycle_trap(n_frames=120, fps=30.0, period_s=1.0)
+    P = take.motion.world_positions()
+    skel = take.motion.skeleton
+    hips = P[:, skel.index("Hips")]
+    # half a cycle later the root is where it was, moved on by half a stride: its height repeats every step
+    assert np.allclose(hips[15:, 1], hips[:-15, 1], atol=1e-6)
+    left, right = P[:, skel.index("LeftFoot")] - hips, P[:, skel.index("RightFoot")] - hips
+    assert np.allclose(left[15:, [1, 2]], right[:-15, [1, 2]], atol=1e-6)  # the feet trade places

@@ -32,8 +32,11 @@ def test_compress_json_then_decompress(walk_file, tmp_path):
     assert r.exit_code == 0, r.output
     facts = json.loads(r.stdout)
     assert set(facts) == {"frames", "keyframes", "error_per_frame_per_joint", "compressed_bytes", "bvh_bytes",
-                          "seconds"}
-    assert facts["frames"] == 240 and facts["keyframes"] == 7
+                          "seconds", "ratio", "period_frames", "keys_per_period", "keyframes_set_by"}
+    # the default ratio 'auto': 4 keys per 60-frame gait period, not the thesis' 3 % (7 keys, 1.75 per period)
+    assert facts["frames"] == 240 and facts["keyframes"] == 17 and facts["ratio"] == "auto"
+    assert abs(facts["period_frames"] - 60) < 2 and facts["keys_per_period"] >= 4
+    assert facts["keyframes_set_by"] == "rhythm"
     assert facts["compressed_bytes"] == mck.stat().st_size < facts["bvh_bytes"] / 5
     out = tmp_path / "w.bvh"
     r = runner.invoke(app, ["decompress", str(mck), "-o", str(out)])
@@ -78,3 +81,11 @@ def test_errors(walk_file, tmp_path, args, msg):
     r = runner.invoke(app, args)
     assert r.exit_code == 1 and msg in r.output
     assert not (tmp_path / "x.bvh").exists() and not (tmp_path / "x.mck").exists()
+
+
+def test_an_explicit_ratio_that_aliases_the_gait_warns(walk_file, tmp_path):
+    r = runner.invoke(app, ["compress", str(walk_file), "-o", str(tmp_path / "w.mck"), "--ratio", "0.03", "--json"])
+    assert r.exit_code == 0, r.output
+    assert "warning:" in r.output and "per period" in r.output and "--ratio auto" in r.output
+    bad = runner.invoke(app, ["compress", str(walk_file), "-o", str(tmp_path / "w.mck"), "--ratio", "x"])
+    assert bad.exit_code == 1 and "'auto' or a number" in bad.output

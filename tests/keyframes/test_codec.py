@@ -30,8 +30,9 @@ def test_round_trip_keeps_keyframes_exactly(walk, kw, tmp_path):
 
 
 def test_spatial_beats_slerp_on_a_periodic_walk(walk):
-    slerp = error_per_frame_per_joint(walk, compress(walk, scheme="slerp").decompress())
-    spatial = error_per_frame_per_joint(walk, compress(walk, scheme="spatial", projection="mds",
+    # at the thesis' 3 % (under 2 keys per gait cycle), where slerp aliases and the 2-D trajectory does not
+    slerp = error_per_frame_per_joint(walk, compress(walk, ratio=0.03, scheme="slerp").decompress())
+    spatial = error_per_frame_per_joint(walk, compress(walk, ratio=0.03, scheme="spatial", projection="mds",
                                                        optimize=True).decompress())
     assert spatial < 0.5 * slerp
 

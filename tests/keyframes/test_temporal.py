@@ -4,8 +4,8 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from helpers import max_angle, random_motion
 from mocycle.errors import MocycleError
-from mocycle.keyframes.temporal import SCHEMES, interpolate_curves, interpolate_rotations, slerp
-from mocycle.rotations import euler_to_quats
+from mocycle.keyframes.temporal import SCHEMES, interpolate_curves, interpolate_rotations
+from mocycle.rotations import euler_to_quats, slerp
 
 
 def test_slerp_matches_scipy():

@@ -5,8 +5,8 @@ from conftest import shared_path
 from mocycle.datasets import synthetic_walk
 from mocycle.errors import MotionFileError
 from mocycle.io import read
+from mocycle.io.mosw import MAGIC
 from mocycle.swings import decode, encode, geodesic_errors, playback, read_swings, segment, size_report, write_swings
-from mocycle.swings.codec import MAGIC
 
 
 @pytest.fixture(scope="module")

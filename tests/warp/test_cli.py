@@ -62,3 +62,14 @@ def test_stretch_errors_are_one_line_and_write_nothing(tmp_path):
 def test_stretch_help():
     result = runner.invoke(app, ["stretch", "--help"])
     assert result.exit_code == 0 and "--factor" in result.output and "--window" in result.output
+
+
+def test_stretch_refuses_a_one_off_gesture_with_exit_3_and_force_warps(tmp_path):
+    from mocycle.datasets import synthetic_gesture
+
+    src = write_bvh(synthetic_gesture(240, fps=60).motion, tmp_path / "gesture.bvh")
+    out = tmp_path / "long.bvh"
+    result = runner.invoke(app, ["stretch", str(src), "--factor", "2", "-o", str(out)])
+    assert result.exit_code == 3 and "no periodic motion to stretch" in result.output and not out.exists()
+    result = runner.invoke(app, ["stretch", str(src), "--factor", "2", "-o", str(out), "--force", "--json"])
+    assert result.exit_code == 0 and "warning:" in result.output and read_bvh(out).n_frames == 480

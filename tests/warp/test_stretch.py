@@ -1,14 +1,15 @@
 import numpy as np
 import pytest
 from scipy.signal import detrend
+from scipy.spatial.transform import Rotation
 
 from conftest import shared_path
 from helpers import max_angle, random_motion
-from mocycle.datasets import humanoid_skeleton, synthetic_still, synthetic_walk
-from mocycle.errors import MocycleError
+from mocycle.datasets import humanoid_skeleton, synthetic_gesture, synthetic_still, synthetic_walk
+from mocycle.errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from mocycle.features import pose_matrix
 from mocycle.io import read
-from mocycle.motion import EndSite, Motion, Skeleton
+from mocycle.motion import EndSite, Motion, Skeleton, concatenate
 from mocycle.warp import fundamental_cycles, group_cycle, joint_groups, stretch_motion, warp_curves
 from mocycle.warp.stretch import refine_window
 
@@ -229,8 +230,10 @@ def test_stretch_rejects_bad_input():
         stretch_motion(take, 2.0, window="big")
     with pytest.raises(MocycleError, match="positive"):
         stretch_motion(take, -1.0)
-    with pytest.raises(MocycleError, match="does not look periodic"):
+    with pytest.raises(NoPeriodicMotion, match="no periodic motion to stretch.*--force"):
         stretch_motion(synthetic_still(200).motion, 2.0)
+    with pytest.warns(MocycleWarning, match="--force"), pytest.raises(MocycleError, match="does not look periodic"):
+        stretch_motion(synthetic_still(200).motion, 2.0, force=True)
 
 
 def test_a_still_group_borrows_the_cycle_of_the_others():
@@ -244,7 +247,11 @@ def test_a_still_group_borrows_the_cycle_of_the_others():
 
 def test_small_random_take_runs_and_keeps_shape():
     m = random_motion(64, seed=2)
-    out, report = stretch_motion(m, 2.0, window=16)
+    with pytest.raises(NoPeriodicMotion):
+        stretch_motion(m, 2.0, window=16)
+    with pytest.warns(MocycleWarning, match="no periodic motion"):
+        out, report = stretch_motion(m, 2.0, window=16, force=True)
+    assert report.forced and report.regions == ()
     assert isinstance(out, Motion) and out.n_frames == 128 and out.skeleton.same_as(m.skeleton)
     assert np.all(np.isfinite(out.rotations)) and np.all(np.isfinite(out.translations))
 
@@ -264,3 +271,72 @@ def test_real_bandai_walk():
     speed_in = np.linalg.norm(np.diff(p_in, axis=0), axis=1).mean()
     speed_out = np.linalg.norm(np.diff(p_out, axis=0), axis=1).mean()
     assert abs(speed_out / speed_in - 1) < 0.05
+
+
+# -- only the periodic part is warped (issue 11, item 8) -------------------------------------------------------------
+
+
+def test_a_one_off_gesture_is_refused_and_force_warps_it_whole():
+    take = synthetic_gesture(240, fps=60).motion
+    with pytest.raises(NoPeriodicMotion, match="no periodic motion to stretch"):
+        stretch_motion(take, 2.0)
+    with pytest.warns(MocycleWarning, match="repeats what happens once"):
+        out, report = stretch_motion(take, 2.0, force=True)
+    assert out.n_frames == 480 and report.forced
+
+
+def _standing_start(stand: int = 90, walk_frames: int = 420):
+    """A walk that starts from standing: the walk's first pose held (with a little sway) for ``stand`` frames."""
+    walk = synthetic_walk(walk_frames, fps=60, period_s=1.0, noise_deg=0.5, seed=5).motion
+    rng = np.random.default_rng(1)
+    q = np.repeat(walk.rotations[:1], stand, axis=0)
+    t = np.repeat(walk.translations[:1], stand, axis=0)
+    sway = Rotation.from_rotvec(np.radians(0.5) * rng.normal(size=(stand * walk.n_joints, 3)))
+    q = (sway * Rotation.from_quat(q.reshape(-1, 4))).as_quat().reshape(q.shape)
+    still = walk.replace(rotations=q, translations=t)
+    return concatenate([still, walk]), stand
+
+
+def test_a_standing_start_is_kept_as_captured_and_only_the_walk_is_stretched():
+    take, stand = _standing_start()
+    out, report = stretch_motion(take, 2.0)
+    assert out.n_frames == 2 * take.n_frames
+    (s, e), = report.regions
+    assert s >= stand - 30 and e == take.n_frames     # the walk, not the standing start
+    assert report.regions_out[0][0] == s and report.regions_out[0][1] == out.n_frames
+    # the standing start comes out once, as captured
+    assert max_angle(out.rotations[:s], take.rotations[:s]) < 1e-9
+    assert np.allclose(out.translations[:s], take.translations[:s])
+    def standing(m):
+        return int((np.linalg.norm(np.diff(m.root_positions, axis=0), axis=1) < 0.05).sum())
+
+    assert standing(out) <= standing(take) + 5       # not a second standing start
+    # no pop at the join: the largest frame step is an ordinary one
+    X, _ = pose_matrix(take, rep="quatlog", root="drop")
+    Y, _ = pose_matrix(out, rep="quatlog", root="drop")
+    assert max_step(Y) <= 1.5 * max_step(X)
+    steps = np.linalg.norm(np.diff(out.root_positions, axis=0), axis=1)
+    assert steps.max() <= 1.5 * np.linalg.norm(np.diff(take.root_positions, axis=0), axis=1).max()
+
+
+def test_a_walk_that_stops_keeps_its_ending_and_walks_further():
+    take, stand = _standing_start()
+    ending = take.replace(rotations=take.rotations[::-1].copy(), translations=take.translations[::-1].copy())  # a stop
+    out, report = stretch_motion(ending, 1.5)
+    (s, e), = report.regions
+    assert s == 0 and e <= ending.n_frames - stand + 30
+    # the walk grows by whole strides (60 frames), so that it ends as captured: about 1.5 times the take
+    assert abs(out.n_frames - 1.5 * ending.n_frames) <= 30 and (out.n_frames - ending.n_frames) % 60 == 0
+    X, _ = pose_matrix(ending, rep="quatlog", root="drop")
+    Y, _ = pose_matrix(out, rep="quatlog", root="drop")
+    assert max_step(Y) <= 1.5 * max_step(X)                                   # no pop where the walk stops
+    assert np.abs(Y).max(axis=0).max() <= 1.05 * np.abs(X).max(axis=0).max()  # and no pose it never had
+    n_end = ending.n_frames - e
+    # the ending is the captured one, moved on by the longer walk (same poses, same relative path)
+    assert max_angle(out.rotations[-n_end:, 1:], ending.rotations[-n_end:, 1:]) < 1e-9
+    rel_in = ending.root_positions[-n_end:] - ending.root_positions[-n_end]
+    rel_out = out.root_positions[-n_end:] - out.root_positions[-n_end]
+    assert np.abs(rel_out - rel_in).max() < 1e-6 * (1 + np.abs(rel_in).max()) + 1e-6
+    walked_in = np.linalg.norm(ending.root_positions[e - 1] - ending.root_positions[0])
+    walked_out = np.linalg.norm(out.root_positions[-n_end - 1] - out.root_positions[0])
+    assert walked_out > 1.3 * walked_in

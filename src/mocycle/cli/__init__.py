@@ -16,7 +16,7 @@ from __future__ import annotations
 import signal
 import sys
 
-__all__ = ["app", "main", "motion_info"]
+__all__ = ["app", "guarded", "main", "motion_info", "run"]
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT
 EXIT_TERMINATED = 143  # 128 + SIGTERM
@@ -50,16 +50,26 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def main() -> None:  # the console script
-    """Run the command line; Ctrl-C exits 130 and SIGTERM 143, each with one line, no traceback."""
+def run() -> None:
+    """The command line itself (no signal handling: see :func:`main`)."""
+    _commands().app()
+
+
+def guarded(body=run) -> None:
+    """Run ``body`` with SIGINT and SIGTERM turned into a clean unwind: exit 130 / 143 with one line."""
     for sig in (signal.SIGINT, signal.SIGTERM):
         try:
             signal.signal(sig, _on_signal)
         except (ValueError, OSError):  # not the main thread, or no such signal here
             pass
     try:
-        _commands().app()
+        body()
     except (Stopped, KeyboardInterrupt) as exc:
         code = exc.code if isinstance(exc, Stopped) else EXIT_INTERRUPTED
         print("terminated" if code == EXIT_TERMINATED else "interrupted", file=sys.stderr)
         sys.exit(code)
+
+
+def main() -> None:  # the console script (through mocycle.__main__)
+    """Run the command line; Ctrl-C exits 130 and SIGTERM 143, each with one line, no traceback."""
+    guarded(run)

@@ -9,12 +9,31 @@ from typing import Annotated
 import typer
 
 from ..errors import MocycleError
-from ..io import read, write
-from .common import FORCE_HELP, app, check_output, count_option, friendly, json_text, out
+from ..io import read_motion as read
+from ..io import write
+from .common import (
+    ClassesOption,
+    DelayOption,
+    JointsOption,
+    MinPeriodsOption,
+    PcaOption,
+    app,
+    check_output,
+    count_option,
+    friendly,
+    json_text,
+    out,
+    phase_options,
+)
 
 METHOD_HELP = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."
 MODEL_HELP = "Harmonic model: M1, M2 or M3 (see mocycle loop)."
 HARMONICS_HELP = "Harmonics K: 'auto' (20, capped by the frames) or a number."
+WhichOption = Annotated[int | None, typer.Option(
+    "--class", min=0, help="Which periodic motion of each take to use (0-based; default: the one covering most "
+                           "frames).")]
+FORCE_HELP = ("Use a take's cycle even when it fails a loop check (a warning names the check); also lets the "
+              "output replace an input file.")
 
 
 def _parse_weights(text: str | None, n: int) -> list[float] | None:
@@ -48,6 +67,12 @@ def blend(
     model: Annotated[str, typer.Option(help=MODEL_HELP)] = "M1",
     harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
     align: Annotated[bool, typer.Option(help="Search each take's phase offset against the first.")] = True,
+    joints: JointsOption = None,
+    classes: ClassesOption = "auto",
+    which: WhichOption = None,
+    pca: PcaOption = "auto",
+    delay: DelayOption = 2,
+    min_periods: MinPeriodsOption = 1.2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
@@ -56,7 +81,8 @@ def blend(
 
     Each take's cycle is extracted, brought to the first one's phase, resampled to the weighted period and
     averaged with the weights in rotation space; root sway and travel per cycle are blended likewise.
-    Exit code 0 on success, 3 when a take holds no periodic motion, 1 for bad input.
+    Exit code 0 on success, 3 when a take holds no periodic motion or its cycle fails a loop check (see
+    mocycle loop), 1 for bad input.
     """
     from ..cycle.blend import blend_cycles, check_weights, cycle_seam
 
@@ -69,9 +95,11 @@ def blend(
     w = _parse_weights(weights, len(paths))
     if w is not None:
         check_weights(w, len(paths))  # refuse bad weights before the (slower) extraction
+    options = phase_options(joints, classes, pca, delay, min_periods)
     motions = _read_all(paths, fps)
     result = blend_cycles(motions, w, align=align, labels=[str(p) for p in paths], method=method, model=model,
-                          n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
+                          n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}), which=which,
+                          force=force, **options)
     write(result.repeat(cycles, root=root), output)
     seconds = time.perf_counter() - t0
     facts = {
@@ -113,6 +141,12 @@ def transition(
     method: Annotated[str, typer.Option(help=METHOD_HELP)] = "harmonic",
     model: Annotated[str, typer.Option(help=MODEL_HELP)] = "M1",
     harmonics: Annotated[str, typer.Option(help=HARMONICS_HELP)] = "auto",
+    joints: JointsOption = None,
+    classes: ClassesOption = "auto",
+    which: WhichOption = None,
+    pca: PcaOption = "auto",
+    delay: DelayOption = 2,
+    min_periods: MinPeriodsOption = 1.2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
@@ -120,7 +154,8 @@ def transition(
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
     The weight moves by a smoothstep over the cycles; period and phase stay continuous (the phase is
-    integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion.
+    integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion or its
+    cycle fails a loop check (see mocycle loop).
     """
     from ..cycle.blend import transition as make_transition
     from ..cycle.blend import transition_smoothness
@@ -129,9 +164,11 @@ def transition(
     check_output(output, [first, second], force, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
+    options = phase_options(joints, classes, pca, delay, min_periods)
     a, b = _read_all([first, second], fps)
     result = make_transition(a, b, cycles, root=root, labels=[str(first), str(second)], method=method,
-                             model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}))
+                             model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}),
+                             which=which, force=force, **options)
     write(result.motion, output)
     seconds = time.perf_counter() - t0
     facts = {

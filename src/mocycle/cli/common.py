@@ -17,7 +17,7 @@ from rich.console import Console
 from rich.markup import escape
 
 from .. import __version__
-from ..errors import MocycleError, NoPeriodicMotion
+from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 
 app = typer.Typer(
     name="mocycle",
@@ -32,12 +32,12 @@ err = Console(stderr=True, highlight=False)
 FORCE_HELP = "Allow an output to replace one of the input files."
 
 EXIT_ERROR = 1
-EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion
+EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion, or its cycle is not a loop
 
 
 def friendly(func: Callable) -> Callable:
-    """Run a command: MocycleError -> one 'error:' line and exit 1 (3 for NoPeriodicMotion); warnings ->
-    'warning:' lines."""
+    """Run a command: MocycleError -> one 'error:' line and exit 1 (3 for NoPeriodicMotion and LoopRefused);
+    warnings -> 'warning:' lines."""
 
     @wraps(func)
     def wrapper(*args, **kwargs):
@@ -49,7 +49,8 @@ def friendly(func: Callable) -> Callable:
                 _print_warnings(caught)
                 message = _naming_the_input(str(exc), kwargs)
                 err.print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
-                raise typer.Exit(EXIT_NOT_FOUND if isinstance(exc, NoPeriodicMotion) else EXIT_ERROR) from None
+                refused = isinstance(exc, (NoPeriodicMotion, LoopRefused))
+                raise typer.Exit(EXIT_NOT_FOUND if refused else EXIT_ERROR) from None
         _print_warnings(caught)
         return result
 
@@ -215,3 +216,30 @@ def json_text(facts, indent: int | None = 2) -> str:
     if nulls and isinstance(out, dict):
         out["null_because_not_finite"] = nulls
     return json.dumps(out, indent=indent, allow_nan=False)
+
+
+# ------------------------------------------------------- the phase options
+# What ``phase`` takes to find the periodic motion; ``loop``, ``blend`` and ``transition`` take the same.
+JointsOption = Annotated[str | None, typer.Option(
+    help="Joints to find the phase on: names, glob patterns or groups (legs, arms, spine), comma-separated; "
+         "default the whole body, then legs, then arms until one shows a periodic motion.")]
+ClassesOption = Annotated[str, typer.Option(help="How many periodic motions to look for: 'auto' or N.")]
+PcaOption = Annotated[str, typer.Option(help="PCA dimensions before the cohomology: 'auto' (8), N or 'none'.")]
+DelayOption = Annotated[int, typer.Option(help="Delay embedding factor m (KTH thesis eq. 3.26; it used 2).")]
+MinPeriodsOption = Annotated[float, typer.Option(
+    help="Periods a periodic motion must cover (>= 1); below 1.5 the result is kept with a warning.")]
+
+
+def phase_options(joints: str | None, classes: str, pca: str, delay: int, min_periods: float) -> dict:
+    """The phase options of the command line as keyword arguments of ``find_phase``/``extract_cycle``."""
+    if delay < 0:
+        raise MocycleError(f"--delay must be >= 0; got {delay}")
+    if not min_periods >= 1.0:
+        raise MocycleError(f"--min-periods must be a number >= 1; got {min_periods:g}")
+    return {
+        "joints": joints,
+        "classes": count_option(classes, "--classes", {"auto": "auto"}),
+        "pca": count_option(pca, "--pca", {"auto": "auto", "none": None, "0": None}),
+        "delay": delay,
+        "min_periods": min_periods,
+    }

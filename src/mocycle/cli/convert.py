@@ -8,8 +8,16 @@ from typing import Annotated
 import typer
 
 from ..errors import MocycleError
-from ..io import read, write
-from .common import FORCE_HELP, app, check_output, friendly, out, parse_range
+from ..io import read_motion as read
+from ..io import write
+from .common import (
+    FORCE_HELP,
+    app,
+    check_output,
+    friendly,
+    out,
+    parse_range,
+)
 
 
 @app.command()

@@ -10,8 +10,14 @@ import numpy as np
 import typer
 
 from ..errors import MocycleError
-from ..io import read, write
-from .common import app, check_folder, friendly, out
+from ..io import read_motion as read
+from ..io import write
+from .common import (
+    app,
+    check_folder,
+    friendly,
+    out,
+)
 
 
 @app.command()

@@ -10,7 +10,7 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ..io import read
+from ..io import read_motion as read
 from ..io.bvh import motion_channels
 from ..motion import Motion
 from .common import app, friendly, json_text, out

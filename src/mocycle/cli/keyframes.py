@@ -9,12 +9,28 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from ..io import read, write
-from .common import FORCE_HELP, app, check_output, friendly, json_text, out
+from ..errors import MocycleError
+from ..io import read_motion as read
+from ..io import write
+from .common import (
+    FORCE_HELP,
+    app,
+    check_output,
+    friendly,
+    json_text,
+    out,
+)
 
 _SELECT_HELP = "Keyframe selection: uniform, scs (curve simplification), pb (position based) or rols."
 _PROJECTION_HELP = "2-D projection of the spatial scheme: pca, mds, isomap, lle, force, tsne, rbfp or lamp."
 _SEED_HELP = "First-step projection of rbfp and lamp (the keyframes' 2-D places): pca, mds, isomap, lle, force, tsne."
+
+
+def _ratio(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise MocycleError(f"--ratio must be 'auto' or a number in (0, 1]; got {text!r}") from None
 
 
 @app.command()
@@ -22,7 +38,9 @@ _SEED_HELP = "First-step projection of rbfp and lamp (the keyframes' 2-D places)
 def compress(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="The .mck file to write.")],
-    ratio: Annotated[float, typer.Option(help="Keyframes as a fraction of the frames (thesis: 0.03).")] = 0.03,
+    ratio: Annotated[str, typer.Option(
+        help="Keyframes as a fraction of the frames (thesis: 0.03), or 'auto': 4 per period of the take's own "
+             "rhythm, at least 3% and 6 keys.")] = "auto",
     select: Annotated[str, typer.Option(help=_SELECT_HELP)] = "uniform",
     scheme: Annotated[str, typer.Option(
         help="Reconstruction: linear, hermite (Euler angles), slerp (quaternions), rbf (1-D RBF in time) or "
@@ -34,20 +52,28 @@ def compress(
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
-    """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size."""
+    """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size.
+
+    The default ratio 'auto' keeps enough keys for the motion's own rhythm; an explicit ratio that leaves
+    fewer than 4 keys per period gets a warning.
+    """
     from ..keyframes import compress as compress_motion
-    from ..keyframes import error_per_frame_per_joint
+    from ..keyframes import error_per_frame_per_joint, keyframe_density
 
     check_output(output, [path], force, ".mck")
+    r = ratio if ratio == "auto" else _ratio(ratio)
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
-    packed = compress_motion(motion, ratio=ratio, select=select, scheme=scheme, projection=projection,
+    density = keyframe_density(motion, r, scheme)
+    packed = compress_motion(motion, count=density.count, select=select, scheme=scheme, projection=projection,
                              optimize=optimize, seed=seed)
     rebuilt = packed.decompress()
     packed.save(output)
     bvh_bytes = path.stat().st_size if path.suffix.lower() == ".bvh" else None
     size = packed.size_report(bvh_bytes)
-    facts = {"frames": motion.n_frames, "keyframes": packed.n_keyframes,
+    facts = {"frames": motion.n_frames, "keyframes": packed.n_keyframes, "ratio": r,
+             "period_frames": density.period_frames, "keys_per_period": density.keys_per_period,
+             "keyframes_set_by": density.rule,
              "error_per_frame_per_joint": error_per_frame_per_joint(motion, rebuilt),
              "compressed_bytes": size["compressed_bytes"], "bvh_bytes": size["bvh_bytes"],
              "seconds": time.perf_counter() - t0}
@@ -59,7 +85,9 @@ def compress(
     table.add_column("")
     table.add_column("value", justify="right")
     table.add_row("frames", str(facts["frames"]))
-    table.add_row("keyframes", f"{facts['keyframes']} ({size['keyframe_ratio']:.1%})")
+    table.add_row("keyframes", f"{facts['keyframes']} ({size['keyframe_ratio']:.1%}, set by {density.rule})")
+    if density.period_frames is not None:
+        table.add_row("keys per period", f"{density.keys_per_period:.1f} (period {density.period_frames:.1f} frames)")
     table.add_row("error per frame per joint (eq. 3.2, rad)", f"{facts['error_per_frame_per_joint']:.4f}")
     table.add_row("compressed bytes", f"{facts['compressed_bytes']:,}")
     table.add_row("BVH bytes", f"{facts['bvh_bytes']:,}")

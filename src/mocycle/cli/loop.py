@@ -10,8 +10,23 @@ import typer
 from rich.table import Table
 
 from ..errors import MocycleError
-from ..io import read, write
-from .common import FORCE_HELP, app, check_output, count_option, friendly, json_text, out, parse_range
+from ..io import read_motion as read
+from ..io import write
+from .common import (
+    ClassesOption,
+    DelayOption,
+    JointsOption,
+    MinPeriodsOption,
+    PcaOption,
+    app,
+    check_output,
+    count_option,
+    friendly,
+    json_text,
+    out,
+    parse_range,
+    phase_options,
+)
 
 METRIC_LABELS = {
     "template_error": ("template error", "rad"),
@@ -44,12 +59,15 @@ def loop(
     = "inplace",
     frame_range: Annotated[str | None, typer.Option("--range", help="Use frames START:STOP of the take.")] = None,
     step: Annotated[int, typer.Option(help="Find the phase on every STEP-th frame (faster on long takes).")] = 1,
-    joints: Annotated[str | None, typer.Option(
-        help="Joints to find the phase on (names, globs, legs/arms/spine); every joint is looped.")] = None,
+    joints: JointsOption = None,
     cycles: Annotated[int, typer.Option(help="Repeat the cycle this many times in the output.")] = 1,
-    classes: Annotated[str, typer.Option(help="How many periodic motions to look for: 'auto' or N.")] = "auto",
-    which: Annotated[int | None, typer.Option(
-        "--class", help="Which periodic motion to loop (0-based; default: the one covering most frames).")] = None,
+    classes: ClassesOption = "auto",
+    which: Annotated[str | None, typer.Option(
+        "--class", help="Which periodic motion to loop (0-based; default: the one covering most frames), or "
+                        "'all': one file per periodic motion, OUT.class0.bvh, OUT.class1.bvh, ...")] = None,
+    pca: PcaOption = "auto",
+    delay: DelayOption = 2,
+    min_periods: MinPeriodsOption = 1.2,
     time_axis: Annotated[str, typer.Option(
         "--time", help="Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) or line.")]
     = "smooth",
@@ -57,61 +75,99 @@ def loop(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: PCA of input and cycle, phase, joint curves.")]
     = None,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
-    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Write the cycle even when it fails a loop check (longer than the take, fits much "
+                        "worse than a plain cut, seam jumps); a warning names the check. It also lets an output "
+                        "replace an input file.")] = False,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
 
-    Exit code 0 on success, 3 when the take holds no periodic motion, 1 for bad input.
+    Exit code 0 on success, 3 when the take holds no periodic motion or its cycle fails a loop check
+    (the reason is printed; --force writes it anyway), 1 for bad input.
     """
-    from ..cycle import extract_cycle, loop_metrics
+    from ..cycle import cycle_phase, extract_cycle, loop_metrics
+    from ..cycle.checks import check_loop
 
     check_output(output, [path], force, ".bvh", "--output")
     check_output(plot, [path], force, ".png", "--plot")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
+    everything = which == "all"
+    chosen = None if which is None or everything else _class_number(which)
+    options = phase_options(joints, classes, pca, delay, min_periods)
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     start, stop = parse_range(frame_range, motion.n_frames)
     motion = motion[start:stop]
-    cycle = extract_cycle(
-        motion, method=method, model=model, n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}),
-        time_axis_method=time_axis, joints=joints, classes=count_option(classes, "--classes", {"auto": "auto"}),
-        which=which, phase_step=step)
-    result = cycle.repeat(cycles, root=root)
-    write(result, output)
-    seconds = time.perf_counter() - t0
-    t1 = time.perf_counter()
-    metrics = loop_metrics(motion, cycle)
-    metrics_seconds = time.perf_counter() - t1
-    if plot is not None:
-        from ..viz import plot_loop
+    phase = cycle_phase(motion, phase_step=step, **options)
+    targets = [(k, output.with_suffix(f".class{k}.bvh")) for k in range(len(phase.classes))] if everything \
+        else [(chosen, output)]
+    if everything and not targets:
+        targets = [(None, output)]  # extract_cycle says why there is nothing to loop
+    made, metrics_seconds = [], 0.0
+    for k, target in targets:  # every cycle is made and checked before any file is written
+        cycle = extract_cycle(
+            motion, method=method, model=model,
+            n_harmonics=count_option(harmonics, "--harmonics", {"auto": "auto"}), time_axis_method=time_axis,
+            which=k, phase=phase)
+        t1 = time.perf_counter()
+        metrics = loop_metrics(motion, cycle)
+        label = f"{path} class {k}" if everything else str(path)
+        failed = check_loop(motion, cycle, metrics, force=force, label=label)
+        metrics_seconds += time.perf_counter() - t1
+        made.append((target, cycle, cycle.repeat(cycles, root=root), metrics, failed))
+    seconds = time.perf_counter() - t0 - metrics_seconds
+    reports = []
+    for target, cycle, result, metrics, failed in made:
+        write(result, target)
+        k = next(i for i, c in enumerate(phase.classes) if c is cycle.periodic)
+        if plot is not None:
+            from ..viz import plot_loop
 
-        plot_loop(motion, cycle, plot, title=f"{path.name}: {method}{' ' + model if method == 'harmonic' else ''}")
-    facts = {
-        "file": str(path),
-        "output": str(output),
-        "frames_in": motion.n_frames,
-        "frames_out": result.n_frames,
-        "fps": motion.fps,
-        **cycle.to_dict(),
-        "model": model if method == "harmonic" else None,
-        "root": root,
-        "cycles": cycles,
-        "metrics": metrics,
-        "seconds": seconds,
-        "metrics_seconds": metrics_seconds,
-    }
+            image = plot.with_suffix(f".class{k}.png") if everything else plot
+            plot_loop(motion, cycle, image,
+                      title=f"{path.name}: {method}{' ' + model if method == 'harmonic' else ''}")
+        reports.append({
+            "file": str(path),
+            "output": str(target),
+            "class": k,
+            "frames_in": motion.n_frames,
+            "frames_out": result.n_frames,
+            "fps": motion.fps,
+            **cycle.to_dict(),
+            "excitation": [[int(s), int(e)] for s, e in cycle.axis.regions],
+            "model": model if method == "harmonic" else None,
+            "root": root,
+            "cycles": cycles,
+            "metrics": metrics,
+            "failed_checks": [f.to_dict() for f in failed],
+            "seconds": seconds,
+            "metrics_seconds": metrics_seconds,
+        })
     if as_json:
-        print(json_text(facts))
+        print(json_text({"file": str(path), "loops": reports} if everything else reports[0]))
         return
-    _print_loop(facts, len(cycle.periodic.excitation), which)
+    for facts, (_, cycle, *_) in zip(reports, made, strict=True):
+        _print_loop(facts, len(cycle.periodic.excitation), which)
+
+
+def _class_number(text: str) -> int:
+    try:
+        k = int(text)
+    except ValueError:
+        k = -1
+    if k < 0:
+        raise MocycleError(f"--class must be a class number (0, 1, ...) or 'all'; got {text!r}")
+    return k
 
 
 def _print_loop(facts: dict, n_regions: int, which: int | None) -> None:
     kind = facts["method"] + (f" {facts['model']}, K = {facts['harmonics']}" if facts["method"] == "harmonic" else "")
     out.print(f"[bold]{facts['file']}[/]: {facts['frames_in']} frames at {facts['fps']:.6g} fps")
-    out.print(f"  {facts['n_periods']:.2f} periods of {facts['period_frames']:.2f} frames "
-              f"(time axis: {facts['time_axis']}, {n_regions} excited region(s))")
+    out.print(f"  class {facts['class']}: {facts['n_periods']:.2f} periods of {facts['period_frames']:.2f} frames "
+              f"(time axis: {facts['time_axis']}, {n_regions} excited region(s): "
+              + ", ".join(f"{s}-{e}" for s, e in facts["excitation"]) + f"; joints used: {facts['joints_used']})")
+    out.print(f"  period: {facts['period_reason']}", soft_wrap=True)
     move = facts["travel_per_cycle"]
     out.print(f"  cycle: {facts['cycle_frames']} frames by {kind}; travel per cycle "
               f"({move[0]:.3g}, {move[1]:.3g}, {move[2]:.3g}), turn {facts['turn_per_cycle_deg']:.3g}°")

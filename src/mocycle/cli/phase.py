@@ -9,20 +9,34 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from ..errors import MocycleError
-from ..io import read
-from .common import EXIT_NOT_FOUND, FORCE_HELP, app, check_output, count_option, err, friendly, json_text, out
+from ..io import read_motion as read
+from .common import (
+    EXIT_NOT_FOUND,
+    FORCE_HELP,
+    ClassesOption,
+    DelayOption,
+    JointsOption,
+    MinPeriodsOption,
+    PcaOption,
+    app,
+    check_output,
+    err,
+    friendly,
+    json_text,
+    out,
+    phase_options,
+)
 
 
 @app.command()
 @friendly
 def phase(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
-    classes: Annotated[str, typer.Option(help="Number of periodic motions: 'auto' or N.")] = "auto",
-    joints: Annotated[str | None, typer.Option(
-        help="Joints to use: names, glob patterns or groups (legs, arms, spine), comma-separated.")] = None,
-    pca: Annotated[str, typer.Option(help="PCA dimensions before the cohomology: 'auto' (8), N or 'none'.")] = "auto",
-    delay: Annotated[int, typer.Option(help="Delay embedding factor m (KTH thesis eq. 3.26; it used 2).")] = 2,
+    classes: ClassesOption = "auto",
+    joints: JointsOption = None,
+    pca: PcaOption = "auto",
+    delay: DelayOption = 2,
+    min_periods: MinPeriodsOption = 1.2,
     landmarks: Annotated[int, typer.Option(help="Landmarks for the Rips filtration.")] = 120,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: diagram, phase per frame, PCA by phase.")] = None,
@@ -37,13 +51,10 @@ def phase(
     from ..phase import find_phase
 
     check_output(plot, [path], force, ".png", "--plot")
-    if delay < 0:
-        raise MocycleError(f"--delay must be >= 0; got {delay}")
+    options = phase_options(joints, classes, pca, delay, min_periods)
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
-    result = find_phase(motion, classes=count_option(classes, "--classes", {"auto": "auto"}), joints=joints,
-                        pca=count_option(pca, "--pca", {"auto": "auto", "none": None, "0": None}),
-                        delay=delay, n_landmarks=landmarks)
+    result = find_phase(motion, n_landmarks=landmarks, keep_features=plot is not None, **options)
     if plot is not None:
         from ..viz import plot_phase
 
@@ -72,6 +83,11 @@ def _print_phase(path: Path, facts: dict) -> None:
         out.print(table)
     acf = facts["autocorrelation_period_frames"]
     out.print(f"  autocorrelation period (cross-check): {'none' if acf is None else f'{acf:.2f} frames'}")
+    legs = facts["legs_period_frames"]
+    out.print(f"  legs' autocorrelation period: {'none' if legs is None else f'{legs:.2f} frames'}; "
+              f"joints used: {facts['joints_used']}")
+    for k, c in enumerate(facts["classes"]):
+        out.print(f"  class {k} period: {c['period_reason']}", soft_wrap=True)
     out.print(f"  why: {facts['reason']}", soft_wrap=True)
     out.print(f"  {facts['seconds']:.3f} s")
 

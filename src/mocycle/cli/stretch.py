@@ -9,8 +9,16 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from ..io import read, write
-from .common import FORCE_HELP, app, check_output, count_option, friendly, json_text, out
+from ..io import read_motion as read
+from ..io import write
+from .common import (
+    app,
+    check_output,
+    count_option,
+    friendly,
+    json_text,
+    out,
+)
 
 
 @app.command()
@@ -23,14 +31,19 @@ def stretch(
         help="Block length in frames: 'auto' (each joint group's largest fundamental cycle) or N.")] = "auto",
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
-    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Warp the whole take even when it has no periodic motion (a warning says so). It also "
+                        "lets an output replace an input file.")] = False,
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
 
-    The lapped cosine transform of every joint curve is dilated in time by
-    replicating its atoms (paper 004); each joint group (legs, arms, spine)
-    uses its own fundamental cycle as the window; the travelling joint keeps
-    its mean velocity.
+    Only the periodic region(s) of the take (its phase's excitation regions) are
+    warped; a lead-in, pauses and a lead-out are kept as captured and follow on
+    without a pop. The lapped cosine transform of every joint curve is dilated
+    in time by replicating its atoms (paper 004); each joint group (legs, arms,
+    spine) uses its own fundamental cycle as the window; the travelling joint
+    keeps its mean velocity. Exit code 3 when the take has no periodic motion
+    (--force warps it whole anyway), 1 for bad input.
     """
     from ..warp import stretch_motion
 
@@ -38,7 +51,7 @@ def stretch(
     win = count_option(window, "--window", {"auto": "auto"})
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
-    result, report = stretch_motion(motion, factor, window=win)
+    result, report = stretch_motion(motion, factor, window=win, force=force)
     write(result, output)
     facts = report.to_dict()
     facts["seconds"] = time.perf_counter() - t0
@@ -54,6 +67,11 @@ def stretch(
         cycle = report.cycles[g]
         table.add_row(g, str(n), "given" if cycle is None else f"{cycle:.2f}", str(len(report.groups[g])))
     out.print(table)
+    if report.regions:
+        kept = report.frames_in - sum(e - s for s, e in report.regions)
+        out.print("  periodic region(s) warped: " + ", ".join(
+            f"{s}:{e} -> {a}:{b}" for (s, e), (a, b) in zip(report.regions, report.regions_out, strict=True))
+            + (f"; {kept} frame(s) kept as captured" if kept else ""), soft_wrap=True)
     if report.trend_curves:
         out.print(f"  warped as line + residual: {', '.join(report.trend_curves)}", soft_wrap=True)
     out.print(f"  {facts['seconds']:.3f} s")

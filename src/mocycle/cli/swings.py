@@ -10,8 +10,17 @@ import typer
 from rich.table import Table
 
 from ..errors import MocycleError
-from ..io import read, write
-from .common import FORCE_HELP, app, check_output, friendly, json_text, out, write_text
+from ..io import read_motion as read
+from ..io import write
+from .common import (
+    FORCE_HELP,
+    app,
+    check_output,
+    friendly,
+    json_text,
+    out,
+    write_text,
+)
 
 _JOINTS_HELP = "Joints to segment: names, glob patterns or groups (legs, arms, spine), comma-separated " \
                "(default: the major bones, by name and motion energy)."

@@ -61,9 +61,10 @@ from scipy.spatial.transform import Rotation
 from ..errors import MocycleError, NoPeriodicMotion
 from ..limits import check_frames
 from ..motion import Motion, Skeleton
-from ..rotations import mean_rotations
+from ..rotations import axis_rotations, mean_rotations, nearest_rotations
+from .checks import check_loop
 from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, metric_features
-from .representation import CycleSpace, axis_rotations, nearest_rotations
+from .representation import CycleSpace
 from .seam import LOCAL, calmest_start, seam_ratios
 from .timeaxis import TimeAxis
 
@@ -129,7 +130,9 @@ def _period_frames(cycle: Cycle) -> float:
     return float(cycle.n_frames if cycle.method == "cut" else cycle.period_frames)
 
 
-def _cycles(takes, labels, extract_options) -> list[Cycle]:
+def _cycles(takes, labels, extract_options, force: bool = False) -> list[Cycle]:
+    """The takes' cycles (Motions are extracted, then checked as loops: :func:`~mocycle.cycle.checks.check_loop`
+    raises LoopRefused, or warns with ``force``)."""
     if isinstance(takes, (Motion, Cycle)) or not isinstance(takes, Sequence) or len(takes) == 0:
         raise MocycleError("expected a non-empty list of takes (Motion or Cycle objects)")
     labels = list(labels) if labels is not None else [f"take {i + 1}" for i in range(len(takes))]
@@ -139,7 +142,7 @@ def _cycles(takes, labels, extract_options) -> list[Cycle]:
     for take, label in zip(takes, labels, strict=True):
         if not isinstance(take, (Motion, Cycle)):
             raise MocycleError(f"{label}: expected a Motion or a Cycle; got {type(take).__name__}")
-        skeletons.append(take.skeleton if isinstance(take, Motion) else take.space.template.skeleton)
+        skeletons.append(take.skeleton if isinstance(take, Motion) else take.space.skeleton)
     for skel, label in zip(skeletons[1:], labels[1:], strict=True):   # before the (slower) extraction
         problems = skeleton_differences(skeletons[0], skel)
         if problems:
@@ -150,15 +153,17 @@ def _cycles(takes, labels, extract_options) -> list[Cycle]:
             cycles.append(take)
             continue
         try:
-            cycles.append(extract_cycle(take, **extract_options))
+            cycle = extract_cycle(take, **extract_options)
         except NoPeriodicMotion as exc:
             raise NoPeriodicMotion(f"{label}: {exc}") from None
         except MocycleError as exc:  # say which take: the user gave several
             raise MocycleError(f"{label}: {exc}") from None
+        check_loop(take, cycle, force=force, label=label)
+        cycles.append(cycle)
     first = cycles[0].space
     for cycle, label in zip(cycles[1:], labels[1:], strict=True):
         if cycle.space.travel != first.travel:
-            names = first.template.skeleton.names
+            names = first.skeleton.names
             raise MocycleError(f"{label} travels on joint {names[cycle.space.travel]!r}, {labels[0]} on "
                                f"{names[first.travel]!r}: the takes cannot be blended")
     return cycles
@@ -226,7 +231,7 @@ def _on(skeleton: Skeleton, motion: Motion) -> Motion:
 
 
 def _prepare(cycle: Cycle, space: CycleSpace, reference: _Loop | None) -> _Loop:
-    skel = space.template.skeleton
+    skel = space.skeleton
     inplace = _on(skel, cycle.motion("inplace"))
     n = cycle.n_frames
     _, L = space.encode(inplace)
@@ -247,7 +252,7 @@ def _prepare(cycle: Cycle, space: CycleSpace, reference: _Loop | None) -> _Loop:
                 turn += extra
     drift = drift.copy()
     drift[:3] = axis_rotations(space.up, np.array([turn]))[0] @ drift[:3]
-    period = _period_frames(cycle) * cycle.space.template.frame_time / space.template.frame_time
+    period = _period_frames(cycle) * cycle.space.frame_time / space.frame_time
     return _Loop(inplace, period, drift, turn, heading, centre, None if travel is None else travel + turn)
 
 
@@ -293,7 +298,7 @@ def _best_shift(A: np.ndarray, B: np.ndarray) -> tuple[float, np.ndarray]:
 
 def _align(loops: list[_Loop], space: CycleSpace, N: int) -> np.ndarray:
     """Phase offsets ``(K,)`` in cycles of every loop against the first (the first gets 0)."""
-    J = space.template.n_joints
+    J = space.n_joints
     grid = np.arange(N) / N
     ref = _rotation_block(_read(loops[0], space, grid)[0], J)
     offsets = [0.0]
@@ -341,17 +346,6 @@ def _blend_P(Ps: Sequence[np.ndarray], w: np.ndarray, n_joints: int) -> np.ndarr
     return P
 
 
-def weighted_rotation_mean(quats: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """The weighted chordal L2 mean ``(..., 4)`` of rotations ``quats`` ``(K, ..., 4)`` with ``weights (K,)``:
-    the rotation nearest (Frobenius) to ``Σ w_k R_k`` — the mean ``Rotation.mean(weights=)`` computes, for
-    many sets at once."""
-    q = np.asarray(quats, dtype=np.float64)
-    w = check_weights(weights, q.shape[0])
-    R = Rotation.from_quat(q.reshape(-1, 4)).as_matrix().reshape(*q.shape[:-1], 3, 3)
-    M = np.tensordot(w, R, axes=1)
-    return Rotation.from_matrix(nearest_rotations(M).reshape(-1, 3, 3)).as_quat().reshape(*q.shape[1:])
-
-
 def cycle_seam(cycle: Cycle) -> dict[str, float]:
     """Seam ratios of a loop as :func:`~mocycle.cycle.loop_metrics` measures them (rotations relative to the
     loop's own mean rotations, and the travel joint's in-place path; the larger of the two)."""
@@ -360,7 +354,7 @@ def cycle_seam(cycle: Cycle) -> dict[str, float]:
     return {f"seam_{k}": max(r[k] for r in seams) for k in ("pose", "velocity", "pose_local", "velocity_local")}
 
 
-@dataclass
+@dataclass(kw_only=True)
 class BlendedCycle:
     """A blend of ``K`` cycles (paper 001 §4.5): a loop like :class:`~mocycle.cycle.Cycle`.
 
@@ -419,7 +413,7 @@ class BlendedCycle:
 
 
 def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool = True, roll: bool = True,
-                 labels: Sequence[str] | None = None, **extract_options) -> BlendedCycle:
+                 labels: Sequence[str] | None = None, force: bool = False, **extract_options) -> BlendedCycle:
     """Paper 001 §4.5: the convex combination of the takes' cycles, a new loop.
 
     ``takes``: Motions (their cycle is extracted with ``extract_cycle(**extract_options)``, e.g.
@@ -427,11 +421,22 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     one per take, ``>= 0``, normalised to sum 1 (default equal); ``align``: search each take's phase offset
     against the first (off: every loop is read from its own frame 0); ``roll``: start the blend at its
     calmest pose, as :func:`extract_cycle` does (off: at the first cycle's frame 0); ``labels``: names for
-    messages.  The result has ``round(Σ w_i T_i)`` frames at the first take's frame time, travels (or, on the
-    spot, faces) like the first take, and its root drifts by the weighted travel and turn per cycle.
+    messages; ``force``: blend a take's cycle that fails a loop check (with a warning) instead of raising
+    :class:`~mocycle.errors.LoopRefused`.  The result has ``round(Σ w_i T_i)`` frames at the first take's
+    frame time, travels (or, on the spot, faces) like the first take, and its root drifts by the weighted
+    travel and turn per cycle.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> slow = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> fast = synthetic_walk(n_frames=300, fps=60, period_s=0.8, seed=1).motion
+    >>> blend = blend_cycles([slow, fast], weights=[0.5, 0.5])
+    >>> blend.n_frames, blend.weights.tolist()      # (60 + 48) / 2 frames
+    (54, [0.5, 0.5])
     """
     t0 = time.perf_counter()
-    cycles = _cycles(takes, labels, extract_options)
+    cycles = _cycles(takes, labels, extract_options, force)
     w = check_weights(weights, len(cycles))
     space = _common_space(cycles)
     first = _prepare(cycles[0], space, None)
@@ -442,19 +447,21 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     offsets = _align(loops, space, N) if align else np.zeros(len(loops))
     grid = np.arange(N) / N
     reads = [_read(loop, space, grid + off) for loop, off in zip(loops, offsets, strict=True)]
-    J = space.template.n_joints
+    J = space.n_joints
     P = _blend_P([r[0] for r in reads], w, J)
     L = _blend_L([r[1] for r in reads], w)
     L[:, :3] += first.centre
     drift = w @ np.stack([loop.drift for loop in loops])
     L += np.outer(grid, drift)                       # the Cycle convention: L carries its drift
-    axis = TimeAxis(grid.copy(), ((0, N),), period, "blend")
-    cycle = Cycle(space, P, L, drift, "blend", None, None, axis, np.arange(N, dtype=np.float64), None)
+    axis = TimeAxis(x=grid.copy(), regions=((0, N),), period_frames=period, method="blend")
+    cycle = Cycle(space=space, P=P, L=L, drift=drift, method="blend", model=None, n_harmonics=None, axis=axis,
+                  positions=np.arange(N, dtype=np.float64), periodic=None)
     start = calmest_start(*loop_blocks(cycle, mean_rotations(cycle.motion("inplace").rotations))) if roll else 0
     cycle = cycle.rolled(start)
     cycle.seconds = time.perf_counter() - t0
-    return BlendedCycle(cycle, w, offsets, start / N, periods, np.array([loop.turn_to for loop in loops]),
-                        cycles, cycle.seconds)
+    return BlendedCycle(cycle=cycle, weights=w, phase_offsets=offsets, start_phase=start / N, input_periods=periods,
+                        heading_offsets=np.array([loop.turn_to for loop in loops]), inputs=cycles,
+                        seconds=cycle.seconds)
 
 
 # ---------------------------------------------------------------- transition
@@ -467,7 +474,7 @@ def _smoothstep_integral(x: np.ndarray) -> np.ndarray:
     return x ** 3 - 0.5 * x ** 4
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Transition:
     """A motion that starts as the first cycle and ends as the second (paper 001 §4.5, the homotopy).
 
@@ -499,7 +506,8 @@ class Transition:
 
 
 def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str = "motion", *,
-               align: bool = True, labels: Sequence[str] | None = None, **extract_options) -> Transition:
+               align: bool = True, labels: Sequence[str] | None = None, force: bool = False,
+               **extract_options) -> Transition:
     """Over ``cycles`` cycles, move from ``a``'s cycle to ``b``'s (paper 001 §4.5: a homotopy of loops).
 
     The weight of ``b`` is ``smoothstep(φ / cycles)`` of the unwrapped phase ``φ``; the local period
@@ -507,7 +515,17 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     (``t(φ) = T_a φ + (T_b - T_a) n (x³ - x⁴/2)``, ``x = φ / n``), and the time axis is scaled by less than
     half a frame so that frame ``T`` would be phase ``n`` exactly: the result can be preceded by ``a``'s loop
     and followed by ``b``'s loop read from its phase offset.  ``root="motion"``: travel and turn per cycle
-    blended with the same weight and integrated along the phase; ``"inplace"``: no travel.
+    blended with the same weight and integrated along the phase; ``"inplace"``: no travel.  A take whose
+    cycle fails a loop check raises :class:`~mocycle.errors.LoopRefused` (``force``: a warning instead).
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> slow = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> fast = synthetic_walk(n_frames=300, fps=60, period_s=0.8, seed=1).motion
+    >>> tr = transition(slow, fast, cycles=2)
+    >>> tr.motion.n_frames, round(float(tr.period_frames[0])), round(float(tr.period_frames[-1]))
+    (108, 60, 48)
     """
     t0 = time.perf_counter()
     if root not in ROOT_MODES:
@@ -515,7 +533,7 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 1:
         raise MocycleError(f"the number of cycles must be a positive integer; got {cycles!r}")
     cyc = _cycles([a, b], labels if labels is not None else ["the first take", "the second take"],
-                  extract_options)
+                  extract_options, force)
     space = _common_space(cyc)
     first = _prepare(cyc[0], space, None)
     loops = [first, _prepare(cyc[1], space, first)]
@@ -523,7 +541,7 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     offset = float(_align(loops, space, max(2, int(round(0.5 * (pa + pb)))))[1]) if align else 0.0
     n = int(cycles)
     total = n * 0.5 * (pa + pb)                       # t(n): frames over the n cycles
-    check_frames(round(total), space.template.n_joints,
+    check_frames(round(total), space.skeleton.n_joints,
                  f"a transition over {n} cycles")
     T = max(2, int(round(total)))
     scale = T / total
@@ -534,7 +552,7 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     Pa, La = _read(loops[0], space, phase)
     Pb, Lb = _read(loops[1], space, phase + offset)
     W = np.stack([1 - w, w])
-    P = _blend_P([Pa, Pb], W, space.template.n_joints)
+    P = _blend_P([Pa, Pb], W, space.n_joints)
     L = _blend_L([La, Lb], W)
     if root == "motion":
         drift = np.outer(1 - w, loops[0].drift) + np.outer(w, loops[1].drift)   # (T, 4) per cycle
@@ -546,7 +564,8 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     L[:, :3] += first.centre
     motion = space.decode(P, L)
     seconds = time.perf_counter() - t0
-    return Transition(motion, phase, w, scale * ((1 - w) * pa + w * pb), offset, (pa, pb), n, cyc, seconds)
+    return Transition(motion=motion, phase=phase, weights=w, period_frames=scale * ((1 - w) * pa + w * pb),
+                      phase_offset=offset, periods=(pa, pb), cycles=n, inputs=cyc, seconds=seconds)
 
 
 def _local_ratios(x: np.ndarray, periodic: bool) -> float:

@@ -27,12 +27,12 @@ from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
 from ..limits import check_frames
 from ..motion import Motion
-from ..phase.analysis import PeriodicMotion, PhaseResult, find_phase
+from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
-from ..rotations import mean_rotations
+from ..rotations import axis_rotations, mean_rotations
 from .differences import HALF, central_acceleration, central_velocity
 from .harmonic import MODELS, HarmonicRegression, max_harmonics
-from .representation import CycleSpace, axis_rotations
+from .representation import CycleSpace
 from .seam import calmest_start
 from .timeaxis import TIME_AXES, TimeAxis, time_axis
 
@@ -45,13 +45,18 @@ CENTROID_NEIGHBOURS = 10  # paper 001 §6: 10 nearest neighbours
 SUBFRAMES = 10           # the harmonic cycle's start is chosen to a tenth of a frame
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Cycle:
     """One cycle of ``N`` frames (frame ``N`` would equal frame 0) and how it was made.
 
     ``P``: ``(N, n_periodic)`` and ``L``: ``(N, 4)`` in the cycle space, ``L`` with its drift;
-    ``drift``: ``(4,)`` change of ``L`` over one cycle (travel per cycle, turn per cycle);
+    ``drift``: ``(4,)`` change of ``L`` over one cycle (horizontal travel per cycle, turn per cycle);
     ``positions``: ``(M,)`` where each frame of ``axis.frames()`` falls in the cycle, in cycle frames.
+
+    The drift carries only what a loop may keep doing: travel across the floor and turn about the
+    vertical.  A vertical component (a take whose root rises or sinks slowly: capture drift, a ramp)
+    is taken out of ``drift`` and of ``L`` on construction, so the root's height is periodic and
+    ``repeat(20, root="motion")`` neither floats nor sinks.
     """
 
     space: CycleSpace
@@ -67,6 +72,16 @@ class Cycle:
     regression: HarmonicRegression | None = field(default=None, repr=False)
     seconds: float = 0.0
 
+    def __post_init__(self):
+        up = self.space.up
+        rise = float(self.drift[:3] @ up)
+        if rise != 0.0:  # level the drift: only horizontal travel and the turn about the vertical remain
+            ramp = np.arange(self.P.shape[0])[:, None] / self.P.shape[0]
+            self.L = self.L.copy()
+            self.L[:, :3] -= ramp * (rise * up)
+            self.drift = self.drift.copy()
+            self.drift[:3] -= rise * up
+
     @property
     def n_frames(self) -> int:
         return self.P.shape[0]
@@ -81,13 +96,26 @@ class Cycle:
         return self.axis.n_periods
 
     def rolled(self, k: int) -> Cycle:
-        """The same loop started at its frame ``k``."""
+        """The same loop started at its frame ``k`` (frames ``N..N+k-1`` are the next repeat's first ones)."""
         N, k = self.n_frames, int(k) % self.n_frames
         if k == 0:
             return self
         idx = (np.arange(N) + k) % N
-        L = self.L[idx] + np.outer(np.arange(N) + k >= N, self.drift)
+        L = self.L[idx].copy()
+        wrapped = np.arange(N) + k >= N
+        L[wrapped] = self._next_repeat(self.L[idx[wrapped]])
         return replace(self, P=self.P[idx], L=L, positions=np.mod(self.positions - k, N))
+
+    def _next_repeat(self, L: np.ndarray, times: int = 1) -> np.ndarray:
+        """Rows of ``L`` as they are ``times`` repeats later: the rigid motion of one cycle (the turn about the
+        vertical through the first frame's position, then the travel) applied ``times`` times."""
+        p0 = self.L[0, :3]
+        out = L.copy()
+        for _ in range(times):
+            R = axis_rotations(self.space.up, np.array([self.drift[3]]))[0]
+            out[:, :3] = (out[:, :3] - p0) @ R.T + p0 + self.drift[:3]
+            out[:, 3] += self.drift[3]
+        return out
 
     def _inplace_L(self) -> np.ndarray:
         ramp = np.arange(self.n_frames)[:, None] / self.n_frames
@@ -103,22 +131,14 @@ class Cycle:
         _check_choice(root, ROOT_MODES, "root")
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
             raise MocycleError(f"the number of cycles must be a positive integer; got {count!r}")
-        check_frames(count * self.n_frames, self.space.template.n_joints,
+        check_frames(count * self.n_frames, self.space.skeleton.n_joints,
                      f"{count} cycles of {self.n_frames} frames")
         P = np.tile(self.P, (count, 1))
         if root == "inplace":
             return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)))
-        Ls = []
-        turn, move = self.drift[3], self.drift[:3]
-        p0 = self.L[0, :3]
-        offset = np.zeros(3)
-        for j in range(count):
-            R = axis_rotations(self.space.up, np.array([j * turn]))[0]
-            Lj = self.L.copy()
-            Lj[:, :3] = (self.L[:, :3] - p0) @ R.T + p0 + offset
-            Lj[:, 3] += j * turn
-            Ls.append(Lj)
-            offset = offset + R @ move
+        Ls = [self.L]
+        for _ in range(count - 1):  # each repeat is the last one moved rigidly: a turning walk walks a circle
+            Ls.append(self._next_repeat(Ls[-1]))
         return self.space.decode(P, np.concatenate(Ls))
 
     def to_dict(self) -> dict:
@@ -132,6 +152,7 @@ class Cycle:
             "time_axis": self.axis.method,
             "travel_per_cycle": self.drift[:3].tolist(),
             "turn_per_cycle_deg": float(np.degrees(self.drift[3])),
+            **self.periodic.provenance(),
         }
 
 
@@ -196,12 +217,14 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     x0 = float(np.floor(x[0]))
     if reference is not None:  # start where the wrap is the calmest step, choosing between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
-        trial = Cycle(space, fit_p.predict(fine), fit_l.predict(fine), fit_l.drift_, "harmonic", model, K, axis,
-                      np.zeros(0), periodic)
+        trial = Cycle(space=space, P=fit_p.predict(fine), L=fit_l.predict(fine), drift=fit_l.drift_,
+                      method="harmonic", model=model, n_harmonics=K, axis=axis, positions=np.zeros(0),
+                      periodic=periodic)
         x0 += calmest_start(*loop_blocks(trial, reference), stride=SUBFRAMES) / (SUBFRAMES * N)
     xs = x0 + np.arange(N) / N
-    return Cycle(space, fit_p.predict(xs), fit_l.predict(xs), fit_l.drift_, "harmonic", model, K, axis,
-                 np.mod(x - x0, 1.0) * N, periodic, fit_p)
+    return Cycle(space=space, P=fit_p.predict(xs), L=fit_l.predict(xs), drift=fit_l.drift_, method="harmonic",
+                 model=model, n_harmonics=K, axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic,
+                 regression=fit_p)
 
 
 # ------------------------------------------------------------------ centroid
@@ -242,7 +265,8 @@ def centroid_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     Pn = _circular_resample(P[frames][nearest].mean(axis=1), N, shift=-0.5)
     Ln = _circular_resample(flat[nearest].mean(axis=1), N, shift=-0.5) + np.outer(np.arange(N) / N, drift)
     positions = np.mod((cdf(phi) * n_samples - 0.5) * N / n_samples, N)
-    return Cycle(space, Pn, Ln, drift, "centroid", None, None, axis, positions, periodic)
+    return Cycle(space=space, P=Pn, L=Ln, drift=drift, method="centroid", model=None, n_harmonics=None, axis=axis,
+                 positions=positions, periodic=periodic)
 
 
 # ----------------------------------------------------------------------- cut
@@ -292,7 +316,8 @@ def cut_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, p
         Lc[k] = (1 - t) * L[a + k] + t * (L[src] + drift)
     x = axis.x[axis.frames()]
     positions = np.mod(x - axis.x[a], 1.0) * lag
-    return Cycle(space, Pc, Lc, drift, "cut", None, None, axis, positions, periodic)
+    return Cycle(space=space, P=Pc, L=Lc, drift=drift, method="cut", model=None, n_harmonics=None, axis=axis,
+                 positions=positions, periodic=periodic)
 
 
 # ------------------------------------------------------------------ pipeline
@@ -335,20 +360,52 @@ def _phase_at_full_rate(result: PhaseResult, step: int, n_frames: int) -> PhaseR
                    autocorrelation_period_frames=result.autocorrelation_period_frames * step)
 
 
+def cycle_phase(motion: Motion, *, joints: str | Iterable[str] | None = None, classes: int | str = "auto",
+                pca: int | str | None = "auto", delay: int = 2, min_periods: float = MIN_PERIODS,
+                phase_step: int = 1) -> PhaseResult:
+    """:func:`~mocycle.phase.find_phase` as the cycle extraction calls it, optionally on every
+    ``phase_step``-th frame only (the thesis plugin's subsampling), brought back to every frame."""
+    if isinstance(phase_step, bool) or not isinstance(phase_step, (int, np.integer)) or phase_step < 1:
+        raise MocycleError(f"the phase step must be a positive integer; got {phase_step!r}")
+    options = dict(classes=classes, joints=joints, pca=pca, delay=delay, min_periods=min_periods)
+    if phase_step > 1:
+        return _phase_at_full_rate(find_phase(motion[::phase_step], **options), phase_step, motion.n_frames)
+    return find_phase(motion, **options)
+
+
 def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n_harmonics: int | str = "auto",
-                  time_axis_method: str = "smooth", joints: str | Iterable[str] | None = None,
-                  classes: int | str = "auto", which: int | None = None, phase: PhaseResult | None = None,
-                  phase_step: int = 1, **phase_options) -> Cycle:
+                  time_axis_method: str = "smooth", *, joints: str | Iterable[str] | None = None,
+                  classes: int | str = "auto", which: int | None = None, pca: int | str | None = "auto",
+                  delay: int = 2, min_periods: float = MIN_PERIODS, phase: PhaseResult | None = None,
+                  phase_step: int = 1) -> Cycle:
     """One seamless cycle of ``motion``.
 
     ``method``: ``harmonic`` | ``centroid`` | ``cut``; ``model``: M1 | M2 | M3 (harmonic only);
     ``n_harmonics``: K or ``"auto"`` (20, capped by the frames); ``time_axis_method``: see
-    :mod:`~mocycle.cycle.timeaxis`; ``joints``: the joints the *phase* is found on (every joint is
-    looped); ``classes``/``which``: how many periodic motions to look for and which to loop;
+    :mod:`~mocycle.cycle.timeaxis`.  The phase options go to :func:`~mocycle.phase.find_phase`:
+    ``joints`` (the joints the *phase* is found on; every joint is looped; default the whole body, then
+    legs, then arms), ``classes`` (how many periodic motions to look for), ``pca``, ``delay`` and
+    ``min_periods``; ``which``: the periodic motion to loop (0-based; default the one covering most frames);
     ``phase``: a :class:`PhaseResult` already computed for this motion (skips :func:`find_phase`);
-    ``phase_step``: find the phase on every ``phase_step``-th frame only (the thesis plugin's subsampling;
-    the cycle is still built from every frame at the capture's rate).
+    ``phase_step``: find the phase on every ``phase_step``-th frame only (the cycle is still built from
+    every frame at the capture's rate).
     Raises :class:`NoPeriodicMotion` when the take has none; warns below 1.5 periods.
+
+    Returns
+    -------
+    Cycle
+        ``motion("inplace")`` / ``motion("motion")``: the loop as a Motion; ``repeat(k, root)``: ``k``
+        seamless repetitions; ``to_dict()``: period, frames, method, travel and turn per cycle.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> walk = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> cycle = extract_cycle(walk, method="harmonic", model="M1")
+    >>> cycle.n_frames, cycle.n_harmonics
+    (60, 20)
+    >>> cycle.motion("inplace").n_frames, cycle.repeat(3, root="motion").n_frames
+    (60, 180)
     """
     t0 = time.perf_counter()
     if not isinstance(motion, Motion):
@@ -357,14 +414,9 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     _check_choice(time_axis_method, TIME_AXES, "the time axis")
     if method == "harmonic":
         _check_choice(model, MODELS, "model")
-    if isinstance(phase_step, bool) or not isinstance(phase_step, (int, np.integer)) or phase_step < 1:
-        raise MocycleError(f"the phase step must be a positive integer; got {phase_step!r}")
     if phase is None:
-        if phase_step > 1:
-            phase = _phase_at_full_rate(find_phase(motion[::phase_step], classes=classes, joints=joints,
-                                                   **phase_options), phase_step, motion.n_frames)
-        else:
-            phase = find_phase(motion, classes=classes, joints=joints, **phase_options)
+        phase = cycle_phase(motion, joints=joints, classes=classes, pca=pca, delay=delay, min_periods=min_periods,
+                            phase_step=phase_step)
     periodic = choose_periodic(phase, which)
     axis = time_axis(periodic, time_axis_method)
     if axis.n_periods < FEW_PERIODS:
@@ -372,14 +424,18 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
                       f"little evidence", MocycleWarning, stacklevel=2)
     space = CycleSpace.fit(motion)
     P, L = space.encode(motion)
+    # The path is fitted straightened (periodic plus a line) and turned back along the cycle's heading.
+    Q = space.straighten(L, axis.period_frames)
     reference = mean_rotations(motion.rotations)
     # The cut's wrap is its seam; the others have none, so they start at the calmest point.
     if method == "harmonic":
-        cycle = harmonic_cycle(space, P, L, axis, periodic, model, n_harmonics, reference)
+        cycle = harmonic_cycle(space, P, Q, axis, periodic, model, n_harmonics, reference)
     elif method == "centroid":
-        cycle = centroid_cycle(space, P, L, axis, periodic)
+        cycle = centroid_cycle(space, P, Q, axis, periodic)
         cycle = cycle.rolled(calmest_start(*loop_blocks(cycle, reference)))
     else:
-        cycle = cut_cycle(space, P, L, axis, periodic, metric_features(motion, reference))
+        cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion, reference))
+    path, drift = space.bend(cycle.L, cycle.drift, space.heading_trend(L[:, 3], axis.period_frames)[0])
+    cycle = replace(cycle, L=path, drift=drift)
     cycle.seconds = time.perf_counter() - t0
     return cycle

@@ -31,11 +31,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from ..axes import vertical_axis
 from ..motion import Motion
 from ..rotations import mean_rotations
 from .differences import HALF, central_acceleration, central_velocity, forward_jerk
 from .extract import Cycle, loop_blocks, metric_features
-from .representation import vertical_axis
 from .seam import seam_ratios
 
 CONTACT_HEIGHT = 0.02  # of the body height
@@ -91,11 +91,12 @@ def jerk_ratio(Y_regions: list[np.ndarray], C: np.ndarray, frame_time: float) ->
     return _rms(forward_jerk(C, frame_time, periodic=True)) / _rms(np.concatenate(j_in))
 
 
-def foot_points(motion: Motion) -> list[int]:
+def foot_points(motion: Motion, up: np.ndarray | None = None) -> list[int]:
     """Indices (in ``world_positions(end_sites=True)``) of the feet: in each of the two branches below the
-    travel joint whose leaves hang lowest on average, the lowest leaf (joint without children, or End Site)."""
+    travel joint whose leaves hang lowest on average, the lowest leaf (joint without children, or End Site).
+    ``up``: the vertical axis (default: detected, :func:`~mocycle.axes.vertical_axis`)."""
     skel = motion.skeleton
-    up = vertical_axis(motion)
+    up = vertical_axis(motion, up)
     parents = list(skel.parents) + [site.parent for site in skel.end_sites]
     has_child = np.zeros(len(parents), bool)
     for p in parents:
@@ -121,14 +122,15 @@ def foot_points(motion: Motion) -> list[int]:
     return feet[:2]
 
 
-def foot_sliding(motion: Motion) -> float:
+def foot_sliding(motion: Motion, up: np.ndarray | None = None) -> float:
     """Mean horizontal speed (units/s) of the feet while they touch the floor.
 
     A foot touches the floor on a frame step when it is, at both ends of the step, within
     ``CONTACT_HEIGHT`` of the body height above its own floor (its 5th-percentile height over the take).
+    ``up``: the vertical axis (default: detected).
     """
-    up = vertical_axis(motion)
-    feet = foot_points(motion)
+    up = vertical_axis(motion, up)
+    feet = foot_points(motion, up)
     W = motion.world_positions(end_sites=True)
     body = np.ptp(W.mean(axis=0) @ up)
     speeds = []
@@ -145,7 +147,24 @@ def foot_sliding(motion: Motion) -> float:
 
 
 def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
-    """Every metric of the module docstring for ``cycle`` extracted from ``motion``."""
+    """Every metric of the module docstring for ``cycle`` extracted from ``motion``.
+
+    Returns
+    -------
+    dict of floats: ``rmse_h``, ``rmse_dh``, ``rmse_ddh``, ``template_error`` (rad) and its
+    ``template_offset`` (frames), ``jerk_ratio``, ``seam_pose``, ``seam_velocity`` (and ``_local``: a seam
+    ratio <= 1 means the wrap is no bigger a step than the loop's own), ``foot_sliding`` and
+    ``input_foot_sliding`` (units/s).
+
+    Examples
+    --------
+    >>> from mocycle.cycle import extract_cycle
+    >>> from mocycle.datasets import synthetic_walk
+    >>> walk = synthetic_walk(n_frames=300, fps=60).motion
+    >>> metrics = loop_metrics(walk, extract_cycle(walk))
+    >>> metrics["template_error"] < 0.1, metrics["seam_pose"] <= 1.0
+    (True, True)
+    """
     ref = mean_rotations(motion.rotations)
     Y = metric_features(motion, ref)
     C, root = loop_blocks(cycle, ref)
@@ -168,6 +187,6 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
         "seam_velocity": max(r["velocity"] for r in seams),
         "seam_pose_local": max(r["pose_local"] for r in seams),
         "seam_velocity_local": max(r["velocity_local"] for r in seams),
-        "foot_sliding": foot_sliding(travelling),
-        "input_foot_sliding": foot_sliding(motion[frames[0]:frames[-1] + 1]),
+        "foot_sliding": foot_sliding(travelling, cycle.space.world_up),
+        "input_foot_sliding": foot_sliding(motion[frames[0]:frames[-1] + 1], cycle.space.world_up),
     }

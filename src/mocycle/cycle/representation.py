@@ -14,6 +14,13 @@ A pose is split in two blocks (:class:`CycleSpace`):
   (3, in its parent's frame, file units) and its heading about the vertical
   axis (1, radians, unwrapped).  These get the translation model with a
   linear term (KTH thesis eq. 3.27): walking moves on and turning keeps turning.
+
+A walk along an arc has a path that is not "periodic plus a line", so the
+cycle is fitted on the *straightened* path (:meth:`CycleSpace.straighten`,
+paper 001 §4.1's differenced root: every horizontal step turned into the
+heading frame and summed again), which is, and turned back along the cycle's
+own heading afterwards (:meth:`CycleSpace.bend`).  For a walk whose heading
+does not change the two are the same path.
 """
 
 from __future__ import annotations
@@ -21,50 +28,34 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import uniform_filter1d
 from scipy.spatial.transform import Rotation
 
+from ..axes import heading_angles, horizontal_basis, vertical_axis
 from ..errors import MocycleError
-from ..motion import Motion
-from ..rotations import continuous_quats, nearest_rotations
+from ..motion import Motion, Skeleton
+from ..rotations import axis_rotations, continuous_quats, nearest_rotations
 
 
-def vertical_axis(motion: Motion) -> np.ndarray:
-    """The world up direction ``(3,)`` of a humanoid take (unit vector along +X, +Y or +Z or their negatives).
-
-    The axis along which the mean pose is tallest; its sign puts most joints in
-    the upper half (spine, arms, head and hands outnumber the legs).
-    """
-    step = max(1, motion.n_frames // 50)
-    pose = motion[::step].world_positions(end_sites=True).mean(axis=0)  # (J', 3)
-    extent = np.ptp(pose, axis=0)
-    axis = int(np.argmax(extent))
-    mid = 0.5 * (pose[:, axis].max() + pose[:, axis].min())
-    up = np.zeros(3)
-    up[axis] = 1.0 if np.median(pose[:, axis]) >= mid else -1.0
-    return up
-
-
-def axis_rotations(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Rotation matrices ``(T, 3, 3)`` about the unit ``axis`` ``(3,)`` by ``angles`` ``(T,)`` radians."""
-    u = np.asarray(axis, dtype=np.float64)
-    c, s = np.cos(angles)[:, None, None], np.sin(angles)[:, None, None]
-    K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
-    return c * np.eye(3) + s * K + (1.0 - c) * np.outer(u, u)
-
-
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class CycleSpace:
     """How a motion maps to ``(P, L)`` and back (see the module docstring).
 
-    ``template``: the input motion (skeleton, frame time, constant translations);
-    ``travel``: index of the travel joint; ``up``: the vertical axis in the
+    It keeps what decoding needs, not the input motion: ``skeleton``; ``frame_time`` (s);
+    ``static_translations`` ``(J, 3)``: every joint's translation in the input's first
+    frame (what the joints whose translation does not move keep);
+    ``travel``: index of the travel joint; ``world_up``: the vertical axis of the
+    take (:func:`~mocycle.axes.vertical_axis`); ``up``: the same in the
     travel joint's parent frame; ``e1``, ``e2``: a horizontal basis there;
     ``forward``: the vector in the travel joint's own frame whose horizontal
     direction defines the heading; ``moving``: the other joints whose translation moves.
     """
 
-    template: Motion
+    skeleton: Skeleton
+    frame_time: float
+    static_translations: np.ndarray
     travel: int
+    world_up: np.ndarray
     up: np.ndarray
     e1: np.ndarray
     e2: np.ndarray
@@ -72,9 +63,11 @@ class CycleSpace:
     moving: tuple[int, ...]
 
     @classmethod
-    def fit(cls, motion: Motion) -> CycleSpace:
+    def fit(cls, motion: Motion, up=None) -> CycleSpace:
+        """The space of ``motion``; ``up``: the vertical axis (``None``: detected; ``"y"``, ``"-z"`` or a
+        3-vector: see :func:`~mocycle.axes.vertical_axis`)."""
         travel = motion.travel_joint
-        up_world = vertical_axis(motion)
+        up_world = vertical_axis(motion, up)
         parent = int(motion.skeleton.parents[travel])
         if parent >= 0:
             world_rot, _ = motion[:: max(1, motion.n_frames // 50)].world_transforms()
@@ -83,20 +76,23 @@ class CycleSpace:
         else:
             up = up_world
         up = up / np.linalg.norm(up)
-        least = np.eye(3)[int(np.argmin(np.abs(up)))]
-        e1 = least - up * (least @ up)
-        e1 /= np.linalg.norm(e1)
-        e2 = np.cross(up, e1)
+        e1, e2 = horizontal_basis(up)
         mean_rot = motion.rotation(travel).mean().as_matrix()
         forward = mean_rot.T @ e1
         moved = np.ptp(motion.translations, axis=0).max(axis=1) > 1e-9
         moving = tuple(int(j) for j in np.flatnonzero(moved) if j != travel)
-        return cls(motion, travel, up, e1, e2, forward, moving)
+        return cls(skeleton=motion.skeleton, frame_time=motion.frame_time,
+                   static_translations=motion.translations[0].copy(), travel=travel, world_up=up_world, up=up,
+                   e1=e1, e2=e2, forward=forward, moving=moving)
 
     # -- sizes ----------------------------------------------------------
     @property
+    def n_joints(self) -> int:
+        return self.skeleton.n_joints
+
+    @property
     def n_periodic(self) -> int:
-        return 9 * self.template.n_joints + 3 * len(self.moving)
+        return 9 * self.n_joints + 3 * len(self.moving)
 
     @property
     def n_drifting(self) -> int:
@@ -104,13 +100,12 @@ class CycleSpace:
 
     def heading(self, rotations: np.ndarray) -> np.ndarray:
         """Unwrapped heading ``(T,)`` radians of the travel joint's rotation matrices ``(T, 3, 3)``."""
-        f = rotations @ self.forward
-        return np.unwrap(np.arctan2(f @ self.e2, f @ self.e1))
+        return heading_angles(rotations @ self.forward, self.e1, self.e2)
 
     # -- motion -> (P, L) -----------------------------------------------
     def encode(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
-        """``P (T, n_periodic)`` and ``L (T, 4)`` of a motion with the template's skeleton."""
-        if not motion.skeleton.same_as(self.template.skeleton):
+        """``P (T, n_periodic)`` and ``L (T, 4)`` of a motion with the space's skeleton."""
+        if not motion.skeleton.same_as(self.skeleton):
             raise MocycleError("this motion's skeleton differs from the one the cycle space was made for")
         R = motion.rotation_matrices()  # (T, J, 3, 3)
         psi = self.heading(R[:, self.travel])
@@ -124,18 +119,71 @@ class CycleSpace:
         L = np.concatenate([motion.translations[:, self.travel], psi[:, None]], axis=1)
         return P, L
 
+    # -- straight and curved paths ---------------------------------------
+    def _turned(self, V: np.ndarray, angles: np.ndarray) -> np.ndarray:
+        """The vectors ``V (T, 3)`` each turned by ``angles (T,)`` about the vertical."""
+        return np.einsum("tij,tj->ti", axis_rotations(self.up, angles), V)
+
+    @staticmethod
+    def heading_trend(psi: np.ndarray, period: float) -> np.ndarray:
+        """The heading ``psi (T,)`` without its within-cycle sway: its mean over one period about each frame.
+
+        The take's straight line through ``psi`` is taken out first and put back after, so the window's
+        ends (shortened there) do not bend a steady turn.
+        """
+        t = np.arange(psi.size, dtype=np.float64)
+        line = np.polyval(np.polyfit(t, psi, 1), t) if psi.size > 1 else psi.copy()
+        width = int(max(1, min(round(period), psi.size)))
+        return line + uniform_filter1d(psi - line, width, mode="nearest")
+
+    def straighten(self, L: np.ndarray, period: float) -> np.ndarray:
+        """``L (T, 4)`` with its path straightened: step ``t`` turned back by the heading trend's change
+        since the first frame (:meth:`heading_trend`, ``period`` in frames).
+
+        The vertical component and the heading are kept; the first frame stays where it is.  A walk along
+        a circle becomes a straight walk (periodic plus a line), which the cycle models can fit; a walk
+        whose heading only sways about a fixed direction is left as it is.
+        """
+        L = np.asarray(L, dtype=np.float64)
+        if L.shape[0] < 2:
+            return L.copy()
+        trend = self.heading_trend(L[:, 3], period)
+        mid = 0.5 * (trend[1:] + trend[:-1])
+        steps = self._turned(np.diff(L[:, :3], axis=0), trend[0] - mid)
+        out = L.copy()
+        out[1:, :3] = L[0, :3] + np.cumsum(steps, axis=0)
+        return out
+
+    def bend(self, Q: np.ndarray, drift: np.ndarray, reference: float) -> tuple[np.ndarray, np.ndarray]:
+        """The inverse of :meth:`straighten` for one cycle: ``Q (N, 4)`` straightened with heading trend
+        ``reference`` at the first frame of its take, ``drift (4,)`` its change over one cycle.
+
+        The cycle's heading trend is its mean heading plus its turn spread evenly over the cycle.  Returns
+        the cycle's path ``(N, 4)`` turned back along it and the drift ``(4,)`` (travel per cycle now in the
+        file's frame, as the path ends one cycle later; turn unchanged).
+        """
+        N = Q.shape[0]
+        full = np.vstack([Q, Q[:1] + drift])
+        # the trend at frame k is the heading's mean over the cycle centred there: the mean over frames
+        # 0..N-1 (centred at (N-1)/2) moved on by the turn; the steps turn at their middles k + 1/2
+        mid = Q[:, 3].mean() + drift[3] * (np.arange(N) + 1 - 0.5 * N) / N - reference
+        steps = self._turned(np.diff(full[:, :3], axis=0), mid)
+        path = np.vstack([full[:1, :3], full[0, :3] + np.cumsum(steps, axis=0)])
+        L = np.column_stack([path[:-1], Q[:, 3]])
+        return L, np.append(path[-1] - path[0], drift[3])
+
     # -- (P, L) -> motion -----------------------------------------------
     def decode(self, P: np.ndarray, L: np.ndarray) -> Motion:
-        """A Motion on the template's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``."""
+        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``."""
         P, L = np.asarray(P, dtype=np.float64), np.asarray(L, dtype=np.float64)
-        N, J = P.shape[0], self.template.n_joints
+        N, J = P.shape[0], self.n_joints
         if P.shape != (N, self.n_periodic) or L.shape != (N, self.n_drifting):
             raise MocycleError(f"expected P ({N}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
         R = nearest_rotations(P[:, : 9 * J].reshape(N, J, 3, 3))
         R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
         quats = continuous_quats(Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat().reshape(N, J, 4))
-        trans = np.broadcast_to(self.template.translations[0], (N, J, 3)).copy()
+        trans = np.broadcast_to(self.static_translations, (N, J, 3)).copy()
         if self.moving:
             trans[:, list(self.moving)] = P[:, 9 * J:].reshape(N, len(self.moving), 3)
         trans[:, self.travel] = L[:, :3]
-        return Motion(self.template.skeleton, quats, trans, self.template.frame_time)
+        return Motion(self.skeleton, quats, trans, self.frame_time)

@@ -29,7 +29,7 @@ from ..phase.period import gmm_cdf_remap, rank_uniform, unwrap_phase
 TIME_AXES = ("smooth", "rank", "gmm", "line")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class TimeAxis:
     """``x``: ``(T,)`` unwrapped time in periods (NaN on frames outside the regions);
     ``regions``: the frame ranges ``[start, end)`` used; ``period_frames``: frames per period."""
@@ -95,4 +95,4 @@ def time_axis(periodic: PeriodicMotion, method: str = "smooth") -> TimeAxis:
             x[s:e] = unwrap_phase(rank_uniform(coords))
         else:
             x[s:e] = unwrap_phase(gmm_cdf_remap(coords))
-    return TimeAxis(x, regions, period, method)
+    return TimeAxis(x=x, regions=regions, period_frames=period, method=method)

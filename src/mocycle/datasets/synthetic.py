@@ -15,7 +15,7 @@ deterministic for a given seed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 
 import numpy as np
@@ -29,11 +29,15 @@ from ..rotations import euler_to_quats
 __all__ = [
     "SyntheticTake",
     "humanoid_skeleton",
+    "synthetic_gesture",
     "synthetic_nonperiodic",
     "synthetic_run",
+    "synthetic_circle_walk",
+    "synthetic_half_cycle_trap",
     "synthetic_still",
     "synthetic_walk",
     "synthetic_walk_then_run",
+    "to_z_up",
 ]
 
 _ROOT_CH = ("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")
@@ -159,6 +163,7 @@ class _Style:
     flight_at: float  # phase of the middle of the first flight
     sway: float
     surge: float
+    symmetric: bool = False  # no left/right asymmetry (limp, arm swing, head tilt)
 
 
 # Approximate normative sagittal curves (after Winter's walking data and
@@ -241,7 +246,8 @@ def _gait_angles(style: _Style, u: np.ndarray) -> np.ndarray:
         a[:, _IX[name], _AXIS[axis]] += values
 
     tilt = s.pelvis_tilt * (1.0 + _cos(u, 2, 0.1))
-    for side, shift, sign, scale in (("Left", 0.0, 1.0, 1.0), ("Right", 0.5, -1.0, _RIGHT_SCALE)):
+    right_scale, left_arm_scale = (1.0, 1.0) if s.symmetric else (_RIGHT_SCALE, _LEFT_ARM_SCALE)
+    for side, shift, sign, scale in (("Left", 0.0, 1.0, 1.0), ("Right", 0.5, -1.0, right_scale)):
         v = u - shift  # this leg's own phase: heel strike at 0
         hip = scale * _curve(s.hip, v)
         knee = scale * _curve(s.knee, v)
@@ -269,10 +275,10 @@ def _gait_angles(style: _Style, u: np.ndarray) -> np.ndarray:
     put("Neck", "X", -0.5 * s.lean - 1.0 * _cos(u, 2, 0.3))
     put("Neck", "Y", -0.3 * s.trunk_rot * _cos(u))
     put("Head", "X", -0.3 * s.lean + 1.5 * _sin(u, 2))
-    put("Head", "Z", 3.0 + 1.0 * _sin(u))  # a slight head tilt
+    put("Head", "Z", 3.0 + (0.0 if s.symmetric else 1.0) * _sin(u))  # a slight head tilt
 
     # arms: lowered from the T-pose, counter-swinging with the legs
-    for side, shift, sign, scale in (("Left", 0.5, 1.0, _LEFT_ARM_SCALE), ("Right", 0.0, -1.0, 1.0)):
+    for side, shift, sign, scale in (("Left", 0.5, 1.0, left_arm_scale), ("Right", 0.0, -1.0, 1.0)):
         v = u - shift  # this arm is furthest forward at v = 0
         put(f"{side}Shoulder", "Z", sign * 2.0 * _cos(v, 2, 0.1))
         put(f"{side}Shoulder", "Y", -sign * 2.0 * _cos(v))
@@ -508,6 +514,40 @@ def synthetic_still(n_frames: int = 300, fps: float = 60.0, noise_deg: float = 0
                          f"noise {noise_deg:g} deg, seed {seed}", chan)
 
 
+def synthetic_gesture(n_frames: int = 240, fps: float = 60.0, noise_deg: float = 0.5,
+                      seed: int = 0) -> SyntheticTake:
+    """A one-off gesture: standing with the arms down, both hands raised above the head once and lowered.
+
+    The raise takes the middle 40 % of the take (up, a short hold, down, smoothstep ramps); the rest is
+    standing still with Gaussian angle noise (``noise_deg``).  Nothing repeats: a take that stretching
+    and looping must refuse.  ``segments``: ``still``, ``gesture``, ``still``.
+    """
+    n_frames, fps = _check(n_frames, fps)
+    if not np.isfinite(noise_deg) or noise_deg < 0:
+        raise MocycleError(f"noise_deg must be >= 0; got {noise_deg!r}")
+    skel = humanoid_skeleton()
+    t = np.arange(n_frames) / max(n_frames - 1, 1)
+    a, b = 0.3, 0.7                                    # the gesture's span (fractions of the take)
+    up = np.clip((t - a) / (0.35 * (b - a)), 0.0, 1.0)
+    down = np.clip((b - t) / (0.35 * (b - a)), 0.0, 1.0)
+    lift = _smoothstep(np.minimum(up, down))           # 0 standing, 1 hands above the head
+    ang = np.zeros((n_frames, skel.n_joints, 3))
+    for side, sign in (("Left", 1.0), ("Right", -1.0)):
+        ang[:, _IX[f"{side}Arm"], _AXIS["Z"]] = sign * (-75.0 + 160.0 * lift)
+        ang[:, _IX[f"{side}ForeArm"], _AXIS["Y"]] = -sign * (15.0 + 20.0 * np.sin(np.pi * lift))
+    ang[:, _IX["Spine1"], _AXIS["X"]] = -4.0 * lift   # a slight lean back with the hands up
+    if noise_deg > 0:
+        ang += np.random.default_rng(seed).normal(0.0, noise_deg, size=ang.shape)
+    q, chan = _quats(skel, ang)
+    root = np.tile([0.0, STAND_HEIGHT, 0.0], (n_frames, 1))
+    nan = np.full(n_frames, np.nan)
+    i, j = int(round(a * (n_frames - 1))), int(round(b * (n_frames - 1))) + 1
+    return SyntheticTake(Motion(skel, q, None, 1.0 / fps, root_positions=root), nan, nan.copy(), nan.copy(),
+                         [("still", 0, i), ("gesture", i, j), ("still", j, n_frames)],
+                         f"synthetic gesture (both hands raised once): {n_frames} frames at {fps:g} fps, "
+                         f"noise {noise_deg:g} deg, seed {seed}", chan)
+
+
 def _smooth_noise(rng: np.random.Generator, shape: tuple[int, ...], sigma: float,
                   walk: bool) -> np.ndarray:
     """Gaussian-filtered white noise (or random walk) along axis 0, zero mean, unit std."""
@@ -640,3 +680,62 @@ def synthetic_walk_then_run(n_walk: int = 600, n_run: int = 600, fps: float = 60
             f"blend {blend_frames} frames, noise {noise_deg:g} deg, seed {seed}")
     return SyntheticTake(Motion(skel, q, None, 1.0 / fps, root_positions=root), phase, u, period,
                          [("walk", 0, n_walk), ("run", n_walk, T)], desc, chan)
+
+
+def to_z_up(motion: Motion) -> Motion:
+    """The same take on a Z-up world: the root's rotation and path turned +90 degrees about X (Y -> Z)."""
+    W = Rotation.from_euler("x", 90.0, degrees=True)
+    q = motion.rotations.copy()
+    q[:, 0] = (W * Rotation.from_quat(q[:, 0])).as_quat()
+    t = motion.translations.copy()
+    t[:, 0] = W.apply(t[:, 0])
+    return Motion(motion.skeleton, q, t, motion.frame_time)
+
+
+def synthetic_circle_walk(n_frames: int = 600, fps: float = 60.0, period_s: float = 1.0,
+                          turn_per_cycle_deg: float = 45.0, noise_deg: float = 0.0, run: bool = False,
+                          up: str = "y", seed: int = 0) -> SyntheticTake:
+    """A walk (or run) along a circle: the body and its path turn ``turn_per_cycle_deg`` degrees per cycle.
+
+    The heading is tied to the phase (``turn_per_cycle_deg * cycles walked``), so the turn per cycle and
+    the period (``period_s``) are exact; the radius is ``stride / turn`` (140 cm per cycle for the walk,
+    250 cm for the run).  ``up="z"`` gives the same take on a Z-up world (:func:`to_z_up`).
+    ``noise_deg``: Gaussian noise on every rotation channel (degrees).
+    """
+    n_frames, fps = _check(n_frames, fps)
+    if not np.isfinite(turn_per_cycle_deg):
+        raise MocycleError(f"turn_per_cycle_deg must be a finite number; got {turn_per_cycle_deg!r}")
+    if not np.isfinite(noise_deg) or noise_deg < 0:
+        raise MocycleError(f"noise_deg must be >= 0; got {noise_deg!r}")
+    if up not in ("y", "z"):
+        raise MocycleError(f"up must be 'y' or 'z'; got {up!r}")
+    style = _RUN if run else _WALK
+    u, phase, period = _phase_truth(n_frames, fps, float(period_s), 0.0, 0.0)
+    skel = humanoid_skeleton()
+    chan = _channels(skel, _gait_angles(style, u))
+    heading = float(turn_per_cycle_deg) * u
+    _turn_root(skel, chan, heading)
+    if noise_deg > 0:
+        chan += np.random.default_rng(seed).normal(0.0, noise_deg, size=chan.shape)
+    motion = Motion(skel, _quats_from_channels(skel, chan), None, 1.0 / fps,
+                    root_positions=_gait_root(style, u, heading))
+    if up == "z":
+        motion = to_z_up(motion)
+    desc = (f"synthetic {style.name} along a circle: {n_frames} frames at {fps:g} fps, period {period_s:g} s, "
+            f"turn {turn_per_cycle_deg:g} deg per cycle, noise {noise_deg:g} deg, {up.upper()} up, seed {seed}")
+    return SyntheticTake(motion, phase, u, period, [(style.name, 0, n_frames)], desc, chan)
+
+
+def synthetic_half_cycle_trap(n_frames: int = 600, fps: float = 60.0, period_s: float = 1.0,
+                              noise_deg: float = 0.0, seed: int = 0) -> SyntheticTake:
+    """A walk whose trunk and root move once per *step*: a trap for phases that wrap twice per cycle.
+
+    The gait of :func:`synthetic_walk` made exactly left/right symmetric (no limp, equal arm swing, no head
+    tilt) and without the trunk and root motions that follow the cycle (pelvis rotation and list, trunk
+    rotation, sideways sway).  The spine, the root's height, tilt and speed then repeat every step (half a
+    cycle), and the left and right step look the same to them; only the legs and arms tell the steps apart.
+    ``period_frames`` is the full cycle (two steps).
+    """
+    style = replace(_WALK, name="symmetric walk", pelvis_rot=0.0, pelvis_list=0.0, trunk_rot=0.0, sway=0.0,
+                    symmetric=True)
+    return _gait_take(style, n_frames, fps, period_s, noise_deg, 0.0, 0.0, 0.0, seed)

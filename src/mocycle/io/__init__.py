@@ -1,52 +1,211 @@
-"""Reading and writing motion files.  Nothing else lives here.
+"""Reading and writing every file mocycle reads or writes.  Nothing else lives here.
 
-``read(path)`` picks the reader from the file name: ``.bvh``, or ``.amc``
-(the ``.asf`` skeleton is then found beside it or given as ``asf=``).
-``write(motion, path)`` writes BVH.
+One way in and one way out, chosen by the file's suffix:
+
+=========  ==========================================  =======================================
+suffix     holds                                       :func:`read` returns / :func:`write` takes
+=========  ==========================================  =======================================
+``.bvh``   a motion (:mod:`.bvh`)                      :class:`~mocycle.motion.Motion`
+``.amc``   a CMU motion, skeleton in an ``.asf``       :class:`~mocycle.motion.Motion` (read only)
+``.mck``   a keyframe-compressed take (:mod:`.mck`)    :class:`~mocycle.io.mck.Compressed`
+``.mosw``  joint swings, compact (:mod:`.mosw`)        :class:`~mocycle.swings.Segmentation`
+``.json``  joint swings as JSON records                :class:`~mocycle.swings.Segmentation`
+=========  ==========================================  =======================================
+
+``write`` also writes any result that has a ``to_dict()`` (cycles, phases, reports) as
+``.json``.  :func:`read_motion` is :func:`read` for the files that hold a motion
+(``.bvh``, ``.amc``), which is what the commands that take a motion use.
 """
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
-from ..errors import MotionFileError
+from ..errors import MocycleError, MotionFileError
 from ..motion import Motion
 from .asfamc import read_amc, read_asf, read_asfamc
+from .atomic import atomic_write
 from .bvh import parse_bvh, read_bvh, write_bvh
 
-__all__ = ["parse_bvh", "read", "read_amc", "read_asf", "read_asfamc", "read_bvh", "write", "write_bvh"]
+__all__ = ["READ_SUFFIXES", "WRITE_SUFFIXES", "parse_bvh", "read", "read_amc", "read_asf", "read_asfamc",
+           "read_bvh", "read_motion", "write", "write_bvh"]
+
+MOTION_SUFFIXES = (".bvh", ".amc")
+READ_SUFFIXES = (".bvh", ".amc", ".mck", ".mosw", ".json")
+WRITE_SUFFIXES = (".bvh", ".mck", ".mosw", ".json")
 
 
-def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = 120.0) -> Motion:
+def _suffix(p: Path, known: tuple[str, ...], what: str) -> str:
+    """The lower-case suffix of ``p`` if it is one of ``known``; otherwise one clear error."""
+    if p.is_dir():
+        raise MotionFileError(f"is a folder; {what} a file ending in {', '.join(known)}", p)
+    suffix = p.suffix.lower()
+    if suffix not in known:
+        raise MotionFileError(f"unknown file type {suffix or '(no suffix)'!r}; {what} {', '.join(known)} files",
+                              p)
+    return suffix
+
+
+def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = 120.0) -> Motion:
     """Read a motion file (``.bvh``, or ``.amc`` with its ``.asf``) into a :class:`Motion`.
 
-    ``fps`` is used for AMC files only (they do not store it; CMU: 120).
+    Parameters
+    ----------
+    path : the ``.bvh`` or ``.amc`` file.
+    asf : the ``.asf`` skeleton of an ``.amc`` file; default: the one beside it (same
+        subject number, or the only one).
+    fps : frame rate of ``.amc`` files, which do not store it (CMU: 120).
+
+    Raises
+    ------
+    MotionFileError
+        The file is missing, a folder, of another type, or not what its suffix promises
+        (the message names the file and the line).
     """
     p = Path(path)
-    suffix = p.suffix.lower()
-    if suffix == ".bvh":
+    if _suffix(p, MOTION_SUFFIXES, "mocycle reads motions from") == ".bvh":
         return read_bvh(p)
-    if suffix == ".amc":
-        if asf is None:
-            candidates = sorted(p.parent.glob("*.asf")) + sorted(p.parent.glob("*.ASF"))
-            stem = p.stem.split("_")[0]
-            named = [c for c in candidates if c.stem == stem]
-            if len(named) == 1:
-                asf = named[0]
-            elif len(candidates) == 1:
-                asf = candidates[0]
-            else:
-                raise MotionFileError(
-                    "cannot tell which .asf skeleton goes with this .amc; pass it explicitly", p
-                )
-        return read_asfamc(asf, p, fps=fps)
-    raise MotionFileError(f"unknown motion file type {suffix or '(none)'!r}; expected .bvh or .amc", p)
+    if asf is None:
+        candidates = sorted(p.parent.glob("*.asf")) + sorted(p.parent.glob("*.ASF"))
+        stem = p.stem.split("_")[0]
+        named = [c for c in candidates if c.stem == stem]
+        if len(named) == 1:
+            asf = named[0]
+        elif len(candidates) == 1:
+            asf = candidates[0]
+        else:
+            raise MotionFileError("cannot tell which .asf skeleton goes with this .amc; pass it explicitly", p)
+    return read_asfamc(asf, p, fps=fps)
 
 
-def write(motion: Motion, path: str | os.PathLike) -> Path:
-    """Write ``motion`` as BVH (the only output format for now)."""
+def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = 120.0):
+    """Read any file mocycle writes, chosen by its suffix (table in the module notes).
+
+    Parameters
+    ----------
+    path : a ``.bvh``, ``.amc``, ``.mck``, ``.mosw`` or swings ``.json`` file.
+    asf, fps : for ``.amc`` files only (see :func:`read_motion`).
+
+    Returns
+    -------
+    Motion, Compressed or Segmentation
+        A :class:`Motion` for ``.bvh``/``.amc``, a :class:`~mocycle.io.mck.Compressed` take for
+        ``.mck`` (``.decompress()`` gives the motion), a :class:`~mocycle.swings.Segmentation` for
+        ``.mosw`` and swings ``.json`` (``mocycle.swings.playback`` gives the motion).
+
+    Raises
+    ------
+    MotionFileError
+        Unknown suffix or a folder (the message lists the known suffixes), or a damaged file.
+
+    Examples
+    --------
+    >>> import mocycle, tempfile, pathlib
+    >>> from mocycle.datasets import synthetic_walk
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> walk = synthetic_walk(n_frames=120, fps=60).motion
+    >>> path = mocycle.write(walk, folder / "walk.bvh")
+    >>> again = mocycle.read(path)
+    >>> again.n_frames, round(again.fps)
+    (120, 60)
+    >>> mocycle.read(folder / "walk.txt")
+    Traceback (most recent call last):
+    ...
+    mocycle.errors.MotionFileError: ...walk.txt: unknown file type '.txt'; mocycle reads .bvh, .amc, ... files
+    """
     p = Path(path)
-    if p.suffix.lower() != ".bvh":
-        raise MotionFileError(f"can only write .bvh files; got {p.suffix or '(no suffix)'!r}", p)
-    return write_bvh(motion, p)
+    suffix = _suffix(p, READ_SUFFIXES, "mocycle reads")
+    if suffix in MOTION_SUFFIXES:
+        return read_motion(p, asf=asf, fps=fps)
+    if suffix == ".mck":
+        from .mck import read_compressed
+
+        return read_compressed(p)
+    if suffix == ".mosw":
+        from .mosw import read_swings
+
+        return read_swings(p)
+    return _read_json(p)
+
+
+def _read_json(p: Path):
+    """The swings records ``mocycle swings -o FILE.json`` writes, as a Segmentation."""
+    from ..swings.segment import Segmentation
+
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise MotionFileError(f"cannot read file ({exc.strerror or exc})", p) from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise MotionFileError(f"not a JSON file ({exc})", p) from None
+    if not (isinstance(data, dict) and "skeleton_bvh" in data and "swings" in data):
+        raise MotionFileError("not a JSON file mocycle reads: expected the swings records that "
+                              "'mocycle swings -o FILE.json' writes (with 'skeleton_bvh' and 'swings')", p)
+    try:
+        return Segmentation.from_dict(data)
+    except MocycleError as exc:
+        raise MotionFileError(str(exc), p) from None
+
+
+def write(obj, path: str | os.PathLike) -> Path:
+    """Write ``obj`` to ``path`` in the format its suffix names, atomically (no half-written file).
+
+    Parameters
+    ----------
+    obj : a :class:`Motion` (``.bvh``), a :class:`~mocycle.io.mck.Compressed` take (``.mck``), a
+        :class:`~mocycle.swings.Segmentation` (``.mosw`` or ``.json``), or any result with a
+        ``to_dict()`` (``.json``).
+    path : the file to write.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    MotionFileError
+        The suffix is unknown, names a folder, or does not fit ``obj`` (the message says which suffixes do).
+
+    Examples
+    --------
+    >>> import mocycle, tempfile, pathlib
+    >>> from mocycle.datasets import synthetic_walk
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> mocycle.write(synthetic_walk(n_frames=60).motion, folder / "walk.bvh").name
+    'walk.bvh'
+    >>> mocycle.write(synthetic_walk(n_frames=60).motion, folder / "walk.mosw")
+    Traceback (most recent call last):
+    ...
+    mocycle.errors.MotionFileError: .../walk.mosw: a Motion is written as .bvh
+    """
+    p = Path(path)
+    suffix = _suffix(p, WRITE_SUFFIXES, "mocycle writes")
+    from ..swings.segment import Segmentation
+    from .mck import Compressed
+
+    fits = {Motion: (".bvh",), Compressed: (".mck",), Segmentation: (".mosw", ".json")}
+    for kind, suffixes in fits.items():
+        if isinstance(obj, kind):
+            if suffix not in suffixes:
+                raise MotionFileError(f"a {kind.__name__} is written as {' or '.join(suffixes)}", p)
+            break
+    else:
+        if suffix != ".json" or not callable(getattr(obj, "to_dict", None)):
+            raise MotionFileError(f"cannot write a {type(obj).__name__} as {suffix}: mocycle writes a Motion as "
+                                  f".bvh, a Compressed take as .mck, swings as .mosw or .json, results with "
+                                  f"to_dict() as .json", p)
+    if suffix == ".bvh":
+        return write_bvh(obj, p)
+    if suffix == ".mck":
+        return obj.save(p)
+    if suffix == ".mosw":
+        from .mosw import write_swings
+
+        return write_swings(obj, p)
+    try:
+        return atomic_write(p, json.dumps(obj.to_dict(), indent=1))
+    except OSError as exc:
+        raise MotionFileError(f"cannot write file ({exc.strerror or exc})", p) from None

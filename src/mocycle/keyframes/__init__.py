@@ -2,11 +2,11 @@
 
 Pose distance and errors (:mod:`.distance`), keyframe selection (:mod:`.select`),
 temporal reconstruction (:mod:`.temporal`), projections to 2-D (:mod:`.projection`),
-Igarashi back-projection and Algorithm 12 (:mod:`.spatial`), and the ``.mck``
-codec (:mod:`.codec`).
+Igarashi back-projection and Algorithm 12 (:mod:`.spatial`); ``compress``, ``Compressed``
+and the ``.mck`` file are in :mod:`mocycle.io.mck`.
 """
 
-from .codec import SCHEMES, Compressed, compress, read_compressed
+from .density import KeyDensity, keyframe_density, rhythm_period
 from .distance import (
     error_per_frame_per_joint,
     frame_errors,
@@ -22,9 +22,22 @@ from .spatial import BackProjection, OptimizeResult, nearest_rotation, optimize_
 from .temporal import interpolate_rotations, slerp
 
 __all__ = [
-    "METHODS", "ONE_STEP", "PROJECTIONS", "SCHEMES", "TWO_STEP", "BackProjection", "Compressed", "OptimizeResult",
-    "PoseSpace", "compress", "error_per_frame_per_joint", "frame_errors", "interpolate_rotations", "joint_weights",
-    "keyframe_count", "nearest_rotation", "optimize_projection", "pose_distance", "pose_distance_matrix",
-    "pose_vectors", "project_one_step", "read_compressed", "reconstruct_spatial", "select_keyframes", "select_pb",
-    "select_rols", "select_scs", "select_uniform", "slerp", "spatial_layout", "stress",
+    "METHODS", "ONE_STEP", "PROJECTIONS", "SCHEMES", "TWO_STEP", "BackProjection", "Compressed", "KeyDensity",
+    "OptimizeResult", "PoseSpace", "compress", "error_per_frame_per_joint", "frame_errors", "interpolate_rotations",
+    "joint_weights", "keyframe_count", "keyframe_density", "nearest_rotation", "optimize_projection",
+    "pose_distance", "pose_distance_matrix", "pose_vectors", "project_one_step", "read_compressed",
+    "reconstruct_spatial", "rhythm_period", "select_keyframes", "select_pb", "select_rols", "select_scs",
+    "select_uniform", "slerp", "spatial_layout", "stress",
 ]
+
+# compress/Compressed live in mocycle.io.mck, which itself imports this package's modules:
+# resolved on first use so that importing either package first works.
+_CODEC = ("SCHEMES", "Compressed", "compress", "read_compressed")
+
+
+def __getattr__(name: str):
+    if name in _CODEC:
+        from ..io import mck
+
+        return getattr(mck, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

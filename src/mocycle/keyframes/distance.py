@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
+from ..rotations import quat_angles
 
 #: Largest take the all-pairs (T × T) computations accept.
 MAX_PAIRWISE_FRAMES = 6000
@@ -36,15 +37,9 @@ def joint_weights(skeleton: Skeleton) -> np.ndarray:
     return (height + 1).astype(np.float64)
 
 
-def joint_angles(qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
-    """Geodesic angle (radians, 0..π) between quaternions ``(..., 4)`` → ``(...)``."""
-    dot = np.abs(np.sum(np.asarray(qa) * np.asarray(qb), axis=-1))
-    return 2.0 * np.arccos(np.minimum(dot, 1.0))
-
-
 def pose_distance(qa: np.ndarray, qb: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """Eq. 3.2 between poses ``(..., J, 4)`` and ``(..., J, 4)`` (broadcasting) → ``(...)``."""
-    return joint_angles(qa, qb) @ np.asarray(weights, dtype=np.float64)
+    return quat_angles(qa, qb) @ np.asarray(weights, dtype=np.float64)
 
 
 def frame_errors(original: Motion, reconstructed: Motion) -> np.ndarray:
@@ -71,7 +66,7 @@ def moving_joints(quats: np.ndarray, tol: float = 1e-9) -> np.ndarray:
     q = np.asarray(quats)
     if q.shape[0] < 2:
         return np.arange(q.shape[1])
-    dev = joint_angles(q, q[:1]).max(axis=0)
+    dev = quat_angles(q, q[:1]).max(axis=0)
     return np.flatnonzero(dev > tol)
 
 

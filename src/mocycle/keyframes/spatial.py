@@ -26,91 +26,18 @@ from scipy.spatial.distance import cdist
 from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError
-from ..rotations import nearest_rotations
+from ..rotations import (
+    angle_to_nearest_rotation,
+    fast_nearest_rotation,
+    nearest_rotation_angle_entries,
+    nearest_rotations,
+)
 from .distance import moving_joints
 
-# ---------------------------------------------------------------- rotations
-
-
+# The rotation helpers live in mocycle.rotations; these names stay importable from here.
 nearest_rotation = nearest_rotations  # the pure rotation closest (Frobenius) to each (..., 3, 3) matrix
-
-
-def fast_nearest_rotation(M: np.ndarray, iterations: int = 8) -> np.ndarray:
-    """Same result as :func:`nearest_rotation`, by scaled Newton polar iterations ``X ← (γX + X⁻ᵀ/γ) / 2``.
-
-    Written on the nine matrix entries as separate arrays (closed-form 3×3 inverse),
-    several times faster than batched SVD; matrices with ``det <= 0`` or that do not
-    converge go to the SVD.
-    """
-    M = np.asarray(M, dtype=np.float64)
-    shape = M.shape
-    flat = M.reshape(-1, 9)
-    scale = np.linalg.norm(flat, axis=1) / np.sqrt(3.0)
-    x = flat / np.where(scale > 0, scale, 1.0)[:, None]
-    bad = ~(np.linalg.det(x.reshape(-1, 3, 3)) > 1e-6)
-    x[bad] = np.eye(3).ravel()  # these go to the SVD below
-    x = list(x.T)  # 9 arrays (N,)
-    for _ in range(iterations):
-        a, b, c, d, e, f, g, h, i = x
-        # cofactor matrix (= det · X⁻ᵀ)
-        C = [e * i - f * h, f * g - d * i, d * h - e * g,
-             c * h - b * i, a * i - c * g, b * g - a * h,
-             b * f - c * e, c * d - a * f, a * e - b * d]
-        det = np.maximum(a * C[0] + b * C[1] + c * C[2], 1e-300)
-        gam = det ** (-1.0 / 3.0)
-        k = 1.0 / (gam * det)
-        x = [0.5 * (gam * xv + k * cv) for xv, cv in zip(x, C, strict=True)]
-    X = np.stack(x, axis=1).reshape(-1, 3, 3)
-    err = np.abs(np.einsum("nji,njk->nik", X, X) - np.eye(3)).max(axis=(1, 2))
-    bad |= ~(err < 1e-9)
-    if np.any(bad):
-        X[bad] = nearest_rotation(flat[bad].reshape(-1, 3, 3))
-    return X.reshape(shape)
-
-
-def angle_to_nearest_rotation(N: np.ndarray, iterations: int = 4) -> np.ndarray:
-    """Rotation angle (radians) of the pure rotation nearest to each ``(..., 3, 3)`` matrix ``N``.
-
-    With ``N = R_targetᵀ·M`` this is the geodesic error of the orthonormalised ``M``
-    without forming it: the nearest rotation's quaternion is the top eigenvector of
-    Bar-Itzhack's symmetric 4×4 matrix of ``N``, found by a few power iterations from
-    the column Shepperd's method would pick (exact for a pure rotation; within about
-    1e-4 rad of the SVD answer for the near-rotations RBF interpolation gives).
-    """
-    N = np.asarray(N, dtype=np.float64)
-    shape = N.shape[:-2]
-    return _angle_of_components(list(N.reshape(-1, 9).T), iterations).reshape(shape)
-
-
-def _angle_of_components(n: list, iterations: int = 4) -> np.ndarray:
-    """:func:`angle_to_nearest_rotation` on the nine entries of ``N`` given as separate arrays (row-major)."""
-    norm2 = n[0] * n[0]
-    for v in n[1:]:
-        norm2 = norm2 + v * v
-    s = np.sqrt(3.0) / np.maximum(np.sqrt(norm2), 1e-300)
-    a, b, c, d, e, f, g, h, i = (v * s for v in n)
-    third = 1.0 / 3.0
-    # Bar-Itzhack's matrix (quaternion order x, y, z, w), shifted by 1/3: a rotation's eigenvalues
-    # 1, -1/3, -1/3, -1/3 become 4/3, 0, 0, 0
-    k00, k11, k22, k33 = (a - e - i + 1) * third, (e - a - i + 1) * third, (i - a - e + 1) * third, \
-        (a + e + i + 1) * third
-    k01, k02, k03 = (b + d) * third, (c + g) * third, (h - f) * third
-    k12, k13, k23 = (f + h) * third, (c - g) * third, (d - b) * third
-    # start from the column of the largest diagonal entry (Shepperd): exact for a pure rotation
-    pick = np.argmax(np.stack([k00, k11, k22, k33]), axis=0)
-    p0, p1, p2 = pick == 0, pick == 1, pick == 2
-    x = np.where(p0, k00, np.where(p1, k01, np.where(p2, k02, k03)))
-    y = np.where(p0, k01, np.where(p1, k11, np.where(p2, k12, k13)))
-    z = np.where(p0, k02, np.where(p1, k12, np.where(p2, k22, k23)))
-    w = np.where(p0, k03, np.where(p1, k13, np.where(p2, k23, k33)))
-    for _ in range(iterations):
-        x, y, z, w = (k00 * x + k01 * y + k02 * z + k03 * w, k01 * x + k11 * y + k12 * z + k13 * w,
-                      k02 * x + k12 * y + k22 * z + k23 * w, k03 * x + k13 * y + k23 * z + k33 * w)
-        norm = np.sqrt(x * x + y * y + z * z + w * w)
-        norm = np.where(norm > 0, norm, 1.0)
-        x, y, z, w = x / norm, y / norm, z / norm, w / norm
-    vec = np.sqrt(x * x + y * y + z * z)
-    return 2.0 * np.arctan2(vec, np.abs(w))
+__all__ = ["BackProjection", "OptimizeResult", "angle_to_nearest_rotation", "fast_nearest_rotation",
+           "nearest_rotation", "optimize_projection", "rbf_solve", "reconstruct_spatial"]
 
 
 # ---------------------------------------------------------------- RBF (eq. 2.1, 2.2; Algorithm 11)
@@ -273,7 +200,7 @@ def optimize_projection(points: np.ndarray, key_idx, quats: np.ndarray, weights:
         # N = R_targetᵀ · M entry by entry: N_ac = Σ_b T_ba M_bc
         N = [Tg[a] * M[..., c] + Tg[3 + a] * M[..., 3 + c] + Tg[6 + a] * M[..., 6 + c]
              for a in range(3) for c in range(3)]
-        return _angle_of_components(N) @ w
+        return nearest_rotation_angle_entries(N) @ w
 
     extent = float(np.ptp(P, axis=0).max()) or 1.0
     r = 0.5 * (np.linalg.norm(P[free] - P[free - 1], axis=1) + np.linalg.norm(P[free] - P[free + 1], axis=1))

@@ -23,7 +23,7 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError
 from ..motion import Skeleton
-from ..rotations import continuous_euler, euler_to_quats
+from ..rotations import continuous_euler, euler_to_quats, nearest_rotations, slerp
 
 SCHEMES = ("linear", "hermite", "slerp", "rbf")
 
@@ -38,24 +38,6 @@ def check_keys(key_idx, n_frames: int) -> np.ndarray:
         raise MocycleError(f"keyframe indices must increase from frame 0 to frame {n_frames - 1}; "
                            f"got {idx[:3].tolist()}...{idx[-3:].tolist()}")
     return idx
-
-
-def slerp(qa: np.ndarray, qb: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """Spherical linear interpolation of quaternions ``(..., 4)`` at fractions ``u`` ``(...)`` (shortest arc)."""
-    qa = np.asarray(qa, dtype=np.float64)
-    qb = np.asarray(qb, dtype=np.float64)
-    u = np.asarray(u, dtype=np.float64)[..., None]
-    dot = np.sum(qa * qb, axis=-1, keepdims=True)
-    qb = np.where(dot < 0, -qb, qb)
-    dot = np.abs(dot)
-    theta = np.arccos(np.minimum(dot, 1.0))
-    s = np.sin(theta)
-    small = s < 1e-9
-    safe = np.where(small, 1.0, s)
-    wa = np.where(small, 1.0 - u, np.sin((1.0 - u) * theta) / safe)
-    wb = np.where(small, u, np.sin(u * theta) / safe)
-    q = wa * qa + wb * qb
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
 def segments(key_idx: np.ndarray, n_frames: int) -> tuple[np.ndarray, np.ndarray]:
@@ -81,12 +63,10 @@ def interpolate_rotations(skeleton: Skeleton, key_idx, key_quats: np.ndarray, n_
         seg, u = segments(idx, n_frames)
         out = slerp(kq[seg], kq[seg + 1], np.broadcast_to(u[:, None], (n_frames, J)))
     elif scheme == "rbf":
-        from .spatial import nearest_rotation
-
         R = Rotation.from_quat(kq.reshape(-1, 4)).as_matrix().reshape(len(idx), J * 9)
         f = RBFInterpolator(idx[:, None].astype(np.float64), R, kernel="linear", degree=1)
         M = f(t[:, None]).reshape(n_frames, J, 3, 3)
-        out = Rotation.from_matrix(nearest_rotation(M).reshape(-1, 3, 3)).as_quat().reshape(n_frames, J, 4)
+        out = Rotation.from_matrix(nearest_rotations(M).reshape(-1, 3, 3)).as_quat().reshape(n_frames, J, 4)
     else:
         out = np.empty((n_frames, J, 4))
         groups: dict[str, list[int]] = {}

@@ -295,6 +295,20 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
     coords_ : ``(T, k)`` coordinates in ``[0, 1)`` (k = len(classes_), may be 0).
     reason_ : why these classes (which bars, which gap).
     landmarks_ : ``(L,)`` indices of the landmark points; ``cover_radius_`` their covering radius.
+
+    Examples
+    --------
+    Four turns around a noisy circle have one circular coordinate that winds four times:
+
+    >>> import numpy as np
+    >>> t = np.linspace(0, 4 * 2 * np.pi, 200, endpoint=False)
+    >>> X = np.c_[np.cos(t), np.sin(t)] + 0.01 * np.random.default_rng(0).normal(size=(200, 2))
+    >>> cc = CircularCoordinates().fit(X)
+    >>> cc.coords_.shape
+    (200, 1)
+    >>> turns = np.unwrap(2 * np.pi * cc.coords_[:, 0]) / (2 * np.pi)
+    >>> round(abs(float(turns[-1] - turns[0])))
+    4
     """
 
     def __init__(self, n_landmarks: int = 120, prime: int = 47, scale: str | float = "auto",

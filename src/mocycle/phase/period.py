@@ -13,7 +13,8 @@ A circular coordinate is one value per frame in *cycles* (the circle is
 
 :func:`autocorrelation_period` is independent of any coordinate: the
 fundamental cycle of a pose matrix from its windowed circular autocorrelation
-(paper 004), used as a cross-check.
+(paper 004), used as a cross-check; :func:`self_similarity` decides between
+period estimates that disagree.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ __all__ = [
     "fit_period",
     "gmm_cdf_remap",
     "rank_uniform",
+    "self_similarity",
     "unwrap_phase",
 ]
 
@@ -370,3 +372,70 @@ def excitation_regions(coords, window: int, threshold: float = 0.3, min_length: 
     cum = np.concatenate([[0.0], np.cumsum(d)])  # cum[i] = unwrapped x[i] - x[0]
     return [(s, e) for s, e in merged
             if e - s >= min_length and abs(cum[e - 1] - cum[s]) >= min_cycles]
+
+
+# -- self-similarity one period apart ----------------------------------------------------------------------------
+
+
+def self_similarity(X, lag: float) -> float:
+    """How unlike itself ``X`` (``(T,)`` or ``(T, D)``) is ``lag`` frames later: 0 identical, about 1 unrelated.
+
+    ``mean_t ||x(t + lag) - x(t)||² / (2 * total variance)``, with ``x(t + lag)`` linearly interpolated for a
+    fractional lag; NaN when fewer than two frames overlap.  A periodic take scores lowest at its period
+    (and its multiples), which decides between two nearby period estimates.
+    """
+    A = np.asarray(X, dtype=np.float64)
+    if A.ndim == 1:
+        A = A[:, None]
+    if A.ndim != 2:
+        raise MocycleError(f"X must be a (T,) or (T, D) array; got shape {A.shape}")
+    lag = float(lag)
+    if not np.isfinite(lag) or lag <= 0:
+        return float("nan")
+    k = int(np.floor(lag))
+    f = lag - k
+    n = A.shape[0] - k - 1
+    if n < 2:
+        return float("nan")
+    later = (1.0 - f) * A[k: k + n] + f * A[k + 1: k + 1 + n]
+    var = float(A.var(axis=0).sum())
+    if not var > 0:
+        return float("nan")
+    return float(np.mean(np.sum((later - A[:n]) ** 2, axis=1)) / (2.0 * var))
+
+
+def repetition_distance(X, period: float, smooth: int = 1) -> np.ndarray:
+    """Per frame, how unlike ``X`` (``(T, D)``) is to itself one ``period`` earlier or later: ``(T,)``.
+
+    ``min(||x(t + P) - x(t)||², ||x(t - P) - x(t)||²) / (2 * total variance)`` (linear interpolation for a
+    fractional period; only the side inside the take where the other is not), averaged over ``smooth``
+    frames.  About 0 where the motion repeats at that period, about 1 or more where it does not (a
+    different motion, a transition).  NaN where neither side is inside the take.
+    """
+    A = np.asarray(X, dtype=np.float64)
+    if A.ndim == 1:
+        A = A[:, None]
+    T = A.shape[0]
+    out = np.full(T, np.nan)
+    P = float(period)
+    var = float(A.var(axis=0).sum())
+    if not (np.isfinite(P) and P > 0 and var > 0) or T < 3:
+        return out
+    t = np.arange(T, dtype=np.float64)
+
+    def at(times: np.ndarray) -> np.ndarray:
+        i0 = np.clip(np.floor(times).astype(int), 0, T - 2)
+        f = (times - i0)[:, None]
+        return (1.0 - f) * A[i0] + f * A[i0 + 1]
+
+    d = np.full((2, T), np.inf)
+    for k, sign in enumerate((1.0, -1.0)):
+        inside = (t + sign * P >= 0) & (t + sign * P <= T - 1)
+        d[k, inside] = np.sum((at(t[inside] + sign * P) - A[inside]) ** 2, axis=1) / (2.0 * var)
+    best = d.min(axis=0)
+    ok = np.isfinite(best)
+    out[ok] = best[ok]
+    if smooth > 1 and ok.any():
+        filled = np.where(ok, out, np.nanmax(out[ok]))
+        out = np.where(ok, uniform_filter1d(filled, size=int(smooth), mode="nearest"), np.nan)
+    return out

@@ -23,8 +23,8 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from ..errors import MocycleError
 from ..motion import Motion
-from ..rotations import quat_multiply
-from .segment import Segmentation, axis_angle_quats, conj, rotvec_quat, twist_angles
+from ..rotations import axis_angle_quats, quat_conj, quat_multiply, rotvec_quat, twist_angles
+from .segment import Segmentation
 
 
 def _resample(q: np.ndarray, times: np.ndarray) -> np.ndarray:
@@ -65,7 +65,7 @@ def edit_swing(motion: Motion, seg: Segmentation, joint: str | int, swing: int, 
         axis = np.asarray(sw.axis)
         base = rotvec_quat(np.asarray(sw.base))
         idx = np.arange(sw.start, sw.end + 1)
-        theta = twist_angles(quat_multiply(q[idx], conj(base)[None, :]), axis)
+        theta = twist_angles(quat_multiply(q[idx], quat_conj(base)[None, :]), axis)
         delta = np.zeros(T)
         delta[idx] = (angle_scale - 1.0) * (theta - theta[0])
         d_end = delta[sw.end]

@@ -21,7 +21,7 @@ import numpy as np
 from scipy.signal import fftconvolve
 
 from ..errors import MocycleError, MocycleWarning
-from ..io import read
+from ..io import read_motion as read
 from ..motion import Motion
 from .segment import DEFAULT_THRESHOLD, Segmentation, segment
 

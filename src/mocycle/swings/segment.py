@@ -33,7 +33,16 @@ from scipy.ndimage import uniform_filter1d
 
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
-from ..rotations import quat_log, quat_multiply
+from ..rotations import (
+    axis_angle_quats,
+    mean_quat,
+    quat_conj,
+    quat_log,
+    quat_multiply,
+    quat_rotvec,
+    rotvec_quat,
+    twist_angles,
+)
 
 #: The paper's box filter and error window: 20 frames at 120 fps, in seconds.
 PAPER_WINDOW_S = 20.0 / 120.0
@@ -49,7 +58,7 @@ MINOR_JOINT_PATTERNS = (
 
 
 # ---------------------------------------------------------------- records
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Swing:
     """One geodesic swing of one joint: ``q(t) = Rot(axis, θ(t)) ⊗ base`` for frames ``start..end``.
 
@@ -96,7 +105,7 @@ class Swing:
         return quat_multiply(axis_angle_quats(np.asarray(self.axis), theta), rotvec_quat(np.asarray(self.base)))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Hold:
     """A still part of one joint: frames ``start..end`` (inclusive) and their mean rotation (rotation vector, rad)."""
 
@@ -111,7 +120,7 @@ class Hold:
         return self.end - self.start + 1
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Segmentation:
     """Swings and holds of every joint of a take, plus what playback needs to rebuild it.
 
@@ -167,7 +176,7 @@ class Segmentation:
 
     def to_dict(self) -> dict:
         """Everything as JSON-ready values (read back with :meth:`from_dict`)."""
-        from .codec import skeleton_text
+        from ..io.mosw import skeleton_text
 
         return dict(
             frames=self.n_frames, frame_time=self.frame_time, fps=self.fps, threshold=self.threshold,
@@ -182,7 +191,7 @@ class Segmentation:
 
     @classmethod
     def from_dict(cls, d: dict) -> Segmentation:
-        from .codec import skeleton_from_text
+        from ..io.mosw import skeleton_from_text
 
         try:
             skel = skeleton_from_text(d["skeleton_bvh"])
@@ -200,45 +209,6 @@ class Segmentation:
             raise MocycleError(f"not a swings JSON document (missing or bad field: {exc})") from None
 
 
-# ---------------------------------------------------------------- quaternion helpers
-def axis_angle_quats(axis: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """Quaternions ``(n, 4)`` of rotations by ``theta`` (n,) radians about one unit ``axis``."""
-    half = 0.5 * np.asarray(theta, dtype=np.float64)
-    return np.concatenate([np.sin(half)[:, None] * np.asarray(axis)[None, :], np.cos(half)[:, None]], axis=1)
-
-
-def rotvec_quat(v: np.ndarray) -> np.ndarray:
-    """Quaternion ``(4,)`` of a rotation vector ``(3,)`` (radians)."""
-    v = np.asarray(v, dtype=np.float64)
-    angle = float(np.linalg.norm(v))
-    if angle < 1e-12:
-        return np.array([0.5 * v[0], 0.5 * v[1], 0.5 * v[2], 1.0]) / np.sqrt(1 + 0.25 * angle**2)
-    return np.concatenate([np.sin(angle / 2) * v / angle, [np.cos(angle / 2)]])
-
-
-def quat_rotvec(q: np.ndarray) -> np.ndarray:
-    """Rotation vector ``(3,)`` (angle ≤ π) of a quaternion ``(4,)``."""
-    q = np.asarray(q, dtype=np.float64)
-    return quat_log(q if q[3] >= 0 else -q)
-
-
-def conj(q: np.ndarray) -> np.ndarray:
-    return np.asarray(q) * np.array([-1.0, -1.0, -1.0, 1.0])
-
-
-def mean_quat(q: np.ndarray) -> np.ndarray:
-    """Mean ``(4,)`` of nearby quaternions ``(n, 4)``: the sign-aligned normalised sum (chordal mean)."""
-    q = np.asarray(q, dtype=np.float64)
-    q = q * np.where(q @ q[0] < 0, -1.0, 1.0)[:, None]
-    s = q.sum(axis=0)
-    return s / np.linalg.norm(s)
-
-
-def twist_angles(q: np.ndarray, axis: np.ndarray) -> np.ndarray:
-    """Angle (radians, unwrapped in time) of the twist of each quaternion ``(n, 4)`` about ``axis``."""
-    return np.unwrap(2.0 * np.arctan2(q[:, :3] @ axis, q[:, 3]))
-
-
 # ---------------------------------------------------------------- the paper's steps
 def window_frames(window_s: float, fps: float) -> int:
     """Box-filter length in frames for ``window_s`` seconds at ``fps`` (at least 1)."""
@@ -253,7 +223,7 @@ def angular_velocity(quats: np.ndarray, frame_time: float) -> np.ndarray:
     a constant direction.
     """
     q = np.asarray(quats, dtype=np.float64)
-    dq = quat_multiply(q[1:], conj(q[:-1]))
+    dq = quat_multiply(q[1:], quat_conj(q[:-1]))
     dq = dq * np.where(dq[..., 3:4] < 0, -1.0, 1.0)  # shortest way
     return quat_log(dq) / frame_time
 
@@ -370,7 +340,7 @@ def fit_swing(q: np.ndarray, axes: np.ndarray, speed: np.ndarray, first: int, la
     theta = twist_angles(qs, axis)
     rest = quat_multiply(axis_angle_quats(axis, -theta), qs)  # Rot(a, -θ) ⊗ q: the part off the axis
     base = mean_quat(rest)
-    theta = twist_angles(quat_multiply(qs, conj(base)[None, :]), axis)
+    theta = twist_angles(quat_multiply(qs, quat_conj(base)[None, :]), axis)
     n = theta.size
     u = np.linspace(0.0, 1.0, n)
     dur = (n - 1) * frame_time
@@ -452,6 +422,21 @@ def segment(motion: Motion, threshold: float = DEFAULT_THRESHOLD, joints: str | 
         so slow drifts are kept by interpolation between their means.
     translation_tol : tolerance of the piecewise-linear translation track in file units
         (default 0.1 % of the skeleton's height).
+
+    Returns
+    -------
+    Segmentation
+        ``swings`` and ``holds`` per joint (``swings_of(j)``, ``holds_of(j)``), ``to_records()``,
+        ``to_dict()``; :func:`~mocycle.swings.playback` rebuilds the motion, ``mocycle.write(seg,
+        "take.mosw")`` stores it.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> walk = synthetic_walk(n_frames=300, fps=60).motion
+    >>> seg = segment(walk, threshold=0.4)
+    >>> seg.n_swings, len(seg.joints), seg.swings_of(seg.joints[1])[0].name
+    (205, 20, 'LeftUpLeg')
     """
     if not isinstance(motion, Motion):
         raise MocycleError(f"segment() needs a Motion; got {type(motion).__name__}")

@@ -1,4 +1,9 @@
-"""Saving matplotlib figures without a screen and without half-written files."""
+"""Drawing figures without a screen and without half-written files.
+
+Figures are :class:`matplotlib.figure.Figure` objects made directly, not through
+``pyplot``: nothing here selects a backend (``matplotlib.use``) or registers a
+window, so importing mocycle inside Blender or Jupyter leaves their backend alone.
+"""
 
 from __future__ import annotations
 
@@ -6,31 +11,32 @@ import io
 import os
 from pathlib import Path
 
-import matplotlib
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")  # no display needed; must precede pyplot
-import matplotlib.pyplot as plt  # noqa: E402
-
-from ..errors import MocycleError  # noqa: E402
-from ..io.atomic import atomic_write  # noqa: E402
+from ..errors import MocycleError
+from ..io.atomic import atomic_write
 
 
-def save(fig, path: str | os.PathLike, dpi: int = 110) -> Path:
-    """Render ``fig`` to PNG in memory, then write it in one step; close the figure."""
+def check_png(path: str | os.PathLike) -> Path:
+    """Refuse a plot path that is not a ``.png`` file (before anything is drawn)."""
     path = Path(path)
     if path.suffix.lower() != ".png":
-        plt.close(fig)
         raise MocycleError(f"{path}: plots are written as .png files")
+    return path
+
+
+def save(fig: Figure, path: str | os.PathLike, dpi: int = 110) -> Path:
+    """Render ``fig`` to PNG in memory, then write it in one step."""
+    path = check_png(path)
     buf = io.BytesIO()
-    try:
-        fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
-    finally:
-        plt.close(fig)
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
     try:
         return atomic_write(path, buf.getvalue())
     except OSError as exc:
         raise MocycleError(f"{path}: cannot write the plot ({exc.strerror or exc})") from None
 
 
-def subplots(*args, **kwargs):
-    return plt.subplots(*args, **kwargs)
+def subplots(nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] | None = None, **kwargs):
+    """A new :class:`Figure` and its axes, like ``pyplot.subplots`` but outside pyplot's state."""
+    fig = Figure(figsize=figsize)
+    return fig, fig.subplots(nrows, ncols, **kwargs)

@@ -13,13 +13,13 @@ from pathlib import Path
 import numpy as np
 from matplotlib.colors import LinearSegmentedColormap
 
-from ..errors import MocycleError
-from .figure import save, subplots
+from .data import projection_plot_data
+from .figure import check_png, save, subplots
 
 TIME_COLOURS = LinearSegmentedColormap.from_list("time", ["red", "green", "blue"])
 
 
-def _panel(ax, points: np.ndarray, key_idx: np.ndarray, title: str) -> None:
+def _panel(ax, points: np.ndarray, key_idx: np.ndarray, title: str):
     t = np.arange(len(points))
     ax.plot(points[:, 0], points[:, 1], "-", color="0.8", lw=0.5, zorder=0)
     sc = ax.scatter(points[:, 0], points[:, 1], c=t, cmap=TIME_COLOURS, s=6, zorder=1)
@@ -37,22 +37,13 @@ def plot_projection(points: np.ndarray, key_idx, path: str | os.PathLike, title:
                     ) -> Path:
     """Write a PNG of the 2-D poses ``points`` ``(T, 2)`` with keyframes ``key_idx``; optionally next to
     ``optimized`` ``(T, 2)``."""
-    P = np.asarray(points, dtype=np.float64)
-    idx = np.asarray(key_idx, dtype=np.int64)
-    if P.ndim != 2 or P.shape[1] != 2 or len(P) < 1:
-        raise MocycleError(f"points must have shape (T, 2); got {P.shape}")
-    if idx.size and (idx.min() < 0 or idx.max() >= len(P)):
-        raise MocycleError(f"keyframe indices must lie in 0..{len(P) - 1}")
-    panels = [(P, labels[0])]
-    if optimized is not None:
-        O = np.asarray(optimized, dtype=np.float64)
-        if O.shape != P.shape:
-            raise MocycleError(f"optimised points must have shape {P.shape}; got {O.shape}")
-        panels.append((O, labels[1]))
+    data = projection_plot_data(points, key_idx, optimized, labels)
+    check_png(path)
+    panels = data["panels"]
     fig, axes = subplots(1, len(panels), figsize=(6.2 * len(panels), 5.6), squeeze=False)
     sc = None
-    for ax, (pts, label) in zip(axes[0], panels, strict=True):
-        sc = _panel(ax, pts, idx, label)
+    for ax, panel in zip(axes[0], panels, strict=True):
+        sc = _panel(ax, panel["points"], data["key_idx"], panel["label"])
     fig.colorbar(sc, ax=list(axes[0]), label="frame", shrink=0.8)
     if title:
         fig.suptitle(title)

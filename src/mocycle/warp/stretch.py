@@ -27,14 +27,16 @@ from __future__ import annotations
 
 import fnmatch
 import math
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
-from ..errors import MocycleError
+from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
 from ..limits import check_frames
-from ..motion import JOINT_GROUPS, Motion, Skeleton
+from ..motion import JOINT_GROUPS, Motion, Skeleton, concatenate
 from ..phase.period import autocorrelation_period
 from .lct import block_edges, ilct, lct
 
@@ -43,6 +45,7 @@ __all__ = [
     "fundamental_cycles",
     "group_cycle",
     "joint_groups",
+    "periodic_regions",
     "refine_window",
     "stretch_motion",
     "warp_curves",
@@ -230,7 +233,7 @@ def joint_groups(skeleton: Skeleton) -> dict[str, list[int]]:
     return {g: js for g, js in groups.items() if js}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class StretchReport:
     """What :func:`stretch_motion` did.
 
@@ -239,6 +242,9 @@ class StretchReport:
     cycles : ``{group: fundamental cycle in frames}`` as estimated (``None`` when ``window`` was given).
     groups : ``{group: joint names}``.
     trend_curves : rotation curves warped as line + residual (e.g. ``"Hips:qy"``).
+    regions, regions_out : the periodic frame ranges warped, in the input and where they are in the output
+        (the frames outside them are kept as captured).
+    forced : the take has no periodic motion and was warped whole anyway (``force=True``).
     """
 
     factor: float
@@ -248,6 +254,9 @@ class StretchReport:
     cycles: dict[str, float | None]
     groups: dict[str, tuple[str, ...]] = field(repr=False)
     trend_curves: tuple[str, ...] = ()
+    regions: tuple[tuple[int, int], ...] = ()
+    regions_out: tuple[tuple[int, int], ...] = ()
+    forced: bool = False
 
     def to_dict(self) -> dict:
         return {
@@ -257,6 +266,9 @@ class StretchReport:
             "windows": dict(self.windows),
             "cycles": {g: (None if c is None else round(float(c), 3)) for g, c in self.cycles.items()},
             "trend_curves": list(self.trend_curves),
+            "periodic_regions": [list(r) for r in self.regions],
+            "periodic_regions_out": [list(r) for r in self.regions_out],
+            "forced": self.forced,
         }
 
 
@@ -276,27 +288,11 @@ def _warp_detrended(Y: np.ndarray, factor: float, window: int) -> np.ndarray:
     return res + a + v * t_out
 
 
-def stretch_motion(motion: Motion, factor: float, window: str | int = "auto") -> tuple[Motion, StretchReport]:
-    """Lengthen (or shorten) a take by time-frequency warping, keeping its cycle: paper 004 §6.
-
-    Parameters
-    ----------
-    motion : the take (at least 8 frames).
-    factor : length ratio (> 0); the result has ``round(T * factor)`` frames at the same frame time.
-    window : ``"auto"`` (each joint group's largest fundamental cycle, :func:`group_cycle`) or a number of
-        frames used for every group (``1 <= window <= T // 2``).
-
-    Returns
-    -------
-    ``(new motion, StretchReport)``.  Raises MocycleError when ``"auto"`` finds no cycle in any group (the
-    take does not look periodic; pass a window).
-    """
-    if not isinstance(motion, Motion):
-        raise MocycleError(f"stretch_motion needs a Motion; got {type(motion).__name__}")
+def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
+               travel: int | None = None) -> tuple[Motion, StretchReport]:
+    """The whole take warped by ``factor`` (paper 004 §6): :func:`stretch_motion` on one periodic region.
+    ``travel``: the travelling joint (default: the take's own)."""
     T = motion.n_frames
-    if T < 8:
-        raise MocycleError(f"stretching needs a take of at least 8 frames; got {T}")
-    factor = _factor(factor)
     n_out = _frames_out(T, factor, motion.n_joints)
     skel = motion.skeleton
     groups = joint_groups(skel)
@@ -361,7 +357,7 @@ def stretch_motion(motion: Motion, factor: float, window: str | int = "auto") ->
 
     # Translations: the travelling joint as mean velocity + warped residual; other moving joints warped.
     trans = np.broadcast_to(motion.translations[0], (n_out,) + motion.translations.shape[1:]).copy()
-    travel = motion.travel_joint
+    travel = motion.travel_joint if travel is None else travel
     for j in range(skel.n_joints):
         p = motion.translations[:, j]
         if j == travel:
@@ -379,4 +375,239 @@ def stretch_motion(motion: Motion, factor: float, window: str | int = "auto") ->
         groups={g: tuple(skel.names[j] for j in js) for g, js in groups.items()},
         trend_curves=tuple(decoder.columns[i] for i in trend_cols),
     )
+    return new, report
+
+
+# -- periodic regions -----------------------------------------------------------------------------------------------
+
+
+def periodic_regions(motion: Motion, phase=None) -> tuple[list[tuple[int, int]], float, str]:
+    """The frame ranges ``[(start, stop), ...]`` of the take's periodic motions, the longest period among them
+    (frames) and the phase's reason when there are none.
+
+    The excitation regions of every periodic motion :func:`~mocycle.phase.find_phase` finds (or ``phase``, a
+    :class:`~mocycle.phase.PhaseResult` of this take), merged where they overlap or are less than a period
+    apart; an end within half a period of the take's is moved to it (excitation ends are not that precise).
+    """
+    from ..phase import find_phase
+
+    if phase is None:
+        phase = find_phase(motion)
+    if not phase.classes:
+        return [], float("nan"), phase.reason
+    T = motion.n_frames
+    period = float(max(c.period_frames for c in phase.classes))
+    spans = sorted((int(s), int(e)) for c in phase.classes for s, e in c.excitation if e > s)
+    merged: list[list[int]] = []
+    for s, e in spans:
+        if merged and s <= merged[-1][1] + period:
+            merged[-1][1] = max(merged[-1][1], e)
+        else:
+            merged.append([s, e])
+    for r in merged:
+        if r[0] < 0.5 * period:
+            r[0] = 0
+        if T - r[1] < 0.5 * period:
+            r[1] = T
+    return [(s, e) for s, e in merged], period, ""
+
+
+def _shares(lengths: list[int], extra: int) -> list[int]:
+    """``extra`` frames (may be negative) shared among regions in proportion to their ``lengths``
+    (largest remainders get the rounding)."""
+    total = float(sum(lengths))
+    raw = np.array([extra * n / total for n in lengths])
+    base = np.floor(raw).astype(int)
+    left = extra - int(base.sum())
+    order = np.argsort(-(raw - base))
+    base[order[:left]] += 1
+    return base.tolist()
+
+
+def _smooth(n: int) -> np.ndarray:
+    """Weights 1 -> 0 over ``n`` frames (smoothstep)."""
+    x = (np.arange(n) + 1.0) / (n + 1.0)
+    return 1.0 - x * x * (3.0 - 2.0 * x)
+
+
+class _Placer:
+    """Where the captured frames go in the output: a turn about the vertical and a shift of the travelling
+    joint (in its parent's frame) that grows at every warped region, so what follows it carries on from where
+    the region ends (a stretched walk travels further and turns more)."""
+
+    def __init__(self, motion: Motion, travel: int):
+        from ..cycle.representation import CycleSpace, axis_rotations
+
+        self.space = CycleSpace.fit(motion)
+        self.turn_about = axis_rotations
+        self.travel = travel
+        self.angle = 0.0
+        self.anchor = np.zeros(3)
+        self.offset = np.zeros(3)
+
+    def _R(self) -> np.ndarray:
+        return self.turn_about(self.space.up, np.array([self.angle]))[0]
+
+    def place(self, m: Motion) -> Motion:
+        R = self._R()
+        q = m.rotations.copy()
+        t = m.translations.copy()
+        j = self.travel
+        q[:, j] = (Rotation.from_matrix(R) * Rotation.from_quat(q[:, j])).as_quat()
+        t[:, j] = (t[:, j] - self.anchor) @ R.T + self.anchor + self.offset
+        return m.replace(rotations=q, translations=t)
+
+    def heading(self, quat: np.ndarray) -> float:
+        return float(self.space.heading(Rotation.from_quat(quat[None]).as_matrix())[0])
+
+    def carry_on(self, captured_last: Motion, placed_last: Motion) -> None:
+        """Place what follows so that the captured frame ``captured_last`` (one frame) lands on ``placed_last``."""
+        j = self.travel
+        turn = self.heading(placed_last.rotations[0, j]) - self.heading(captured_last.rotations[0, j])
+        self.angle = float(np.angle(np.exp(1j * turn)))
+        self.anchor = captured_last.translations[0, j].copy()
+        self.offset = placed_last.translations[0, j] - self.anchor
+
+
+def _fade(warped: Motion, target: Motion, at_start: bool, n: int) -> Motion:
+    """Bend the first (or last) ``n`` frames of ``warped`` so that its first (last) frame is ``target``'s
+    (one frame): the rotation and translation differences, faded out by a smoothstep (no pop at a join)."""
+    if n < 1:
+        return warped
+    n = min(n, warped.n_frames)
+    k = 0 if at_start else warped.n_frames - 1
+    diff = (Rotation.from_quat(target.rotations[0]) * Rotation.from_quat(warped.rotations[k]).inv()).as_rotvec()
+    dt = target.translations[0] - warped.translations[k]
+    w = _smooth(n) if at_start else _smooth(n)[::-1]
+    rows = np.arange(n) if at_start else np.arange(warped.n_frames - n, warped.n_frames)
+    q = warped.rotations.copy()
+    t = warped.translations.copy()
+    J = warped.n_joints
+    fix = Rotation.from_rotvec((w[:, None, None] * diff[None]).reshape(-1, 3))
+    q[rows] = (fix * Rotation.from_quat(q[rows].reshape(-1, 4))).as_quat().reshape(n, J, 4)
+    t[rows] += w[:, None, None] * dt[None]
+    return warped.replace(rotations=q, translations=t)
+
+
+def stretch_motion(motion: Motion, factor: float, window: str | int = "auto", force: bool = False,
+                   phase=None) -> tuple[Motion, StretchReport]:
+    """Lengthen (or shorten) a take by time-frequency warping its periodic part: paper 004 §6.
+
+    Only the periodic region(s) are warped (:func:`periodic_regions`: the excitation regions of the take's
+    phase); the frames before, between and after them are kept as captured, turned and moved on so that they
+    follow the stretched regions, and each join is faded over a window so that nothing pops.  The regions
+    absorb the whole change, in proportion to their lengths; the output has ``round(T * factor)`` frames,
+    or within half a window of it per region when captured frames follow the last region (a region with
+    frames after it grows by whole windows, so that it ends as captured).
+
+    Parameters
+    ----------
+    motion : the take (at least 8 frames).
+    factor : length ratio (> 0); the result has about ``round(T * factor)`` frames at the same frame time.
+    window : ``"auto"`` (each joint group's largest fundamental cycle in the region, :func:`group_cycle`) or
+        a number of frames used for every group (``1 <= window <= region // 2``).
+    force : warp the whole take when it has no periodic motion (a warning) instead of raising
+        :class:`~mocycle.errors.NoPeriodicMotion` (a one-off gesture would be repeated, a standing start
+        shuffled twice).
+    phase : a :class:`~mocycle.phase.PhaseResult` of ``motion`` already computed.
+
+    Returns
+    -------
+    ``(new motion, StretchReport)``.  Raises NoPeriodicMotion when the take has no periodic motion (or its
+    periodic region is too short to warp) and ``force`` is off; MocycleError for bad input.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> walk = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
+    >>> longer, report = stretch_motion(walk, factor=1.5)
+    >>> longer.n_frames, report.windows
+    (450, {'legs': 60, 'arms': 60, 'spine': 60})
+    """
+    if not isinstance(motion, Motion):
+        raise MocycleError(f"stretch_motion needs a Motion; got {type(motion).__name__}")
+    T = motion.n_frames
+    if T < 8:
+        raise MocycleError(f"stretching needs a take of at least 8 frames; got {T}")
+    factor = _factor(factor)
+    n_out = _frames_out(T, factor, motion.n_joints)
+    if isinstance(window, str) and window != "auto":
+        raise MocycleError(f"window must be 'auto' or a number of frames; got {window!r}")
+    if not isinstance(window, str):
+        _window(window, T)
+    try:
+        regions, period, reason = periodic_regions(motion, phase)
+    except MocycleError as exc:  # too short for a phase
+        regions, period, reason = [], float("nan"), str(exc)
+    short = [(s, e) for s, e in regions if e - s < 2 * max(period, 2.0 if isinstance(window, str) else window)]
+    if short and len(short) == len(regions):
+        reason = (f"the periodic region(s) {', '.join(f'{s}:{e}' for s, e in short)} hold fewer than two periods "
+                  f"of {period:.1f} frames")
+        regions = []
+    regions = [r for r in regions if r not in short]
+    if not regions:
+        if not force:
+            raise NoPeriodicMotion(f"no periodic motion to stretch ({reason}): warping would repeat what happens "
+                                   f"once; --force warps the whole take anyway")
+        warnings.warn(f"the take has no periodic motion ({reason}); warping it whole (--force) repeats what "
+                      f"happens once", MocycleWarning, stacklevel=2)
+        new, report = _warp_take(motion, factor, window)
+        return new, replace(report, factor=factor, forced=True)
+    if regions == [(0, T)]:
+        new, report = _warp_take(motion, factor, window)
+        return new, replace(report, factor=factor, regions=((0, T),), regions_out=((0, n_out),))
+
+    travel = motion.travel_joint
+    placer = _Placer(motion, travel)
+    lengths = [e - s for s, e in regions]
+    shares = _shares(lengths, n_out - T)
+    parts: list[Motion] = []
+    reports: list[StretchReport] = []
+    regions_out = []
+    done, frames = 0, 0
+    for (s, e), extra in zip(regions, shares, strict=True):
+        if s > done:
+            parts.append(placer.place(motion[done:s]))
+            frames += s - done
+        n_seg = e - s + extra
+        if n_seg < 2:
+            raise MocycleError(f"factor {factor:g} leaves {n_seg} frame(s) of the periodic region {s}:{e}")
+        if not isinstance(window, str) and window > (e - s) // 2:
+            raise MocycleError(f"window must be between 1 and half the periodic region {s}:{e} "
+                               f"({(e - s) // 2} frames); got {window}")
+        warped, rep = _warp_take(motion[s:e], n_seg / (e - s), window, travel)
+        if e < T:
+            # The warp copies whole windows and keeps the last block (one window plus the remainder) last; a
+            # length between two whole numbers of copies would cut that block, and the captured frames after
+            # the region would not follow.  So a region with frames after it grows by whole windows.
+            N = max(rep.windows.values())
+            last = N + (e - s) % N
+            whole = last + max(0, int(round((n_seg - last) / N))) * N
+            if whole != n_seg:
+                n_seg = whole
+                warped, rep = _warp_take(motion[s:e], n_seg / (e - s), window, travel)
+        elif (s, e) == regions[-1]:
+            n_seg = n_out - frames  # the last region ends the take: it takes what is left (cut mid-cycle)
+            warped, rep = _warp_take(motion[s:e], n_seg / (e - s), window, travel) if n_seg != warped.n_frames \
+                else (warped, rep)
+        warped = placer.place(warped)
+        fade = int(min(max(rep.windows.values()), n_seg // 3))
+        if s > 0:
+            warped = _fade(warped, placer.place(motion[s:s + 1]), True, fade)
+        if e < T:
+            captured_last = motion[e - 1:e]
+            placer.carry_on(captured_last, warped[n_seg - 1:n_seg])
+            warped = _fade(warped, placer.place(captured_last), False, fade)
+        parts.append(warped)
+        reports.append(rep)
+        regions_out.append((frames, frames + n_seg))
+        frames += n_seg
+        done = e
+    if done < T:
+        parts.append(placer.place(motion[done:T]))
+    new = concatenate(parts)
+    main = reports[int(np.argmax(lengths))]
+    report = replace(main, factor=factor, frames_in=T, frames_out=new.n_frames, regions=tuple(regions),
+                     regions_out=tuple(regions_out),
+                     trend_curves=tuple(sorted({c for r in reports for c in r.trend_curves})))
     return new, report

@@ -32,7 +32,7 @@ from ..io.bvh import format_bvh, parse_bvh
 from ..io.inflate import Inflater
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion, Skeleton
-from .segment import Hold, Segmentation, Swing
+from ..swings.segment import Hold, Segmentation, Swing
 
 MAGIC = b"MOSW\x01"
 _PI_Q = 32767.0 / np.pi  # int16 steps per radian for angles within [-π, π]

@@ -37,20 +37,21 @@ from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..io.atomic import atomic_write
 from ..io.bvh import format_bvh, parse_bvh
 from ..io.inflate import Inflater
+from ..keyframes.density import SPATIAL_MIN_KEYS, keyframe_density
+from ..keyframes.distance import joint_weights
+from ..keyframes.projection import ONE_STEP, PROJECTIONS, PoseSpace, select_keyframes, spatial_layout
+from ..keyframes.select import METHODS, keyframe_count
+from ..keyframes.spatial import optimize_projection, reconstruct_spatial
+from ..keyframes.temporal import SCHEMES as TEMPORAL_SCHEMES
+from ..keyframes.temporal import check_keys, interpolate_rotations
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion, Skeleton
-from .distance import joint_weights
-from .projection import ONE_STEP, PROJECTIONS, PoseSpace, select_keyframes, spatial_layout
-from .select import METHODS, keyframe_count
-from .spatial import optimize_projection, reconstruct_spatial
-from .temporal import SCHEMES as TEMPORAL_SCHEMES
-from .temporal import check_keys, interpolate_rotations
 
 MAGIC = b"MOCK\x01"
 SCHEMES = TEMPORAL_SCHEMES + ("spatial",)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class Compressed:
     """A take reduced to keyframes (and, for the spatial scheme, a 2-D trajectory).
 
@@ -92,7 +93,18 @@ class Compressed:
         return interpolate_rotations(self.skeleton, self.key_idx, self.key_quats, self.n_frames, self.scheme)
 
     def decompress(self) -> Motion:
-        """The rebuilt take; the keyframes are the original poses."""
+        """The rebuilt take; the keyframes are the original poses.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from mocycle.datasets import synthetic_walk
+        >>> walk = synthetic_walk(n_frames=300, fps=60).motion
+        >>> packed = compress(walk, ratio=0.03)
+        >>> again = packed.decompress()
+        >>> again.n_frames, bool(np.allclose(again.rotations[packed.key_idx], walk.rotations[packed.key_idx]))
+        (300, True)
+        """
         trans = np.broadcast_to(self.static, (self.n_frames,) + self.static.shape).copy()
         trans[:, self.track_joints] = self.track
         return Motion(self.skeleton, self.rotations(), trans, self.frame_time)
@@ -285,7 +297,7 @@ def read_compressed(path: str | os.PathLike) -> Compressed:
     return Compressed.from_bytes(data, path)
 
 
-def compress(motion: Motion, ratio: float | None = 0.03, count: int | None = None, select: str = "uniform",
+def compress(motion: Motion, ratio: float | str | None = "auto", count: int | None = None, select: str = "uniform",
              scheme: str = "slerp", projection: str = "mds", optimize: bool = False, seed: str = "mds",
              random_state: int = 0, space: PoseSpace | None = None) -> Compressed:
     """Keyframe-compress a take.
@@ -293,12 +305,28 @@ def compress(motion: Motion, ratio: float | None = 0.03, count: int | None = Non
     Parameters
     ----------
     ratio, count : keyframes as a fraction of the frames (thesis: 3%) or a number (``count`` wins); at least 2.
+        ``ratio="auto"`` (default): enough keys for the take's own rhythm (:mod:`.density`: 4 per period, at
+        least 3% and 6 keys).  The spatial scheme gets at least 6 keys from any ratio.
     select : ``uniform``, ``scs``, ``pb`` or ``rols``.
     scheme : ``linear``, ``hermite``, ``slerp``, ``rbf`` (temporal) or ``spatial``.
     projection : the spatial scheme's projector (:data:`~mocycle.keyframes.projection.PROJECTIONS`);
         ``seed`` is the first-step projector of ``rbfp`` and ``lamp``.
     optimize : run Algorithm 12 on the 2-D trajectory (spatial scheme).
     space : a :class:`PoseSpace` of ``motion`` whose distances are already computed (saves time).
+
+    Returns
+    -------
+    Compressed
+        ``decompress()`` rebuilds the take, ``save(path)`` writes the ``.mck`` file (also
+        ``mocycle.write(packed, "take.mck")``), ``size_report()`` compares sizes.
+
+    Examples
+    --------
+    >>> from mocycle.datasets import synthetic_walk
+    >>> walk = synthetic_walk(n_frames=300, fps=60).motion
+    >>> packed = compress(walk, ratio=0.03, select="uniform", scheme="slerp")
+    >>> packed.n_keyframes, packed.key_idx.tolist()
+    (9, [0, 37, 75, 112, 150, 187, 224, 262, 299])
     """
     if scheme not in SCHEMES:
         raise MocycleError(f"scheme must be one of {', '.join(SCHEMES)}; got {scheme!r}")
@@ -309,7 +337,12 @@ def compress(motion: Motion, ratio: float | None = 0.03, count: int | None = Non
     if seed not in ONE_STEP:
         raise MocycleError(f"the seed projection must be one of {', '.join(ONE_STEP)}; got {seed!r}")
     n = motion.n_frames
-    k = keyframe_count(n, ratio=None if count is not None else ratio, count=count)
+    if count is None and isinstance(ratio, str):
+        k = keyframe_density(motion, ratio, scheme).count
+    else:
+        k = keyframe_count(n, ratio=None if count is not None else ratio, count=count)
+        if count is None and scheme == "spatial":
+            k = max(k, min(n, SPATIAL_MIN_KEYS))
     space = PoseSpace(motion.rotations, joint_weights(motion.skeleton)) if space is None else space
     points = None
     if scheme == "spatial":

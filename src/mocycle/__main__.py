@@ -1,0 +1,37 @@
+"""``mocycle`` and ``python -m mocycle``: the command line, which needs the ``cli`` extra (typer, rich)."""
+
+from __future__ import annotations
+
+import sys
+
+INSTALL_HINT = "pip install 'mocycle[cli]'"
+
+
+def main() -> None:
+    """Run the ``mocycle`` command, or say in one line how to install it when typer or rich is missing.
+
+    ``mocycle.cli`` is light to import; its :func:`~mocycle.cli.guarded` installs the SIGINT/SIGTERM
+    handlers before typer, rich, numpy and scipy are imported, so a signal at any moment ends the run with
+    one line and no traceback.
+    """
+    from .cli import guarded
+
+    guarded(_run)
+
+
+def _run() -> None:
+    try:
+        import rich  # noqa: F401
+        import typer  # noqa: F401
+    except ImportError as exc:
+        missing = exc.name or "typer"
+        sys.stderr.write(f"mocycle: the command line needs the cli extra ({missing} is not installed): "
+                         f"{INSTALL_HINT}\n")
+        raise SystemExit(1) from None
+    from .cli import run
+
+    run()
+
+
+if __name__ == "__main__":
+    main()

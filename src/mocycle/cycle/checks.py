@@ -1,0 +1,169 @@
+"""Is a cycle a loop?  The checks a cycle must pass before it is written (issue 11).
+
+A cycle is refused (:class:`~mocycle.errors.LoopRefused`, CLI exit 3) when
+
+* **length** — it is longer than the frames it was fitted on: the take does not
+  hold one whole cycle, so the "cycle" is an extrapolation (a 573-frame take gave
+  an 872-frame cycle);
+* **fit** — its template error (thesis eq. 4.4-4.5, the repeated cycle slid along
+  the take's longest excited region) is more than :data:`MAX_FIT_RATIO` times that
+  of the best *plain cut*: frames ``a .. a+lag`` of the take itself, with ``lag``
+  near the found period or near the take's own autocorrelation period
+  (:func:`best_cut_error`).  A cut copies the take, so a fitted cycle that fits
+  much worse than a copy of one period is not the take's cycle (usually the
+  period found is wrong).  An error under :data:`FIT_FLOOR` of the take's own
+  spread (RMS distance of its poses from their mean) passes whatever the cut
+  does: on a noise-free take the cut is exact and any fit is "infinitely" worse;
+* **seam** — its wrap jumps: the local seam ratio (the step across the wrap over
+  the steps next to it, for pose or velocity, rotations or root path;
+  :func:`~mocycle.cycle.seam.seam_ratios`) is above :data:`MAX_SEAM`.
+
+Thresholds, from ``benchmarks/cycles.py`` on the 45 shared walks, runs and dashes
+that have a cycle (docs/cycles.md): the template error of the harmonic M1 cycle
+over the best cut's is 0.44-1.47 on all but one (run_chimpira 2.06, whose period
+is 4 % off the legs' own); the local seam ratios stay under 1.8.  A cycle of the
+wrong period fits 4-6 times worse than the cut, with an error about the take's
+spread (tests/cycle/test_checks.py); on the shared takes the harmonic cycle's error
+is 25-50 % of the spread.  A pop that a viewer sees is a step several times its
+neighbours.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import LoopRefused, MocycleWarning
+from ..motion import Motion
+from ..phase.period import autocorrelation_period
+from ..rotations import mean_rotations
+from .extract import Cycle, loop_blocks, metric_features
+from .metrics import template_error
+from .seam import seam_ratios
+
+MAX_FIT_RATIO = 2.0   # template error over the best plain cut's
+FIT_FLOOR = 0.25      # template errors under this fraction of the take's spread always pass
+MAX_SEAM = 3.0        # local seam ratio (step across the wrap over the nearby steps)
+CUT_SPAN = 0.15       # the plain cut's lag within 15 % of a period estimate
+MIN_PERIOD_S = 0.25   # the autocorrelation period is searched from a quarter of a second
+
+
+@dataclass(frozen=True)
+class FailedCheck:
+    """One check a cycle failed: ``name`` (length, fit, seam), the measured ``value``, its ``limit``."""
+
+    name: str
+    value: float
+    limit: float
+    reason: str
+
+    def to_dict(self) -> dict:
+        return {"check": self.name, "value": self.value, "limit": self.limit, "reason": self.reason}
+
+
+def _plain_cut_error(Y: np.ndarray, period: float) -> float:
+    """Template error of the best plain cut of ``Y (M, D)`` with a lag within :data:`CUT_SPAN` of ``period``.
+
+    The cut is frames ``a .. a+lag-1`` between the two windows (a fifth of a period wide) that are most
+    alike ``lag`` frames apart, as :func:`~mocycle.cycle.extract.cut_cycle` picks them, without its
+    cross-fade.  NaN when the frames hold no such pair.
+    """
+    M = Y.shape[0]
+    if not np.isfinite(period) or period < 2:
+        return float("nan")
+    lags = np.arange(max(2, int(np.floor((1 - CUT_SPAN) * period))), int(np.ceil((1 + CUT_SPAN) * period)) + 1)
+    lags = lags[lags < M - 1]
+    h = max(1, int(round(0.1 * period)))
+    best = (np.inf, 0, 0)
+    for lag in lags:
+        d = ((Y[:-lag] - Y[lag:]) ** 2).sum(axis=1)
+        if d.size < 2 * h + 1:
+            continue
+        c = np.concatenate([[0.0], np.cumsum(d)])
+        cost = (c[2 * h + 1:] - c[:-2 * h - 1]) / (2 * h + 1)
+        j = int(np.argmin(cost))
+        if cost[j] < best[0]:
+            best = (float(cost[j]), j + h, int(lag))
+    if not np.isfinite(best[0]):
+        return float("nan")
+    _, a, lag = best
+    a = min(a, M - lag)
+    return template_error(Y, Y[a:a + lag])[0]
+
+
+def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = None) -> tuple[float, float]:
+    """``(template error of the best plain cut, its period estimate in frames)`` on the cycle's longest
+    excited region: the better of cuts near the cycle's period and near the region's own autocorrelation
+    period (paper 004 eq. 1 on the pose features; independent of the phase)."""
+    ref = mean_rotations(motion.rotations) if reference is None else reference
+    s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
+    Y = metric_features(motion[s:e], ref)
+    candidates = [cycle.period_frames]
+    if Y.shape[0] >= 8:
+        min_lag = max(2, int(round(MIN_PERIOD_S / motion.frame_time)))
+        if min_lag <= Y.shape[0] // 2:
+            candidates.append(autocorrelation_period(Y, min_lag=min_lag))
+    best = (float("nan"), float("nan"))
+    for p in candidates:
+        err = _plain_cut_error(Y, p)
+        if np.isfinite(err) and not err >= best[0]:
+            best = (err, float(p))
+    return best
+
+
+def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> list[FailedCheck]:
+    """The checks of the module docstring that ``cycle`` (extracted from ``motion``) fails; empty when it is
+    a loop.  ``metrics``: :func:`~mocycle.cycle.loop_metrics` of the pair if already computed (saves time)."""
+    failed = []
+    fitted = int(cycle.axis.frames().size)
+    if cycle.n_frames > fitted:
+        failed.append(FailedCheck(
+            "length", float(cycle.n_frames), float(fitted),
+            f"the cycle ({cycle.n_frames} frames) is longer than the {fitted} frames it was fitted on: the take "
+            f"holds {cycle.n_periods:.2f} periods, not one whole cycle"))
+    ref = mean_rotations(motion.rotations)
+    C, root = loop_blocks(cycle, ref)
+    if metrics is not None:
+        tmpl = metrics["template_error"]
+        seam = max(metrics["seam_pose_local"], metrics["seam_velocity_local"])
+    else:
+        tmpl = template_error(metric_features(motion[slice(*max(cycle.axis.regions, key=lambda r: r[1] - r[0]))],
+                                              ref), C)[0]
+        ratios = [seam_ratios(C), seam_ratios(root)]
+        seam = max(max(r["pose_local"], r["velocity_local"]) for r in ratios)
+    cut, cut_period = best_cut_error(motion, cycle, ref)
+    s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
+    Y = metric_features(motion[s:e], ref)
+    spread = float(np.sqrt(((Y - Y.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    if np.isfinite(cut) and not tmpl <= max(MAX_FIT_RATIO * cut, FIT_FLOOR * spread):
+        why = (f"the period found ({cycle.period_frames:.1f} frames) is probably wrong"
+               if abs(cut_period / cycle.period_frames - 1) > CUT_SPAN else
+               "the take's cycles differ too much for one typical cycle (a cut copies one of them)")
+        failed.append(FailedCheck(
+            "fit", float(tmpl / cut), MAX_FIT_RATIO,
+            f"the cycle fits the take {tmpl / cut:.1f} times worse than a plain cut of about {cut_period:.1f} "
+            f"frames (template error {tmpl:.3g} against {cut:.3g} rad; limit {MAX_FIT_RATIO:g}×): {why}"))
+    if not seam <= MAX_SEAM:
+        failed.append(FailedCheck(
+            "seam", float(seam), MAX_SEAM,
+            f"the seam jumps: the step across the wrap is {seam:.1f} times the steps next to it "
+            f"(limit {MAX_SEAM:g})"))
+    return failed
+
+
+def check_loop(motion: Motion, cycle: Cycle, metrics: dict | None = None, force: bool = False,
+               label: str | None = None) -> list[FailedCheck]:
+    """Raise :class:`~mocycle.errors.LoopRefused` when ``cycle`` fails a check of :func:`loop_checks`; with
+    ``force`` warn instead (naming each failed check) and return the failures.  ``label`` names the take."""
+    failed = loop_checks(motion, cycle, metrics)
+    if not failed:
+        return failed
+    where = f"{label}: " if label else ""
+    text = "; ".join(f"{f.name}: {f.reason}" for f in failed)
+    if not force:
+        raise LoopRefused(f"{where}not a loop ({text}); --force writes it anyway", failed)
+    warnings.warn(f"{where}kept although it fails the loop check(s) {', '.join(f.name for f in failed)} "
+                  f"(--force): {text}", MocycleWarning, stacklevel=2)
+    return failed
