@@ -100,10 +100,10 @@ def _targets():
     from mocycle.datasets import synthetic_walk
     from mocycle.io.asfamc import parse_amc, parse_asf
     from mocycle.io.bvh import format_bvh, parse_bvh
+    from mocycle.io.mck import MAGIC as MCK
+    from mocycle.io.mosw import MAGIC as MOSW
     from mocycle.keyframes import Compressed, compress
-    from mocycle.keyframes.codec import MAGIC as MCK
     from mocycle.swings import decode, encode, playback, segment
-    from mocycle.swings.codec import MAGIC as MOSW
 
     warnings.simplefilter("ignore")
     walk = synthetic_walk(n_frames=90, fps=30, seed=5).motion
@@ -264,8 +264,8 @@ def child_atheris(reader: str, seconds: float, rss_mb: int, timeout: float, out:
         import mocycle.io.asfamc  # noqa: F401
         import mocycle.io.bvh  # noqa: F401
         import mocycle.io.inflate  # noqa: F401
-        import mocycle.keyframes.codec  # noqa: F401
-        import mocycle.swings.codec  # noqa: F401
+        import mocycle.io.mck  # noqa: F401
+        import mocycle.io.mosw  # noqa: F401
         import mocycle.swings.playback  # noqa: F401
         from mocycle.errors import MotionFileError
     run, seeds, magic = _targets()[reader]

@@ -37,11 +37,11 @@ def build(folder: Path) -> None:
 
     from mocycle.datasets import synthetic_walk
     from mocycle.io import write
+    from mocycle.io.mck import MAGIC as MCK
+    from mocycle.io.mosw import MAGIC as MOSW
+    from mocycle.io.mosw import skeleton_text
     from mocycle.keyframes import compress
-    from mocycle.keyframes.codec import MAGIC as MCK
     from mocycle.motion import Skeleton
-    from mocycle.swings.codec import MAGIC as MOSW
-    from mocycle.swings.codec import skeleton_text
 
     walk = synthetic_walk(n_frames=300, fps=60, seed=1).motion
     write(walk, folder / "walk.bvh")

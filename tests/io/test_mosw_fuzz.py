@@ -18,8 +18,8 @@ from hypothesis import strategies as st
 from fuzzing import INTERESTING, fuzz_settings, limits, mutated, mutated_zlib_file, zlib_file
 from mocycle.datasets import synthetic_walk
 from mocycle.errors import MotionFileError
+from mocycle.io.mosw import MAGIC
 from mocycle.swings import decode, encode, playback, segment
-from mocycle.swings.codec import MAGIC
 
 WALK = synthetic_walk(n_frames=90, fps=30, seed=2).motion
 SEG = segment(WALK)

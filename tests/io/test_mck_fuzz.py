@@ -19,8 +19,8 @@ from hypothesis import strategies as st
 from fuzzing import fuzz_settings, limits, mutated, mutated_zlib_file, zlib_file
 from mocycle.datasets import synthetic_walk
 from mocycle.errors import MotionFileError
+from mocycle.io.mck import MAGIC
 from mocycle.keyframes import Compressed, compress
-from mocycle.keyframes.codec import MAGIC
 from mocycle.motion import Motion
 
 WALK = synthetic_walk(n_frames=60, fps=30, seed=3).motion
