@@ -118,8 +118,20 @@ class Cycle:
         return out
 
     def _inplace_L(self) -> np.ndarray:
-        ramp = np.arange(self.n_frames)[:, None] / self.n_frames
-        return self.L - ramp * self.drift
+        """``L (N, 4)`` walking on the spot: the path straightened (each step turned back by the turn spread
+        evenly over the cycle, so a turning walk's steps line up as a straight walk's) and its travel and turn
+        taken out along a ramp.  Position and velocity both wrap seamlessly; a straight walk's path is only
+        ramped."""
+        N = self.n_frames
+        ramp = np.arange(N) / N
+        full = np.vstack([self.L, self._next_repeat(self.L[:1])])  # the next repeat's first frame closes it
+        steps = np.einsum("tij,tj->ti", axis_rotations(self.space.up, -self.drift[3] * (ramp + 0.5 / N)),
+                          np.diff(full[:, :3], axis=0))
+        path = full[0, :3] + np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])  # (N + 1, 3)
+        out = self.L.copy()
+        out[:, :3] = path[:-1] - ramp[:, None] * (path[-1] - path[0])
+        out[:, 3] -= ramp * self.drift[3]
+        return out
 
     def motion(self, root: str = "inplace") -> Motion:
         """The cycle as a Motion; ``root="inplace"`` walks on the spot, ``"motion"`` moves on by ``drift``."""

@@ -414,7 +414,7 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
     >>> result = find_phase(walk)
     >>> gait = result.classes[0]
     >>> print(f"{gait.period_frames:.1f} frames ({gait.period_s:.2f} s), {gait.n_periods:.1f} periods")
-    60.0 frames (1.00 s), 4.9 periods
+    59.9 frames (1.00 s), 5.0 periods
     >>> gait.coords.shape                           # phase in [0, 1) per frame
     (300,)
     """
