@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -20,9 +19,10 @@ from .common import (
     MinPeriodsOption,
     PcaOption,
     app,
-    check_suffix,
+    check_output,
     count_option,
     friendly,
+    json_text,
     out,
     parse_range,
     phase_options,
@@ -77,7 +77,8 @@ def loop(
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
     force: Annotated[bool, typer.Option(
         "--force", help="Write the cycle even when it fails a loop check (longer than the take, fits much "
-                        "worse than a plain cut, seam jumps); a warning names the check.")] = False,
+                        "worse than a plain cut, seam jumps); a warning names the check. It also lets an output "
+                        "replace an input file.")] = False,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
 
@@ -87,8 +88,8 @@ def loop(
     from ..cycle import cycle_phase, extract_cycle, loop_metrics
     from ..cycle.checks import check_loop
 
-    check_suffix(output, ".bvh", "--output")
-    check_suffix(plot, ".png", "--plot")
+    check_output(output, [path], force, ".bvh", "--output")
+    check_output(plot, [path], force, ".png", "--plot")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     everything = which == "all"
@@ -144,7 +145,7 @@ def loop(
             "metrics_seconds": metrics_seconds,
         })
     if as_json:
-        print(json.dumps({"file": str(path), "loops": reports} if everything else reports[0], indent=2))
+        print(json_text({"file": str(path), "loops": reports} if everything else reports[0]))
         return
     for facts, (_, cycle, *_) in zip(reports, made, strict=True):
         _print_loop(facts, len(cycle.periodic.excitation), which)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -12,7 +11,14 @@ from rich.table import Table
 
 from ..io import read_motion as read
 from ..io import write
-from .common import app, check_suffix, count_option, friendly, out
+from .common import (
+    app,
+    check_output,
+    count_option,
+    friendly,
+    json_text,
+    out,
+)
 
 
 @app.command()
@@ -26,7 +32,8 @@ def stretch(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
     force: Annotated[bool, typer.Option(
-        "--force", help="Warp the whole take even when it has no periodic motion (a warning says so).")] = False,
+        "--force", help="Warp the whole take even when it has no periodic motion (a warning says so). It also "
+                        "lets an output replace an input file.")] = False,
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
 
@@ -40,7 +47,7 @@ def stretch(
     """
     from ..warp import stretch_motion
 
-    check_suffix(output, ".bvh")
+    check_output(output, [path], force, ".bvh")
     win = count_option(window, "--window", {"auto": "auto"})
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
@@ -49,7 +56,7 @@ def stretch(
     facts = report.to_dict()
     facts["seconds"] = time.perf_counter() - t0
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     out.print(f"[bold]{path}[/]: {report.frames_in} frames -> {output}: {report.frames_out} frames "
               f"(factor {report.factor:g}, {motion.fps:.6g} fps)", soft_wrap=True)

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
+from ..limits import check_frames
 from ..motion import Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
@@ -142,6 +143,8 @@ class Cycle:
         _check_choice(root, ROOT_MODES, "root")
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
             raise MocycleError(f"the number of cycles must be a positive integer; got {count!r}")
+        check_frames(count * self.n_frames, self.space.skeleton.n_joints,
+                     f"{count} cycles of {self.n_frames} frames")
         P = np.tile(self.P, (count, 1))
         if root == "inplace":
             return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)))
