@@ -24,6 +24,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from .errors import MocycleError
+from .limits import MAX_MAGNITUDE, check_frames, frame_time_problem
 from .rotations import continuous_quats
 
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
@@ -230,9 +231,13 @@ class Motion:
             trans[:, 0] = rp
         if not np.all(np.isfinite(trans)):
             raise MocycleError("translations contain NaN or infinite values")
+        if trans.size and np.abs(trans).max() > MAX_MAGNITUDE:
+            raise MocycleError(f"translations reach {np.abs(trans).max():.3g}, beyond ±{MAX_MAGNITUDE:g}")
         frame_time = float(frame_time)
         if not np.isfinite(frame_time) or frame_time <= 0:
             raise MocycleError(f"frame time must be a positive number of seconds; got {frame_time}")
+        if frame_time_problem(frame_time):
+            raise MocycleError(frame_time_problem(frame_time))
         rot.setflags(write=False)
         trans.setflags(write=False)
         self.skeleton = skeleton
@@ -369,13 +374,14 @@ class Motion:
         frame is kept; the last new frame is at or before the old last frame.
         """
         fps = float(fps)
-        if not np.isfinite(fps) or fps <= 0:
-            raise MocycleError(f"fps must be a positive number; got {fps}")
+        if not np.isfinite(fps) or fps <= 0 or frame_time_problem(1.0 / fps):
+            raise MocycleError(f"fps must be a positive number within [1e-4, 1e6]; got {fps:g}")
         new_dt = 1.0 / fps
         if self.n_frames == 1:
             return self.replace(frame_time=new_dt)
         old_t = np.arange(self.n_frames) * self.frame_time
-        n_new = int(np.floor(self.duration / new_dt + 1e-9)) + 1
+        n_new = check_frames(np.floor(self.duration / new_dt + 1e-9) + 1, self.n_joints,
+                             f"resampling {self.n_frames} frames to {fps:g} fps")
         new_t = np.minimum(np.arange(n_new) * new_dt, old_t[-1])
         rot = np.empty((n_new, self.n_joints, 4))
         for j in range(self.n_joints):

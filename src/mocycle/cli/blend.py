@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import replace as dc_replace
 from pathlib import Path
@@ -20,9 +19,10 @@ from .common import (
     MinPeriodsOption,
     PcaOption,
     app,
-    check_suffix,
+    check_output,
     count_option,
     friendly,
+    json_text,
     out,
     phase_options,
 )
@@ -34,7 +34,8 @@ HARMONICS_HELP = "Harmonics K: 'auto' (20, capped by the frames) or a number."
 WhichOption = Annotated[int | None, typer.Option(
     "--class", min=0, help="Which periodic motion of each take to use (0-based; default: the one covering most "
                            "frames).")]
-FORCE_HELP = "Use a take's cycle even when it fails a loop check (a warning names the check)."
+FORCE_HELP = ("Use a take's cycle even when it fails a loop check (a warning names the check); also lets the "
+              "output replace an input file.")
 
 
 def _parse_weights(text: str | None, n: int) -> list[float] | None:
@@ -92,7 +93,7 @@ def blend(
     t0 = time.perf_counter()
     if len(paths) < 2:
         raise MocycleError(f"blend needs at least two takes; got {len(paths)}")
-    check_suffix(output, ".bvh")
+    check_output(output, paths, force, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     check_feet_mode(feet)
@@ -121,7 +122,7 @@ def blend(
         "seconds": seconds,
     }
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     out.print(f"[bold]blend[/] of {len(paths)} takes, weights "
               + ", ".join(f"{p.name} {x:.3g}" for p, x in zip(paths, result.weights, strict=True)))
@@ -172,7 +173,7 @@ def transition(
     from ..cycle.blend import transition_smoothness
 
     t0 = time.perf_counter()
-    check_suffix(output, ".bvh")
+    check_output(output, [first, second], force, ".bvh")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     check_feet_mode(feet)
@@ -194,7 +195,7 @@ def transition(
         "seconds": seconds,
     }
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     out.print(f"[bold]transition[/] {first.name} -> {second.name} over {cycles} cycle(s)")
     out.print(f"  period {facts['period_frames_start']:.2f} -> {facts['period_frames_end']:.2f} frames; "

@@ -10,7 +10,14 @@ import typer
 from ..errors import MocycleError
 from ..io import read_motion as read
 from ..io import write
-from .common import app, friendly, out, parse_range
+from .common import (
+    FORCE_HELP,
+    app,
+    check_output,
+    friendly,
+    out,
+    parse_range,
+)
 
 
 @app.command()
@@ -21,8 +28,11 @@ def convert(
     fps: Annotated[float | None, typer.Option(help="Resample to this frame rate (slerp).")] = None,
     amc_fps: Annotated[float, typer.Option(help="Frame rate of the AMC input (CMU: 120).")] = 120.0,
     frame_range: Annotated[str | None, typer.Option("--range", help="Keep frames START:STOP.")] = None,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Convert ASF/AMC to BVH, or rewrite a BVH (optionally a frame range, another fps)."""
+    if len(paths) in (2, 3):
+        check_output(paths[-1], paths[:-1], force, ".bvh", "the output")
     if len(paths) == 2:
         motion = read(paths[0], fps=amc_fps)
     elif len(paths) == 3:

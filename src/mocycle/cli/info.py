@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -14,7 +13,7 @@ from rich.table import Table
 from ..io import read_motion as read
 from ..io.bvh import motion_channels
 from ..motion import Motion
-from .common import app, friendly, out
+from .common import app, friendly, json_text, out
 
 
 def motion_info(motion: Motion) -> dict:
@@ -69,7 +68,7 @@ def info(
     facts["file"] = str(path)
     facts["seconds"] = time.perf_counter() - t0
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     _print_info(facts)
 

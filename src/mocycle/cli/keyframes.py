@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -13,7 +12,14 @@ from rich.table import Table
 from ..errors import MocycleError
 from ..io import read_motion as read
 from ..io import write
-from .common import app, check_suffix, friendly, out
+from .common import (
+    FORCE_HELP,
+    app,
+    check_output,
+    friendly,
+    json_text,
+    out,
+)
 
 _SELECT_HELP = "Keyframe selection: uniform, scs (curve simplification), pb (position based) or rols."
 _PROJECTION_HELP = "2-D projection of the spatial scheme: pca, mds, isomap, lle, force, tsne, rbfp or lamp."
@@ -44,6 +50,7 @@ def compress(
     optimize: Annotated[bool, typer.Option("--optimize", help="Optimise the 2-D trajectory (Algorithm 12).")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size.
 
@@ -53,7 +60,7 @@ def compress(
     from ..keyframes import compress as compress_motion
     from ..keyframes import error_per_frame_per_joint, keyframe_density
 
-    check_suffix(output, ".mck")
+    check_output(output, [path], force, ".mck")
     r = ratio if ratio == "auto" else _ratio(ratio)
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
@@ -71,7 +78,7 @@ def compress(
              "compressed_bytes": size["compressed_bytes"], "bvh_bytes": size["bvh_bytes"],
              "seconds": time.perf_counter() - t0}
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     what = scheme if scheme != "spatial" else f"spatial/{projection}" + ("/optimised" if optimize else "")
     table = Table(title=f"{path.name} -> {output.name} ({what}, {select} keyframes)")
@@ -95,11 +102,12 @@ def compress(
 def decompress(
     path: Annotated[Path, typer.Argument(help="A .mck file written by 'mocycle compress'.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh file to write.")],
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Rebuild a take from its keyframes; the keyframes come back exactly."""
     from ..keyframes import read_compressed
 
-    check_suffix(output, ".bvh")
+    check_output(output, [path], force, ".bvh")
     packed = read_compressed(path)
     motion = packed.decompress()
     write(motion, output)
@@ -120,10 +128,12 @@ def project(
                                                    "marked (thesis Figure 6.2).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON (includes the 2-D points).")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."""
     from ..keyframes import PoseSpace, keyframe_count, optimize_projection, spatial_layout, stress
 
+    check_output(plot, [path], force, ".png", "--plot")
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     space = PoseSpace(motion)
@@ -145,7 +155,7 @@ def project(
         facts["points"] = points.round(6).tolist()
         if opt is not None:
             facts["points_optimized"] = opt.round(6).tolist()
-        print(json.dumps(facts))
+        print(json_text(facts, indent=None))
         return
     out.print(f"[bold]{path}[/]: {facts['frames']} frames, {len(key)} keyframes ({select}), projection {projection}")
     out.print(f"  stress (eq. 4.1): {facts['stress']:.4g}" + (

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -21,9 +20,10 @@ from .common import (
     MinPeriodsOption,
     PcaOption,
     app,
-    check_suffix,
+    check_output,
     count_option,
     friendly,
+    json_text,
     out,
     parse_range,
     phase_options,
@@ -82,7 +82,8 @@ def loop(
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
     force: Annotated[bool, typer.Option(
         "--force", help="Write the cycle even when it fails a loop check (longer than the take, fits much "
-                        "worse than a plain cut, seam jumps); a warning names the check.")] = False,
+                        "worse than a plain cut, seam jumps); a warning names the check. It also lets an output "
+                        "replace an input file.")] = False,
     feet: Annotated[str, typer.Option(help=FEET_HELP)] = "auto",
     feet_plot: Annotated[Path | None, typer.Option(
         help="Write a PNG of the contacts: each ankle and toe's height and speed over two cycles, before (dashed) "
@@ -97,9 +98,9 @@ def loop(
     from ..cycle import cycle_phase, extract_cycle, loop_metrics
     from ..cycle.checks import check_loop
 
-    check_suffix(output, ".bvh", "--output")
-    check_suffix(plot, ".png", "--plot")
-    check_suffix(feet_plot, ".png", "--feet-plot")
+    check_output(output, [path], force, ".bvh", "--output")
+    check_output(plot, [path], force, ".png", "--plot")
+    check_output(feet_plot, [path], force, ".png", "--feet-plot")
     if cycles < 1:
         raise MocycleError(f"--cycles must be a positive integer; got {cycles}")
     check_feet_mode(feet)
@@ -166,7 +167,7 @@ def loop(
             "metrics_seconds": metrics_seconds,
         })
     if as_json:
-        print(json.dumps({"file": str(path), "loops": reports} if everything else reports[0], indent=2))
+        print(json_text({"file": str(path), "loops": reports} if everything else reports[0]))
         return
     for facts, (_, cycle, *_) in zip(reports, made, strict=True):
         _print_loop(facts, len(cycle.periodic.excitation), which)

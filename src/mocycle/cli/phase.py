@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -13,14 +12,17 @@ from rich.table import Table
 from ..io import read_motion as read
 from .common import (
     EXIT_NOT_FOUND,
+    FORCE_HELP,
     ClassesOption,
     DelayOption,
     JointsOption,
     MinPeriodsOption,
     PcaOption,
     app,
+    check_output,
     err,
     friendly,
+    json_text,
     out,
     phase_options,
 )
@@ -38,6 +40,7 @@ def phase(
     landmarks: Annotated[int, typer.Option(help="Landmarks for the Rips filtration.")] = 120,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: diagram, phase per frame, PCA by phase.")] = None,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
 ):
     """Find periodic motions and the phase of every frame (persistent cohomology).
@@ -47,6 +50,7 @@ def phase(
     """
     from ..phase import find_phase
 
+    check_output(plot, [path], force, ".png", "--plot")
     options = phase_options(joints, classes, pca, delay, min_periods)
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
@@ -58,7 +62,7 @@ def phase(
     facts = result.to_dict()
     facts["seconds"] = time.perf_counter() - t0
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
     else:
         _print_phase(path, facts)
     if not result.classes:

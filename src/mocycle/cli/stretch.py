@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -12,7 +11,14 @@ from rich.table import Table
 
 from ..io import read_motion as read
 from ..io import write
-from .common import app, check_suffix, count_option, friendly, out
+from .common import (
+    app,
+    check_output,
+    count_option,
+    friendly,
+    json_text,
+    out,
+)
 from .feet import FEET_HELP, FOOT_JOINTS_HELP, check_feet_mode, lock_motion, travels
 
 
@@ -27,7 +33,8 @@ def stretch(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
     force: Annotated[bool, typer.Option(
-        "--force", help="Warp the whole take even when it has no periodic motion (a warning says so).")] = False,
+        "--force", help="Warp the whole take even when it has no periodic motion (a warning says so). It also "
+                        "lets an output replace an input file.")] = False,
     feet: Annotated[str, typer.Option(help=FEET_HELP.replace("with --root motion", "when the take travels"))]
     = "auto",
     foot_joints: Annotated[str | None, typer.Option(help=FOOT_JOINTS_HELP)] = None,
@@ -44,7 +51,7 @@ def stretch(
     """
     from ..warp import stretch_motion
 
-    check_suffix(output, ".bvh")
+    check_output(output, [path], force, ".bvh")
     win = count_option(window, "--window", {"auto": "auto"})
     check_feet_mode(feet)
     t0 = time.perf_counter()
@@ -56,7 +63,7 @@ def stretch(
     facts["feet"] = feet_facts
     facts["seconds"] = time.perf_counter() - t0
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     out.print(f"[bold]{path}[/]: {report.frames_in} frames -> {output}: {report.frames_out} frames "
               f"(factor {report.factor:g}, {motion.fps:.6g} fps)", soft_wrap=True)

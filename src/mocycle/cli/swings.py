@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Annotated
@@ -13,7 +12,15 @@ from rich.table import Table
 from ..errors import MocycleError
 from ..io import read_motion as read
 from ..io import write
-from .common import app, check_suffix, friendly, out
+from .common import (
+    FORCE_HELP,
+    app,
+    check_output,
+    friendly,
+    json_text,
+    out,
+    write_text,
+)
 
 _JOINTS_HELP = "Joints to segment: names, glob patterns or groups (legs, arms, spine), comma-separated " \
                "(default: the major bones, by name and motion energy)."
@@ -43,12 +50,14 @@ def swings(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: one row per joint, swings as bars in time.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Segment a take into joint swings and holds; report playback error and compressed size."""
     from ..swings import encode, playback, playback_errors, size_report
 
-    if output is not None and output.suffix.lower() not in (".json", ".mosw"):
-        raise MocycleError(f"-o {output}: the swings are written as .json or .mosw")
+    check_output(output, [path], force, (".json", ".mosw"))
+    check_output(playback_path, [path], force, ".bvh", "--playback")
+    check_output(plot, [path], force, ".png", "--plot")
     t0 = time.perf_counter()
     motion, seg = _load(path, threshold, joints, fps)
     seconds = time.perf_counter() - t0
@@ -64,12 +73,10 @@ def swings(
     facts.update(compressed_bytes=size["compressed_bytes"], raw_float32_bytes=size["raw_float32_bytes"],
                  seconds=seconds)
     if output is not None:
-        from ..io.atomic import atomic_write
-
         if output.suffix.lower() == ".json":
-            atomic_write(output, json.dumps(seg.to_dict(), indent=1))
+            write_text(output, json_text(seg.to_dict(), indent=1), "swings")
         else:
-            atomic_write(output, encode(seg))
+            write_text(output, encode(seg), "swings file")
     if playback_path is not None:
         write(rebuilt, playback_path)
     if plot is not None:
@@ -77,7 +84,7 @@ def swings(
 
         plot_swings(seg, plot, title=f"{path.name}: {seg.n_swings} swings (threshold {seg.threshold:g})")
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
         return
     out.print(f"[bold]{path}[/]: {seg.n_frames} frames at {seg.fps:.6g} fps, "
               f"Acceptable Swing Error {seg.threshold:g}")
@@ -123,7 +130,7 @@ def search(
     hits = index.query(motion, top=top, exclude=query)
     seconds = time.perf_counter() - t0
     if as_json:
-        print(json.dumps({"query": str(query), "indexed": len(index), "seconds": seconds,
+        print(json_text({"query": str(query), "indexed": len(index), "seconds": seconds,
                           "results": [{"rank": k + 1, "path": str(h.path), "score": h.score,
                                        "offset_s": h.offset_s} for k, h in enumerate(hits)]}, indent=2))
         return
@@ -150,11 +157,12 @@ def edit(
     joints: Annotated[str | None, typer.Option(help=_JOINTS_HELP)] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     fps: Annotated[float, typer.Option(help="Frame rate of AMC files (they do not store it).")] = 120.0,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Scale the angle or the duration of one swing of one joint and write the edited motion."""
     from ..swings import edit_swing, segment
 
-    check_suffix(output, ".bvh")
+    check_output(output, [path], force, ".bvh")
     t0 = time.perf_counter()
     motion = read(path, fps=fps)
     seg = segment(motion, threshold=threshold, joints=joints)
@@ -169,7 +177,7 @@ def edit(
              "angle_deg": abs(sw.end_angle - sw.start_angle) * 57.29577951308232, "angle_scale": angle_scale,
              "duration_scale": duration_scale, "output": str(output), "seconds": time.perf_counter() - t0}
     if as_json:
-        print(json.dumps(facts, indent=2))
+        print(json_text(facts))
     else:
         out.print(f"{joint} swing {swing} (frames {sw.start}-{sw.end}, {facts['angle_deg']:.1f} deg): "
                   f"angle x{angle_scale:g}, duration x{duration_scale:g} -> {output}")

@@ -59,10 +59,11 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.spatial.transform import Rotation
 
 from ..errors import MocycleError, NoPeriodicMotion
+from ..limits import check_frames
 from ..motion import Motion, Skeleton
 from ..rotations import axis_rotations, mean_rotations, nearest_rotations
 from .checks import check_loop
-from .extract import ROOT_MODES, Cycle, extract_cycle, loop_blocks, metric_features
+from .extract import ROOT_MODES, Cycle, drifting_L, extract_cycle, loop_blocks, metric_features
 from .representation import CycleSpace
 from .seam import LOCAL, calmest_start, seam_ratios
 from .timeaxis import TimeAxis
@@ -155,6 +156,8 @@ def _cycles(takes, labels, extract_options, force: bool = False) -> list[Cycle]:
             cycle = extract_cycle(take, **extract_options)
         except NoPeriodicMotion as exc:
             raise NoPeriodicMotion(f"{label}: {exc}") from None
+        except MocycleError as exc:  # say which take: the user gave several
+            raise MocycleError(f"{label}: {exc}") from None
         check_loop(take, cycle, force=force, label=label)
         cycles.append(cycle)
     first = cycles[0].space
@@ -449,7 +452,7 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     L = _blend_L([r[1] for r in reads], w)
     L[:, :3] += first.centre
     drift = w @ np.stack([loop.drift for loop in loops])
-    L += np.outer(grid, drift)                       # the Cycle convention: L carries its drift
+    L = drifting_L(space.up, L, drift)               # the Cycle convention: L carries its drift
     axis = TimeAxis(x=grid.copy(), regions=((0, N),), period_frames=period, method="blend")
     cycle = Cycle(space=space, P=P, L=L, drift=drift, method="blend", model=None, n_harmonics=None, axis=axis,
                   positions=np.arange(N, dtype=np.float64), periodic=None)
@@ -538,6 +541,8 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     offset = float(_align(loops, space, max(2, int(round(0.5 * (pa + pb)))))[1]) if align else 0.0
     n = int(cycles)
     total = n * 0.5 * (pa + pb)                       # t(n): frames over the n cycles
+    check_frames(round(total), space.skeleton.n_joints,
+                 f"a transition over {n} cycles")
     T = max(2, int(round(total)))
     scale = T / total
     grid = np.linspace(0.0, n, 256 * n + 1)

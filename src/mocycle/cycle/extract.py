@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
+from ..limits import check_frames
 from ..motion import Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
@@ -120,11 +121,11 @@ class Cycle:
         """``L (N, 4)`` walking on the spot: the path straightened (each step turned back by the turn spread
         evenly over the cycle, so a turning walk's steps line up as a straight walk's) and its travel and turn
         taken out along a ramp.  Position and velocity both wrap seamlessly; a straight walk's path is only
-        ramped."""
+        ramped.  :func:`drifting_L` is the inverse."""
         N = self.n_frames
         ramp = np.arange(N) / N
         full = np.vstack([self.L, self._next_repeat(self.L[:1])])  # the next repeat's first frame closes it
-        steps = np.einsum("tij,tj->ti", axis_rotations(self.space.up, -self.drift[3] * (ramp + 0.5 / N)),
+        steps = np.einsum("tij,tj->ti", _step_turns(self.space.up, self.drift[3], N).swapaxes(1, 2),
                           np.diff(full[:, :3], axis=0))
         path = full[0, :3] + np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])  # (N + 1, 3)
         out = self.L.copy()
@@ -142,6 +143,8 @@ class Cycle:
         _check_choice(root, ROOT_MODES, "root")
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
             raise MocycleError(f"the number of cycles must be a positive integer; got {count!r}")
+        check_frames(count * self.n_frames, self.space.skeleton.n_joints,
+                     f"{count} cycles of {self.n_frames} frames")
         P = np.tile(self.P, (count, 1))
         if root == "inplace":
             return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)))
@@ -163,6 +166,28 @@ class Cycle:
             "turn_per_cycle_deg": float(np.degrees(self.drift[3])),
             **self.periodic.provenance(),
         }
+
+
+def _step_turns(up: np.ndarray, turn: float, n: int) -> np.ndarray:
+    """Rotations ``(n, 3, 3)`` about ``up`` by the turn ``turn`` (rad per cycle) spread over a cycle of ``n``
+    frames, at the middle of each step ``k -> k + 1``."""
+    return axis_rotations(up, turn * (np.arange(n) + 0.5) / n)
+
+
+def drifting_L(up: np.ndarray, inplace: np.ndarray, drift: np.ndarray) -> np.ndarray:
+    """The cycle's ``L (N, 4)`` that moves on by ``drift (4,)`` (travel in the file's frame, turn in rad) and
+    walks on the spot as ``inplace (N, 4)``: the inverse of ``Cycle._inplace_L``.  The straight travel ``s``
+    that, bent by the turn, ends at ``drift[:3]`` solves ``mean_k(R_k) s = drift - sum_k R_k (step_k)``."""
+    N = inplace.shape[0]
+    R = _step_turns(up, drift[3], N)
+    d_in = np.diff(np.vstack([inplace[:, :3], inplace[:1, :3]]), axis=0)  # (N, 3), closing step included
+    rhs = drift[:3] - np.einsum("tij,tj->i", R, d_in)
+    s = np.linalg.lstsq(R.mean(axis=0), rhs, rcond=None)[0]
+    steps = np.einsum("tij,tj->ti", R, d_in + s / N)
+    out = inplace.copy()
+    out[1:, :3] = inplace[0, :3] + np.cumsum(steps[:-1], axis=0)
+    out[:, 3] += np.arange(N) / N * drift[3]
+    return out
 
 
 def _check_choice(value, choices, name):
