@@ -18,10 +18,10 @@ A cycle is refused (:class:`~mocycle.errors.LoopRefused`, CLI exit 3) when
   the steps next to it, for pose or velocity, rotations or root path;
   :func:`~mocycle.cycle.seam.seam_ratios`) is above :data:`MAX_SEAM`.
 
-Thresholds, from ``benchmarks/cycles.py`` on the 45 shared walks, runs and dashes
+Thresholds, from ``benchmarks/cycles.py`` on the 59 shared walks, runs and dashes
 that have a cycle (docs/cycles.md): the template error of the harmonic M1 cycle
-over the best cut's is 0.44-1.47 on all but one (run_chimpira 2.06, whose period
-is 4 % off the legs' own); the local seam ratios stay under 1.8.  A cycle of the
+over the best cut's is 0.44-1.25 (2.03 on run_chimpira while its period was found
+6.6 % short of the legs' own); the local seam ratios stay under 2.2.  A cycle of the
 wrong period fits 4-6 times worse than the cut, with an error about the take's
 spread (tests/cycle/test_checks.py); on the shared takes the harmonic cycle's error
 is 25-50 % of the spread.  A pop that a viewer sees is a step several times its
