@@ -96,14 +96,14 @@ class Cycle:
         return self.axis.n_periods
 
     def rolled(self, k: int) -> Cycle:
-        """The same loop started at its frame ``k`` (frames ``N..N+k-1`` are the next repeat's first ones)."""
+        """The same loop started at its frame ``k``: frames ``N..N+k-1`` are the first ones moved on by the
+        drift.  Exact for a path in the straight form the cycles are fitted and blended in (periodic plus a
+        line); :meth:`repeat` turns each repeat as a whole."""
         N, k = self.n_frames, int(k) % self.n_frames
         if k == 0:
             return self
         idx = (np.arange(N) + k) % N
-        L = self.L[idx].copy()
-        wrapped = np.arange(N) + k >= N
-        L[wrapped] = self._next_repeat(self.L[idx[wrapped]])
+        L = self.L[idx] + np.outer(np.arange(N) + k >= N, self.drift)
         return replace(self, P=self.P[idx], L=L, positions=np.mod(self.positions - k, N))
 
     def _next_repeat(self, L: np.ndarray, times: int = 1) -> np.ndarray:
