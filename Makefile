@@ -47,6 +47,7 @@ bench: $(VENV)/.installed
 	$(BIN)/python benchmarks/stretch.py
 	$(BIN)/python benchmarks/swings.py
 	$(BIN)/python benchmarks/keyframes.py
+	$(BIN)/python benchmarks/feet.py
 
 clean:
 	rm -rf $(VENV) $(NP1) out .pytest_cache .ruff_cache

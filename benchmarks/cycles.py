@@ -208,8 +208,9 @@ def trust(data: Path, quick: bool) -> None:
         sys.stdout.flush()
     made = {n: r for n, r in rows.items() if "cycle" in r}
     ok = {n: r for n, r in made.items() if not r["refused"]}
+    errors = sum(r.get("why") == "error" for r in rows.values())
     print(f"\n## goals (trust): {len(rows)} takes, {len(ok)} loops written with exit 0, "
-          f"{len(rows) - len(ok)} refused (exit 3)")
+          f"{len(rows) - len(ok) - errors} refused (exit 3), {errors} bad input (exit 1)")
     period_off = [n for n, r in ok.items() if not abs(r["cycle"] / r["gait"] - 1) <= PERIOD_GOAL]
     listed = ", ".join(f"{n} ({made[n]['cycle']} vs {made[n]['gait']:.1f})" for n in period_off)
     print(f"cycle within {PERIOD_GOAL:.0%} of the gait period: {len(ok) - len(period_off)}/{len(ok)}"

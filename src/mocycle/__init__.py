@@ -9,9 +9,21 @@ The public surface most users need::
 """
 
 from .errors import MocycleError, MocycleWarning, MotionFileError
-from .features import delay_embed, pose_matrix
-from .io import read, write
-from .motion import EndSite, Motion, Skeleton
+
+# The rest is imported on first use (PEP 562), so that ``import mocycle.cli`` stays cheap and the command
+# line can take Ctrl-C cleanly from its first moment.
+_LAZY = {"delay_embed": "features", "pose_matrix": "features", "read": "io", "write": "io", "EndSite": "motion",
+         "Motion": "motion", "Skeleton": "motion"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __version__ = "0.1.0"
 

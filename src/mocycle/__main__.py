@@ -8,7 +8,18 @@ INSTALL_HINT = "pip install 'mocycle[cli]'"
 
 
 def main() -> None:
-    """Run the ``mocycle`` command, or say in one line how to install it when typer or rich is missing."""
+    """Run the ``mocycle`` command, or say in one line how to install it when typer or rich is missing.
+
+    ``mocycle.cli`` is light to import; its :func:`~mocycle.cli.guarded` installs the SIGINT/SIGTERM
+    handlers before typer, rich, numpy and scipy are imported, so a signal at any moment ends the run with
+    one line and no traceback.
+    """
+    from .cli import guarded
+
+    guarded(_run)
+
+
+def _run() -> None:
     try:
         import rich  # noqa: F401
         import typer  # noqa: F401
@@ -17,9 +28,9 @@ def main() -> None:
         sys.stderr.write(f"mocycle: the command line needs the cli extra ({missing} is not installed): "
                          f"{INSTALL_HINT}\n")
         raise SystemExit(1) from None
-    from .cli import main as cli_main
+    from .cli import run
 
-    cli_main()
+    run()
 
 
 if __name__ == "__main__":

@@ -13,6 +13,7 @@ import numpy as np
 
 from .errors import OptionError
 from .motion import Motion
+from .rotations import nearest_rotations
 
 AXIS_NAMES = ("x", "y", "z", "+x", "+y", "+z", "-x", "-y", "-z")
 
@@ -79,6 +80,19 @@ def vertical_axis(motion: Motion, up=None) -> np.ndarray:
     v = np.zeros(3)
     v[axis] = 1.0 if np.median(pose[:, axis]) >= mid else -1.0
     return v
+
+
+def up_in_parent_frame(motion: Motion, joint: int, world_up: np.ndarray) -> np.ndarray:
+    """The world up ``(3,)`` seen from ``joint``'s parent: in the frame of the parent's mean world rotation
+    over the take (the world up itself for a root).  Unit vector."""
+    parent = int(motion.skeleton.parents[joint])
+    if parent >= 0:
+        world_rot, _ = motion[:: max(1, motion.n_frames // 50)].world_transforms()
+        mean_parent = nearest_rotations(world_rot[:, parent].mean(axis=0))
+        up = mean_parent.T @ world_up
+    else:
+        up = np.asarray(world_up, dtype=np.float64)
+    return up / np.linalg.norm(up)
 
 
 def horizontal_basis(up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

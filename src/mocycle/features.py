@@ -39,6 +39,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from . import _validate
+from .axes import heading_angles, horizontal_basis, up_in_parent_frame, vertical_axis
 from .errors import MocycleError, OptionError
 from .motion import Motion
 from .rotations import continuous_euler, continuous_rotvec, euler_to_quats, mean_rotations, quat_exp
@@ -159,8 +160,8 @@ class HeadingFrame:
 
     ``up``: the vertical axis ``(3,)`` in the travel joint's parent frame; ``e1``, ``e2``: a horizontal
     basis there; ``forward``: the vector in the travel joint's own frame whose horizontal direction is the
-    heading (``up``, ``e1``, ``e2`` as found by :meth:`~mocycle.cycle.representation.CycleSpace.fit`;
-    ``forward`` perpendicular to the joint's mean local up, so it does not depend on the headings).
+    heading (``up``, ``e1``, ``e2`` from :mod:`mocycle.axes`, as :class:`~mocycle.cycle.representation.CycleSpace`
+    finds them; ``forward`` perpendicular to the joint's mean local up, so it does not depend on the headings).
     """
 
     travel: int
@@ -171,19 +172,17 @@ class HeadingFrame:
 
     @classmethod
     def fit(cls, motion: Motion) -> HeadingFrame:
-        from .cycle.representation import CycleSpace  # the one vertical-axis detection (Y-up, Z-up rigs)
-
-        space = CycleSpace.fit(motion)
+        travel = motion.travel_joint
+        up = up_in_parent_frame(motion, travel, vertical_axis(motion))  # the one detection (Y-up, Z-up rigs)
+        e1, e2 = horizontal_basis(up)
         # Forward: perpendicular to the joint's mean *local* up direction (R^T up does not change when
         # the walker turns about up), so the tilt is the same whichever way the take faces.
-        R = Rotation.from_quat(motion.rotations[:: max(1, motion.n_frames // 200), space.travel])
-        local_up = R.inv().apply(space.up).mean(axis=0)
-        if not np.linalg.norm(local_up) > 1e-9:
-            return cls(space.travel, space.up, space.e1, space.e2, space.forward)
-        local_up /= np.linalg.norm(local_up)
-        least = np.eye(3)[int(np.argmin(np.abs(local_up)))]
-        forward = least - local_up * (least @ local_up)
-        return cls(space.travel, space.up, space.e1, space.e2, forward / np.linalg.norm(forward))
+        R = Rotation.from_quat(motion.rotations[:: max(1, motion.n_frames // 200), travel])
+        local_up = R.inv().apply(up).mean(axis=0)
+        if not np.linalg.norm(local_up) > 1e-9:  # as the cycle space's forward
+            return cls(travel, up, e1, e2, motion.rotation(travel).mean().as_matrix().T @ e1)
+        forward, _ = horizontal_basis(local_up / np.linalg.norm(local_up))
+        return cls(travel, up, e1, e2, forward)
 
     def _about_up(self, angles: np.ndarray) -> Rotation:
         return Rotation.from_rotvec(np.outer(angles, self.up))
@@ -191,8 +190,7 @@ class HeadingFrame:
     def tilt(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
         """The travel joint's rotation without its heading ``(T, 4)`` and the unwrapped heading ``(T,)`` rad."""
         R = Rotation.from_quat(motion.rotations[:, self.travel])
-        f = R.apply(self.forward)
-        psi = np.unwrap(np.arctan2(f @ self.e2, f @ self.e1))
+        psi = heading_angles(R.apply(self.forward), self.e1, self.e2)
         return (self._about_up(-psi) * R).as_quat(), psi
 
     def turn(self, quats: np.ndarray, angles: np.ndarray) -> np.ndarray:

@@ -25,6 +25,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from . import _validate
 from .errors import MocycleError
+from .limits import MAX_MAGNITUDE, check_frames, frame_time_problem
 from .rotations import continuous_quats
 
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
@@ -231,7 +232,11 @@ class Motion:
             trans[:, 0] = rp
         if not np.all(np.isfinite(trans)):
             raise MocycleError("translations contain NaN or infinite values")
+        if trans.size and np.abs(trans).max() > MAX_MAGNITUDE:
+            raise MocycleError(f"translations reach {np.abs(trans).max():.3g}, beyond ±{MAX_MAGNITUDE:g}")
         frame_time = _validate.positive("frame_time", frame_time)
+        if frame_time_problem(frame_time):
+            raise MocycleError(frame_time_problem(frame_time))
         rot.setflags(write=False)
         trans.setflags(write=False)
         self.skeleton = skeleton
@@ -370,12 +375,15 @@ class Motion:
         new frame before it.  273 frames at 30 fps give 545 at 60 fps.
         """
         fps = _validate.positive("fps", fps)
+        if frame_time_problem(1.0 / fps):
+            raise MocycleError(f"fps must be a positive number within [1e-4, 1e6]; got {fps:g}")
         new_dt = 1.0 / fps
         if self.n_frames == 1:
             return self.replace(frame_time=new_dt)
         old_t = np.arange(self.n_frames) * self.frame_time
         steps = self.duration / new_dt
-        n_new = int(np.floor(steps + max(1e-9, 1e-5 * steps))) + 1
+        n_new = check_frames(np.floor(steps + max(1e-9, 1e-5 * steps)) + 1, self.n_joints,
+                             f"resampling {self.n_frames} frames to {fps:g} fps")
         new_t = np.minimum(np.arange(n_new) * new_dt, old_t[-1])
         rot = np.empty((n_new, self.n_joints, 4))
         for j in range(self.n_joints):

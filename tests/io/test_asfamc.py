@@ -377,3 +377,25 @@ def test_cmu_11_structure():
     assert np.all(np.isfinite(m.rotations)) and np.all(np.isfinite(m.translations))
     assert np.all(np.isfinite(m.world_positions(end_sites=True)))
     np.testing.assert_allclose(np.linalg.norm(m.rotations, axis=-1), 1.0)
+
+
+def test_deep_bone_chain_reads_and_writes(tmp_path):
+    """An ASF chain deeper than Python's recursion limit reads, converts and writes as BVH."""
+    import sys
+
+    from mocycle.io import read, write
+
+    n = sys.getrecursionlimit() + 500
+    asf = [":units", "  angle deg", ":root", "   order TX TY TZ RX RY RZ", "   axis XYZ", "   position 0 0 0",
+           "   orientation 0 0 0", ":bonedata"]
+    for i in range(n):
+        asf += ["  begin", f"     name b{i}", "     direction 0 1 0", "     length 1", "     dof rx", "  end"]
+    asf += [":hierarchy", "  begin", "    root b0", *(f"    b{i} b{i + 1}" for i in range(n - 1)), "  end"]
+    (tmp_path / "chain.asf").write_text("\n".join(asf) + "\n")
+    amc = ["1", "root 0 0 0 0 0 0", *(f"b{i} 1" for i in range(n))]
+    (tmp_path / "chain_01.amc").write_text("\n".join(amc) + "\n")
+    m = read(tmp_path / "chain_01.amc")
+    assert m.n_joints == n + 1 and m.skeleton.parents[-1] == n - 1
+    back = read(write(m, tmp_path / "chain.bvh"))
+    assert back.n_joints == n + 1
+    assert np.abs(back.world_positions()[0, -1] - m.world_positions()[0, -1]).max() < 1e-6

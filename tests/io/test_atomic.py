@@ -21,3 +21,28 @@ def test_existing_file_keeps_its_mode(tmp_path):
     atomic_write(path, b"new")
     assert path.read_bytes() == b"new" and stat.S_IMODE(path.stat().st_mode) == 0o640
     assert [p.name for p in tmp_path.iterdir()] == ["b.bin"]
+
+
+def test_leftovers_of_killed_writes_are_removed_live_ones_kept(tmp_path):
+    target = tmp_path / "out.bvh"
+    dead = tmp_path / ".out.bvh.4194399.x1y2.tmp"  # above Linux's largest pid: no such process
+    old = tmp_path / ".out.bvh.k3j4l5.tmp"  # the old name, without a pid: stale once it is an hour old
+    live = tmp_path / f".out.bvh.{os.getpid()}.abcd.tmp"  # a write in progress (this process)
+    other = tmp_path / ".other.bvh.4194399.x1y2.tmp"  # another target's: not ours to touch
+    for p in (dead, old, live, other):
+        p.write_text("partial")
+    os.utime(old, (1, 1))
+    atomic_write(target, "new")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([target.name, live.name, other.name])
+
+
+def test_failed_write_leaves_no_temporary_file(tmp_path, monkeypatch):
+    import pytest
+
+    def boom(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "replace", boom)
+    with pytest.raises(OSError):
+        atomic_write(tmp_path / "c.bvh", "data")
+    assert list(tmp_path.iterdir()) == []

@@ -124,3 +124,24 @@ def test_cmu_bvh_facts():
     assert m.n_frames == 2752 and m.n_joints == 31
     assert np.isclose(m.frame_time, 0.0083333)
     assert m.skeleton.euler_order(0) == "ZYX"
+
+
+def _chain_skeleton(n: int):
+    from mocycle.motion import EndSite, Skeleton
+
+    return Skeleton(tuple(f"j{i}" for i in range(n)), list(range(-1, n - 1)), [[0.0, 1.0, 0.0]] * n,
+                    (("Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation", "Yrotation"),)
+                    + (("Zrotation", "Xrotation", "Yrotation"),) * (n - 1), (EndSite(n - 1, (0.0, 1.0, 0.0)),))
+
+
+def test_deep_hierarchy_writes_and_reads_back_without_recursion(tmp_path):
+    import sys
+
+    from mocycle.motion import Motion
+
+    n = sys.getrecursionlimit() + 500  # deeper than any recursive writer could go
+    m = Motion.rest(_chain_skeleton(n), 2)
+    back = read_bvh(write_bvh(m, tmp_path / "deep.bvh"))
+    assert back.skeleton.names == m.skeleton.names
+    assert np.array_equal(back.skeleton.parents, m.skeleton.parents)
+    assert back.skeleton.end_sites[0].parent == n - 1

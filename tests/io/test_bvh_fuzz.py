@@ -17,6 +17,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from fuzzing import limits
 from mocycle.errors import MocycleWarning, MotionFileError
 from mocycle.io import atomic
 from mocycle.io.bvh import format_bvh, parse_bvh, write_bvh
@@ -125,7 +126,7 @@ def check(data: str | bytes) -> Motion | None:
     Warnings other than MocycleWarning (numpy's, say) are errors here: they are noise to users.
     """
     try:
-        with warnings.catch_warnings():
+        with limits(), warnings.catch_warnings():  # memory and time limits per example
             warnings.simplefilter("error")
             warnings.simplefilter("ignore", MocycleWarning)
             motion = parse_bvh(data, path="fuzz.bvh")

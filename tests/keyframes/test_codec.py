@@ -48,7 +48,7 @@ def test_size_report_formulas(walk):
 
 def test_damaged_files(walk, tmp_path):
     data = compress(walk).to_bytes()
-    with pytest.raises(MotionFileError, match="damaged or truncated"):
+    with pytest.raises(MotionFileError, match="damaged.*truncated"):
         Compressed.from_bytes(data[:-40])
     with pytest.raises(MotionFileError, match="not a mocycle keyframe file"):
         Compressed.from_bytes(b"BVH" + data)

@@ -196,3 +196,11 @@ def test_walk_then_run_regions_do_not_bleed_into_each_other():
     run_alone = loop_metrics(alone, extract_cycle(alone))["template_error"]
     run_here = loop_metrics(take.motion, extract_cycle(take.motion, phase=result, which=1))["template_error"]
     assert run_here < 1.2 * run_alone  # before this: 1.7 times (0.34 rad against 0.20)
+
+
+def test_a_take_too_short_for_a_phase_has_no_periodic_motion():
+    """Valid input shorter than a phase needs is the outcome 'no periodic motion' (CLI exit 3), not a bad file."""
+    from mocycle.errors import NoPeriodicMotion
+
+    with pytest.raises(NoPeriodicMotion, match="needs at least"):
+        find_phase(synthetic_walk(n_frames=20).motion)

@@ -10,7 +10,7 @@ import typer
 
 from .. import tasks
 from ..io import write
-from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line
 
 B = tasks.blend.Options
 T = tasks.transition.Options
@@ -39,6 +39,8 @@ def blend(
     plot: Annotated[Path | None, typer.Option(help=PLOT_HELP)] = None,
     amc_fps: Annotated[float, flag(B, "amc_fps")] = default(B, "amc_fps"),
     force: Annotated[bool, flag(B, "force")] = default(B, "force"),
+    feet: Annotated[str, flag(B, "feet")] = default(B, "feet"),
+    foot_joints: Annotated[str | None, flag(B, "foot_joints")] = default(B, "foot_joints"),
 ):
     """Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).
 
@@ -47,11 +49,11 @@ def blend(
     Exit code 0 on success, 3 when a take holds no periodic motion or its cycle fails a loop check (see
     mocycle loop; --force uses it anyway), 1 for bad input, 2 for a bad option.
     """
-    check_suffix(output, ".bvh")
-    check_suffix(plot, ".png", "--plot")
+    check_output(output, paths, force, ".bvh", "--output")
+    check_output(plot, paths, force, ".png", "--plot")
     options = B(weights=weights, root=root, cycles=cycles, method=method, model=model, harmonics=harmonics,
                 align=align, joints=joints, classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods,
-                amc_fps=amc_fps, force=force)
+                amc_fps=amc_fps, force=force, feet=feet, foot_joints=foot_joints)
     report = tasks.blend.run(paths, options)
     print_warnings(report)
     write(report.motions["loop"], output)
@@ -83,6 +85,7 @@ def blend(
               f"turn {facts['turn_per_cycle_deg']:.3g}°")
     seam = facts["seam"]
     out.print(f"  seam jump: pose {seam['seam_pose']:.3g}, velocity {seam['seam_velocity']:.3g} (× median step)")
+    _print_feet(facts["feet"])
     out.print(f"wrote {output}: {facts['frames_out']} frames ({cycles} cycle(s), root {root})", soft_wrap=True)
     if plot is not None:
         out.print(f"wrote {plot}", soft_wrap=True)
@@ -111,6 +114,8 @@ def transition(
         help="Write a PNG: the most moving joint curves over the transition's phase, and the weight.")] = None,
     amc_fps: Annotated[float, flag(T, "amc_fps")] = default(T, "amc_fps"),
     force: Annotated[bool, flag(T, "force")] = default(T, "force"),
+    feet: Annotated[str, flag(T, "feet")] = default(T, "feet"),
+    foot_joints: Annotated[str | None, flag(T, "foot_joints")] = default(T, "foot_joints"),
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
@@ -118,11 +123,11 @@ def transition(
     integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion or its
     cycle fails a loop check (see mocycle loop), 1 for bad input, 2 for a bad option.
     """
-    check_suffix(output, ".bvh")
-    check_suffix(plot, ".png", "--plot")
+    check_output(output, [first, second], force, ".bvh", "--output")
+    check_output(plot, [first, second], force, ".png", "--plot")
     options = T(cycles=cycles, root=root, method=method, model=model, harmonics=harmonics, joints=joints,
                 classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods, amc_fps=amc_fps,
-                force=force)
+                force=force, feet=feet, foot_joints=foot_joints)
     report = tasks.transition.run([first, second], options)
     print_warnings(report)
     write(report.motions["transition"], output)
@@ -142,7 +147,13 @@ def transition(
     sm = facts["smoothness"]
     out.print(f"  largest step {sm['step_local']:.3g} × its neighbours' median (inputs {sm['input_step_local']:.3g}); "
               f"largest velocity change {sm['velocity_local']:.3g} × (inputs {sm['input_velocity_local']:.3g})")
+    _print_feet(facts["feet"])
     out.print(f"wrote {output}: {facts['frames']} frames (root {root})", soft_wrap=True)
     if plot is not None:
         out.print(f"wrote {plot}", soft_wrap=True)
     out.print(timing_line(report))
+
+
+def _print_feet(feet: dict) -> None:
+    if feet["mode"] == "lock":
+        out.print(f"  feet locked: skate {feet['skate_before']:.4g} -> {feet['skate_after']:.4g} units/s")

@@ -4,15 +4,18 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import sys
+import math
+import os
 import warnings
 from collections.abc import Callable, Mapping
 from functools import wraps
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
@@ -30,6 +33,8 @@ app = typer.Typer(
 )
 out = Console(highlight=False)
 err = Console(stderr=True, highlight=False)
+
+FORCE_HELP = "Allow an output to replace one of the input files."
 
 EXIT_ERROR = 1
 EXIT_USAGE = 2  # a bad option value (typer/click use 2 for usage errors too)
@@ -63,7 +68,8 @@ def friendly(func: Callable) -> Callable:
                 raise typer.Exit(EXIT_USAGE) from None
             except MocycleError as exc:
                 _print_warnings(caught)
-                err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
+                message = _naming_the_input(str(exc), kwargs)
+                err.print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
                 refused = isinstance(exc, (NoPeriodicMotion, LoopRefused))
                 raise typer.Exit(EXIT_NOT_FOUND if refused else EXIT_ERROR) from None
         _print_warnings(caught)
@@ -72,11 +78,28 @@ def friendly(func: Callable) -> Callable:
     return wrapper
 
 
+#: The command arguments that name input files.
+INPUT_ARGUMENTS = ("path", "query", "first", "second", "paths")
+
+
+def _naming_the_input(message: str, kwargs: dict) -> str:
+    """``message`` with the input file in front when it names none of the command's files (so that in
+    ``blend`` or ``transition`` the user can tell which take is meant).  Option errors stay as they are."""
+    inputs = []
+    for key in INPUT_ARGUMENTS:
+        value = kwargs.get(key)
+        inputs += [str(v) for v in value] if isinstance(value, (list, tuple)) else [str(value)] if value else []
+    files = inputs + [str(v) for v in kwargs.values() if isinstance(v, Path)]
+    if len(inputs) != 1 or any(f in message for f in files) or message.startswith("-") or " --" in message:
+        return message
+    return f"{inputs[0]}: {message}"
+
+
 def _print_warnings(caught) -> None:
     for w in caught:
         if issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)):
             continue
-        err.print(f"[yellow]warning:[/] {w.message}", markup=True, soft_wrap=True)
+        err.print(f"[yellow]warning:[/] {escape(str(w.message))}", markup=True, soft_wrap=True)
 
 
 def print_warnings(report) -> None:
@@ -137,7 +160,8 @@ def timing_line(report) -> str:
 
 
 def print_json(facts: Mapping, indent: int | None = 2) -> None:
-    print(json.dumps(facts, indent=indent))
+    """Strict JSON on stdout (:func:`json_text`: non-finite numbers as null, and the JSON says which)."""
+    print(json_text(facts, indent=indent))
 
 
 # ------------------------------------------------------------ option parsing
@@ -147,9 +171,83 @@ def check_suffix(path: Path | None, suffix: str, option: str = "-o") -> None:
         raise MocycleError(f"{path}: {option} must name a {suffix} file")
 
 
-def main() -> None:  # the console script
+def check_output(path: Path | None, inputs=(), force: bool = False, suffix: str | tuple[str, ...] | None = None,
+                 option: str = "-o") -> None:
+    """Refuse an output before any work is done: wrong suffix, a folder that is missing or not writable,
+    a folder in its place, or one of the ``inputs`` (unless ``force``).  Nothing gets written here."""
+    if path is None:
+        return
+    if suffix is not None:
+        suffixes = (suffix,) if isinstance(suffix, str) else tuple(suffix)
+        if path.suffix.lower() not in suffixes:
+            raise MocycleError(f"{path}: {option} must name a {' or '.join(suffixes)} file")
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise MocycleError(f"{path}: {option}: the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise MocycleError(f"{path}: {option}: the folder {folder} is not writable")
+    if path.is_dir():
+        raise MocycleError(f"{path}: {option} names a folder; expected a file")
+    for source in inputs:
+        if source is not None and _same_file(path, Path(source)):
+            if not force:
+                raise MocycleError(f"{path}: {option} is the input {source}; pass --force to replace it")
+
+
+def _same_file(a: Path, b: Path) -> bool:
     try:
-        app()
-    except KeyboardInterrupt:  # pragma: no cover
-        err.print("interrupted")
-        sys.exit(130)
+        return a.exists() and b.exists() and os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_folder(folder: Path, option: str = "--out") -> None:
+    """Refuse an output folder that cannot be made or written, before any work is done."""
+    probe = folder
+    while not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise MocycleError(f"{folder}: {option}: {probe} is a file, not a folder")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise MocycleError(f"{folder}: {option}: {probe} is not writable")
+
+
+def write_text(path: Path, text: str | bytes, what: str = "file") -> Path:
+    """Write an output through the atomic writer; an OS error becomes one clear MocycleError."""
+    from ..io.atomic import atomic_write
+
+    try:
+        return atomic_write(path, text)
+    except OSError as exc:
+        raise MocycleError(f"{path}: cannot write the {what} ({exc.strerror or exc})") from None
+
+
+# ------------------------------------------------------------ output
+def json_text(facts, indent: int | None = 2) -> str:
+    """Strict JSON of ``facts``: NaN and infinities become ``null``, and the JSON says which and why.
+
+    ``json.dumps`` would write ``NaN``/``Infinity``, which JSON parsers refuse.  The paths of the values
+    written as ``null`` are listed under ``"null_because_not_finite"`` (for a dict at the top).
+    """
+    nulls: list[str] = []
+
+    def clean(x, where: str):
+        if isinstance(x, (float, np.floating)):
+            if math.isfinite(x):
+                return float(x)
+            nulls.append(f"{where or 'value'} ({x})")
+            return None
+        if isinstance(x, np.integer):
+            return int(x)
+        if isinstance(x, np.ndarray):
+            x = x.tolist()
+        if isinstance(x, dict):
+            return {k: clean(v, f"{where}.{k}" if where else str(k)) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [clean(v, f"{where}[{i}]") for i, v in enumerate(x)]
+        return x
+
+    out = clean(facts, "")
+    if nulls and isinstance(out, dict):
+        out["null_because_not_finite"] = nulls
+    return json.dumps(out, indent=indent, allow_nan=False)

@@ -10,7 +10,7 @@ import typer
 from ..errors import MocycleError
 from ..io import AMC_FPS, write
 from ..io import read_motion as read
-from .common import app, friendly, out, parse_range
+from .common import FORCE_HELP, app, check_output, friendly, out, parse_range
 
 
 @app.command()
@@ -23,8 +23,11 @@ def convert(
     amc_fps: Annotated[float, typer.Option(
         help="Frame rate of AMC input files, which do not store it (CMU: 120).")] = AMC_FPS,
     frame_range: Annotated[str | None, typer.Option("--range", help="Keep frames START:STOP.")] = None,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Convert ASF/AMC to BVH, or rewrite a BVH (optionally a frame range, another fps)."""
+    if len(paths) in (2, 3):
+        check_output(paths[-1], paths[:-1], force, ".bvh", "the output")
     if len(paths) == 2:
         motion = read(paths[0], fps=amc_fps)
     elif len(paths) == 3:

@@ -9,9 +9,15 @@ from typing import Annotated
 import numpy as np
 import typer
 
+from ..errors import MocycleError
 from ..io import read_motion as read
 from ..io import write
-from .common import app, friendly, out
+from .common import (
+    app,
+    check_folder,
+    friendly,
+    out,
+)
 
 
 @app.command()
@@ -26,9 +32,13 @@ def demo(
     from ..tasks.loop import METRIC_LABELS
     from ..viz import plot_loop
 
+    check_folder(out_dir)
     t0 = time.perf_counter()
     take = synthetic_walk(seed=seed, noise_deg=1.0, speed_change=0.1)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MocycleError(f"{out_dir}: --out: cannot make the folder ({exc.strerror or exc})") from None
     source = write(take.motion, out_dir / "synthetic_walk.bvh")
     motion = read(source)
     true_period = float(np.median(take.period_frames))

@@ -9,7 +9,7 @@ import typer
 
 from .. import tasks
 from ..io import write
-from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import FORCE_HELP, app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line
 
 C = tasks.compress.Options
 P = tasks.project.Options
@@ -28,13 +28,14 @@ def compress(
     optimize: Annotated[bool, flag(C, "optimize")] = default(C, "optimize"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(C, "amc_fps")] = default(C, "amc_fps"),
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size.
 
     The default ratio 'auto' keeps enough keys for the motion's own rhythm; an explicit ratio that leaves
     fewer than 4 keys per period gets a warning.
     """
-    check_suffix(output, ".mck")
+    check_output(output, [path], force, ".mck", "--output")
     options = C(ratio=ratio, select=select, scheme=scheme, projection=projection, seed_projection=seed_projection,
                 optimize=optimize, amc_fps=amc_fps)
     report = tasks.compress.run(path, options)
@@ -71,9 +72,10 @@ def compress(
 def decompress(
     path: Annotated[Path, typer.Argument(help="A .mck file written by 'mocycle compress'.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh file to write.")],
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Rebuild a take from its keyframes; the keyframes come back exactly."""
-    check_suffix(output, ".bvh")
+    check_output(output, [path], force, ".bvh", "--output")
     report = tasks.decompress.run(path)
     print_warnings(report)
     write(report.motions["motion"], output)
@@ -94,9 +96,10 @@ def project(
                                                    "marked (thesis Figure 6.2).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON (includes the 2-D points).")] = False,
     amc_fps: Annotated[float, flag(P, "amc_fps")] = default(P, "amc_fps"),
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."""
-    check_suffix(plot, ".png", "--plot")
+    check_output(plot, [path], force, ".png", "--plot")
     options = P(projection=projection, select=select, ratio=ratio, seed_projection=seed_projection,
                 optimize=optimize, amc_fps=amc_fps)
     report = tasks.project.run(path, options)

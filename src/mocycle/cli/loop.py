@@ -8,9 +8,10 @@ from typing import Annotated
 import typer
 
 from .. import tasks
+from ..errors import MocycleError
 from ..io import write
 from ..tasks.loop import METRIC_LABELS
-from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line
 
 O = tasks.loop.Options
 
@@ -40,20 +41,31 @@ def loop(
     = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
     force: Annotated[bool, flag(O, "force")] = default(O, "force"),
+    feet: Annotated[str, flag(O, "feet")] = default(O, "feet"),
+    feet_plot: Annotated[Path | None, typer.Option(
+        help="Write a PNG of the contacts: each ankle and toe's height and speed over two cycles, before (dashed) "
+             "and after locking (with --class all: OUT.classK.png).")] = None,
+    foot_joints: Annotated[str | None, flag(O, "foot_joints")] = default(O, "foot_joints"),
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
 
     Exit code 0 on success, 3 when the take holds no periodic motion or its cycle fails a loop check
     (the reason is printed; --force writes it anyway), 1 for bad input, 2 for a bad option.
     """
-    check_suffix(output, ".bvh", "--output")
-    check_suffix(plot, ".png", "--plot")
+    check_output(output, [path], force, ".bvh", "--output")
+    check_output(plot, [path], force, ".png", "--plot")
+    check_output(feet_plot, [path], force, ".png", "--feet-plot")
     options = O(method=method, model=model, harmonics=harmonics, root=root, frame_range=frame_range, step=step,
                 joints=joints, cycles=cycles, classes=classes, which=which, pca=pca, delay=delay,
-                min_periods=min_periods, time_axis=time_axis, amc_fps=amc_fps, force=force)
+                min_periods=min_periods, time_axis=time_axis, amc_fps=amc_fps, force=force, feet=feet,
+                foot_joints=foot_joints)
     report = tasks.loop.run(path, options)
-    print_warnings(report)
     everything = options.which == "all"
+    roles = [f"loop.class{f['class']}" for f in report.facts["loops"]] if everything else ["loop"]
+    if feet_plot is not None and any(report.extras[r]["contacts"] is None for r in roles):
+        # refused before any file is written
+        raise MocycleError("--feet-plot needs locked feet (--feet lock, or auto with --root motion)")
+    print_warnings(report)
     loops = report.facts["loops"] if everything else [report.facts]
     cycles_made = report.result if everything else [report.result]
     shown = []
@@ -61,6 +73,10 @@ def loop(
         k = facts["class"]
         target = output.with_suffix(f".class{k}.bvh") if everything else output
         write(report.motions[f"loop.class{k}" if everything else "loop"], target)
+        if feet_plot is not None:
+            extra = report.extras[f"loop.class{k}" if everything else "loop"]
+            image = feet_plot.with_suffix(f".class{k}.png") if everything else feet_plot
+            _plot_feet(extra["fitted"], cycle, extra["contacts"], image, f"{path.name}: feet locked")
         image = None
         if plot is not None:
             from ..viz import plot_loop
@@ -78,6 +94,19 @@ def loop(
         if image is not None:
             out.print(f"wrote {image}", soft_wrap=True)
     out.print(timing_line(report))
+
+
+def _plot_feet(fitted, cycle, contacts, image: Path, title: str) -> None:
+    """The contacts plot over two cycles of the locked loop, the fitted one dashed."""
+    import numpy as np
+
+    from ..contacts import Contacts
+    from ..viz import plot_contacts
+
+    twice = Contacts(contacts.feet, contacts.joints, contacts.foot_of, np.tile(contacts.mask, (2, 1)), contacts.up,
+                     contacts.body, contacts.frame_time)
+    plot_contacts(cycle.repeat(2, root="motion"), twice, image, title=title, before=fitted.repeat(2, root="motion"))
+    out.print(f"wrote {image}", soft_wrap=True)
 
 
 def _print_loop(facts: dict) -> None:
@@ -99,5 +128,11 @@ def _print_loop(facts: dict) -> None:
     for key, (label, unit) in METRIC_LABELS.items():
         table.add_row(label, f"{facts['metrics'][key]:.4g}", unit)
     out.print(table)
+    f = facts["feet"]
+    if f["mode"] == "lock":
+        spans = "; ".join(f"{side} {' '.join(f'{a}-{b}' for a, b in v['contacts'])}" for side, v in
+                          f["contacts"].items())
+        out.print(f"  feet locked (contacts, cycle frames: {spans}); skate {f['skate_before']:.4g} -> "
+                  f"{f['skate_after']:.4g} units/s in {f['seconds']:.2f} s", soft_wrap=True)
     out.print(f"wrote {facts['output']}: {facts['frames_out']} frames ({facts['cycles']} cycle(s), root "
               f"{facts['root']})", soft_wrap=True)

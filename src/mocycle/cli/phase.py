@@ -8,7 +8,20 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import EXIT_NOT_FOUND, app, default, err, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import (
+    EXIT_NOT_FOUND,
+    FORCE_HELP,
+    app,
+    check_output,
+    default,
+    err,
+    flag,
+    friendly,
+    out,
+    print_json,
+    print_warnings,
+    timing_line,
+)
 
 O = tasks.phase.Options
 
@@ -26,12 +39,14 @@ def phase(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: diagram, phase per frame, PCA by phase.")] = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Find periodic motions and the phase of every frame (persistent cohomology).
 
     Exit code 0 when at least one periodic motion is found, 3 when none is
     (the reason is printed), 1 for bad input, 2 for a bad option.
     """
+    check_output(plot, [path], force, ".png", "--plot")
     options = O(classes=classes, joints=joints, pca=pca, delay=delay, min_periods=min_periods, n_landmarks=landmarks,
                 amc_fps=amc_fps)
     report = tasks.phase.run(path, options, keep_features=plot is not None)

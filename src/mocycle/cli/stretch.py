@@ -9,7 +9,7 @@ import typer
 
 from .. import tasks
 from ..io import write
-from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line
 
 O = tasks.stretch.Options
 
@@ -26,6 +26,8 @@ def stretch(
         help="Write a PNG: the most moving joint curves of the input and the stretched take in seconds.")] = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
     force: Annotated[bool, flag(O, "force")] = default(O, "force"),
+    feet: Annotated[str, flag(O, "feet")] = default(O, "feet"),
+    foot_joints: Annotated[str | None, flag(O, "foot_joints")] = default(O, "foot_joints"),
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
 
@@ -37,9 +39,10 @@ def stretch(
     keeps its mean velocity. Exit code 3 when the take has no periodic motion
     (--force warps it whole anyway), 1 for bad input, 2 for a bad option.
     """
-    check_suffix(output, ".bvh")
-    check_suffix(plot, ".png", "--plot")
-    report = tasks.stretch.run(path, O(factor=factor, window_frames=window, amc_fps=amc_fps, force=force))
+    check_output(output, [path], force, ".bvh", "--output")
+    check_output(plot, [path], force, ".png", "--plot")
+    report = tasks.stretch.run(path, O(factor=factor, window_frames=window, amc_fps=amc_fps, force=force, feet=feet,
+                                       foot_joints=foot_joints))
     print_warnings(report)
     write(report.motions["stretched"], output)
     if plot is not None:
@@ -70,6 +73,8 @@ def stretch(
             f"{s}:{e} -> {a}:{b}" for (s, e), (a, b) in zip(r["periodic_regions"], r["periodic_regions_out"],
                                                              strict=True))
             + (f"; {kept} frame(s) kept as captured" if kept else ""), soft_wrap=True)
+    if r["feet"]["mode"] == "lock":
+        out.print(f"  feet locked: skate {r['feet']['skate_before']:.4g} -> {r['feet']['skate_after']:.4g} units/s")
     if r["trend_curves"]:
         out.print(f"  warped as line + residual: {', '.join(r['trend_curves'])}", soft_wrap=True)
     if plot is not None:

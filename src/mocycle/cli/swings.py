@@ -2,16 +2,27 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from .. import tasks
-from ..errors import MocycleError
 from ..io import write
-from .common import app, check_suffix, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import (
+    FORCE_HELP,
+    app,
+    check_output,
+    default,
+    flag,
+    friendly,
+    json_text,
+    out,
+    print_json,
+    print_warnings,
+    timing_line,
+    write_text,
+)
 
 S = tasks.swings.Options
 Q = tasks.search.Options
@@ -35,24 +46,26 @@ def swings(
     = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(S, "amc_fps")] = default(S, "amc_fps"),
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Segment a take into joint swings and holds; report playback error and compressed size.
 
     The table lists each joint's swing indices (0-based, in time order): what `mocycle edit --swing` takes.
     """
-    if output is not None and output.suffix.lower() not in (".json", ".mosw"):
-        raise MocycleError(f"-o {output}: the swings are written as .json or .mosw")
-    check_suffix(playback_path, ".bvh", "--playback")
-    check_suffix(plot, ".png", "--plot")
+    check_output(output, [path], force, (".json", ".mosw"), "--output")
+    check_output(playback_path, [path], force, ".bvh", "--playback")
+    check_output(plot, [path], force, ".png", "--plot")
     report = tasks.swings.run(path, S(threshold=threshold, joints=joints, amc_fps=amc_fps))
     print_warnings(report)
     seg, r = report.result, report.facts
     written = []
     if output is not None:
-        from ..io.atomic import atomic_write
         from ..swings import encode
 
-        atomic_write(output, json.dumps(seg.to_dict(), indent=1) if output.suffix.lower() == ".json" else encode(seg))
+        if output.suffix.lower() == ".json":
+            write_text(output, json_text(seg.to_dict(), indent=1), "swings")
+        else:
+            write_text(output, encode(seg), "swings file")
         written.append(f"{output} ({seg.n_swings} swings)")
     if playback_path is not None:
         write(report.motions["playback"], playback_path)
@@ -133,9 +146,10 @@ def edit(
     joints: Annotated[str | None, flag(E, "joints")] = default(E, "joints"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(E, "amc_fps")] = default(E, "amc_fps"),
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Scale the angle or the duration of one swing of one joint and write the edited motion."""
-    check_suffix(output, ".bvh")
+    check_output(output, [path], force, ".bvh", "--output")
     options = E(joint=joint, swing=swing, angle_scale=angle_scale, duration_scale=duration_scale,
                 threshold=threshold, joints=joints, amc_fps=amc_fps)
     report = tasks.edit.run(path, options)

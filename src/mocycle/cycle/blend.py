@@ -60,6 +60,7 @@ from scipy.spatial.transform import Rotation
 
 from .. import _validate
 from ..errors import MocycleError, NoPeriodicMotion, OptionError
+from ..limits import check_frames
 from ..motion import Motion, Skeleton
 from ..rotations import axis_rotations, mean_rotations, nearest_rotations
 from .checks import check_loop
@@ -156,6 +157,8 @@ def _cycles(takes, labels, extract_options, force: bool = False) -> list[Cycle]:
             cycle = extract_cycle(take, **extract_options)
         except NoPeriodicMotion as exc:
             raise NoPeriodicMotion(f"{label}: {exc}") from None
+        except MocycleError as exc:  # say which take: the user gave several
+            raise MocycleError(f"{label}: {exc}") from None
         check_loop(take, cycle, force=force, label=label)
         cycles.append(cycle)
     first = cycles[0].space
@@ -536,6 +539,8 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     offset = float(_align(loops, space, max(2, int(round(0.5 * (pa + pb)))))[1]) if align else 0.0
     n = int(cycles)
     total = n * 0.5 * (pa + pb)                       # t(n): frames over the n cycles
+    check_frames(round(total), space.skeleton.n_joints,
+                 f"a transition over {n} cycles")
     T = max(2, int(round(total)))
     scale = T / total
     grid = np.linspace(0.0, n, 256 * n + 1)

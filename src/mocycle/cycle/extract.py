@@ -26,6 +26,7 @@ import numpy as np
 from .. import _validate
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
+from ..limits import check_frames
 from ..motion import Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
@@ -96,14 +97,14 @@ class Cycle:
         return self.axis.n_periods
 
     def rolled(self, k: int) -> Cycle:
-        """The same loop started at its frame ``k`` (frames ``N..N+k-1`` are the next repeat's first ones)."""
+        """The same loop started at its frame ``k``: frames ``N..N+k-1`` are the first ones moved on by the
+        drift.  Exact for a path in the straight form the cycles are fitted and blended in (periodic plus a
+        line); :meth:`repeat` turns each repeat as a whole."""
         N, k = self.n_frames, int(k) % self.n_frames
         if k == 0:
             return self
         idx = (np.arange(N) + k) % N
-        L = self.L[idx].copy()
-        wrapped = np.arange(N) + k >= N
-        L[wrapped] = self._next_repeat(self.L[idx[wrapped]])
+        L = self.L[idx] + np.outer(np.arange(N) + k >= N, self.drift)
         return replace(self, P=self.P[idx], L=L, positions=np.mod(self.positions - k, N))
 
     def _next_repeat(self, L: np.ndarray, times: int = 1) -> np.ndarray:
@@ -142,6 +143,8 @@ class Cycle:
         """The cycle ``count`` times, seamlessly; with ``root="motion"`` each repeat starts where the last ends."""
         _check_choice(root, ROOT_MODES, "root")
         count = _validate.integer("count", count, 1)
+        check_frames(count * self.n_frames, self.space.skeleton.n_joints,
+                     f"{count} cycles of {self.n_frames} frames")
         P = np.tile(self.P, (count, 1))
         if root == "inplace":
             return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)))

@@ -24,6 +24,11 @@ vector of each joint relative to the input's mean rotation of that joint
 * ``foot_sliding`` and ``input_foot_sliding`` — mean horizontal speed (file
   units/s) of each foot while it is within 2 % of the body height of its
   floor, for the cycle repeated twice with its root motion and for the input.
+* ``skate`` and ``input_skate`` — the foot-skate measure of
+  :func:`mocycle.contacts.skate` (units/s: horizontal speed of each ankle and
+  toe weighted by ``2 - 2**(h/H)`` below ``H`` = 2.5 % of the body height,
+  averaged over frames) for the same two motions; ``nan`` when the rig's feet
+  are not found by name.
 """
 
 from __future__ import annotations
@@ -32,6 +37,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from ..axes import vertical_axis
+from ..errors import MocycleError
 from ..motion import Motion
 from ..rotations import mean_rotations
 from .differences import HALF, central_acceleration, central_velocity, forward_jerk
@@ -146,6 +152,15 @@ def foot_sliding(motion: Motion, up: np.ndarray | None = None) -> float:
     return float(speeds.mean()) if speeds.size else float("nan")
 
 
+def _skate(motion: Motion, up: np.ndarray) -> float:
+    from ..contacts.skate import skate
+
+    try:
+        return skate(motion, up=up)
+    except MocycleError:  # no feet found by name
+        return float("nan")
+
+
 def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
     """Every metric of the module docstring for ``cycle`` extracted from ``motion``.
 
@@ -153,8 +168,8 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
     -------
     dict of floats: ``rmse_h``, ``rmse_dh``, ``rmse_ddh``, ``template_error`` (rad) and its
     ``template_offset`` (frames), ``jerk_ratio``, ``seam_pose``, ``seam_velocity`` (and ``_local``: a seam
-    ratio <= 1 means the wrap is no bigger a step than the loop's own), ``foot_sliding`` and
-    ``input_foot_sliding`` (units/s).
+    ratio <= 1 means the wrap is no bigger a step than the loop's own), ``foot_sliding``,
+    ``input_foot_sliding``, ``skate`` and ``input_skate`` (units/s).
 
     Examples
     --------
@@ -176,6 +191,7 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
     tmpl, offset = template_error(Y[s:e], C)
     seams = [seam_ratios(C), seam_ratios(root)]
     travelling = cycle.repeat(2, root="motion")
+    captured = motion[frames[0]:frames[-1] + 1]
     return {
         "rmse_h": rmse_h,
         "rmse_dh": rmse_dh,
@@ -188,5 +204,7 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
         "seam_pose_local": max(r["pose_local"] for r in seams),
         "seam_velocity_local": max(r["velocity_local"] for r in seams),
         "foot_sliding": foot_sliding(travelling, cycle.space.world_up),
-        "input_foot_sliding": foot_sliding(motion[frames[0]:frames[-1] + 1], cycle.space.world_up),
+        "input_foot_sliding": foot_sliding(captured, cycle.space.world_up),
+        "skate": _skate(travelling, cycle.space.world_up),
+        "input_skate": _skate(captured, cycle.space.world_up),
     }

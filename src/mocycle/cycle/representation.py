@@ -31,7 +31,7 @@ import numpy as np
 from scipy.ndimage import uniform_filter1d
 from scipy.spatial.transform import Rotation
 
-from ..axes import heading_angles, horizontal_basis, vertical_axis
+from ..axes import heading_angles, horizontal_basis, up_in_parent_frame, vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
 from ..rotations import axis_rotations, continuous_quats, nearest_rotations
@@ -68,14 +68,7 @@ class CycleSpace:
         3-vector: see :func:`~mocycle.axes.vertical_axis`)."""
         travel = motion.travel_joint
         up_world = vertical_axis(motion, up)
-        parent = int(motion.skeleton.parents[travel])
-        if parent >= 0:
-            world_rot, _ = motion[:: max(1, motion.n_frames // 50)].world_transforms()
-            mean_parent = nearest_rotations(world_rot[:, parent].mean(axis=0))
-            up = mean_parent.T @ up_world
-        else:
-            up = up_world
-        up = up / np.linalg.norm(up)
+        up = up_in_parent_frame(motion, travel, up_world)
         e1, e2 = horizontal_basis(up)
         mean_rot = motion.rotation(travel).mean().as_matrix()
         forward = mean_rot.T @ e1

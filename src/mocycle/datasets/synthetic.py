@@ -85,6 +85,13 @@ _AXIS = {"X": 0, "Y": 1, "Z": 2}
 STAND_HEIGHT = 97.0
 
 
+
+def _rng(seed) -> np.random.Generator:
+    """numpy's generator for ``seed`` (a whole number >= 0), else a MocycleError."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise MocycleError(f"the seed must be a whole number >= 0; got {seed!r}")
+    return np.random.default_rng(seed)
+
 def humanoid_skeleton() -> Skeleton:
     """A 22-joint humanoid: Y up, centimetres, facing +Z, left = +X, T-pose at rest.
 
@@ -441,7 +448,7 @@ def _gait_take(style: _Style, n_frames, fps, period_s, noise_deg, drift, speed_c
         heading = 3.0 * drift * t  # degrees
         _turn_root(skel, chan, heading)
     if noise_deg > 0:
-        chan += np.random.default_rng(seed).normal(0.0, noise_deg, size=chan.shape)
+        chan += _rng(seed).normal(0.0, noise_deg, size=chan.shape)
     q = _quats_from_channels(skel, chan)
     root = _gait_root(style, u, heading)
     motion = Motion(skel, q, None, 1.0 / fps, root_positions=root)
@@ -492,7 +499,7 @@ def synthetic_still(n_frames: int = 300, fps: float = 60.0, noise_deg: float = 0
     skel = humanoid_skeleton()
     ang = np.zeros((n_frames, skel.n_joints, 3))
     if noise_deg > 0:
-        ang += np.random.default_rng(seed).normal(0.0, noise_deg, size=ang.shape)
+        ang += _rng(seed).normal(0.0, noise_deg, size=ang.shape)
     q, chan = _quats(skel, ang)
     root = np.tile([0.0, STAND_HEIGHT, 0.0], (n_frames, 1))
     nan = np.full(n_frames, np.nan)
@@ -559,7 +566,7 @@ def synthetic_nonperiodic(n_frames: int = 600, fps: float = 60.0, seed: int = 0)
     ``unwrapped_phase`` and ``period_frames`` are all NaN.
     """
     n_frames, fps = _check(n_frames, fps)
-    rng = np.random.default_rng(seed)
+    rng = _rng(seed)
     skel = humanoid_skeleton()
     ref = _gait_angles(_WALK, np.arange(120) / 120.0)
     mean, sd = ref.mean(axis=0), np.maximum(ref.std(axis=0), 3.0)
@@ -640,7 +647,7 @@ def synthetic_walk_then_run(n_walk: int = 600, n_run: int = 600, fps: float = 60
             chan[inside, j] = Rotation.from_quat(q_clean[inside, j]).as_euler(
                 skel.euler_order(j), degrees=True)
     if noise_deg > 0:
-        chan = chan + np.random.default_rng(seed).normal(0.0, noise_deg, size=chan.shape)
+        chan = chan + _rng(seed).normal(0.0, noise_deg, size=chan.shape)
         q = _quats_from_channels(skel, chan)
     else:
         q = q_clean

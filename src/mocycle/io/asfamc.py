@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -34,9 +35,10 @@ from scipy.spatial.transform import Rotation
 
 from .. import _validate
 from ..errors import MocycleError, MocycleWarning, MotionFileError
+from ..limits import MAX_MAGNITUDE, frame_time_problem
 from ..motion import EndSite, Motion, Skeleton
 
-__all__ = ["AsfSkeleton", "read_amc", "read_asf", "read_asfamc"]
+__all__ = ["AsfSkeleton", "parse_amc", "parse_asf", "read_amc", "read_asf", "read_asfamc"]
 
 #: Frame rate of AMC files, which do not store it (CMU captured at 120 fps).
 AMC_FPS = 120.0
@@ -185,6 +187,18 @@ def read_asf(path: str | os.PathLike) -> AsfSkeleton:
     return _parse_asf(_read_text(path), path)
 
 
+def parse_asf(text: str, path: str | os.PathLike | None = None) -> AsfSkeleton:
+    """Parse ASF text (``path`` only names errors)."""
+    return _parse_asf(text.replace("\r\n", "\n").replace("\r", "\n"), path)
+
+
+def parse_amc(text: str, asf: AsfSkeleton, path: str | os.PathLike | None = None, fps: float = 120.0) -> Motion:
+    """Parse AMC text for skeleton ``asf`` (``path`` only names errors)."""
+    frame_time = _frame_time(fps)
+    values, unit = _parse_amc(text.replace("\r\n", "\n").replace("\r", "\n"), path, asf)
+    return _to_motion(asf, values, unit or asf.angle_unit, frame_time)
+
+
 def read_amc(path: str | os.PathLike, asf: AsfSkeleton | str | os.PathLike,
              fps: float = AMC_FPS) -> Motion:
     """Read an ``.amc`` motion for skeleton ``asf`` (an :class:`AsfSkeleton` or its path).
@@ -210,7 +224,10 @@ def read_asfamc(asf_path: str | os.PathLike, amc_path: str | os.PathLike,
 # helpers
 # --------------------------------------------------------------------------
 def _frame_time(fps) -> float:
-    return 1.0 / _validate.positive("fps", fps)
+    fps = _validate.positive("fps", fps)
+    if frame_time_problem(1.0 / fps):
+        raise MocycleError(f"fps must be a positive number within [1e-4, 1e6]; got {fps}")
+    return 1.0 / fps
 
 
 def _read_text(path) -> str:
@@ -238,8 +255,9 @@ def _numbers(tokens, count, path, line, what, allow_inf=False) -> list[float]:
             v = float(tok)
         except ValueError:
             raise MotionFileError(f"{what}: expected a number, got {tok!r}", path, line) from None
-        if math.isnan(v) or (math.isinf(v) and not allow_inf):
-            raise MotionFileError(f"{what}: expected a finite number, got {tok!r}", path, line)
+        if math.isnan(v) or (math.isinf(v) and not allow_inf) or (math.isfinite(v) and abs(v) > MAX_MAGNITUDE):
+            raise MotionFileError(f"{what}: expected a finite number within ±{MAX_MAGNITUDE:g}, got {tok!r}",
+                                  path, line)
         out.append(v)
     return out
 
@@ -548,7 +566,8 @@ def _parse_amc(text: str, path, asf: AsfSkeleton) -> tuple[list[np.ndarray], str
     labels = (asf.root_order,) + asf.dofs
     lookup = {n: j for j, n in enumerate(names)}
     lower = [n.lower() for n in names]
-    lookup_lower = {n: j for j, n in enumerate(lower) if lower.count(n) == 1}
+    counts = Counter(lower)
+    lookup_lower = {n: j for j, n in enumerate(lower) if counts[n] == 1}
     J = len(names)
     rows: list[list[list[str]]] = [[] for _ in range(J)]
     frames: list[list[int]] = [[] for _ in range(J)]
@@ -625,12 +644,13 @@ def _parse_amc(text: str, path, asf: AsfSkeleton) -> tuple[list[np.ndarray], str
                 arr = np.array(rows[j], dtype=np.float64)
             except ValueError:
                 arr = None
-            bad = (np.flatnonzero(~np.all(np.isfinite(arr), axis=1)) if arr is not None
+            bad = (np.flatnonzero(~np.all(np.isfinite(arr) & (np.abs(arr) <= MAX_MAGNITUDE), axis=1))
+                   if arr is not None
                    else [_first_bad_row(rows[j])])
             if len(bad):
                 k = int(bad[0])
                 raise MotionFileError(
-                    f"bone {names[j]!r}: expected {expected[j]} finite numbers "
+                    f"bone {names[j]!r}: expected {expected[j]} finite numbers within ±{MAX_MAGNITUDE:g} "
                     f"({' '.join(labels[j])}), got {' '.join(rows[j][k])!r}", path, lines[j][k])
             data[frames[j]] = arr
         values.append(data)

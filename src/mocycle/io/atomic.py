@@ -1,10 +1,21 @@
-"""Write files all at once: to a temporary file beside the target, then rename."""
+"""Write files all at once: to a temporary file beside the target, then rename.
+
+The temporary file is ``.<name>.<pid>.<random>.tmp`` beside the target; it is removed on every exit
+the process lives to see (an exception, Ctrl-C, SIGTERM handled by the CLI).  A run killed outright
+(SIGKILL, power loss) leaves it behind: the next write to the same target removes such leftovers of
+processes that no longer run (:func:`clean_stale`).  Readers never take them for takes (they end in
+``.tmp``).
+"""
 
 from __future__ import annotations
 
 import os
 import tempfile
+import time
 from pathlib import Path
+
+#: A leftover temporary file without a process id in its name counts as stale after this many seconds.
+STALE_AFTER_S = 3600.0
 
 
 def _file_mode(path: Path) -> int:
@@ -25,7 +36,8 @@ def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
     """
     path = Path(path)
     mode = "wb" if isinstance(data, bytes) else "w"
-    fd, tmp = tempfile.mkstemp(prefix="." + path.name + ".", suffix=".tmp", dir=path.parent or ".")
+    clean_stale(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent or ".")
     try:
         with os.fdopen(fd, mode, **({} if mode == "wb" else {"encoding": "utf-8", "newline": ""})) as fh:
             fh.write(data)
@@ -38,3 +50,41 @@ def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
             pass
         raise
     return path
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return True  # someone else's process (or an odd number): leave its file alone
+    return True
+
+
+def clean_stale(path: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files a killed write to ``path`` left behind; returns the ones removed.
+
+    ``.<name>.<pid>.<random>.tmp`` goes when process ``pid`` no longer runs; an older
+    ``.<name>.<random>.tmp`` (no process id) when it is older than :data:`STALE_AFTER_S`.
+    """
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    prefix = f".{path.name}."
+    removed = []
+    try:
+        candidates = [p for p in folder.iterdir() if p.name.startswith(prefix) and p.name.endswith(".tmp")]
+    except OSError:
+        return removed
+    now = time.time()
+    for p in candidates:
+        middle = p.name[len(prefix):-len(".tmp")]
+        pid_text = middle.split(".", 1)[0] if "." in middle else ""
+        try:
+            stale = (not _alive(int(pid_text))) if pid_text.isdigit() else now - p.stat().st_mtime > STALE_AFTER_S
+            if stale:
+                p.unlink()
+                removed.append(p)
+        except OSError:
+            continue
+    return removed

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import MocycleError, MocycleWarning, MotionFileError
+from ..limits import MAX_MAGNITUDE, check_frames, frame_time_problem
 from ..motion import POSITION_CHANNELS, ROTATION_CHANNELS, EndSite, Motion, Skeleton
 from ..rotations import continuous_euler, euler_to_quats
 from .atomic import atomic_write
@@ -59,6 +60,7 @@ class _Header:
     def __init__(self, path):
         self.path = path
         self.names: list[str] = []
+        self.known: set[str] = set()
         self.parents: list[int] = []
         self.offsets: list[tuple[float, float, float] | None] = []
         self.channels: list[tuple[str, ...]] = []
@@ -77,8 +79,9 @@ class _Header:
             vals = tuple(float(w) for w in words)
         except ValueError:
             raise self.error(lineno, f"expected {n} numbers after {what}, found {' '.join(words)!r}") from None
-        if not all(np.isfinite(vals)):
-            raise self.error(lineno, f"{what} values must be finite, found {' '.join(words)!r}")
+        if not all(np.isfinite(vals)) or max(map(abs, vals)) > MAX_MAGNITUDE:
+            raise self.error(lineno, f"{what} values must be finite numbers within ±{MAX_MAGNITUDE:g}, "
+                                     f"found {' '.join(words)!r}")
         return vals
 
     def open_node(self, lineno: int):
@@ -134,8 +137,9 @@ class _Header:
                 raise self.error(lineno, "found a second ROOT; only one skeleton per file is supported")
             if key == "JOINT" and not (self.stack and self.stack[-1][0] == "joint"):
                 raise self.error(lineno, "JOINT outside of a ROOT or JOINT block")
-            if name in self.names:
+            if name in self.known:
                 raise self.error(lineno, f"joint name {name!r} is used twice")
+            self.known.add(name)
             parent = self.stack[-1][1] if self.stack else -1
             self.pending = ("joint", parent, name)
         elif key == "END" and len(words) >= 2 and words[1].upper() == "SITE":
@@ -219,6 +223,9 @@ def _motion_header(lines: list[str], first: int, path) -> tuple[int | None, floa
         raise MotionFileError(f"expected 'Frame Time: <seconds>', found {lines[i].strip()!r}", path, i + 1) from None
     if not np.isfinite(frame_time) or frame_time <= 0:
         raise MotionFileError(f"Frame Time must be a positive number of seconds, found {val.strip()!r}", path, i + 1)
+    problem = frame_time_problem(frame_time)
+    if problem:
+        raise MotionFileError(f"{problem} (Frame Time: {val.strip()})", path, i + 1)
     return frames, frame_time, i + 1
 
 
@@ -237,7 +244,8 @@ def _parse_rows(lines: list[str], start: int, n_channels: int, path) -> np.ndarr
                 values = np.loadtxt(body, dtype=np.float64, ndmin=2, comments=None)
         except ValueError:
             values = None
-    if values is None or values.shape[1] != n_channels or not np.all(np.isfinite(values)):
+    if (values is None or values.shape[1] != n_channels or not np.all(np.isfinite(values))
+            or (values.size and np.abs(values).max() > MAX_MAGNITUDE)):
         _find_bad_row(body, start, n_channels, path)
     if values.shape[0] == 0:
         raise MotionFileError("no frame rows after 'Frame Time:'; expected at least one", path, len(lines))
@@ -260,8 +268,9 @@ def _find_bad_row(body: list[str], start: int, n_channels: int, path) -> None:
                 v = float(word) if word.isascii() and "_" not in word else np.nan
             except ValueError:
                 v = np.nan
-            if not np.isfinite(v):
-                raise MotionFileError(f"expected a finite number, found {word!r}", path, start + k + 1)
+            if not np.isfinite(v) or abs(v) > MAX_MAGNITUDE:
+                raise MotionFileError(f"expected a finite number within ±{MAX_MAGNITUDE:g}, found {word!r}",
+                                      path, start + k + 1)
     if n_channels == 0:
         raise MotionFileError("the hierarchy declares no channels; nothing to read", path, start)
     raise MotionFileError("no frame rows after 'Frame Time:'; expected at least one", path, start)
@@ -309,7 +318,9 @@ def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motio
         if not frames or frames < 1:
             raise MotionFileError("the hierarchy declares no channels and 'Frames:' gives no count", path,
                                   data_start)
-        return _motion_from_channels(skel, np.zeros((frames, 0)), frame_time)
+        # no row holds data, so the count is only a claim: bound it like a size asked for by an option
+        check_frames(frames, skel.n_joints, f"'Frames: {frames}' with no channels", path, data_start - 1)
+        return _motion_from_channels(skel, np.zeros((frames, 0)), frame_time, path)
     values = _parse_rows(lines, data_start, skel.n_channels, path)
     T = values.shape[0]
     if frames is not None and frames != T:
@@ -317,10 +328,10 @@ def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motio
             f"{path or 'BVH'}: 'Frames: {frames}' but {T} frame rows follow; using the {T} rows",
             MocycleWarning, stacklevel=2,
         )
-    return _motion_from_channels(skel, values, frame_time)
+    return _motion_from_channels(skel, values, frame_time, path)
 
 
-def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float) -> Motion:
+def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float, path=None) -> Motion:
     T, J = values.shape[0], skel.n_joints
     quats = np.zeros((T, J, 4))
     quats[..., 3] = 1.0
@@ -336,7 +347,10 @@ def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float)
         cols = [c for _, cs in items for c in cs]
         angles = values[:, cols].reshape(T, len(joints), len(order))
         quats[:, joints] = euler_to_quats(angles, order, degrees=True)
-    return Motion(skel, quats, trans, frame_time)
+    try:
+        return Motion(skel, quats, trans, frame_time)
+    except MocycleError as exc:
+        raise MotionFileError(f"cannot build a motion from this file: {exc}", path) from None
 
 
 def motion_channels(motion: Motion) -> np.ndarray:
@@ -363,28 +377,36 @@ def _fmt(x: float) -> str:
 
 
 def format_bvh(motion: Motion) -> str:
-    """The BVH text of ``motion``."""
+    """The BVH text of ``motion`` (written without recursion: any depth of hierarchy)."""
     skel = motion.skeleton
     out = io.StringIO()
     out.write("HIERARCHY\n")
-    children = [skel.children(j) for j in range(skel.n_joints)]
-    sites = [[s for s in skel.end_sites if s.parent == j] for j in range(skel.n_joints)]
-
-    def joint(j: int, depth: int):
+    children: list[list[int]] = [[] for _ in range(skel.n_joints)]
+    for j, p in enumerate(skel.parents.tolist()):
+        if p >= 0:
+            children[p].append(j)
+    sites: list[list[EndSite]] = [[] for _ in range(skel.n_joints)]
+    for site in skel.end_sites:
+        sites[site.parent].append(site)
+    # A stack of ("open", joint, depth) and ("close", joint, depth): depth-first, children in order.
+    stack = [("close", 0, 0), ("open", 0, 0)]
+    while stack:
+        what, j, depth = stack.pop()
         tab = "\t" * depth
+        if what == "close":
+            for s in sites[j]:
+                label = "End Site" + (f" {s.name}" if s.name else "")
+                out.write(f"{tab}\t{label}\n{tab}\t{{\n")
+                out.write(f"{tab}\t\tOFFSET {' '.join(_fmt(v) for v in s.offset)}\n{tab}\t}}\n")
+            out.write(f"{tab}}}\n")
+            continue
         out.write(f"{tab}{'ROOT' if j == 0 else 'JOINT'} {skel.names[j]}\n{tab}{{\n")
         out.write(f"{tab}\tOFFSET {' '.join(_fmt(v) for v in skel.offsets[j])}\n")
         chans = skel.channels[j]
         out.write(f"{tab}\tCHANNELS {len(chans)}{''.join(' ' + c for c in chans)}\n")
-        for c in children[j]:
-            joint(c, depth + 1)
-        for s in sites[j]:
-            label = "End Site" + (f" {s.name}" if s.name else "")
-            out.write(f"{tab}\t{label}\n{tab}\t{{\n")
-            out.write(f"{tab}\t\tOFFSET {' '.join(_fmt(v) for v in s.offset)}\n{tab}\t}}\n")
-        out.write(f"{tab}}}\n")
+        for c in reversed(children[j]):
+            stack += [("close", c, depth + 1), ("open", c, depth + 1)]
 
-    joint(0, 0)
     out.write(f"MOTION\nFrames: {motion.n_frames}\nFrame Time: {motion.frame_time!r}\n")
     values = motion_channels(motion)
     if values.shape[1]:

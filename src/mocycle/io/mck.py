@@ -25,6 +25,7 @@ import io
 import json
 import os
 import struct
+import warnings
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,9 +34,10 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .. import _validate
-from ..errors import MotionFileError
+from ..errors import MocycleWarning, MotionFileError
 from ..io.atomic import atomic_write
 from ..io.bvh import format_bvh, parse_bvh
+from ..io.inflate import Inflater
 from ..keyframes.density import SPATIAL_MIN_KEYS, keyframe_density
 from ..keyframes.distance import joint_weights
 from ..keyframes.projection import ONE_STEP, PROJECTIONS, PoseSpace, select_keyframes, spatial_layout
@@ -43,6 +45,7 @@ from ..keyframes.select import METHODS, keyframe_count
 from ..keyframes.spatial import optimize_projection, reconstruct_spatial
 from ..keyframes.temporal import SCHEMES as TEMPORAL_SCHEMES
 from ..keyframes.temporal import check_keys, interpolate_rotations
+from ..limits import check_frames, frame_time_problem
 from ..motion import Motion, Skeleton
 
 MAGIC = b"MOCK\x01"
@@ -137,36 +140,60 @@ class Compressed:
 
     @classmethod
     def from_bytes(cls, data: bytes, path: str | os.PathLike | None = None) -> Compressed:
+        """Read :meth:`to_bytes`'s bytes; every count, shape, index and value is checked (MotionFileError)."""
         if not data.startswith(MAGIC):
             raise MotionFileError(f"not a mocycle keyframe file (expected it to start with {MAGIC!r})", path)
+        z = Inflater(data[len(MAGIC):], path, "keyframe file")
+        (n,) = z.unpack("<I", "the header length")
+        if n > MAX_HEADER_BYTES:
+            raise z.error(f"its header claims {n:,} bytes (at most {MAX_HEADER_BYTES:,} expected)")
+        text = z.take(n, "the header")
         try:
-            raw = zlib.decompress(data[len(MAGIC):])
-            (n,) = struct.unpack("<I", raw[:4])
-            header = json.loads(raw[4: 4 + n].decode("utf-8"))
-            pos = 4 + n
-            arrays = {}
-            for name, dtype, shape in header["arrays"]:
-                dt = np.dtype(dtype)
-                size = int(np.prod(shape)) * dt.itemsize
-                if pos + size > len(raw):
-                    raise ValueError("truncated")
-                arrays[name] = np.frombuffer(raw[pos: pos + size], dtype=dt).reshape(shape)
-                pos += size
-            skeleton = parse_bvh(header["skeleton"]).skeleton
-        except (zlib.error, ValueError, KeyError, TypeError, struct.error, UnicodeDecodeError) as exc:
-            raise MotionFileError(f"keyframe file is damaged or truncated ({exc})", path) from None
-        K = len(arrays["key_idx"])
-        key_quats = Rotation.from_rotvec(arrays["key_rotvec"].reshape(-1, 3).astype(np.float64)).as_quat()
+            header = json.loads(text.decode("utf-8"), parse_constant=_no_constant)
+        except (ValueError, RecursionError) as exc:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
+            raise z.error(f"its header is not valid UTF-8 JSON ({type(exc).__name__})") from None
+        h = _check_header(header, z)
+        skeleton = h["skeleton"]
+        T, J = h["n_frames"], skeleton.n_joints
+        shapes = dict(header_shapes(header, z))
+        key_shape, track_shape = shapes.get("key_idx", ("", ()))[1], shapes.get("track_joints", ("", ()))[1]
+        K = key_shape[0] if len(key_shape) == 1 else -1
+        M = track_shape[0] if len(track_shape) == 1 else -1
+        expected = {"key_idx": ("<u4", (K,)), "key_rotvec": ("<f8", (K, J, 3)), "track_joints": ("<u2", (M,)),
+                    "key_track": ("<f8", (K, M, 3)), "track": ("<f4", (T, M, 3)), "static": ("<f8", (J, 3))}
+        if h["scheme"] == "spatial":
+            expected["points"] = ("<f4", (T, 2))
+        if list(shapes) != list(expected) or any(shapes[k] != (dt, shape) for k, (dt, shape) in expected.items()):
+            got = ", ".join(f"{k} {dt}{list(sh)}" for k, (dt, sh) in shapes.items())
+            want = ", ".join(f"{k} {dt}{list(sh)}" for k, (dt, sh) in expected.items())
+            raise z.error(f"its arrays do not fit {T} frames of {J} joints: expected {want}; found {got}")
+        check_frames(T, J, f"'n_frames: {T}'", path)
+        arrays = {}
+        for name, (dt, shape) in expected.items():
+            size = int(np.prod(shape)) * np.dtype(dt).itemsize
+            arrays[name] = np.frombuffer(z.take(size, name), dtype=dt).reshape(shape)
+        z.finish()
         key_idx = arrays["key_idx"].astype(np.int64)
+        if K < 2 or key_idx[0] != 0 or key_idx[-1] != T - 1 or np.any(np.diff(key_idx) <= 0):
+            raise z.error(f"its {K} keyframe indices must increase from frame 0 to frame {T - 1}")
+        tj = arrays["track_joints"].astype(np.int64)
+        if np.any(tj >= J) or np.any(np.diff(tj) <= 0):
+            raise z.error(f"its moving joints must be increasing joint numbers below {J}")
+        for name, a in arrays.items():
+            if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
+                raise z.error(f"{name} holds NaN or infinite values")
+            if a.dtype.kind == "f" and a.size and np.abs(a).max() > MAX_VALUE:
+                raise z.error(f"{name} holds values beyond ±{MAX_VALUE:g}")
+        with np.errstate(all="ignore"):
+            key_quats = Rotation.from_rotvec(arrays["key_rotvec"].reshape(-1, 3).astype(np.float64)).as_quat()
         track = arrays["track"].astype(np.float64)
         track[key_idx] = arrays["key_track"]
         points = arrays.get("points")
-        return cls(skeleton=skeleton, frame_time=float(header["frame_time"]), n_frames=int(header["n_frames"]),
-                   key_idx=key_idx, key_quats=key_quats.reshape(K, skeleton.n_joints, 4), scheme=header["scheme"],
-                   select=header["select"], projection=header["projection"], seed=header["seed"],
-                   optimized=bool(header["optimized"]), points=None if points is None else points.astype(np.float64),
-                   track_joints=arrays["track_joints"].astype(np.int64), track=track,
-                   static=arrays["static"].astype(np.float64))
+        return cls(skeleton=skeleton, frame_time=h["frame_time"], n_frames=T,
+                   key_idx=key_idx, key_quats=key_quats.reshape(K, J, 4), scheme=h["scheme"],
+                   select=h["select"], projection=h["projection"], seed=h["seed"],
+                   optimized=h["optimized"], points=None if points is None else points.astype(np.float64),
+                   track_joints=tj, track=track, static=arrays["static"].astype(np.float64))
 
     def save(self, path: str | os.PathLike) -> Path:
         """Write the ``.mck`` file atomically."""
@@ -193,6 +220,73 @@ class Compressed:
         return {"frames": f, "joints": dof, "keyframes": self.n_keyframes, "keyframe_ratio": r,
                 "formula_uncompressed_numbers": m, "formula_compressed_numbers": c, "formula_ratio": c / m,
                 "compressed_bytes": real, "bvh_bytes": int(bvh_bytes), "real_ratio": real / bvh_bytes}
+
+
+#: The longest JSON header a ``.mck`` file may have (the skeleton text of ~100k joints fits).
+MAX_HEADER_BYTES = 64 * 2**20
+#: The largest magnitude a stored number may have (angles, file units, 2-D points): far above any take,
+#: far below where squares overflow.
+MAX_VALUE = 1e12
+
+
+def _no_constant(name: str):
+    raise ValueError(f"{name} is not a number")
+
+
+def header_shapes(header: dict, z: Inflater):
+    """``(name, (dtype, shape))`` of each array the header lists (checked: names, dtypes, small shapes)."""
+    arrays = header.get("arrays")
+    if not isinstance(arrays, list) or len(arrays) > 16:
+        raise z.error("its header has no list of arrays")
+    seen = set()
+    for item in arrays:
+        ok = (isinstance(item, list) and len(item) == 3 and isinstance(item[0], str) and isinstance(item[1], str)
+              and isinstance(item[2], list) and len(item[2]) <= 4
+              and all(type(d) is int and 0 <= d < 2**40 for d in item[2]))
+        if not ok or item[0] in seen:
+            raise z.error(f"its header lists a bad array entry {str(item)[:80]!r}")
+        seen.add(item[0])
+        yield item[0], (item[1], tuple(item[2]))
+
+
+def _check_header(header, z: Inflater) -> dict:
+    """The header's fields, checked: skeleton, frame count and time, scheme and options."""
+    if not isinstance(header, dict):
+        raise z.error("its header is not a JSON object")
+    missing = [k for k in ("skeleton", "frame_time", "n_frames", "scheme", "select", "projection", "seed",
+                           "optimized", "arrays") if k not in header]
+    if missing:
+        raise z.error(f"its header lacks {', '.join(missing)}")
+    n_frames, frame_time = header["n_frames"], header["frame_time"]
+    if type(n_frames) is not int or n_frames < 2:
+        raise z.error(f"n_frames must be a whole number >= 2; found {str(n_frames)[:40]!r}")
+    if type(frame_time) not in (int, float):
+        raise z.error(f"frame_time must be a number of seconds; found {str(frame_time)[:40]!r}")
+    if frame_time_problem(frame_time):
+        raise z.error(frame_time_problem(frame_time))
+    scheme = header["scheme"]
+    if scheme not in SCHEMES:
+        raise z.error(f"unknown scheme {str(scheme)[:40]!r}; expected one of {', '.join(SCHEMES)}")
+    if header["select"] not in METHODS:
+        raise z.error(f"unknown keyframe selection {str(header['select'])[:40]!r}")
+    projection, seed = header["projection"], header["seed"]
+    if projection is not None and projection not in PROJECTIONS or seed is not None and seed not in ONE_STEP:
+        raise z.error(f"unknown projection {str(projection)[:40]!r} or seed {str(seed)[:40]!r}")
+    if not isinstance(header["optimized"], bool):
+        raise z.error("optimized must be true or false")
+    text = header["skeleton"]
+    if not isinstance(text, str):
+        raise z.error("its skeleton is not BVH text")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MocycleWarning)
+            skeleton = parse_bvh(text, path="(skeleton)").skeleton
+    except MotionFileError as exc:
+        raise z.error(f"its skeleton does not read as BVH ({exc})") from None
+    return {"skeleton": skeleton, "n_frames": n_frames, "frame_time": float(frame_time), "scheme": scheme,
+            "select": header["select"], "projection": projection, "seed": seed,
+            "optimized": header["optimized"]}
+
 
 
 def read_compressed(path: str | os.PathLike) -> Compressed:

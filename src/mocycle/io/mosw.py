@@ -20,14 +20,17 @@ from __future__ import annotations
 import io
 import os
 import struct
+import warnings
 import zlib
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import MocycleError, MotionFileError
+from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..io.atomic import atomic_write
 from ..io.bvh import format_bvh, parse_bvh
+from ..io.inflate import Inflater
+from ..limits import check_frames, frame_time_problem
 from ..motion import Motion, Skeleton
 from ..swings.segment import Hold, Segmentation, Swing
 
@@ -54,23 +57,27 @@ def _put(buf: io.BytesIO, arr: np.ndarray, dtype: str) -> None:
 
 
 class _Reader:
+    """Arrays from a bounded zlib stream: each count is checked against ``limit`` before its bytes are taken."""
+
     def __init__(self, data: bytes, path):
-        self.data, self.pos, self.path = data, 0, path
+        self.z = Inflater(data, path, "swings file")
+        self.path = path
 
-    def take(self, n: int) -> bytes:
-        if self.pos + n > len(self.data):
-            raise MotionFileError("swings file is truncated", self.path)
-        out = self.data[self.pos:self.pos + n]
-        self.pos += n
-        return out
+    def error(self, reason: str) -> MotionFileError:
+        return self.z.error(reason)
 
-    def unpack(self, fmt: str):
-        return struct.unpack(fmt, self.take(struct.calcsize(fmt)))
+    def take(self, n: int, purpose: str = "data") -> bytes:
+        return self.z.take(n, purpose)
 
-    def array(self, dtype: str) -> np.ndarray:
-        (n,) = self.unpack("<I")
+    def unpack(self, fmt: str, purpose: str = "header"):
+        return self.z.unpack(fmt, purpose)
+
+    def array(self, dtype: str, limit: int, purpose: str) -> np.ndarray:
+        (n,) = self.unpack("<I", purpose)
+        if n > limit:
+            raise self.error(f"{purpose}: {n:,} values where at most {limit:,} fit the take")
         dt = np.dtype(dtype).newbyteorder("<")
-        return np.frombuffer(self.take(n * dt.itemsize), dtype=dt).astype(dtype)
+        return np.frombuffer(self.take(n * dt.itemsize, purpose), dtype=dt).astype(dtype)
 
 
 def _q(x, scale: float, lim: float | None = None) -> np.ndarray:
@@ -115,48 +122,131 @@ def encode(seg: Segmentation) -> bytes:
     return MAGIC + zlib.compress(buf.getvalue(), 9)
 
 
+#: The longest skeleton text a swings file may hold (about 100k joints).
+MAX_SKELETON_BYTES = 64 * 2**20
+
+
 def decode(data: bytes, path: str | os.PathLike | None = None) -> Segmentation:
-    """A :class:`Segmentation` from :func:`encode`'s bytes (quantised values)."""
+    """A :class:`Segmentation` from :func:`encode`'s bytes (quantised values).
+
+    Every count is checked against the take's frames and joints before its bytes are decompressed, and
+    every index, length and value after: damage gives one :class:`MotionFileError` naming the file.
+    """
     if not data.startswith(MAGIC[:4]):
         raise MotionFileError("not a mocycle swings file (expected it to start with 'MOSW')", path)
     if data[4:5] != MAGIC[4:5]:
         raise MotionFileError(f"swings file version {data[4] if len(data) > 4 else '?'} is not supported "
                               f"(this mocycle reads version {MAGIC[4]})", path)
+    r = _Reader(data[5:], path)
+    (n_text,) = r.unpack("<I", "the skeleton length")
+    if n_text > MAX_SKELETON_BYTES:
+        raise r.error(f"its skeleton claims {n_text:,} bytes (at most {MAX_SKELETON_BYTES:,} expected)")
     try:
-        raw = zlib.decompress(data[5:])
-    except zlib.error:
-        raise MotionFileError("swings file is damaged (its compressed data does not decode)", path) from None
-    r = _Reader(raw, path)
-    (n_text,) = r.unpack("<I")
-    skel = skeleton_from_text(r.take(n_text).decode("utf-8"))
-    n_frames, frame_time, threshold, window_s = r.unpack("<Idff")
-    joints = r.array("u2").astype(int).tolist()
-    names = skel.names
-    sj, ss, sl = r.array("u2"), r.array("u4"), r.array("u4")
-    az, el = r.array("i2") / _PI_Q, r.array("i2") / _PI_Q
-    a0, rng = r.array("i2") / _PI_Q, r.array("i2") / _RANGE_Q
-    v0, v1 = r.array("f2").astype(float), r.array("f2").astype(float)
-    base = (r.array("i2") / _PI_Q).reshape(-1, 3)
-    errs = r.array("u1") / 127.0
-    axis = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
-    hj, hs, hl = r.array("u2"), r.array("u4"), r.array("u4")
-    hm = (r.array("i2") / _PI_Q).reshape(-1, 3)
-    tj = r.array("u2")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MocycleWarning)
+            skel = parse_bvh(r.take(n_text, "the skeleton").decode("utf-8"), path="(skeleton)").skeleton
+    except (MotionFileError, UnicodeDecodeError) as exc:
+        raise r.error(f"its skeleton does not read as BVH ({exc})") from None
+    J = skel.n_joints
+    n_frames, frame_time, threshold, window_s = r.unpack("<Idff", "the frame count and time")
+    if n_frames < 1 or frame_time_problem(frame_time):
+        raise r.error(f"{n_frames} frames of {frame_time!r} s (expected >= 1 frame and a positive frame time)")
+    if not (np.isfinite(threshold) and np.isfinite(window_s)):
+        raise r.error("its threshold or window is not a finite number")
+    T = check_frames(n_frames, J, f"a swings file of {n_frames} frames", path)
+    events = T * J  # at most one swing (and one hold) per frame and joint
+    joints = r.array("u2", J, "segmented joints").astype(int).tolist()
+    sj = r.array("u2", events, "swing joints")
+    n = sj.size
+    ss, sl = r.array("u4", n, "swing starts"), r.array("u4", n, "swing lengths")
+    az, el = r.array("i2", n, "swing axes") / _PI_Q, r.array("i2", n, "swing axes") / _PI_Q
+    a0, rng = r.array("i2", n, "swing angles") / _PI_Q, r.array("i2", n, "swing angles") / _RANGE_Q
+    v0, v1 = r.array("f2", n, "swing speeds").astype(float), r.array("f2", n, "swing speeds").astype(float)
+    base = r.array("i2", 3 * n, "swing bases") / _PI_Q
+    errs = r.array("u1", n, "swing errors") / 127.0
+    hj = r.array("u2", events, "hold joints")
+    m = hj.size
+    hs, hl = r.array("u4", m, "hold starts"), r.array("u4", m, "hold lengths")
+    hm = r.array("i2", 3 * m, "hold rotations") / _PI_Q
+    tj = r.array("u2", J, "translated joints")
     keys = {}
     for j in tj.tolist():
-        f = r.array("u4").astype(np.int64)
-        keys[int(j)] = (f, r.array("f4").astype(np.float64).reshape(-1, 3))
-    if max([*sj.tolist(), *hj.tolist(), *joints, -1]) >= skel.n_joints:
-        raise MotionFileError("swings file names a joint the skeleton does not have", path)
+        f = r.array("u4", T, "translation key frames").astype(np.int64)
+        with np.errstate(invalid="ignore"):  # a signalling NaN in the file: refused below
+            v = r.array("f4", 3 * f.size, "translation key values").astype(np.float64)
+        keys[int(j)] = (f, v)
+    r.z.finish()
+    sizes = {"swing": (sj, ss, sl, az, el, a0, rng, v0, v1, errs), "hold": (hj, hs, hl)}
+    for what, arrays in sizes.items():
+        if any(a.size != arrays[0].size for a in arrays):
+            raise r.error(f"its {what} columns differ in length")
+    if base.size != 3 * n or hm.size != 3 * m:
+        raise r.error("its swing bases or hold rotations differ in length from the swings or holds")
+    _check_events(r, "swing", sj, ss, sl, T, J, min_length=1)
+    _check_events(r, "hold", hj, hs, hl, T, J, min_length=0)
+    _check_cover(r, np.concatenate([sj, hj]).astype(np.int64), np.concatenate([ss, hs]).astype(np.int64),
+                 np.concatenate([ss + sl, hs + hl]).astype(np.int64), T)
+    if len(set(joints)) != len(joints) or any(j >= J for j in joints):
+        raise r.error(f"its segmented joints repeat or exceed the skeleton's {J} joints")
+    if not (np.all(np.isfinite(v0)) and np.all(np.isfinite(v1))):
+        raise r.error("a swing's end speed is not a finite number")
+    if np.any(np.diff(tj.astype(np.int64)) <= 0) or np.any(tj >= J):
+        raise r.error(f"its translated joints must be increasing joint numbers below {J}")
+    for j, (f, v) in keys.items():
+        if v.size != 3 * f.size or f.size == 0:
+            raise r.error(f"joint {j}'s translation keys: {f.size} frames but {v.size} values")
+        if f[0] != 0 or f[-1] >= T or np.any(np.diff(f) <= 0) or (f.size > 1 and f[-1] != T - 1):
+            raise r.error(f"joint {j}'s translation key frames must increase from 0 (to {T - 1} when they move)")
+        if not np.all(np.isfinite(v)) or np.abs(v).max() > MAX_VALUE:
+            raise r.error(f"joint {j}'s translation values are not finite numbers within ±{MAX_VALUE:g}")
+        keys[j] = (f, v.reshape(-1, 3))
+    axis = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
+    base, hm = base.reshape(-1, 3), hm.reshape(-1, 3)
+    names = skel.names
     swings = [Swing(joint=int(sj[i]), name=names[sj[i]], start=int(ss[i]), end=int(ss[i] + sl[i]),
                     axis=tuple(float(x) for x in axis[i]), start_angle=float(a0[i]),
                     end_angle=float(a0[i] + rng[i]), start_speed=float(v0[i]), end_speed=float(v1[i]),
-                    base=tuple(float(x) for x in base[i]), error=float(errs[i])) for i in range(sj.size)]
+                    base=tuple(float(x) for x in base[i]), error=float(errs[i])) for i in range(n)]
     holds = [Hold(joint=int(hj[i]), name=names[hj[i]], start=int(hs[i]), end=int(hs[i] + hl[i]),
-                  mean=tuple(float(x) for x in hm[i])) for i in range(hj.size)]
-    return Segmentation(skeleton=skel, n_frames=int(n_frames), frame_time=float(frame_time), joints=joints,
+                  mean=tuple(float(x) for x in hm[i])) for i in range(m)]
+    return Segmentation(skeleton=skel, n_frames=T, frame_time=float(frame_time), joints=joints,
                         swings=swings, holds=holds, translation_keys=keys, threshold=float(threshold),
                         window_s=float(window_s))
+
+
+#: The largest translation a swings file may hold (file units): far above any take, far below overflow.
+MAX_VALUE = 1e12
+
+
+def _check_cover(r: _Reader, joint: np.ndarray, start: np.ndarray, end: np.ndarray, T: int) -> None:
+    """The swings and holds of every joint that has any run from frame 0 to the last frame (what
+    :func:`~mocycle.swings.segment` writes): a frame count that no record reaches is damage."""
+    if not joint.size:
+        return
+    first = np.full(joint.max() + 1, T, dtype=np.int64)
+    last = np.full(joint.max() + 1, -1, dtype=np.int64)
+    np.minimum.at(first, joint, start)
+    np.maximum.at(last, joint, end)
+    used = np.unique(joint)
+    if np.any(first[used] != 0) or np.any(last[used] != T - 1):
+        raise r.error(f"its swings and holds do not span the take's {T} frames (from 0 to {T - 1})")
+
+
+def _check_events(r: _Reader, what: str, joint, start, length, T: int, J: int, min_length: int) -> None:
+    """Swings or holds: joints below ``J``, sorted by (joint, start), inside the take, not overlapping
+    (a swing may start on the frame the one before it ends)."""
+    if not joint.size:
+        return
+    j = joint.astype(np.int64)
+    s = start.astype(np.int64)
+    e = s + length.astype(np.int64)
+    if j.max() >= J:
+        raise r.error(f"a {what} names joint {int(j.max())}; the skeleton has {J}")
+    if np.any(length < min_length) or e.max() >= T:
+        raise r.error(f"a {what} lies outside the take's {T} frames or is shorter than {min_length} frame(s)")
+    same = j[1:] == j[:-1]
+    if np.any(j[1:] < j[:-1]) or np.any(same & (s[1:] < e[:-1])):
+        raise r.error(f"its {what}s are not in time order per joint or overlap")
 
 
 def write_swings(seg: Segmentation, path: str | os.PathLike) -> Path:

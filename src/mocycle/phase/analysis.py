@@ -34,7 +34,7 @@ import numpy as np
 from sklearn.decomposition import PCA
 
 from .. import _validate
-from ..errors import MocycleError
+from ..errors import MocycleError, NoPeriodicMotion
 from ..features import delay_embed, pose_matrix
 from ..motion import Motion
 from .cohomology import MIN_FRAMES, CircularCoordinates
@@ -422,8 +422,9 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
         raise MocycleError(f"find_phase needs a Motion; got {type(motion).__name__}")
     min_periods = _validate.real("min_periods", min_periods, 1.0)  # periods over the take
     if motion.n_frames < MIN_FRAMES + delay:
-        raise MocycleError(f"finding a phase needs at least {MIN_FRAMES + delay} frames; the take has "
-                           f"{motion.n_frames}")
+        # valid input, too short to hold a repeat: the same outcome as no periodic motion (CLI exit 3)
+        raise NoPeriodicMotion(f"no periodic motion found: finding a phase needs at least {MIN_FRAMES + delay} "
+                               f"frames; the take has {motion.n_frames}")
     # Periods under a quarter of a second are not motions people capture; shorter
     # lags pick up frame-to-frame jitter (e.g. takes resampled by frame doubling).
     min_lag = max(2, int(round(0.25 / motion.frame_time)))

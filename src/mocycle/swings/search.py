@@ -35,6 +35,9 @@ class Signature:
     n_samples: int
 
 
+#: The longest sliding window of a search (seconds): an hour, longer than any take.
+MAX_WINDOW_S = 3600.0
+
 def signature(seg: Segmentation, rate_hz: float = 30.0) -> Signature:
     """The swing signature of a segmentation (see the module docstring)."""
     if not rate_hz > 0:
@@ -143,8 +146,8 @@ def build_index(folder: str | os.PathLike, pattern: str = "*.bvh", threshold: fl
     folder = Path(folder)
     if not folder.is_dir():
         raise MocycleError(f"{folder}: not a folder of takes")
-    if not window_s > 0:
-        raise MocycleError(f"window_s must be > 0 seconds; got {window_s}")
+    if not 0 < window_s <= MAX_WINDOW_S:
+        raise MocycleError(f"the window must be a number of seconds in (0, {MAX_WINDOW_S:g}]; got {window_s}")
     paths, sigs, skipped = [], [], []
     for p in sorted(folder.glob(pattern)):
         try:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -55,6 +56,8 @@ class Options(_Options):
     min_periods: float = fields.min_periods()
     amc_fps: float = fields.amc_fps()
     force: bool = fields.force_cycle()
+    feet: str = fields.feet()
+    foot_joints: str | None = fields.foot_joints()
 
 
 def run(takes: Sequence, options: Options | None = None) -> Report:
@@ -62,6 +65,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     ``motions["loop"]`` is it repeated ``cycles`` times. Raises NoPeriodicMotion when a take has no cycle and
     LoopRefused when a take's cycle fails a loop check (``force``: a warning instead)."""
     from ..cycle.blend import blend_cycles, check_weights, cycle_seam
+    from .feet import clean_feet
 
     o = options or Options()
     takes = list(takes)
@@ -76,6 +80,9 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
         result = blend_cycles(motions, o.weights, align=o.align, labels=[label_of(t, k) for k, t in enumerate(takes)],
                               method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force,
                               **phase_options(o))
+        with rec.part("feet"):
+            cleaned, feet_facts, _ = clean_feet(result.cycle, o.feet, o.root, o.foot_joints)
+        result = dataclasses.replace(result, cycle=cleaned)
         loop = result.repeat(o.cycles, root=o.root)
         facts = {
             **result.to_dict(),
@@ -84,5 +91,6 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
             "cycles": o.cycles,
             "seam": result.seam(),
             "input_seams": [cycle_seam(c) for c in result.inputs],
+            "feet": feet_facts,
         }
     return rec.report("blend", facts, {"loop": loop}, result)

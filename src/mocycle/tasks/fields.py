@@ -7,9 +7,9 @@ from ..phase.analysis import MIN_PERIODS
 from ..swings.segment import DEFAULT_THRESHOLD as SWING_THRESHOLD
 from .options import Choice, Flag, Integer, Real, Text, option
 
-__all__ = ["AMC_FPS", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay", "force_cycle",
-           "harmonics", "joints", "method", "min_periods", "model", "pca", "phase_joints", "root", "swing_joints",
-           "threshold", "which"]
+__all__ = ["AMC_FPS", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay", "feet", "foot_joints",
+           "force_cycle", "harmonics", "joints", "method", "min_periods", "model", "pca", "phase_joints", "root",
+           "swing_joints", "threshold", "which"]
 
 METHODS = ("harmonic", "centroid", "cut")
 MODELS = ("M1", "M2", "M3")
@@ -89,6 +89,18 @@ def phase_options(options) -> dict:
     """The phase options of an Options object as keyword arguments of ``extract_cycle``/``blend_cycles``."""
     return {"joints": options.joints, "classes": options.classes, "which": options.which, "pca": options.pca,
             "delay": options.delay, "min_periods": options.min_periods}
+
+
+def feet(help: str | None = None):
+    from .feet import FEET_HELP, FEET_MODES
+
+    return option("auto", help or FEET_HELP, Choice(FEET_MODES))
+
+
+def foot_joints():
+    from .feet import FOOT_JOINTS_HELP
+
+    return option(None, FOOT_JOINTS_HELP, Text())
 
 
 def swing_joints():

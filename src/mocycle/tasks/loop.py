@@ -23,6 +23,8 @@ METRIC_LABELS = {
     "seam_velocity_local": ("seam jump, velocity (local)", "× nearby changes"),
     "foot_sliding": ("foot sliding, cycle", "units/s"),
     "input_foot_sliding": ("foot sliding, input", "units/s"),
+    "skate": ("foot skate, cycle (as fitted)", "units/s"),
+    "input_skate": ("foot skate, input", "units/s"),
 }
 
 TIME_AXES = ("smooth", "rank", "gmm", "line")
@@ -83,7 +85,10 @@ class Options(_Options):
                                       "or line.", Choice(TIME_AXES), flag="--time")
     amc_fps: float = fields.amc_fps()
     force: bool = option(False, "Write the cycle even when it fails a loop check (longer than the take, fits much "
-                                "worse than a plain cut, seam jumps); a warning names the check.", Flag())
+                                "worse than a plain cut, seam jumps); a warning names the check. It also lets an "
+                                "output replace an input file.", Flag())
+    feet: str = fields.feet()
+    foot_joints: str | None = fields.foot_joints()
 
 
 def run(take, options: Options | None = None) -> Report:
@@ -96,6 +101,7 @@ def run(take, options: Options | None = None) -> Report:
     """
     from ..cycle import cycle_phase, extract_cycle, loop_metrics
     from ..cycle.checks import check_loop
+    from .feet import clean_feet
 
     o = options or Options()
     everything = o.which == "all"
@@ -109,16 +115,21 @@ def run(take, options: Options | None = None) -> Report:
         targets = list(range(len(phase.classes))) if everything else [o.which]
         if everything and not targets:
             targets = [None]  # extract_cycle says why there is nothing to loop
-        loops, motions, cycles = [], {}, []
+        loops, motions, cycles, extras = [], {}, [], {}
         for k in targets:
             with rec.part("cycle"):
-                cycle = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
-                                      time_axis_method=o.time_axis, which=k, phase=phase)
+                fitted = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
+                                       time_axis_method=o.time_axis, which=k, phase=phase)
+            with rec.part("feet"):
+                cycle, feet_facts, contacts = clean_feet(fitted, o.feet, o.root, o.foot_joints)
+            with rec.part("cycle"):
                 result = cycle.repeat(o.cycles, root=o.root)
             with rec.part("metrics"):
-                metrics = loop_metrics(motion, cycle)
+                # the metrics and checks judge the fitted cycle against the take (locking changes the legs on
+                # purpose); the feet block says what locking did
+                metrics = loop_metrics(motion, fitted)
                 label = f"{label_of(take)} class {k}" if everything else label_of(take)
-                failed = check_loop(motion, cycle, metrics, force=o.force, label=label)
+                failed = check_loop(motion, fitted, metrics, force=o.force, label=label)
             index = next(i for i, c in enumerate(phase.classes) if c is cycle.periodic)
             loops.append({
                 "class": index,
@@ -132,10 +143,13 @@ def run(take, options: Options | None = None) -> Report:
                 "cycles": o.cycles,
                 "metrics": metrics,
                 "failed_checks": [f.to_dict() for f in failed],
+                "feet": feet_facts,
                 "excited_regions": len(cycle.periodic.excitation),
             })
-            motions[f"loop.class{index}" if everything else "loop"] = result
+            role = f"loop.class{index}" if everything else "loop"
+            motions[role] = result
+            extras[role] = {"fitted": fitted, "contacts": contacts}
             cycles.append(cycle)
     motions["input"] = motion
     facts = {"loops": loops} if everything else loops[0]
-    return rec.report("loop", facts, motions, cycles if everything else cycles[0])
+    return rec.report("loop", facts, motions, cycles if everything else cycles[0], extras)

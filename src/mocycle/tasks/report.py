@@ -28,6 +28,8 @@ class Report:
     motions : the output motion(s) by role (``{"loop": Motion}``); not part of :meth:`to_dict` (write them
         with ``mocycle.write``).
     result : the library's own result object (e.g. a ``Cycle``), for plots; not part of :meth:`to_dict`.
+    extras : other library objects a front end may draw (e.g. the fitted cycle and the foot contacts of a
+        loop whose feet were locked, by the role of its motion); not part of :meth:`to_dict`.
     """
 
     task: str
@@ -36,6 +38,7 @@ class Report:
     timings_s: Mapping[str, float] = field(default_factory=dict)
     motions: Mapping[str, Motion] = field(default_factory=dict, compare=False, repr=False)
     result: object = field(default=None, compare=False, repr=False)
+    extras: Mapping[str, object] = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def seconds(self) -> float:
@@ -80,9 +83,9 @@ class Recorder:
         return _Part(self.timings_s, label)
 
     def report(self, task: str, facts: Mapping, motions: Mapping[str, Motion] | None = None,
-               result: object = None) -> Report:
+               result: object = None, extras: Mapping[str, object] | None = None) -> Report:
         return Report(task=task, facts=facts, warnings=self.warnings, timings_s=dict(self.timings_s),
-                      motions=dict(motions or {}), result=result)
+                      motions=dict(motions or {}), result=result, extras=dict(extras or {}))
 
 
 class _Part:

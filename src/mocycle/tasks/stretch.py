@@ -27,8 +27,11 @@ class Options(_Options):
                                               "fundamental cycle) or N.", Integer(1, words={"auto": "auto"}),
                                       flag="--window")
     amc_fps: float = fields.amc_fps()
-    force: bool = option(False, "Warp the whole take even when it has no periodic motion (a warning says so).",
-                         Flag())
+    force: bool = option(False, "Warp the whole take even when it has no periodic motion (a warning says so). It "
+                                "also lets an output replace an input file.", Flag())
+    feet: str = fields.feet("lock (feet held still on the floor during each contact), keep (as warped) or auto "
+                            "(lock when the take travels and feet are found, else keep).")
+    foot_joints: str | None = fields.foot_joints()
 
 
 def run(take, options: Options) -> Report:
@@ -37,10 +40,13 @@ def run(take, options: Options) -> Report:
     Only the periodic region(s) are warped; raises NoPeriodicMotion when there is none (``force``: the whole take
     is warped, with a warning)."""
     from ..warp import stretch_motion
+    from .feet import lock_motion, travels
 
     with Recorder() as rec:
         motion = load(take, options.amc_fps)
         result, report = stretch_motion(motion, options.factor, window=options.window_frames, force=options.force)
+        with rec.part("feet"):
+            result, feet_facts = lock_motion(result, options.feet, options.foot_joints, travels(motion))
         facts = {**report.to_dict(), "fps": motion.fps,
-                 "joints_per_group": {g: len(names) for g, names in report.groups.items()}}
+                 "joints_per_group": {g: len(names) for g, names in report.groups.items()}, "feet": feet_facts}
     return rec.report("stretch", facts, {"stretched": result, "input": motion}, report)

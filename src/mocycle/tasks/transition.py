@@ -35,11 +35,14 @@ class Options(_Options):
     min_periods: float = fields.min_periods()
     amc_fps: float = fields.amc_fps()
     force: bool = fields.force_cycle()
+    feet: str = fields.feet()
+    foot_joints: str | None = fields.foot_joints()
 
 
 def run(takes: Sequence, options: Options | None = None) -> Report:
     """A motion that starts as the first take's cycle and ends as the second's (``motions["transition"]``)."""
     from ..cycle.blend import transition, transition_smoothness
+    from .feet import lock_motion
 
     o = options or Options()
     takes = list(takes)
@@ -51,4 +54,6 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
                             method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force,
                             **phase_options(o))
         facts = {**result.to_dict(), "root": o.root, "smoothness": transition_smoothness(result)}
-    return rec.report("transition", facts, {"transition": result.motion}, result)
+        with rec.part("feet"):
+            written, facts["feet"] = lock_motion(result.motion, o.feet, o.foot_joints, o.root == "motion")
+    return rec.report("transition", facts, {"transition": written}, result)

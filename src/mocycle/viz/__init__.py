@@ -7,11 +7,11 @@ Importing this package does not import matplotlib; the ``plot_*`` names do on fi
 
 from .data import curves_plot_data, loop_plot_data, phase_plot_data, projection_plot_data, swings_plot_data
 
-_PLOTS = {"plot_loop": "cycle", "plot_phase": "phase", "plot_projection": "keyframes", "plot_swings": "swings",
-          "plot_curves": "curves"}
+_PLOTS = {"plot_contacts": "contacts", "plot_curves": "curves", "plot_loop": "cycle", "plot_phase": "phase",
+          "plot_projection": "keyframes", "plot_swings": "swings"}
 
-__all__ = ["curves_plot_data", "loop_plot_data", "phase_plot_data", "plot_curves", "plot_loop", "plot_phase",
-           "plot_projection", "plot_swings", "projection_plot_data", "swings_plot_data"]
+__all__ = ["curves_plot_data", "loop_plot_data", "phase_plot_data", "plot_contacts", "plot_curves", "plot_loop",
+           "plot_phase", "plot_projection", "plot_swings", "projection_plot_data", "swings_plot_data"]
 
 
 def __getattr__(name: str):

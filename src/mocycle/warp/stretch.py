@@ -36,12 +36,12 @@ from scipy.spatial.transform import Rotation
 from .. import _validate
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
+from ..limits import check_frames
 from ..motion import JOINT_GROUPS, Motion, Skeleton, concatenate
 from ..phase.period import autocorrelation_period
 from .lct import block_edges, ilct, lct
 
 __all__ = [
-    "MAX_FRAMES_OUT",
     "StretchReport",
     "fundamental_cycles",
     "group_cycle",
@@ -52,8 +52,6 @@ __all__ = [
     "warp_curves",
 ]
 
-#: The longest output :func:`warp_curves` and :func:`stretch_motion` make (frames).
-MAX_FRAMES_OUT = 200_000
 #: Groups in the order they are reported.
 GROUP_NAMES = ("legs", "arms", "spine")
 #: A per-curve cycle counts when its autocorrelation maximum reaches this fraction of ``r(0)``.
@@ -74,12 +72,11 @@ def _factor(factor) -> float:
     return _validate.positive("factor", factor)
 
 
-def _frames_out(n_frames: int, factor: float) -> int:
+def _frames_out(n_frames: int, factor: float, n_joints: int = 1) -> int:
+    check_frames(round(n_frames * factor), n_joints, f"stretching {n_frames} frames by {factor:g}")
     n = int(round(n_frames * factor))
     if n < 2:
         raise MocycleError(f"factor {factor:g} leaves {n} frame(s) of {n_frames}; the result needs at least 2")
-    if n > MAX_FRAMES_OUT:
-        raise MocycleError(f"factor {factor:g} would make {n} frames; the limit is {MAX_FRAMES_OUT}")
     return n
 
 
@@ -285,7 +282,7 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
     """The whole take warped by ``factor`` (paper 004 §6): :func:`stretch_motion` on one periodic region.
     ``travel``: the travelling joint (default: the take's own)."""
     T = motion.n_frames
-    n_out = _frames_out(T, factor)
+    n_out = _frames_out(T, factor, motion.n_joints)
     skel = motion.skeleton
     groups = joint_groups(skel)
     X, decoder = pose_matrix(motion, rep="quatlog", root="drop")
@@ -522,7 +519,7 @@ def stretch_motion(motion: Motion, factor: float, window: str | int = "auto", fo
     if T < 8:
         raise MocycleError(f"stretching needs a take of at least 8 frames; got {T}")
     factor = _factor(factor)
-    n_out = _frames_out(T, factor)
+    n_out = _frames_out(T, factor, motion.n_joints)
     window = _validate.integer("window", window, 1, max(T // 2, 1), words={"auto": "auto"},
                                note=f"half the take's {T} frames")
     try:

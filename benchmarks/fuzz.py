@@ -1,0 +1,398 @@
+"""Long fuzzing run of every reader, to run before releases (the suite's fuzz tests are the short version).
+
+    python benchmarks/fuzz.py [--seconds 3600] [--readers bvh,asf,amc,mck,mosw] [--engine auto|atheris|random]
+                              [--rss-mb 2048] [--timeout 10] [--out DIR] [--data DIR]
+
+Each reader runs in its own process under a memory limit (``RLIMIT_AS`` of ``--rss-mb``) and a time limit
+per input (``--timeout`` seconds).  A reader passes an input when it returns a result that goes on working
+(``.mck`` decompresses, ``.mosw`` plays back, BVH/ASF/AMC write as BVH and read back) or raises one
+:class:`~mocycle.errors.MotionFileError`; anything else is a crash, a run past the time limit a hang, a
+``MemoryError`` a blow-up.
+
+Engines: ``atheris`` (coverage-guided libFuzzer; ``pip install atheris``, a wheel exists for CPython 3.11 on
+x86-64 Linux; the binary formats are mutated inside their zlib payload by a custom mutator) or ``random``
+(mutations of the seeds, no coverage feedback); ``auto`` takes atheris when it imports.  Seeds are generated
+takes and, when ``../shared/data`` is present, a few real files.
+
+Prints per reader: inputs tried, accepted, refused, crashes (by signature), hangs, blow-ups and peak memory;
+crashing inputs are kept in ``--out``.  Exit code 1 when any reader crashed, hung or blew up.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import random
+import resource
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import traceback
+import zlib
+from pathlib import Path
+
+READERS = ("bvh", "asf", "amc", "mck", "mosw")
+DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+ASF = """:version 1.10
+:name fuzz
+:units
+  mass 1.0
+  length 0.45
+  angle deg
+:root
+   order TX TY TZ RX RY RZ
+   axis XYZ
+   position 0 0 0
+   orientation 0 0 0
+:bonedata
+  begin
+     id 1
+     name lfemur
+     direction 0 -1 0
+     length 7
+     axis 0 0 20 XYZ
+    dof rx ry rz
+    limits (-160 20)
+           (-70 70)
+           (-60 70)
+  end
+  begin
+     id 2
+     name ltibia
+     direction 0 -1 0
+     length 7.5
+     axis 0 0 20 XYZ
+    dof rx
+  end
+  begin
+     id 3
+     name thorax
+     direction 0 1 0
+     length 3
+     axis 0 0 0 ZYX
+    dof rz rx
+  end
+:hierarchy
+  begin
+    root lfemur thorax
+    lfemur ltibia
+  end
+"""
+AMC = ":FULLY-SPECIFIED\n:DEGREES\n" + "".join(
+    f"{f}\nroot {f} 2 3 {f} 0 0\nlfemur {10 + f} -5 3\nltibia {40 + f}\nthorax 5 {f}\n" for f in range(1, 5))
+
+
+class Hang(Exception):
+    pass
+
+
+# ---------------------------------------------------------------- targets (run in the child)
+def _targets():
+    """``{reader: (run(data), seeds, zlib magic or None)}``; run raises MotionFileError for refused input."""
+    import warnings
+
+    import numpy as np
+
+    from mocycle.datasets import synthetic_walk
+    from mocycle.io.asfamc import parse_amc, parse_asf
+    from mocycle.io.bvh import format_bvh, parse_bvh
+    from mocycle.io.mck import MAGIC as MCK
+    from mocycle.io.mosw import MAGIC as MOSW
+    from mocycle.keyframes import Compressed, compress
+    from mocycle.swings import decode, encode, playback, segment
+
+    warnings.simplefilter("ignore")
+    walk = synthetic_walk(n_frames=90, fps=30, seed=5).motion
+    skeleton = parse_asf(ASF, "seed.asf")
+
+    def finite(motion):
+        assert np.all(np.isfinite(motion.rotations)) and np.all(np.isfinite(motion.translations))
+
+    def bvh(data):
+        m = parse_bvh(data, "fuzz.bvh")
+        finite(parse_bvh(format_bvh(m), "again.bvh"))
+
+    def asf(data):
+        a = parse_asf(data.decode("utf-8", "replace"), "fuzz.asf")
+        parse_bvh(format_bvh(parse_amc("1\nroot 0 0 0 0 0 0\n", a, "rest.amc")), "again.bvh")
+
+    def amc(data):
+        finite(parse_bvh(format_bvh(parse_amc(data.decode("utf-8", "replace"), skeleton, "fuzz.amc")), "again"))
+
+    def mck(data):
+        finite(Compressed.from_bytes(data, "fuzz.mck").decompress())
+
+    def mosw(data):
+        finite(playback(decode(data, "fuzz.mosw")))
+
+    bvh_seeds = [format_bvh(walk).encode(), format_bvh(walk[:3]).encode()]
+    mck_seeds = [compress(walk, count=5, scheme=s).to_bytes() for s in ("slerp", "hermite", "rbf")]
+    mck_seeds.append(compress(walk, count=5, scheme="spatial", projection="pca").to_bytes())
+    data = Path(os.environ.get("MOCYCLE_FUZZ_DATA", DEFAULT_DATA))
+    real_bvh = sorted(data.glob("*/*.bvh"), key=lambda p: p.stat().st_size)[:2] if data.is_dir() else []
+    bvh_seeds += [p.read_bytes() for p in real_bvh]
+    return {"bvh": (bvh, bvh_seeds, None), "asf": (asf, [ASF.encode()], None), "amc": (amc, [AMC.encode()], None),
+            "mck": (mck, mck_seeds, MCK), "mosw": (mosw, [encode(segment(walk))], MOSW)}
+
+
+INTERESTING = [b"\x00", b"\xff", b"\x7f", b"\x80", b"\x00\x00\x00\x00", b"\xff\xff\xff\xff", b"\x00\xca\x9a\x3b",
+               b"\x00\x00\x80\x7f", b"\x00\x00\xc0\x7f", b"\xff\xff\xff\x7f", b"nan", b"inf", b"1e308", b"-1",
+               b"\n", b"{", b"}", b"99999999999"]
+
+
+def mutate_bytes(data: bytes, rng: random.Random) -> bytes:
+    out = bytearray(data)
+    for _ in range(rng.randint(1, 8)):
+        pos = rng.randrange(len(out) + 1)
+        op = rng.choice(("flip", "value", "value", "delete", "insert", "dup", "truncate"))
+        if op == "flip" and pos < len(out):
+            out[pos] ^= 1 << rng.randrange(8)
+        elif op == "value":
+            chunk = rng.choice(INTERESTING)
+            out[pos:pos + len(chunk)] = chunk
+        elif op == "delete":
+            del out[pos:pos + rng.randint(1, 64)]
+        elif op == "insert":
+            out[pos:pos] = bytes(rng.randrange(256) for _ in range(rng.randint(1, 16)))
+        elif op == "dup":
+            out[pos:pos] = out[pos:pos + rng.randint(1, 256)] * rng.randint(1, 4)
+        elif op == "truncate":
+            del out[pos:]
+    return bytes(out)
+
+
+def in_payload(magic: bytes | None, data: bytes, change) -> bytes:
+    """``change`` applied inside the zlib payload of a binary file (re-compressed), else to the bytes."""
+    if magic is None or not data.startswith(magic):
+        return change(data)
+    try:
+        payload = zlib.decompressobj().decompress(data[len(magic):], 1 << 24)
+    except zlib.error:
+        return change(data)
+    return magic + zlib.compress(change(payload), 6)
+
+
+def signature(exc: BaseException) -> str:
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if "mocycle" in f.filename] or \
+        traceback.extract_tb(exc.__traceback__)
+    where = f"{Path(frames[-1].filename).name}:{frames[-1].lineno}" if frames else "?"
+    return f"{type(exc).__name__} at {where}"
+
+
+def _limit_memory(rss_mb: int) -> None:
+    limit = rss_mb * 2**20 + _mapped()
+    resource.setrlimit(resource.RLIMIT_AS, (limit, resource.getrlimit(resource.RLIMIT_AS)[1]))
+
+
+def _mapped() -> int:
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def _peak_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # Linux: kilobytes
+
+
+# ---------------------------------------------------------------- the random engine
+def child_random(reader: str, seconds: float, rss_mb: int, timeout: float, out: Path, seed: int) -> dict:
+    from mocycle.errors import MotionFileError
+
+    run, seeds, magic = _targets()[reader]
+    _limit_memory(rss_mb)
+    rng = random.Random(seed)
+    stats = {"reader": reader, "engine": "random", "tried": 0, "accepted": 0, "refused": 0, "crashes": {},
+             "hangs": 0, "blowups": 0, "slowest_s": 0.0}
+
+    def alarm(signum, frame):
+        raise Hang()
+
+    signal.signal(signal.SIGALRM, alarm)
+    corpus = list(seeds)
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        base = rng.choice(corpus)
+        data = in_payload(magic, base, lambda d: mutate_bytes(d, rng)) if rng.random() < 0.75 else \
+            mutate_bytes(base, rng)
+        stats["tried"] += 1
+        t0 = time.monotonic()
+        signal.setitimer(signal.ITIMER_REAL, timeout)
+        try:
+            run(data)
+            stats["accepted"] += 1
+            if len(corpus) < 200:
+                corpus.append(data)  # accepted variants seed further mutations
+        except MotionFileError:
+            stats["refused"] += 1
+        except Hang:
+            stats["hangs"] += 1
+            _keep(out, reader, "hang", data)
+        except MemoryError:
+            stats["blowups"] += 1
+            _keep(out, reader, "oom", data)
+        except Exception as exc:  # noqa: BLE001 - this is what the fuzzer hunts
+            sig = signature(exc)
+            stats["crashes"][sig] = stats["crashes"].get(sig, 0) + 1
+            _keep(out, reader, "crash", data)
+        finally:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+        stats["slowest_s"] = max(stats["slowest_s"], time.monotonic() - t0)
+    stats["peak_mb"] = _peak_mb()
+    return stats
+
+
+def _keep(out: Path, reader: str, kind: str, data: bytes) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{reader}-{kind}-{zlib.crc32(data):08x}").write_bytes(data)
+
+
+# ---------------------------------------------------------------- the atheris engine
+def child_atheris(reader: str, seconds: float, rss_mb: int, timeout: float, out: Path, seed: int) -> None:
+    import atheris
+    import numpy  # noqa: F401 - third-party code is imported first so that only mocycle gets instrumented
+    import scipy.interpolate  # noqa: F401
+    import scipy.linalg  # noqa: F401
+    import scipy.ndimage  # noqa: F401
+    import scipy.sparse  # noqa: F401
+    import scipy.spatial  # noqa: F401
+    import scipy.spatial.transform  # noqa: F401
+
+    with atheris.instrument_imports(include=["mocycle"]):
+        import mocycle.io.asfamc  # noqa: F401
+        import mocycle.io.bvh  # noqa: F401
+        import mocycle.io.inflate  # noqa: F401
+        import mocycle.io.mck  # noqa: F401
+        import mocycle.io.mosw  # noqa: F401
+        import mocycle.swings.playback  # noqa: F401
+        from mocycle.errors import MotionFileError
+    run, seeds, magic = _targets()[reader]
+    corpus = Path(tempfile.mkdtemp(prefix=f"mocycle-fuzz-{reader}-"))
+    for k, s in enumerate(seeds):
+        (corpus / f"seed{k}").write_bytes(s)
+
+    def one(data: bytes) -> None:
+        try:
+            run(data)
+        except MotionFileError:
+            pass
+
+    def mutator(data: bytes, max_size: int, mseed: int) -> bytes:
+        out = in_payload(magic, data, lambda d: atheris.Mutate(d, max(len(d) * 2, 64)))
+        return out if len(out) <= max_size else atheris.Mutate(data, max_size)
+
+    out.mkdir(parents=True, exist_ok=True)
+    argv = [sys.argv[0], f"-max_total_time={int(seconds)}", f"-rss_limit_mb={rss_mb}", f"-timeout={int(timeout)}",
+            f"-seed={seed}", f"-artifact_prefix={out}/{reader}-", "-print_final_stats=1", "-max_len=262144",
+            str(corpus)]
+    atheris.Setup(argv, one, custom_mutator=mutator if magic else None)
+    atheris.Fuzz()
+
+
+def parse_libfuzzer(text: str) -> dict:
+    stats = {"tried": 0, "peak_mb": 0.0}
+    for line in text.splitlines():
+        words = line.split()
+        if line.startswith("#") and words[0][1:].isdigit():
+            stats["tried"] = max(stats["tried"], int(words[0][1:]))
+        if "rss:" in words:
+            stats["peak_mb"] = max(stats["peak_mb"], float(words[words.index("rss:") + 1].rstrip("Mb")))
+        if line.startswith("stat::number_of_executed_units:"):
+            stats["tried"] = max(stats["tried"], int(words[-1]))
+        if line.startswith("stat::peak_rss_mb:"):
+            stats["peak_mb"] = max(stats["peak_mb"], float(words[-1]))
+    return stats
+
+
+# ---------------------------------------------------------------- the parent
+def run_reader(reader: str, engine: str, args) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src") + os.pathsep
+           + os.environ.get("PYTHONPATH", ""), "MOCYCLE_FUZZ_DATA": str(args.data)}
+    cmd = [sys.executable, __file__, "--child", reader, "--engine", engine, "--seconds", str(args.seconds),
+           "--rss-mb", str(args.rss_mb), "--timeout", str(args.timeout), "--out", str(args.out)]
+    if engine == "random":
+        proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
+        try:
+            return json.loads(proc.stdout.strip().splitlines()[-1])
+        except (IndexError, json.JSONDecodeError):
+            return {"reader": reader, "engine": engine, "tried": 0, "crashes": {f"child died: {proc.stderr[-300:]}": 1},
+                    "hangs": 0, "blowups": 0, "peak_mb": 0.0}
+    # atheris stops at its first finding: restart until the time is used, counting findings
+    stats = {"reader": reader, "engine": "atheris", "tried": 0, "crashes": {}, "hangs": 0, "blowups": 0,
+             "peak_mb": 0.0}
+    end = time.monotonic() + args.seconds
+    restarts = 0
+    while (left := end - time.monotonic()) > 1 and restarts < 50:
+        cmd[cmd.index("--seconds") + 1] = str(max(int(left), 1))
+        cmd += ["--seed", str(restarts + 1)]
+        before = set(args.out.glob(f"{reader}-*")) if args.out.exists() else set()
+        proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
+        found = parse_libfuzzer(proc.stderr)
+        stats["tried"] += found["tried"]
+        stats["peak_mb"] = max(stats["peak_mb"], found["peak_mb"])
+        new = set(args.out.glob(f"{reader}-*")) - before if args.out.exists() else set()
+        for p in new:
+            kind = p.name.split("-")[1]
+            if kind == "timeout":
+                stats["hangs"] += 1
+            elif kind in ("oom", "leak"):
+                stats["blowups"] += 1
+            else:
+                lines = [ln for ln in proc.stderr.splitlines() if "Error" in ln or "Exception" in ln]
+                sig = lines[-1].strip()[:120] if lines else p.name
+                stats["crashes"][sig] = stats["crashes"].get(sig, 0) + 1
+        if proc.returncode == 0 or not new:
+            break
+        restarts += 1
+    return stats
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=60.0, help="per reader")
+    parser.add_argument("--readers", default=",".join(READERS))
+    parser.add_argument("--engine", choices=("auto", "atheris", "random"), default="auto")
+    parser.add_argument("--rss-mb", type=int, default=2048)
+    parser.add_argument("--timeout", type=float, default=10.0, help="seconds per input")
+    parser.add_argument("--out", type=Path, default=Path(tempfile.gettempdir()) / "mocycle-fuzz")
+    parser.add_argument("--data", type=Path, default=DEFAULT_DATA)
+    parser.add_argument("--child", choices=READERS)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    if args.child:
+        if args.engine == "atheris":
+            child_atheris(args.child, args.seconds, args.rss_mb, args.timeout, args.out, args.seed)
+            return 0
+        print(json.dumps(child_random(args.child, args.seconds, args.rss_mb, args.timeout, args.out, args.seed)))
+        return 0
+    engine = args.engine
+    if engine == "auto":
+        try:
+            import atheris  # noqa: F401
+
+            engine = "atheris"
+        except ImportError:
+            engine = "random"
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=f"fuzzing, {engine} engine, {args.seconds:g} s per reader, {args.rss_mb} MB, "
+                        f"{args.timeout:g} s per input")
+    for col in ("reader", "inputs tried", "crashes", "hangs", "blow-ups", "peak MB", "crash signatures"):
+        table.add_column(col, justify="left" if col in ("reader", "crash signatures") else "right")
+    bad = False
+    for reader in args.readers.split(","):
+        s = run_reader(reader, engine, args)
+        n_crash = sum(s["crashes"].values())
+        bad |= bool(n_crash or s["hangs"] or s["blowups"])
+        table.add_row(reader, f"{s['tried']:,}", str(n_crash), str(s["hangs"]), str(s["blowups"]),
+                      f"{s['peak_mb']:.0f}", "; ".join(f"{k} ×{v}" for k, v in s["crashes"].items()) or "-")
+    Console().print(table)
+    print(f"inputs that failed are kept in {args.out}" if bad else "no crash, hang or blow-up")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,45 @@
+"""Foot locking for loops: contacts that cross the seam are one contact, and the cleaned cycle still loops.
+
+A cycle of ``N`` frames is repeated three times with its root motion (each
+repeat moved on by the travel and turned by the turn per cycle), contacts are
+found and locked on those ``3N`` frames, and the middle ``N`` frames are read
+back into the cycle's own space, moved back by one cycle.  Everything the
+clean-up does depends only on the frames around it (contacts, their means,
+the blend windows and the root lowering reach less than a cycle), so the
+middle cycle is cleaned exactly as its neighbours are: frame ``N`` of the
+cleaned loop is frame 0 moved on by exactly the travel per cycle, the held
+feet of consecutive cycles are exactly one travel apart, and the in-place
+loop (the travel taken out at a constant rate) slides a held foot back at
+exactly the treadmill speed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from ..cycle.extract import Cycle
+from ..rotations import axis_rotations
+from .detect import Contacts, detect_contacts
+from .feet import Foot
+from .lock import BLEND_SECONDS, REACH, lock_feet
+
+
+def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend: float = BLEND_SECONDS,
+               reach: float = REACH, **detect_options) -> tuple[Cycle, Contacts]:
+    """The cycle with its feet locked, and its contacts over its ``N`` frames (a contact running over the
+    last frame continues at frame 0)."""
+    N = cycle.n_frames
+    ext = cycle.repeat(4, root="motion")
+    contacts = detect_contacts(ext, feet, **detect_options)
+    locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N)[N:2 * N]
+    P, L = cycle.space.encode(locked)
+    turn, move = cycle.drift[3], cycle.drift[:3]
+    R = axis_rotations(cycle.space.up, np.array([turn]))[0]
+    p0 = cycle.L[0, :3]
+    L[:, :3] = (L[:, :3] - p0 - move) @ R + p0    # undo repeat's move to the second cycle
+    L[:, 3] -= turn
+    L[:, 3] += 2 * np.pi * np.round((cycle.L[0, 3] - L[0, 3]) / (2 * np.pi))
+    return replace(cycle, P=P, L=L, regression=None), contacts.window(N, 2 * N)

@@ -1,0 +1,185 @@
+"""Foot contacts: when each contact joint (ankle, toe) is planted.
+
+A contact joint is planted while it is **near its floor and slow**: its height
+above its lowest level is under ``height``, its horizontal speed under
+``speed`` and its vertical speed under ``rise`` (a heel that starts to lift or
+is still coming down is not planted).
+Both are fractions of the body height (and body heights per second), so the
+same numbers work for centimetres, metres or inches, and the
+speed is measured on positions smoothed over a fixed time (not a fixed number
+of frames), so 30, 60 and 120 fps agree.
+
+* **hysteresis** — a contact starts below ``height`` and ``speed`` and ends
+  only above ``release`` times them, so noise at the threshold does not
+  chatter;
+* **minimum durations** — gaps shorter than ``min_gap`` seconds are filled,
+  contacts shorter than ``min_contact`` seconds dropped.
+
+A foot is in contact while its ankle or its toe is.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.ndimage import gaussian_filter1d
+
+from ..errors import MocycleError
+from ..motion import Motion
+from .feet import Foot, body_height, find_feet, up_axis
+
+CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
+CONTACT_SPEED = 0.15    # body heights per second, horizontal
+CONTACT_RISE = 0.05     # body heights per second, vertical: a heel that lifts faster is not planted
+RELEASE = 1.5           # a contact ends above RELEASE × the thresholds
+SMOOTH_SECONDS = 1 / 60  # std of the Gaussian the positions are smoothed with before differencing
+MIN_CONTACT = 0.06      # seconds
+MIN_GAP = 0.06          # seconds
+
+
+def ranges(mask: np.ndarray) -> list[tuple[int, int]]:
+    """``[(start, stop), ...]`` (stop exclusive) of the runs of True in a boolean ``(T,)`` array."""
+    m = np.concatenate([[False], np.asarray(mask, bool), [False]])
+    edges = np.flatnonzero(m[1:] != m[:-1])
+    return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+@dataclass(frozen=True, eq=False)
+class Contacts:
+    """Contacts of ``feet`` over ``T`` frames.
+
+    ``joints``: the contact joints ``(C,)`` (each foot's ankle, then its toe if any); ``foot_of``: the foot
+    (index into ``feet``) of each; ``mask``: ``(T, C)`` True while planted; ``up``: world up ``(3,)``;
+    ``body``: the body height (file units); ``frame_time``: seconds.
+    """
+
+    feet: tuple[Foot, ...]
+    joints: tuple[int, ...]
+    foot_of: tuple[int, ...]
+    mask: np.ndarray
+    up: np.ndarray
+    body: float
+    frame_time: float
+
+    @property
+    def n_frames(self) -> int:
+        return self.mask.shape[0]
+
+    def joint_ranges(self, c: int) -> list[tuple[int, int]]:
+        """Frame ranges of contact joint ``c`` (index into ``joints``)."""
+        return ranges(self.mask[:, c])
+
+    def foot_mask(self, f: int) -> np.ndarray:
+        """``(T,)`` True while foot ``f`` touches the floor (ankle or toe)."""
+        return self.mask[:, [c for c, g in enumerate(self.foot_of) if g == f]].any(axis=1)
+
+    def foot_ranges(self, f: int) -> list[tuple[int, int]]:
+        return ranges(self.foot_mask(f))
+
+    def window(self, start: int, stop: int) -> Contacts:
+        """The contacts of frames ``start .. stop-1``."""
+        return Contacts(self.feet, self.joints, self.foot_of, self.mask[start:stop], self.up, self.body,
+                        self.frame_time)
+
+    def to_dict(self, names: Sequence[str], period: int | None = None) -> dict:
+        """Per foot (by side): its joints and its contacts as ``[start, stop]`` frame ranges (stop exclusive).
+
+        With ``period`` (a loop of that many frames) a contact that runs over the end and on at frame 0 is
+        one contact ``[start, stop]`` with ``stop > period``: it crosses the seam.
+        """
+        out = {}
+        for f, foot in enumerate(self.feet):
+            cs = [c for c, g in enumerate(self.foot_of) if g == f]
+            entry = {"joints": foot.names_of(names),
+                     "contacts": _as_lists(ranges(self.foot_mask(f)), period)}
+            for c in cs:
+                kind = "ankle" if self.joints[c] == foot.ankle else "toe"
+                entry[f"{kind}_contacts"] = _as_lists(self.joint_ranges(c), period)
+            out[foot.side] = entry
+        return out
+
+
+def _as_lists(rs: list[tuple[int, int]], period: int | None) -> list[list[int]]:
+    rs = [list(r) for r in rs]
+    if period and len(rs) >= 2 and rs[0][0] == 0 and rs[-1][1] == period:
+        first = rs.pop(0)
+        rs[-1][1] = period + first[1]
+    return rs
+
+
+def _hysteresis(on: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """True from each frame where ``on`` holds for as long as ``keep`` holds (``on`` implies ``keep``)."""
+    keep = keep | on
+    out = np.zeros_like(on)
+    for a, b in ranges(keep):
+        hits = np.flatnonzero(on[a:b])
+        if hits.size:
+            out[a + hits[0]:b] = True
+    return out
+
+
+def _durations(mask: np.ndarray, min_contact: int, min_gap: int) -> np.ndarray:
+    mask = mask.copy()
+    rs = ranges(mask)
+    for (_, b), (c, _) in zip(rs[:-1], rs[1:], strict=True):
+        if c - b < min_gap:
+            mask[b:c] = True
+    for a, b in ranges(mask):
+        if b - a < min_contact:
+            mask[a:b] = False
+    return mask
+
+
+def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, smooth: float = SMOOTH_SECONDS,
+                       positions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Height above the lowest level ``(T, C)``, horizontal speed ``(T, C)`` and vertical speed ``(T, C)``
+    (units/s) of ``joints``.
+
+    Speeds are central differences of positions smoothed by a Gaussian of ``smooth`` seconds.
+    """
+    W = motion.world_positions() if positions is None else positions
+    P = W[:, list(joints)]
+    h = P @ up
+    h = h - h.min(axis=0)
+    sigma = smooth / motion.frame_time
+    Ps = gaussian_filter1d(P, sigma, axis=0, mode="nearest") if sigma >= 0.3 else P
+    if motion.n_frames < 2:
+        return h, np.zeros_like(h), np.zeros_like(h)
+    v = np.gradient(Ps, motion.frame_time, axis=0)
+    vu = v @ up
+    return h, np.linalg.norm(v - vu[..., None] * up, axis=-1), np.abs(vu)
+
+
+def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = CONTACT_HEIGHT,
+                    speed: float = CONTACT_SPEED, rise: float = CONTACT_RISE, release: float = RELEASE,
+                    min_contact: float = MIN_CONTACT,
+                    min_gap: float = MIN_GAP, up: np.ndarray | None = None) -> Contacts:
+    """Contacts of every contact joint of ``feet`` (default: :func:`find_feet`; a string names them).
+
+    ``height``: fraction of the body height above the joint's lowest level; ``speed``: body heights per
+    second (horizontal), ``rise``: body heights per second (vertical); ``release``: hysteresis factor (> 1);
+    ``min_contact``, ``min_gap``: seconds.
+    """
+    if not (height > 0 and speed > 0 and rise > 0 and release >= 1 and min_contact >= 0 and min_gap >= 0):
+        raise MocycleError(f"contact thresholds must be positive (height {height}, speed {speed}, release "
+                           f"{release} >= 1, durations {min_contact}, {min_gap} >= 0)")
+    if feet is None or isinstance(feet, str):
+        feet = find_feet(motion.skeleton, feet)
+    feet = tuple(feet)
+    up = up_axis(motion) if up is None else np.asarray(up, dtype=np.float64)
+    body = body_height(motion, up)
+    joints = tuple(j for f in feet for j in f.contact_joints)
+    foot_of = tuple(i for i, f in enumerate(feet) for _ in f.contact_joints)
+    h, v, vu = heights_and_speeds(motion, joints, up)
+    h, v, vu = h / body, v / body, vu / body
+    fps = motion.fps
+    n_contact = max(1, int(round(min_contact * fps)))
+    n_gap = max(1, int(round(min_gap * fps)))
+    mask = np.zeros(h.shape, bool)
+    for c in range(len(joints)):
+        on = (h[:, c] < height) & (v[:, c] < speed) & (vu[:, c] < rise)
+        keep = (h[:, c] < release * height) & (v[:, c] < release * speed) & (vu[:, c] < release * rise)
+        mask[:, c] = _durations(_hysteresis(on, keep), n_contact, n_gap)
+    return Contacts(feet, joints, foot_of, mask, up, body, motion.frame_time)

@@ -1,0 +1,214 @@
+"""Which joints are the feet, and which way is up, on any humanoid skeleton.
+
+A :class:`Foot` is one leg's chain for two-bone IK (hip, knee, ankle) and its
+contact joints: the ankle (heel) and, when the rig has one, the toe (ball of
+the foot).  They are found by name patterns that cover the common rigs:
+
+* CMU ASF ``lfemur/ltibia/lfoot/ltoes``, CMU BVH and Mixamo
+  ``LeftUpLeg/LeftLeg/LeftFoot/LeftToeBase`` (``mixamorig:`` prefix allowed),
+* Bandai Namco ``UpperLeg_L/LowerLeg_L/Foot_L/Toes_L``,
+* Character Creator / iClone ``CC_Base_L_Thigh/CC_Base_L_Calf/CC_Base_L_Foot/CC_Base_L_ToeBase``,
+
+and, when they fail, named by the caller (``"lfoot:ltoes,rfoot:rtoes"``).
+The knee and hip are the ankle's parent and grandparent, skipping joints
+whose offset is too short to be a leg bone (twist or helper joints).
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..axes import vertical_axis
+from ..errors import MocycleError
+from ..motion import Motion, Skeleton
+
+#: Glob patterns (case-insensitive) of ankle joints and toe joints.
+ANKLE_PATTERNS = ("*foot", "*foot_l", "*foot_r", "*foot.l", "*foot.r", "*ankle*", "?foot*", "foot*")
+TOE_PATTERNS = ("*toebase", "*toe", "*toes", "*toes_l", "*toes_r", "*toe_l", "*toe_r", "*toebase_l",
+                "*toebase_r", "*ball*", "*toe.l", "*toe.r")
+_LEFT = re.compile(r"(^|[^a-z])l($|[^a-z])|left|^l(?=foot|toe|ankle|femur|tibia)")
+_RIGHT = re.compile(r"(^|[^a-z])r($|[^a-z])|right|^r(?=foot|toe|ankle|femur|tibia)")
+SHORT_BONE = 0.05  # of the body height: a shorter offset is a helper joint, not a leg bone
+MAX_LISTED = 12
+
+
+@dataclass(frozen=True)
+class Foot:
+    """One leg: ``side`` (``"left"``, ``"right"`` or the ankle's name), joint indices ``hip``, ``knee``,
+    ``ankle`` and ``toe`` (``None`` when the rig has no toe joint)."""
+
+    side: str
+    hip: int
+    knee: int
+    ankle: int
+    toe: int | None
+
+    @property
+    def contact_joints(self) -> tuple[int, ...]:
+        """The joints that touch the floor: ankle (heel) and toe."""
+        return (self.ankle,) if self.toe is None else (self.ankle, self.toe)
+
+    def names(self, skeleton: Skeleton) -> dict[str, str | None]:
+        return self.names_of(skeleton.names)
+
+    def names_of(self, n: Sequence[str]) -> dict[str, str | None]:
+        return {"hip": n[self.hip], "knee": n[self.knee], "ankle": n[self.ankle],
+                "toe": None if self.toe is None else n[self.toe]}
+
+
+def _bare(name: str) -> str:
+    """The lower-case name without a namespace prefix (``mixamorig:LeftFoot`` -> ``leftfoot``)."""
+    return name.rsplit(":", 1)[-1].rsplit("|", 1)[-1].lower()
+
+
+def _matches(name: str, patterns: Sequence[str]) -> bool:
+    return any(fnmatch.fnmatchcase(_bare(name), p) for p in patterns)
+
+
+def side_of(name: str) -> str | None:
+    """``"left"``, ``"right"`` or ``None`` from a joint name."""
+    n = _bare(name)
+    left, right = bool(_LEFT.search(n)), bool(_RIGHT.search(n))
+    return "left" if left and not right else "right" if right and not left else None
+
+
+def _ancestors(skeleton: Skeleton, j: int) -> list[int]:
+    out = []
+    while skeleton.parents[j] >= 0:
+        j = int(skeleton.parents[j])
+        out.append(j)
+    return out
+
+
+def _descendants(skeleton: Skeleton, j: int) -> list[int]:
+    """Joints below ``j``, nearest first."""
+    out, frontier = [], [j]
+    while frontier:
+        nxt = [c for f in frontier for c in skeleton.children(f)]
+        out.extend(nxt)
+        frontier = nxt
+    return out
+
+
+def _rest_height(skeleton: Skeleton) -> float:
+    """A length scale of the rig from its offsets alone: the longest root-to-leaf chain of offsets."""
+    lengths = np.zeros(skeleton.n_joints)
+    norms = np.linalg.norm(skeleton.offsets, axis=1)
+    for j in range(1, skeleton.n_joints):
+        lengths[j] = lengths[skeleton.parents[j]] + norms[j]
+    return float(lengths.max()) or 1.0
+
+
+def _leg(skeleton: Skeleton, ankle: int, toe: int | None, side: str) -> Foot:
+    """Knee and hip above ``ankle``: the nearest ancestors whose offsets are long enough to be leg bones."""
+    short = SHORT_BONE * _rest_height(skeleton)
+    norms = np.linalg.norm(skeleton.offsets, axis=1)
+    chain, j = [], ankle
+    for _ in range(2):
+        # the bone ending at j is j's offset; a helper joint (short offset) in between is skipped
+        p = int(skeleton.parents[j])
+        while p >= 0 and norms[j] < short and skeleton.parents[p] >= 0:
+            j, p = p, int(skeleton.parents[p])
+        if p < 0:
+            raise MocycleError(f"foot joint {skeleton.names[ankle]!r} has no knee and hip above it")
+        chain.append(p)
+        j = p
+    knee, hip = chain
+    return Foot(side, hip, knee, ankle, toe)
+
+
+def _toe_below(skeleton: Skeleton, ankle: int) -> int | None:
+    below = _descendants(skeleton, ankle)
+    hits = [j for j in below if _matches(skeleton.names[j], TOE_PATTERNS)]
+    if not hits:
+        hits = [j for j in below if "toe" in _bare(skeleton.names[j]) and "share" not in _bare(skeleton.names[j])]
+    if not hits:
+        kids = skeleton.children(ankle)  # a single child of the ankle is the ball of the foot
+        return kids[0] if len(kids) == 1 else None
+    return hits[0]
+
+
+def _listed(skeleton: Skeleton) -> str:
+    names = skeleton.names
+    shown = ", ".join(names[:MAX_LISTED])
+    return shown + (f" and {len(names) - MAX_LISTED} more" if len(names) > MAX_LISTED else "")
+
+
+def _split_item(skeleton: Skeleton, item: str) -> tuple[str, str]:
+    """``"ANKLE:TOE"`` or ``"ANKLE"`` into names; a ``:`` inside a joint name (``mixamorig:LeftFoot``) is
+    kept by trying every split."""
+    if item in skeleton.names:
+        return item, ""
+    for k in [m.start() for m in re.finditer(":", item)]:
+        a, t = item[:k], item[k + 1:]
+        if a in skeleton.names and t in skeleton.names:
+            return a, t
+    a, _, t = item.partition(":")
+    return a, t
+
+
+def _named(skeleton: Skeleton, spec: str | Sequence[str]) -> list[Foot]:
+    items = [s.strip() for s in spec.split(",")] if isinstance(spec, str) else [s.strip() for s in spec]
+    items = [s for s in items if s]
+    if not items:
+        raise MocycleError("name the feet as ANKLE[:TOE],ANKLE[:TOE] (e.g. lfoot:ltoes,rfoot:rtoes)")
+    feet = []
+    for item in items:
+        ankle_name, toe_name = _split_item(skeleton, item)
+        ankle = skeleton.index(ankle_name)
+        toe = skeleton.index(toe_name) if toe_name else None
+        if toe is not None and ankle not in _ancestors(skeleton, toe):
+            raise MocycleError(f"toe joint {toe_name!r} is not below the ankle {ankle_name!r}")
+        feet.append(_leg(skeleton, ankle, toe, side_of(ankle_name) or ankle_name))
+    return feet
+
+
+def find_feet(skeleton: Skeleton, names: str | Sequence[str] | None = None) -> list[Foot]:
+    """The feet of ``skeleton``, left first.
+
+    ``names``: ``None`` to find them by name patterns, or ``"ANKLE[:TOE],ANKLE[:TOE]"`` (a string or a
+    list of such items) to name them.  Raises :class:`MocycleError` naming the joints when no feet are
+    found (so the caller can name them).
+    """
+    if names:
+        return _named(skeleton, names)
+    found = [j for j, n in enumerate(skeleton.names) if _matches(n, ANKLE_PATTERNS) and "toe" not in _bare(n)]
+    found = [j for j in found if not any(a in found for a in _ancestors(skeleton, j))]  # the top-most per leg
+    feet: dict[str, Foot] = {}
+    for j in found:
+        side = side_of(skeleton.names[j])
+        if side is None or side in feet:
+            continue
+        feet[side] = _leg(skeleton, j, _toe_below(skeleton, j), side)
+    if len(feet) < 2:
+        have = ", ".join(skeleton.names[f.ankle] for f in feet.values()) or "none"
+        raise MocycleError(
+            f"no left and right foot found by name (foot joints found: {have}); name them as "
+            f"ANKLE[:TOE],ANKLE[:TOE] (option --foot-joints); joints are: {_listed(skeleton)}")
+    return [feet["left"], feet["right"]]
+
+
+def up_axis(motion: Motion, up=None) -> np.ndarray:
+    """The world up direction ``(3,)`` of ``motion`` (:func:`mocycle.axes.vertical_axis`; ``up`` overrides)."""
+    return vertical_axis(motion, up)
+
+
+def body_height(motion: Motion, up: np.ndarray | None = None) -> float:
+    """The body's height along ``up`` in file units: the extent of the mean pose of the travel joint, the
+    joints below it and their End Sites, each frame taken relative to the travel joint (about 50 frames)."""
+    up = up_axis(motion) if up is None else np.asarray(up, dtype=np.float64)
+    skel, travel = motion.skeleton, motion.travel_joint
+    above, j = set(), int(skel.parents[travel])
+    while j >= 0:
+        above.add(j)
+        j = int(skel.parents[j])
+    keep = [j for j in range(skel.n_joints) if j not in above] + [
+        skel.n_joints + i for i, site in enumerate(skel.end_sites) if site.parent not in above]
+    W = motion[::max(1, motion.n_frames // 50)].world_positions(end_sites=True)
+    pose = (W[:, keep] - W[:, travel:travel + 1]).mean(axis=0)
+    return float(np.ptp(pose @ up)) or 1.0

@@ -1,0 +1,355 @@
+"""Foot locking (Kovar, Schreiner and Gleicher 2002, "Footskate cleanup for motion capture editing").
+
+1. **Hips follow the planted feet.** The root is first moved horizontally by
+   the opposite of the hold-weighted mean horizontal velocity of the planted
+   contact joints (less its mean over the take, or over one period of a
+   repeated loop, so the travel is kept): in single support the stance foot
+   then stands still with no change to the legs at all.
+2. **Holds.** Each contact of a contact joint is held at one point in world
+   space: at the joint's lowest height during the contact (so its lowest
+   level does not change) and horizontally at its mean position, or at one of
+   its positions during the contact when that needs less lowering of the root.
+   The toe of a foot whose ankle and toe are both held is held at the ankle's
+   point plus the foot vector in the middle of their overlap, so a rigid foot
+   meets both holds exactly.  Over ``blend`` seconds before and after each
+   contact (at most half the gap to the next) the hold is cross-faded with
+   the joint's own path by a smoothstep, so corrections grow and fade.
+3. **Ankle goals.** The held ankle; while only the toe is held, the ankle
+   moved with the toe (the foot keeps its orientation and pivots on the
+   ball), and where that is beyond the leg's reach the heel lifts (the foot
+   turns about the held toe) until it is within reach.
+4. **Root lowering.** Where an ankle goal is still farther from its hip than
+   ``reach`` of the leg's length, the root goes down along the vertical
+   (smoothed over the blend window so it never jumps and is never less than
+   needed); a free leg that is bent keeps its foot where it was, a straight
+   one rides down with the root (bending a straight leg by a few millimetres
+   takes a large knee angle: a pop).
+5. **Two-bone IK.** The knee bends about the normal of the hip-knee-ankle
+   plane until the hip-ankle distance is right, then the thigh swings by the
+   smallest rotation that puts the ankle on its goal (the knee stays in the
+   leg's plane, only turned with it); the foot keeps its world orientation,
+   turned by the smallest rotation that points it at the toe goal.
+
+Only local rotations of hips, knees and ankles change, and the travel
+joint's translation, so every bone keeps its length exactly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.ndimage import maximum_filter1d, uniform_filter1d
+from scipy.spatial.transform import Rotation
+
+from ..motion import Motion
+from .detect import Contacts, ranges
+
+BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
+REACH = 0.995        # of hip-knee plus knee-ankle: farther goals lower the root
+# hip-ankle distance over leg length: a free leg rides down with the root above STRAIGHT, keeps its foot below BENT
+STRAIGHT, BENT = 0.999, 0.98
+DISTANCE_WEIGHT = 1.0  # a hold this much farther from the mean weighs like the same lowering of the root
+
+
+def _smoothstep(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def _holds(mask: np.ndarray, targets: list[np.ndarray], n_blend: int) -> tuple[np.ndarray, np.ndarray]:
+    """Weights ``(T,)`` and held points ``(T, 3)`` of one contact joint: 1 inside each contact, smoothstep
+    ramps of ``n_blend`` frames (at most half the gap to the neighbour contact) outside."""
+    T = mask.shape[0]
+    rs = ranges(mask)
+    w = np.zeros(T)
+    hold = np.zeros((T, 3))
+    for k, ((a, b), target) in enumerate(zip(rs, targets, strict=True)):
+        before = a - (rs[k - 1][1] if k else -n_blend * 2)
+        after = (rs[k + 1][0] if k + 1 < len(rs) else T + n_blend * 2) - b
+        r_in, r_out = min(n_blend, before // 2), min(n_blend, after // 2)
+        w[a:b] = 1.0
+        hold[a:b] = target
+        if r_in > 0:
+            t = np.arange(max(0, a - r_in), a)
+            w[t] = _smoothstep((t - (a - r_in - 1)) / (r_in + 1))
+            hold[t] = target
+        if r_out > 0:
+            t = np.arange(b, min(T, b + r_out))
+            w[t] = _smoothstep((b + r_out - t) / (r_out + 1))
+            hold[t] = target
+    return w, hold
+
+
+def _normalize(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.maximum(n, 1e-300)
+
+
+def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The smallest rotations ``(T, 3, 3)`` turning the directions of ``a`` into those of ``b`` ``(T, 3)``."""
+    a, b = _normalize(a), _normalize(b)
+    axis = np.cross(a, b)
+    s = np.linalg.norm(axis, axis=-1)
+    angle = np.arctan2(s, np.sum(a * b, axis=-1))
+    rotvec = _normalize(axis) * angle[:, None]
+    return Rotation.from_rotvec(rotvec).as_matrix()
+
+
+def _reach(W: np.ndarray, foot, reach: float) -> np.ndarray:
+    """How far ``(T,)`` a held ankle may be from its hip: ``reach`` of the leg's length (a held knee never
+    goes fully straight, where a millimetre of length takes a large knee angle)."""
+    H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
+    legs = np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
+    return np.maximum(reach * legs, np.linalg.norm(A - H, axis=1))
+
+
+def _need(goals: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """Smallest lowering ``delta >= 0`` of the hips along ``-up`` putting each goal within ``R`` of its hip
+    (as close as it gets when the goal is too far sideways); broadcasts over leading axes."""
+    d = goals - hips
+    du = d @ up
+    disc = du ** 2 - np.sum(d * d, axis=-1) + R ** 2
+    return np.maximum(np.where(disc >= 0, -du - np.sqrt(np.maximum(disc, 0.0)), -du), 0.0)
+
+
+def _best_hold(path: np.ndarray, offsets: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray,
+               body: float) -> np.ndarray:
+    """Where to hold a contact: at the joint's lowest height during the contact, and horizontally at one of
+    its positions during the contact or their mean: the one whose
+    ankle goals (hold + ``offsets``, ``(m, 3)``) need the least lowering of the root, then the one nearest
+    the mean (``DISTANCE_WEIGHT`` × the distance to the mean weighs like the same lowering)."""
+    floor = (path @ up).min()
+    mean = path.mean(axis=0)
+    cands = np.vstack([mean, path])                                   # (n, 3)
+    cands = cands + np.outer(floor - cands @ up, up)                  # planted at the contact's lowest point
+    mean = cands[0]
+    need = _need(cands[:, None, :] + offsets[None], hips[None], R[None], up).max(axis=1)
+    cost = need + DISTANCE_WEIGHT * np.linalg.norm(cands - mean, axis=1)
+    k = int(np.argmin(cost))
+    return cands[0] if need[0] <= need[k] + 1e-6 * body else cands[k]
+
+
+def _toward(correction: np.ndarray, w: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """``correction`` ``(T, 3)`` scaled by the hold weight ``w`` ``(T,)``; a downward part by ``w**3``, so a
+    heel still coming down (or already lifting) is not pulled to the floor while it moves fast."""
+    vert = correction @ up
+    wv = np.where(vert < 0, w ** 3, w)
+    return w[:, None] * (correction - np.outer(vert, up)) + np.outer(wv * vert, up)
+
+
+def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: float):
+    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and the foot's hold weight ``(T,)`` (0: free)."""
+    foot = contacts.feet[f]
+    up, body = contacts.up, contacts.body
+    cols = {contacts.joints[c]: c for c, g in enumerate(contacts.foot_of) if g == f}
+    a, hips, R = W[:, foot.ankle], W[:, foot.hip], _reach(W, foot, reach)
+    ma = contacts.mask[:, cols[foot.ankle]]
+    ra = ranges(ma)
+    mt = contacts.mask[:, cols[foot.toe]] if foot.toe is not None else np.zeros_like(ma)
+    rt = ranges(mt)
+    t = W[:, foot.toe] if foot.toe is not None else a
+    # each ankle contact with the toe contacts it overlaps most: one rigid-foot hold
+    partner = {}
+    for i, (s, e) in enumerate(rt):
+        overlaps = [min(e, y) - max(s, x) for x, y in ra]
+        k = int(np.argmax(overlaps)) if overlaps else -1
+        if k >= 0 and overlaps[k] > 0:
+            partner[i] = (k, (max(s, ra[k][0]) + min(e, ra[k][1]) - 1) // 2)
+    held_a = []
+    for k, (s, e) in enumerate(ra):
+        frames = [np.arange(s, e)]
+        offsets = [np.zeros((e - s, 3))]
+        for i, (k2, mid) in partner.items():
+            if k2 == k:  # toe-only frames of the partner contact: the ankle follows the held toe
+                only = np.array([x for x in range(*rt[i]) if not ma[x]], dtype=int)
+                frames.append(only)
+                offsets.append((t[mid] - a[mid]) - (t[only] - a[only]))
+        fr, off = np.concatenate(frames), np.concatenate(offsets)
+        held_a.append(_best_hold(a[s:e], off, hips[fr], R[fr], up, body)
+                      if fr.size else a[s:e].mean(axis=0))
+    w_a, hold_a = _holds(ma, held_a, n_blend)
+    if foot.toe is None:
+        return a + _toward(hold_a - a, w_a, up), None, w_a
+    held_t = []
+    for i, (s, e) in enumerate(rt):
+        if i in partner:  # a rigid foot can meet both holds: toe = held ankle + foot vector
+            k, mid = partner[i]
+            held_t.append(held_a[k] + (t[mid] - a[mid]))
+        else:
+            fr = np.arange(s, e)
+            held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
+    w_t, hold_t = _holds(mt, held_t, n_blend)
+    wa, wt = w_a[:, None], w_t[:, None]
+    goal_a = a + _toward(hold_a - a, w_a, up) + (1.0 - wa) * _toward(hold_t - t, w_t, up)
+    goal_t = goal_a + t - a + _toward(hold_t - (goal_a + t - a), w_t, up)
+    # while the toe is held harder than the ankle, put the ankle on the sphere of foot length around the toe
+    length = np.linalg.norm(t - a, axis=1, keepdims=True)
+    on_sphere = goal_t - length * _normalize(goal_t - goal_a)
+    den = 1.0 - wa * wt
+    lam = np.where(den > 1e-12, wt * (1.0 - wa) / np.maximum(den, 1e-12), 0.0)
+    goal_a = goal_a + lam * (on_sphere - goal_a)
+    # a held toe with the ankle out of the leg's reach: the heel lifts (the foot turns about the toe) until
+    # the ankle is back within reach, rather than the root going down
+    lifted = _within_reach(goal_a, goal_t, length[:, 0], hips, R)
+    goal_a = goal_a + lam * (lifted - goal_a)
+    return goal_a, goal_t, np.maximum(w_a, w_t)
+
+
+def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray, r2: np.ndarray) -> np.ndarray:
+    """``p`` on the sphere ``(c1, r1)`` moved along it to the nearest point within ``r2`` of ``c2`` (where
+    it is out of reach and the spheres meet; unchanged elsewhere).  All ``(T, 3)`` / ``(T,)``."""
+    out = p.copy()
+    far = np.linalg.norm(p - c2, axis=1) > r2
+    axis = c2 - c1
+    d = np.linalg.norm(axis, axis=1)
+    a = (d ** 2 + r1 ** 2 - r2 ** 2) / (2 * np.maximum(d, 1e-300))
+    meet = far & (d > 1e-12) & (np.abs(a) <= r1)
+    if meet.any():
+        n = axis[meet] / d[meet, None]
+        centre = c1[meet] + a[meet, None] * n
+        radius = np.sqrt(np.maximum(r1[meet] ** 2 - a[meet] ** 2, 0.0))
+        q = p[meet] - centre
+        q = q - np.sum(q * n, axis=1, keepdims=True) * n
+        out[meet] = centre + radius[:, None] * _normalize(q)
+    return out
+
+
+def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray], reach: float,
+              n_blend: int) -> np.ndarray:
+    """How far ``(T,)`` the root must go down so every held ankle goal (weight > 0) is within reach, smoothed
+    so it is never less."""
+    need = np.zeros(W.shape[0])
+    for foot, g, w in zip(contacts.feet, goals, weights, strict=True):
+        need = np.maximum(need, np.where(w > 0, _need(g, W[:, foot.hip], _reach(W, foot, reach), contacts.up), 0.0))
+    if not need.any():
+        return need
+    width = 2 * max(1, n_blend) + 1
+    return uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
+
+
+def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+    """Unit normals ``(T, 3)`` of the hip-knee-ankle plane; a straight leg takes the mean normal in its
+    thigh's frame over the frames where the knee is bent."""
+    n = np.cross(u1, u2)
+    s = np.linalg.norm(n, axis=1)
+    ok = s > 1e-4
+    n = np.where(ok[:, None], n / np.maximum(s, 1e-300)[:, None], 0.0)
+    if not ok.all():
+        if ok.any():
+            local = np.einsum("tji,tj->ti", Rw_hip[ok], n[ok]).mean(axis=0)
+        else:  # never bent: any axis across the leg
+            local = np.cross(np.einsum("tji,tj->ti", Rw_hip, u1).mean(axis=0), [0.0, 0.0, 1.0])
+            if np.linalg.norm(local) < 1e-9:
+                local = np.array([1.0, 0.0, 0.0])
+        local = local / np.linalg.norm(local)
+        n[~ok] = np.einsum("tij,j->ti", Rw_hip[~ok], local)
+    return n
+
+
+def _weights(contacts: Contacts, n_blend: int) -> np.ndarray:
+    """Hold weights ``(T, C)`` of every contact joint: 1 in contact, smoothstep ramps around."""
+    T, C = contacts.mask.shape
+    w = np.zeros((T, C))
+    for c in range(C):
+        n = len(ranges(contacts.mask[:, c]))
+        w[:, c] = _holds(contacts.mask[:, c], [np.zeros(3)] * n, n_blend)[0]
+    return w
+
+
+def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | None) -> np.ndarray:
+    """Horizontal world displacement ``(T, 3)`` of the root that cancels the hold-weighted mean horizontal
+    velocity of the planted contact joints (the hips follow the planted foot, as in a real stance), less
+    its mean over a period (or the take) so the travel is kept."""
+    T = W.shape[0]
+    if T < 2:
+        return np.zeros((T, 3))
+    up = contacts.up
+    w = _weights(contacts, n_blend)
+    v = np.diff(W[:, list(contacts.joints)], axis=0)                  # (T-1, C, 3)
+    v = v - (v @ up)[..., None] * up
+    ws = 0.5 * (w[1:] + w[:-1])
+    u = -np.einsum("tc,tci->ti", ws, v) / np.maximum(ws.sum(axis=1), 1.0)[:, None]
+    u -= u[period:2 * period].mean(axis=0) if period and T >= 3 * period else u.mean(axis=0)
+    shift = np.vstack([np.zeros(3), np.cumsum(u, axis=0)])
+    return shift - shift.mean(axis=0)
+
+
+def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
+    """``motion`` with its travel joint moved by ``world`` ``(T, 3)`` (world frame)."""
+    travel = motion.travel_joint
+    parent = int(motion.skeleton.parents[travel])
+    step = np.einsum("tji,tj->ti", Rw[:, parent], world) if parent >= 0 else world
+    trans = motion.translations.copy()
+    trans[:, travel] += step
+    return motion.replace(translations=trans)
+
+
+def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
+              follow: bool = True, period: int | None = None) -> Motion:
+    """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
+
+    ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
+    beyond which the root is lowered; ``follow``: first move the root horizontally with the planted feet;
+    ``period``: the motion is a loop repeated every ``period`` frames (at least three times), so the root
+    correction keeps the travel of each period.  Returns a new Motion with the same skeleton and frame time.
+    """
+    if contacts.n_frames != motion.n_frames:
+        raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
+    n_blend = max(1, int(round(blend / motion.frame_time)))
+    skel = motion.skeleton
+    Rw, W = motion.world_transforms()
+    if follow:
+        shift = _root_shift(W, contacts, n_blend, period)
+        if np.abs(shift).max() > 0:
+            motion = _move_travel(motion, Rw, shift)
+            Rw, W = motion.world_transforms()
+    goals, toe_goals, active = [], [], []
+    for f in range(len(contacts.feet)):
+        g, gt, act = _foot_goals(W, contacts, f, n_blend, reach)
+        goals.append(g)
+        toe_goals.append(gt)
+        active.append(act)
+    delta = _lowering(W, contacts, goals, active, reach, n_blend)
+    lowered = delta > 0
+    if lowered.any():
+        # a free leg that is bent keeps its foot where it was; a straight one rides down with the root
+        for f, foot in enumerate(contacts.feet):
+            H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
+            stretch = np.linalg.norm(A - H, axis=1) / (np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1))
+            keep = _smoothstep((STRAIGHT - stretch) / (STRAIGHT - BENT))
+            goals[f] = goals[f] - ((1.0 - active[f]) * (1.0 - keep) * delta)[:, None] * contacts.up
+        motion = _move_travel(motion, Rw, -np.outer(delta, contacts.up))
+        Rw, W = motion.world_transforms()
+    local = motion.rotation_matrices().copy()
+    for foot, g, gt, act in zip(contacts.feet, goals, toe_goals, active, strict=True):
+        t = np.flatnonzero((act > 0) | lowered)
+        if t.size == 0:
+            continue
+        H, K, A, G = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle], g[t]
+        l1 = np.linalg.norm(K - H, axis=1)
+        l2 = np.linalg.norm(A - K, axis=1)
+        u1, u2 = (K - H) / l1[:, None], (A - K) / l2[:, None]
+        n = _bend_normals(Rw[t, foot.hip], u1, u2)
+        beta0 = np.arctan2(np.sum(np.cross(u1, u2) * n, axis=1), np.sum(u1 * u2, axis=1))
+        d = np.clip(np.linalg.norm(G - H, axis=1), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
+        beta1 = np.pi - np.arccos(np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0))
+        R1 = Rotation.from_rotvec(n * (beta1 - beta0)[:, None]).as_matrix()     # knee bend, world frame
+        A1 = K + np.einsum("tij,tj->ti", R1, A - K)
+        R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
+        hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
+        Rp_hip = Rw[t, hp] if hp >= 0 else np.broadcast_to(np.eye(3), (t.size, 3, 3))
+        local[t, foot.hip] = np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rw[t, foot.hip]
+        local[t, foot.knee] = np.swapaxes(Rw[t, kp], 1, 2) @ R1 @ Rw[t, foot.knee]
+        aim = np.broadcast_to(np.eye(3), (t.size, 3, 3))
+        if gt is not None:
+            aim = _swing(W[t, foot.toe] - A, gt[t] - G)
+        new_parent = R2 @ R1 @ Rw[t, ap]
+        local[t, foot.ankle] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
+    T, J = motion.n_frames, motion.n_joints
+    quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, J, 4)
+    # frames and joints not touched keep their exact quaternions
+    touched = np.zeros((T, J), bool)
+    for foot, act in zip(contacts.feet, active, strict=True):
+        touched[np.ix_((act > 0) | lowered, [foot.hip, foot.knee, foot.ankle])] = True
+    quats = np.where(touched[..., None], quats, motion.rotations)
+    sign = np.where(np.sum(quats * motion.rotations, axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    return motion.replace(rotations=quats * sign)

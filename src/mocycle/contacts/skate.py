@@ -1,0 +1,58 @@
+"""How much the feet skate: the foot-skate measure, and leg pops.
+
+``skate`` — for each contact joint (ankle and toe of each foot), its
+horizontal speed on each frame step weighted by ``2 - 2**(h/H)`` while its
+height ``h`` above its lowest level is under ``H`` (weight 1 on the floor, 0 at
+``H``), averaged over all frame steps, then over the contact joints; in file
+units per second.  ``H`` is ``SKATE_HEIGHT`` of the body height.  A foot that
+glides while it is down counts fully, one that lifts away counts less and less.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..motion import Motion
+from .feet import Foot, body_height, find_feet, up_axis
+
+SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual absolute H
+
+
+def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = SKATE_HEIGHT,
+          up: np.ndarray | None = None, per_joint: bool = False) -> float | dict[str, float]:
+    """The skate measure of the module docstring (units/s); ``per_joint=True``: a dict joint name -> value."""
+    if feet is None or isinstance(feet, str):
+        feet = find_feet(motion.skeleton, feet)
+    up = up_axis(motion) if up is None else np.asarray(up, dtype=np.float64)
+    H = height * body_height(motion, up)
+    joints = [j for f in feet for j in f.contact_joints]
+    if motion.n_frames < 2:
+        return {motion.skeleton.names[j]: 0.0 for j in joints} if per_joint else 0.0
+    P = motion.world_positions()[:, joints]                     # (T, C, 3)
+    h = P @ up
+    h = h - h.min(axis=0)
+    step = np.diff(P, axis=0)
+    step = step - (step @ up)[..., None] * up
+    speed = np.linalg.norm(step, axis=-1) / motion.frame_time    # (T-1, C)
+    hm = 0.5 * (h[1:] + h[:-1])
+    w = np.where(hm < H, 2.0 - 2.0 ** (hm / H), 0.0)
+    values = (w * speed).mean(axis=0)
+    if per_joint:
+        return {motion.skeleton.names[j]: float(v) for j, v in zip(joints, values, strict=True)}
+    return float(values.mean())
+
+
+def leg_joints(feet: Sequence[Foot]) -> list[int]:
+    return sorted({j for f in feet for j in (f.hip, f.knee, f.ankle) + ((f.toe,) if f.toe is not None else ())})
+
+
+def largest_leg_step(motion: Motion, feet: Sequence[Foot] | None = None) -> float:
+    """The largest frame-to-frame change of any leg joint's local rotation (radians): a knee pop shows here."""
+    feet = find_feet(motion.skeleton) if feet is None else feet
+    q = motion.rotations[:, leg_joints(feet)]
+    if q.shape[0] < 2:
+        return 0.0
+    dots = np.clip(np.abs(np.sum(q[1:] * q[:-1], axis=-1)), 0.0, 1.0)
+    return float(2.0 * np.arccos(dots).max())

@@ -1,0 +1,82 @@
+"""Foot locking as the tasks that write motion use it (``feet``, ``foot_joints`` options; :mod:`mocycle.contacts`)."""
+
+from __future__ import annotations
+
+import time
+import warnings
+
+import numpy as np
+
+from ..errors import MocycleError, MocycleWarning
+
+FEET_MODES = ("auto", "lock", "keep")
+FEET_HELP = ("lock (feet held still on the floor during each contact; in place they slide back at the treadmill "
+             "speed), keep (as fitted) or auto (lock with --root motion when feet are found, else keep).")
+FOOT_JOINTS_HELP = ("Name the feet when the name patterns fail: ANKLE[:TOE],ANKLE[:TOE] (e.g. "
+                    "lfoot:ltoes,rfoot:rtoes).")
+
+
+def clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
+    """The cycle with its feet locked (or not), and what the JSON says about it."""
+    from ..contacts import find_feet, largest_leg_step, lock_cycle, skate
+
+    if mode == "auto":
+        try:
+            find_feet(cycle.space.skeleton, foot_joints)
+            mode = "lock" if root == "motion" else "keep"
+        except MocycleError as exc:
+            if root == "motion":
+                warnings.warn(f"feet not locked: {exc}", MocycleWarning, stacklevel=2)
+            mode = "keep"
+    facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
+             "largest_leg_step_before": None, "largest_leg_step_after": None, "seconds": 0.0}
+    if mode == "keep":
+        return cycle, facts, None
+    t0 = time.perf_counter()
+    cleaned, contacts = lock_cycle(cycle, foot_joints)
+    facts["seconds"] = time.perf_counter() - t0
+    before, after = cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
+    names = cycle.space.skeleton.names
+    facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=skate(before, contacts.feet),
+                 skate_after=skate(after, contacts.feet),
+                 largest_leg_step_before=largest_leg_step(before, contacts.feet),
+                 largest_leg_step_after=largest_leg_step(after, contacts.feet))
+    return cleaned, facts, contacts
+
+
+def travels(motion) -> bool:
+    """True when the take moves on: its travel joint goes farther than half the body height horizontally."""
+    from ..contacts import body_height, up_axis
+
+    up = up_axis(motion)
+    path = motion.world_positions()[:, motion.travel_joint]
+    step = path[-1] - path[0]
+    return bool(np.linalg.norm(step - (step @ up) * up) > 0.5 * body_height(motion, up))
+
+
+def lock_motion(motion, mode: str, foot_joints: str | None, moves: bool):
+    """Any motion with its feet locked (``mode`` lock, or auto when ``moves`` and feet are found) and what the
+    JSON says about it: a thin wrapper over :func:`mocycle.contacts.detect_contacts` and ``lock_feet``."""
+    from ..contacts import detect_contacts, find_feet, largest_leg_step, lock_feet, skate
+
+    if mode == "auto":
+        try:
+            find_feet(motion.skeleton, foot_joints)
+            mode = "lock" if moves else "keep"
+        except MocycleError as exc:
+            if moves:
+                warnings.warn(f"feet not locked: {exc}", MocycleWarning, stacklevel=2)
+            mode = "keep"
+    facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
+             "largest_leg_step_before": None, "largest_leg_step_after": None, "seconds": 0.0}
+    if mode == "keep":
+        return motion, facts
+    t0 = time.perf_counter()
+    contacts = detect_contacts(motion, foot_joints)
+    locked = lock_feet(motion, contacts)
+    facts["seconds"] = time.perf_counter() - t0
+    facts.update(contacts=contacts.to_dict(motion.skeleton.names), skate_before=skate(motion, contacts.feet),
+                 skate_after=skate(locked, contacts.feet),
+                 largest_leg_step_before=largest_leg_step(motion, contacts.feet),
+                 largest_leg_step_after=largest_leg_step(locked, contacts.feet))
+    return locked, facts

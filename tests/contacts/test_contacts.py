@@ -1,0 +1,125 @@
+import numpy as np
+import pytest
+
+from mocycle.contacts import detect_contacts, find_feet, largest_leg_step, lock_cycle, lock_feet, ranges, skate
+from mocycle.cycle import extract_cycle
+from mocycle.datasets import synthetic_still, synthetic_walk
+from mocycle.motion import Motion
+
+
+def test_ranges():
+    assert ranges(np.array([0, 1, 1, 0, 1], bool)) == [(1, 3), (4, 5)]
+    assert ranges(np.zeros(4, bool)) == []
+
+
+def _planted_walk(n_frames=240, fps=60.0, **kw):
+    """The synthetic walk (whose designed angles let the stance foot slide) with its root moved so that the
+    lower ankle stands still horizontally: a walk whose feet are planted."""
+    take = synthetic_walk(n_frames=n_frames, fps=fps, **kw)
+    m = take.motion
+    W = m.world_positions()
+    feet = find_feet(m.skeleton)
+    ankles = W[:, [f.ankle for f in feet]]                      # (T, 2, 3)
+    low = np.argmin(ankles[:, :, 1], axis=1)
+    step = np.diff(ankles, axis=0)[np.arange(m.n_frames - 1), low[:-1]]
+    t = m.translations.copy()
+    t[1:, 0, [0, 2]] -= np.cumsum(step[:, [0, 2]], axis=0)
+    return take, Motion(m.skeleton, m.rotations, t, m.frame_time)
+
+
+@pytest.mark.parametrize("fps", [30.0, 60.0, 120.0])
+def test_each_foot_is_planted_for_a_stance_of_every_step_at_any_frame_rate(fps):
+    _, walk = _planted_walk(n_frames=int(4 * fps), fps=fps)  # 4 steps per foot, 1 s period
+    con = detect_contacts(walk)
+    for f in range(2):
+        rs = con.foot_ranges(f)
+        inner = [r for r in rs if r[0] > 0 and r[1] < con.n_frames]
+        assert len(inner) >= 3
+        share = con.foot_mask(f).mean()
+        assert 0.3 < share < 0.75, share   # a walk's stance is about 60 % of the cycle
+
+
+def _slid_walk():
+    """The synthetic walk with a deliberate slide: the root surges back and forth by 6 cm at the step
+    frequency, so a planted foot slides with it."""
+    take, m = _planted_walk()
+    t = m.translations.copy()
+    t[:, 0, 2] += 6.0 * np.sin(2 * np.pi * 2 * take.unwrapped_phase)
+    return Motion(m.skeleton, m.rotations, t, m.frame_time)
+
+
+def test_locking_holds_the_feet_still_and_leaves_the_rest_alone():
+    m = _slid_walk()
+    con = detect_contacts(m)
+    out = lock_feet(m, con)
+    W0, W1 = m.world_positions(), out.world_positions()
+    assert con.mask.any(axis=0).all()  # every contact joint is planted somewhere despite the slide
+    for c, j in enumerate(con.joints):
+        for s, e in ranges(con.mask[:, c]):
+            assert np.abs(W1[s:e, j] - W1[s, j]).max() < 1e-6
+    # bone lengths exact: every joint keeps its distance to its parent (the root's translation may change)
+    par = m.skeleton.parents[1:]
+    assert np.abs(np.linalg.norm(W1[:, 1:] - W1[:, par], axis=-1)
+                  - np.linalg.norm(W0[:, 1:] - W0[:, par], axis=-1)).max() < 1e-9
+    # outside a foot's contacts and their blend windows its leg is unchanged, where the root was not lowered
+    n_blend = int(round(0.1 * m.fps))
+    lowered = ~np.all(out.translations == m.translations, axis=(1, 2))
+    checked = 0
+    for f, foot in enumerate(con.feet):
+        near = np.zeros(m.n_frames, bool)
+        for s, e in con.foot_ranges(f):
+            near[max(0, s - n_blend):e + n_blend] = True
+        free = ~near & ~lowered
+        leg = [foot.hip, foot.knee, foot.ankle]
+        assert np.array_equal(out.rotations[free][:, leg], m.rotations[free][:, leg])
+        checked += free.sum()
+    # only the root's translation changes; vertically it only ever goes down; without the horizontal
+    # follow step the root keeps its path horizontally
+    moved = out.translations - m.translations
+    assert np.abs(moved[:, 1:]).max() == 0.0 and (moved[:, 0, 1] <= 1e-12).all()
+    fixed = lock_feet(m, con, follow=False).translations - m.translations
+    assert np.abs(fixed[..., [0, 2]]).max() < 1e-12
+    # the non-leg joints keep their local rotations everywhere
+    legs = {j for f in con.feet for j in (f.hip, f.knee, f.ankle)}
+    others = [j for j in range(m.n_joints) if j not in legs]
+    assert np.allclose(out.rotations[:, others], m.rotations[:, others], atol=1e-12)
+
+
+def test_the_cleaned_cycle_loops_and_its_held_feet_advance_by_the_travel():
+    m = _planted_walk(n_frames=300, fps=60.0, noise_deg=0.3)[1]
+    cycle = extract_cycle(m)
+    cleaned, con = lock_cycle(cycle)
+    N = cleaned.n_frames
+    two = cleaned.repeat(2, root="motion")
+    W = two.world_positions()
+    # the seam: the step from frame N-1 to N is an ordinary step
+    steps = np.linalg.norm(np.diff(W, axis=0), axis=-1).max(axis=1)
+    assert steps[N - 1] < 1.5 * np.delete(steps, N - 1).max()
+    # a held foot of cycle 2 is the same foot of cycle 1 moved by exactly the travel
+    travel = cycle.drift[:3]
+    for c, j in enumerate(con.joints):
+        for s, e in ranges(con.mask[:, c]):
+            if e <= N:
+                # exact up to the fitted turn per cycle (a few hundredths of a degree here)
+                assert np.allclose(W[s + N:e + N, j] - W[s:e, j], travel, atol=1e-3 * np.linalg.norm(travel))
+                assert np.abs(W[s:e, j] - W[s, j]).max() < 1e-6
+    # in place, a held foot slides back at exactly the treadmill speed
+    inplace = cleaned.repeat(1, root="inplace").world_positions()
+    for c, j in enumerate(con.joints):
+        for s, e in ranges(con.mask[:, c]):
+            if e - s >= 2:
+                step = np.diff(inplace[s:e, j], axis=0)
+                assert np.allclose(step, -travel / N, atol=1e-3 * np.linalg.norm(travel) / N)
+    assert largest_leg_step(two) < 10 * largest_leg_step(cycle.repeat(2, root="motion"))
+
+
+def test_skate_counts_feet_gliding_on_the_floor():
+    still = synthetic_still(n_frames=30).motion
+    assert skate(still) == pytest.approx(0.0, abs=1e-9)
+    glide = still.translations.copy()
+    glide[:, 0, 2] += np.arange(30) * 2.0        # 2 cm per frame at 60 fps, feet on the floor
+    moving = Motion(still.skeleton, still.rotations, glide, still.frame_time)
+    assert skate(moving) == pytest.approx(2.0 * 60.0, rel=1e-6)
+    per = skate(moving, per_joint=True)
+    assert set(per) == {"LeftFoot", "LeftToeBase", "RightFoot", "RightToeBase"}
+    assert find_feet(still.skeleton)[0].side == "left"
