@@ -38,17 +38,17 @@ def _fails(args, *phrases, code=1):
     return result
 
 
-@pytest.mark.parametrize("args, phrase", [
-    (["convert", "{take}", "{out}/c.bvh", "--fps", "9e5"], "MOCYCLE_MAX_FRAMES"),
-    (["loop", "{take}", "-o", "{out}/l.bvh", "--cycles", "100000"], "MOCYCLE_MAX_FRAMES"),
-    (["stretch", "{take}", "--factor", "1e7", "-o", "{out}/s.bvh"], "MOCYCLE_MAX_FRAMES"),
-    (["convert", "{take}", "{out}/c.bvh", "--fps", "1e-300"], "fps"),
-    (["search", "{take}", "{out}", "--window", "inf"], "window"),
-    (["demo", "--seed", "-1", "--out", "{out}/demo"], "seed"),
+@pytest.mark.parametrize("args, phrase, code", [
+    (["convert", "{take}", "{out}/c.bvh", "--fps", "9e5"], "MOCYCLE_MAX_FRAMES", 1),
+    (["loop", "{take}", "-o", "{out}/l.bvh", "--cycles", "100000"], "MOCYCLE_MAX_FRAMES", 1),
+    (["stretch", "{take}", "--factor", "1e7", "-o", "{out}/s.bvh"], "MOCYCLE_MAX_FRAMES", 1),
+    (["convert", "{take}", "{out}/c.bvh", "--fps", "1e-300"], "fps", 1),
+    (["search", "{take}", "{out}", "--window", "inf"], "window", 2),   # a bad option value: a usage error
+    (["demo", "--seed", "-1", "--out", "{out}/demo"], "seed", 1),
 ])
-def test_absurd_options_are_one_line(take, tmp_path, args, phrase):
+def test_absurd_options_are_one_line(take, tmp_path, args, phrase, code):
     args = [a.format(take=take, out=tmp_path) for a in args]
-    result = _fails(args, phrase)
+    result = _fails(args, phrase, code=code)
     assert "Traceback" not in result.output
     assert [p.name for p in tmp_path.iterdir() if p.suffix == ".bvh" or p.name.endswith(".tmp")] == []
 

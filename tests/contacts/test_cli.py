@@ -36,7 +36,7 @@ def test_loop_feet_options(tmp_path):
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout)["feet"]["mode"] == "keep"
     result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--feet", "slide"])
-    assert result.exit_code == 1 and "--feet must be one of" in result.output
+    assert result.exit_code == 2 and "--feet must be one of" in result.output   # a bad option value: usage
     result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--feet", "lock", "--foot-joints", "nope"])
     assert result.exit_code == 1 and "no joint named 'nope'" in result.output
     result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--json", "--feet", "lock",

@@ -73,25 +73,25 @@ def loop(
         k = facts["class"]
         target = output.with_suffix(f".class{k}.bvh") if everything else output
         write(report.motions[f"loop.class{k}" if everything else "loop"], target)
+        images = []
         if feet_plot is not None:
             extra = report.extras[f"loop.class{k}" if everything else "loop"]
-            image = feet_plot.with_suffix(f".class{k}.png") if everything else feet_plot
-            _plot_feet(extra["fitted"], cycle, extra["contacts"], image, f"{path.name}: feet locked")
-        image = None
+            images.append(feet_plot.with_suffix(f".class{k}.png") if everything else feet_plot)
+            _plot_feet(extra["fitted"], cycle, extra["contacts"], images[-1], f"{path.name}: feet locked")
         if plot is not None:
             from ..viz import plot_loop
 
-            image = plot.with_suffix(f".class{k}.png") if everything else plot
-            plot_loop(report.motions["input"], cycle, image,
+            images.append(plot.with_suffix(f".class{k}.png") if everything else plot)
+            plot_loop(report.motions["input"], cycle, images[-1],
                       title=f"{path.name}: {method}{' ' + model if method == 'harmonic' else ''}")
         shown.append(({"file": str(path), "output": str(target), **facts, "seconds": report.seconds,
-                       "metrics_seconds": report.timings_s["metrics"]}, image))
+                       "metrics_seconds": report.timings_s["metrics"]}, images))
     if as_json:
         print_json({"file": str(path), "loops": [f for f, _ in shown]} if everything else shown[0][0])
         return
-    for facts, image in shown:
+    for facts, images in shown:
         _print_loop(facts)
-        if image is not None:
+        for image in images:
             out.print(f"wrote {image}", soft_wrap=True)
     out.print(timing_line(report))
 
@@ -106,7 +106,6 @@ def _plot_feet(fitted, cycle, contacts, image: Path, title: str) -> None:
     twice = Contacts(contacts.feet, contacts.joints, contacts.foot_of, np.tile(contacts.mask, (2, 1)), contacts.up,
                      contacts.body, contacts.frame_time)
     plot_contacts(cycle.repeat(2, root="motion"), twice, image, title=title, before=fitted.repeat(2, root="motion"))
-    out.print(f"wrote {image}", soft_wrap=True)
 
 
 def _print_loop(facts: dict) -> None:
