@@ -4,6 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 from typer.testing import CliRunner
 
 import mocycle.cli.blend  # noqa: F401  (registers the commands)
@@ -59,6 +60,25 @@ def test_a_wrong_period_fits_worse_than_a_plain_cut_and_is_refused(walk, wrong_p
     assert info.value.failed[0].name == "fit"
     with pytest.warns(MocycleWarning, match="fails the loop check.*fit.*--force"):
         assert check_loop(walk, cycle, force=True)
+
+
+def test_a_joint_turning_a_full_circle_every_cycle_is_a_loop():
+    """A left arm that spins once per cycle is a correct loop: the metrics' ruler must not wrap at ±π."""
+    take = synthetic_walk(n_frames=600, noise_deg=1.0)
+    motion = take.motion
+    arm = motion.skeleton.index("LeftArm")
+    q = motion.rotations.copy()
+    spin = Rotation.from_rotvec(np.outer(2 * np.pi * take.unwrapped_phase, [0, 0, 1]))
+    q[:, arm] = (spin * Rotation.from_quat(q[:, arm])).as_quat()
+    spinning = motion.replace(rotations=q)
+    cycle = extract_cycle(spinning)
+    metrics = loop_metrics(spinning, cycle)
+    for key in ("seam_pose", "seam_velocity", "seam_pose_local", "seam_velocity_local"):
+        assert metrics[key] < 1.5, key
+    plain = loop_metrics(motion, extract_cycle(motion))
+    assert metrics["template_error"] < 1.5 * plain["template_error"]  # the spin costs little, not 30 times more
+    assert loop_checks(spinning, cycle) == []
+    assert loop_checks(spinning, cycle, metrics) == []
 
 
 def test_a_cycle_longer_than_the_take_is_refused(walk):

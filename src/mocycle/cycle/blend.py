@@ -347,8 +347,8 @@ def _blend_P(Ps: Sequence[np.ndarray], w: np.ndarray, n_joints: int) -> np.ndarr
 
 
 def cycle_seam(cycle: Cycle) -> dict[str, float]:
-    """Seam ratios of a loop as :func:`~mocycle.cycle.loop_metrics` measures them (rotations relative to the
-    loop's own mean rotations, and the travel joint's in-place path; the larger of the two)."""
+    """Seam ratios of a loop as :func:`~mocycle.cycle.loop_metrics` measures them (rotations in the metrics'
+    rotation-matrix space, and the travel joint's in-place path; the larger of the two)."""
     C, root = loop_blocks(cycle, mean_rotations(cycle.motion("inplace").rotations))
     seams = [seam_ratios(C), seam_ratios(root)]
     return {f"seam_{k}": max(r[k] for r in seams) for k in ("pose", "velocity", "pose_local", "velocity_local")}
@@ -579,9 +579,10 @@ def _local_ratios(x: np.ndarray, periodic: bool) -> float:
 
 
 def transition_smoothness(tr: Transition) -> dict[str, float]:
-    """Whether a transition jumps anywhere: its largest pose step and velocity change (rotations relative to
-    the mean pose, radians) over the median of the 8 nearest (``step_local``, ``velocity_local``) and over the
-    median of all (``step_ratio``, ``velocity_ratio``); the same for the two input loops (``input_*``)."""
+    """Whether a transition jumps anywhere: its largest pose step and velocity change (in the loop metrics'
+    rotation-matrix space, :func:`~mocycle.cycle.extract.metric_features`) over the median of the 8 nearest
+    (``step_local``, ``velocity_local``) and over the median of all (``step_ratio``, ``velocity_ratio``); the
+    same for the two input loops (``input_*``)."""
     def ratios(m: Motion, periodic: bool) -> dict[str, float]:
         F = metric_features(m)
         if periodic:

@@ -12,7 +12,8 @@ A cycle is refused (:class:`~mocycle.errors.LoopRefused`, CLI exit 3) when
   (:func:`best_cut_error`).  A cut copies the take, so a fitted cycle that fits
   much worse than a copy of one period is not the take's cycle (usually the
   period found is wrong).  An error under :data:`FIT_FLOOR` of the take's own
-  spread (RMS distance of its poses from their mean) passes whatever the cut
+  spread (RMS distance of its poses from their mean, in the metrics' rotation-matrix
+  space: a joint turning full circles adds its circle's radius, not its growing angle) passes whatever the cut
   does: on a noise-free take the cut is exact and any fit is "infinitely" worse;
 * **seam** — its wrap jumps: the local seam ratio (the step across the wrap over
   the steps next to it, for pose or velocity, rotations or root path;

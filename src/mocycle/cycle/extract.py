@@ -354,14 +354,21 @@ def cut_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, p
 
 # ------------------------------------------------------------------ pipeline
 def metric_features(motion: Motion, reference: np.ndarray | None = None) -> np.ndarray:
-    """``(T, 3J)`` rotation vectors of every joint relative to ``reference`` ``(J, 4)`` (default: the
-    motion's own mean rotation per joint), in radians: the space the loop metrics are measured in.
-    It is the ``quatlog`` pose matrix (half the rotation vector) doubled."""
-    return 2.0 * pose_matrix(motion, rep="quatlog", root="drop", reference=reference)[0]
+    """``(T, 9J)`` the space the loop metrics are measured in: every joint's rotation matrix (its 9 entries,
+    :func:`~mocycle.features.pose_matrix` ``rotmat``) divided by √2.
+
+    The distance between two poses is then, per joint, ``||R1 - R2||_F / √2 = 2 sin(θ/2)`` for a relative
+    rotation of ``θ``: about ``θ`` in radians for small angles (0.5 % short at 20°, 4 % at 60°), and, unlike
+    a rotation vector, continuous for a joint that turns a full circle every cycle (no wrap at ±π); it is
+    the same wrap-free space the cycle is regressed in (:class:`~mocycle.cycle.representation.CycleSpace`).
+    ``reference`` (``(J, 4)``, the input's mean rotation per joint, as the callers pass it) changes no
+    distance in this space and is accepted for the callers' sake only; values are not relative to it.
+    """
+    return pose_matrix(motion, rep="rotmat", root="drop")[0] / np.sqrt(2.0)
 
 
 def loop_blocks(cycle: Cycle, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """What the seam of a cycle is judged on: its in-place rotations as :func:`metric_features` ``(N, 3J)``
+    """What the seam of a cycle is judged on: its in-place rotations as :func:`metric_features` ``(N, 9J)``
     and the world path of its travel joint ``(N, 3)``."""
     inplace = cycle.motion("inplace")
     return metric_features(inplace, reference), inplace.world_positions()[:, cycle.space.travel]

@@ -1,8 +1,12 @@
 """How good is a loop?  The numbers ``mocycle loop --json`` and ``benchmarks/cycles.py`` print.
 
-All pose errors are measured in one space for every method: the rotation
-vector of each joint relative to the input's mean rotation of that joint
-(radians, ``(T, 3J)``; :func:`~mocycle.cycle.extract.metric_features`).
+All pose errors are measured in one space for every method: each joint's
+rotation matrix, its 9 entries divided by √2 (``(T, 9J)``;
+:func:`~mocycle.cycle.extract.metric_features`).  Per joint the distance is
+``2 sin(θ/2)`` for a relative rotation of ``θ``: radians for small angles
+(0.5 % short at 20°), and continuous for a joint that turns a full circle
+every cycle, where a rotation vector would wrap at ±π and call a correct
+loop broken.
 
 * ``rmse_h``, ``rmse_dh``, ``rmse_ddh`` — KTH thesis eq. 4.1-4.3: the cycle read
   at each input frame's phase against the input, for poses (rad), velocities

@@ -48,21 +48,22 @@ def loop_plot_data(motion, cycle, n_joints: int = 3) -> dict:
     Returns
     -------
     dict with ``input_xy`` ``(T, 2)`` and ``cycle_xy`` ``(N + 1, 2)`` (closed): the input's poses and the
-    cycle in the 2-D PCA of the excited input frames; ``frames`` ``(M,)``: the excited frames;
+    cycle in the 2-D PCA of the excited input frames (in the loop metrics' rotation-matrix space,
+    :func:`~mocycle.cycle.extract.metric_features`); ``frames`` ``(M,)``: the excited frames;
     ``input_phase`` ``(M,)``: where each falls in the cycle (cycles); ``coords`` ``(T,)``: the circular
     coordinate (``None`` for a blend); ``axis_phase`` ``(M,)``: the time axis mod 1; ``regions``;
-    ``curves``: the ``n_joints`` most moving rotation columns, each with its ``name``, ``cycle_deg``
-    ``(2N,)`` over two repetitions and the input's ``input_deg`` ``(M,)`` at ``positions`` ``(M,)`` (cycle
-    frames); ``n_frames``, ``n_periods``, ``period_frames``, ``method``, ``model``, ``axis_method``.
+    ``curves``: the ``n_joints`` most moving rotation-vector components about the mean pose, each with its
+    ``name``, ``cycle_deg`` ``(2N,)`` over two repetitions and the input's ``input_deg`` ``(M,)`` at
+    ``positions`` ``(M,)`` (cycle frames); ``n_frames``, ``n_periods``, ``period_frames``, ``method``,
+    ``model``, ``axis_method``.
     """
     from ..cycle.extract import metric_features
     from ..features import pose_matrix
     from ..rotations import mean_rotations
 
     ref = mean_rotations(motion.rotations)
-    Y = metric_features(motion, ref)
-    names = pose_matrix(motion[:1], rep="quatlog", root="drop", reference=ref)[1].columns
-    C = metric_features(cycle.motion("inplace"), ref)
+    inplace = cycle.motion("inplace")
+    Y, C = metric_features(motion, ref), metric_features(inplace, ref)  # the metrics' wrap-free space
     frames = cycle.axis.frames()
     if Y.shape[1] >= 2:
         pca = PCA(n_components=2).fit(Y[frames])
@@ -70,10 +71,14 @@ def loop_plot_data(motion, cycle, n_joints: int = 3) -> dict:
     else:
         input_xy = np.c_[Y[:, 0], np.zeros(len(Y))]
         cycle_xy = np.c_[np.r_[C[:, 0], C[:1, 0]], np.zeros(len(C) + 1)]
-    spread = np.ptp(Y[frames], axis=0)
+    # The curves are what an animator reads: rotation-vector components about the mean pose (a joint turning
+    # a full circle shows its turn as a 360° jump there; the PCA above has none).
+    V, decoder = pose_matrix(motion, rep="quatlog", root="drop", reference=ref)
+    V, Vc = 2.0 * V, 2.0 * pose_matrix(inplace, rep="quatlog", root="drop", reference=ref)[0]
+    spread = np.ptp(V[frames], axis=0)
     cols = np.argsort(spread)[::-1][:n_joints]
-    curves = [{"name": names[col], "cycle_deg": np.degrees(np.tile(C[:, col], 2)),
-               "input_deg": np.degrees(Y[frames, col])} for col in cols]
+    curves = [{"name": decoder.columns[col], "cycle_deg": np.degrees(np.tile(Vc[:, col], 2)),
+               "input_deg": np.degrees(V[frames, col])} for col in cols]
     return {
         "input_xy": input_xy, "cycle_xy": cycle_xy, "frames": frames,
         "input_phase": np.mod(cycle.positions / cycle.n_frames, 1),
