@@ -144,14 +144,14 @@ def curves_plot_data(series, n_joints: int = 3) -> dict:
     ``series``: one dict per motion with ``label``, ``x`` ``(T,)`` and ``degrees`` ``(T, n_joints)``: the
     rotation from the first motion's mean pose (quaternion log, degrees).
     """
-    from ..cycle.extract import metric_features
     from ..features import pose_matrix
     from ..rotations import mean_rotations
 
     first = series[0][1]
     ref = mean_rotations(first.rotations)
     names = pose_matrix(first[:1], rep="quatlog", root="drop", reference=ref)[1].columns
-    feats = [metric_features(m, ref) for _, m, _ in series]
+    # rotation vectors about the first motion's mean pose (2 x quaternion log, rad): angles a plot can label
+    feats = [2.0 * pose_matrix(m, rep="quatlog", root="drop", reference=ref)[0] for _, m, _ in series]
     cols = np.argsort(np.ptp(feats[0], axis=0))[::-1][:n_joints]
     out = []
     for (label, motion, x), F in zip(series, feats, strict=True):
