@@ -34,57 +34,12 @@ import traceback
 import zlib
 from pathlib import Path
 
+from mocycle.datasets.asfamc_text import TINY_AMC, TINY_ASF
+
 READERS = ("bvh", "asf", "amc", "mck", "mosw")
 DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
-ASF = """:version 1.10
-:name fuzz
-:units
-  mass 1.0
-  length 0.45
-  angle deg
-:root
-   order TX TY TZ RX RY RZ
-   axis XYZ
-   position 0 0 0
-   orientation 0 0 0
-:bonedata
-  begin
-     id 1
-     name lfemur
-     direction 0 -1 0
-     length 7
-     axis 0 0 20 XYZ
-    dof rx ry rz
-    limits (-160 20)
-           (-70 70)
-           (-60 70)
-  end
-  begin
-     id 2
-     name ltibia
-     direction 0 -1 0
-     length 7.5
-     axis 0 0 20 XYZ
-    dof rx
-  end
-  begin
-     id 3
-     name thorax
-     direction 0 1 0
-     length 3
-     axis 0 0 0 ZYX
-    dof rz rx
-  end
-:hierarchy
-  begin
-    root lfemur thorax
-    lfemur ltibia
-  end
-"""
-AMC = ":FULLY-SPECIFIED\n:DEGREES\n" + "".join(
-    f"{f}\nroot {f} 2 3 {f} 0 0\nlfemur {10 + f} -5 3\nltibia {40 + f}\nthorax 5 {f}\n" for f in range(1, 5))
-
+ASF, AMC = TINY_ASF, TINY_AMC
 
 class Hang(Exception):
     pass

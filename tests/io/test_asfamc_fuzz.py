@@ -12,81 +12,14 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from fuzzing import edited_text, fuzz_settings, limits
+from mocycle.datasets.asfamc_text import TINY_AMC, TINY_ASF
 from mocycle.errors import MocycleWarning, MotionFileError
 from mocycle.io.asfamc import parse_amc, parse_asf
 from mocycle.io.bvh import format_bvh, parse_bvh
 
 pytestmark = pytest.mark.filterwarnings("ignore::mocycle.errors.MocycleWarning")
 
-ASF = """\
-:version 1.10
-:name fuzz
-:units
-  mass 1.0
-  length 0.45
-  angle deg
-:root
-   order TX TY TZ RX RY RZ
-   axis XYZ
-   position 0 0 0
-   orientation 0 0 0
-:bonedata
-  begin
-     id 1
-     name lfemur
-     direction 0 -1 0
-     length 7
-     axis 0 0 20 XYZ
-    dof rx ry rz
-    limits (-160 20)
-           (-70 70)
-           (-60 70)
-  end
-  begin
-     id 2
-     name ltibia
-     direction 0 -1 0
-     length 7.5
-     axis 0 0 20 XYZ
-    dof rx
-    limits (-10 170)
-  end
-  begin
-     id 3
-     name thorax
-     direction 0 1 0
-     length 3
-     axis 0 0 0 ZYX
-    dof rz rx
-    limits (-inf inf) (-20 20)
-  end
-:hierarchy
-  begin
-    root lfemur thorax
-    lfemur ltibia
-  end
-"""
-
-AMC = """\
-:FULLY-SPECIFIED
-:DEGREES
-1
-root 1 2 3 0 0 0
-lfemur 10 -5 3
-ltibia 40
-thorax 5 2
-2
-root 1.5 2 3.5 1 2 3
-lfemur 12 -4 2
-ltibia 45
-thorax 6 1
-3
-root 2 2 4 2 4 6
-lfemur 14 -3 1
-ltibia 50
-thorax 7 0
-"""
-
+ASF, AMC = TINY_ASF, TINY_AMC
 VOCAB = [":version", ":name", ":units", ":root", ":bonedata", ":hierarchy", ":DEGREES", ":RADIANS", "begin", "end",
          "id", "name", "direction", "length", "axis", "dof", "limits", "order", "position", "orientation", "root",
          "lfemur", "ltibia", "thorax", "rx", "ry", "rz", "tx", "l", "XYZ", "ZYX", "XXY", "TX", "RZ", "(", ")", "deg",

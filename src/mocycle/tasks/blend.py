@@ -11,7 +11,6 @@ from ..errors import OptionError
 from . import fields
 from .fields import phase_options
 from .options import Flag, option
-from .options import Options as _Options
 from .report import Recorder, Report, label_of, load
 
 LABELS = {
@@ -37,27 +36,14 @@ def _weights(name: str, value):
 
 
 @dataclass(frozen=True)
-class Options(_Options):
-    """Options of ``blend``."""
+class Options(fields.CycleOptions):
+    """Options of ``blend`` (and how each take's cycle is found: :class:`~mocycle.tasks.fields.CycleOptions`)."""
 
     weights: tuple[float, ...] | None = option(
         None, "One weight >= 0 per take, comma-separated (normalised to sum 1); default equal.", _weights)
     root: str = fields.root("inplace", "inplace (on the spot) or motion (moves on by the blended stride).")
     cycles: int = fields.cycles(1, "Repeat the loop this many times in the output.")
-    method: str = fields.method()
-    model: str = fields.model()
-    harmonics: int | str = fields.harmonics()
     align: bool = option(True, "Search each take's phase offset against the first.", Flag())
-    joints: str | None = fields.phase_joints()
-    classes: int | str = fields.classes()
-    which: int | None = fields.which()
-    pca: int | str | None = fields.pca()
-    delay: int = fields.delay()
-    min_periods: float = fields.min_periods()
-    amc_fps: float = fields.amc_fps()
-    force: bool = fields.force_cycle()
-    feet: str = fields.feet()
-    foot_joints: str | None = fields.foot_joints()
 
 
 def run(takes: Sequence, options: Options | None = None) -> Report:

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from ..io.asfamc import AMC_FPS
 from ..phase.analysis import MIN_PERIODS
 from ..swings.segment import DEFAULT_THRESHOLD as SWING_THRESHOLD
-from .options import Choice, Flag, Integer, Real, Text, option
+from .options import Choice, Flag, Integer, Options, Real, Text, option
 
-__all__ = ["AMC_FPS", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay", "feet", "foot_joints",
-           "force_cycle", "harmonics", "joints", "method", "min_periods", "model", "pca", "phase_joints", "root",
-           "swing_joints", "threshold", "which"]
+__all__ = ["AMC_FPS", "CycleOptions", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay",
+           "feet", "foot_joints", "force_cycle", "harmonics", "joints", "method", "min_periods", "model", "pca",
+           "phase_joints", "root", "swing_joints", "threshold", "which"]
 
 METHODS = ("harmonic", "centroid", "cut")
 MODELS = ("M1", "M2", "M3")
@@ -106,3 +108,22 @@ def foot_joints():
 def swing_joints():
     return joints("Joints to segment: names, glob patterns or groups (legs, arms, spine), comma-separated "
                   "(default: the major bones, by name and motion energy).")
+
+
+@dataclass(frozen=True)
+class CycleOptions(Options):
+    """How the cycle of each input take is found and checked: the options ``blend`` and ``transition`` share."""
+
+    method: str = method()
+    model: str = model()
+    harmonics: int | str = harmonics()
+    joints: str | None = phase_joints()
+    classes: int | str = classes()
+    which: int | None = which()
+    pca: int | str | None = pca()
+    delay: int = delay()
+    min_periods: float = min_periods()
+    amc_fps: float = amc_fps()
+    force: bool = force_cycle()
+    feet: str = feet()
+    foot_joints: str | None = foot_joints()

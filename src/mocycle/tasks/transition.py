@@ -8,7 +8,6 @@ from dataclasses import dataclass
 from ..errors import OptionError
 from . import fields
 from .fields import phase_options
-from .options import Options as _Options
 from .report import Recorder, Report, label_of, load
 
 LABELS = {
@@ -19,24 +18,11 @@ LABELS = {
 
 
 @dataclass(frozen=True)
-class Options(_Options):
-    """Options of ``transition``."""
+class Options(fields.CycleOptions):
+    """Options of ``transition`` (and how each take's cycle is found: :class:`~mocycle.tasks.fields.CycleOptions`)."""
 
     cycles: int = fields.cycles(3, "Cycles over which the weight moves from the first to the second.")
     root: str = fields.root("motion", "motion (travels on) or inplace (on the spot).")
-    method: str = fields.method()
-    model: str = fields.model()
-    harmonics: int | str = fields.harmonics()
-    joints: str | None = fields.phase_joints()
-    classes: int | str = fields.classes()
-    which: int | None = fields.which()
-    pca: int | str | None = fields.pca()
-    delay: int = fields.delay()
-    min_periods: float = fields.min_periods()
-    amc_fps: float = fields.amc_fps()
-    force: bool = fields.force_cycle()
-    feet: str = fields.feet()
-    foot_joints: str | None = fields.foot_joints()
 
 
 def run(takes: Sequence, options: Options | None = None) -> Report:
