@@ -1,0 +1,6 @@
+"""placeholder"""
+def register():
+    import mocycle
+    print("REGISTER", mocycle.__file__)
+def unregister():
+    pass
