@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
+from scipy.spatial.transform import Rotation
+
 from mocycle import Motion, Skeleton
 from mocycle.errors import MocycleError
 from mocycle.rotations import continuous_euler, euler_to_quats
-from scipy.spatial.transform import Rotation
 
 from . import channels
 
@@ -65,11 +66,12 @@ def _euler_channels(mode: str) -> tuple:
 
 
 def skeleton_of(arm, moving: set | None = None) -> Skeleton:
-    """The armature's rest skeleton in world units: offsets ``s R_O (h_j − h_p)``, the root at its world head."""
+    """The armature's rest skeleton in world units: offsets ``s (h_j − h_p)`` (in the parent's frame, which only
+    the root's rotation turns into the world), the root at its world head ``s R_O h + o``."""
     bones = bone_order(arm)
     s, R_O, o = _object_frame(arm)
     _, h, parents = _rest(arm, bones)
-    offsets = s * (h - np.where(parents[:, None] >= 0, h[parents], 0.0)) @ R_O.T
+    offsets = s * (h - np.where(parents[:, None] >= 0, h[parents], 0.0))
     offsets[0] = s * R_O @ h[0] + o
     pos = ("Xposition", "Yposition", "Zposition")
     chans = []

@@ -1,0 +1,240 @@
+"""The operators: read the active armature's action, call ``mocycle.tasks``, write new actions. No algorithm."""
+
+from __future__ import annotations
+
+import json
+
+import bpy
+
+from mocycle import tasks
+from mocycle.errors import MocycleError
+
+from . import props, rig
+
+
+def _armature(context):
+    arm = context.active_object
+    if arm is None or arm.type != "ARMATURE":
+        raise MocycleError("select an armature (the active object is not one)")
+    if arm.animation_data is None or arm.animation_data.action is None:
+        raise MocycleError(f"armature {arm.name!r} has no active action")
+    return arm
+
+
+def _selected_bones(arm) -> list[str]:
+    """Bones selected in Pose Mode (5.0 keeps the flag on the pose bone, earlier versions on the bone)."""
+    def selected(pb):
+        flag = getattr(pb, "select", None)
+        return pb.bone.select if flag is None else flag
+    return [pb.name for pb in arm.pose.bones if selected(pb) and not pb.bone.hide]
+
+
+def _joints(op, arm) -> str | None:
+    """The thesis' options 25-26: in Pose Mode the selected bones carry the phase (None: the task decides)."""
+    if op.selected_bones and arm.mode == "POSE":
+        names = _selected_bones(arm)
+        if names:
+            return ",".join(names)
+    return None
+
+
+def _frame_range(op, action) -> tuple[int, int, str | None]:
+    """(first frame read, last frame read, the task's START:STOP over those frames or None)."""
+    first, last = rig.action_frames(action)
+    if not op.use_frame_range:
+        return first, last, None
+    start, end = max(op.frame_start, first), min(op.frame_end, last)
+    if end <= start:
+        raise MocycleError(f"frame range {op.frame_start}..{op.frame_end} leaves no frames of {action.name!r} "
+                           f"({first}..{last})")
+    return first, last, f"{start - first}:{end - first + 1}"
+
+
+def _actions(arm, first, other: str) -> list:
+    names = [n.strip() for n in other.split(",") if n.strip()]
+    missing = [n for n in names if n not in bpy.data.actions]
+    if missing:
+        raise MocycleError(f"no action named {', '.join(map(repr, missing))}")
+    return [first] + [bpy.data.actions[n] for n in names]
+
+
+def _state(context):
+    return context.scene.mocycle
+
+
+def _record(context, task: str, action, period=-1.0, seam=-1.0, skate=-1.0, message="") -> None:
+    st = _state(context)
+    st.last_task, st.last_action = task, action.name if action else ""
+    st.last_period, st.last_seam, st.last_skate, st.last_message = period, seam, skate, message
+
+
+def _keep_facts(action, report) -> None:
+    action["mocycle"] = json.dumps({"task": report.task, **report.facts}, default=str)
+
+
+def _wrap(result, cycles: int, root: str):
+    """The pose after the last frame of ``cycles`` repeats: the loop's first pose (moved on with the root)."""
+    n = result.n_frames
+    return result.repeat(cycles + 1, root=root)[cycles * n:cycles * n + 1]
+
+
+class _Task(bpy.types.Operator):
+    """Shared run/report of the operators; subclasses implement ``work(context, arm) -> str``."""
+
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.active_object
+        return ob is not None and ob.type == "ARMATURE"
+
+    def execute(self, context):
+        try:
+            arm = _armature(context)
+            message = self.work(context, arm)
+        except (MocycleError, ValueError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        for w in getattr(self, "_warnings", ()):
+            self.report({"WARNING"}, w)
+        self.report({"INFO"}, message)
+        return {"FINISHED"}
+
+
+def _task_operator(idname, label, description, options_cls, extra: dict):
+    annotations = {**props.annotations(options_cls), **extra}
+    return type(f"MOCYCLE_OT_{idname}", (_Task,), {
+        "bl_idname": f"mocycle.{idname}", "bl_label": label, "bl_description": description,
+        "__annotations__": annotations, "options_cls": options_cls})
+
+
+def _find_phase(self, context, arm):
+    action = arm.animation_data.action
+    first, last, window = _frame_range(self, action)
+    motion = rig.to_motion(arm, action, (first, last))
+    if window:
+        a, b = (int(x) for x in window.split(":"))
+        motion = motion[a:b]
+    report = tasks.phase.run(motion, props.options_from(tasks.phase.Options, self, joints=_joints(self, arm)))
+    st = _state(context)
+    st.periodic.clear()
+    for c in report.facts["classes"]:
+        item = st.periodic.add()
+        item.period_frames, item.period_s, item.n_periods = c["period_frames"], c["period_s"], c["n_periods"]
+        item.excitation = ", ".join(f"{s + first}-{e + first - 1}" for s, e in c["excitation"])
+    st.periodic_index = 0 if len(st.periodic) else -1
+    self._warnings = report.warnings
+    if not st.periodic:
+        message = f"{action.name}: no periodic motion ({report.facts['reason']})"
+        _record(context, "find_phase", action, message=message)
+        return message
+    best = report.facts["classes"][0]
+    message = (f"{action.name}: {len(st.periodic)} periodic motion(s); first: period "
+               f"{best['period_frames']:.1f} frames ({best['period_s']:.2f} s), {best['n_periods']:.1f} periods")
+    _record(context, "find_phase", action, period=best["period_frames"], message=message)
+    return message
+
+
+def _extract_cycle(self, context, arm):
+    action = arm.animation_data.action
+    first, last, window = _frame_range(self, action)
+    motion = rig.to_motion(arm, action, (first, last))
+    options = props.options_from(tasks.loop.Options, self, frame_range=window, joints=_joints(self, arm),
+                                 which=None if self.which < 0 else self.which)
+    report = tasks.loop.run(motion, options)
+    cycle, loop = report.result, report.motions["loop"]
+    new = rig.write_action(arm, loop, f"{action.name}_cycle", first, wrap=_wrap(cycle, options.cycles, options.root),
+                           travel=options.root == "motion")
+    _keep_facts(new, report)
+    rig_assign(arm, new)
+    f = report.facts
+    skate = f["feet"]["skate_after"] if f["feet"].get("skate_after") is not None else f["metrics"]["skate"]
+    self._warnings = report.warnings
+    message = (f"{new.name}: period {f['period_frames']:.1f} frames, {f['cycle_frames']} frames a cycle × "
+               f"{options.cycles}, seam {f['metrics']['seam_pose']:.2f}× median step, foot skate {skate:.3g}")
+    _record(context, "extract_cycle", new, f["period_frames"], f["metrics"]["seam_pose"], skate, message)
+    return message
+
+
+def _blend_cycles(self, context, arm):
+    action = arm.animation_data.action
+    actions = _actions(arm, action, self.other)
+    if len(actions) < 2:
+        raise MocycleError("blend needs at least one other action (Other actions)")
+    motions = [rig.to_motion(arm, a) for a in actions]
+    options = props.options_from(tasks.blend.Options, self, which=None if self.which < 0 else self.which)
+    report = tasks.blend.run(motions, options)
+    result = report.result
+    new = rig.write_action(arm, report.motions["loop"], f"{action.name}_blend", rig.action_frames(action)[0],
+                           wrap=_wrap(result, options.cycles, options.root), travel=options.root == "motion")
+    _keep_facts(new, report)
+    rig_assign(arm, new)
+    f = report.facts
+    self._warnings = report.warnings
+    message = (f"{new.name}: blend of {', '.join(a.name for a in actions)}, period {f['period_frames']:.1f} "
+               f"frames, seam {f['seam']['seam_pose']:.2f}× median step")
+    _record(context, "blend_cycles", new, f["period_frames"], f["seam"]["seam_pose"], -1.0, message)
+    return message
+
+
+def _transition(self, context, arm):
+    action = arm.animation_data.action
+    actions = _actions(arm, action, self.other)
+    if len(actions) != 2:
+        raise MocycleError("transition needs exactly one other action (Other actions)")
+    motions = [rig.to_motion(arm, a) for a in actions]
+    options = props.options_from(tasks.transition.Options, self, which=None if self.which < 0 else self.which)
+    report = tasks.transition.run(motions, options)
+    new = rig.write_action(arm, report.motions["transition"], f"{actions[0].name}_to_{actions[1].name}",
+                           rig.action_frames(action)[0])
+    _keep_facts(new, report)
+    rig_assign(arm, new)
+    f = report.facts
+    self._warnings = report.warnings
+    message = (f"{new.name}: {f['frames']} frames over {f['cycles']} cycles, period {f['period_frames_start']:.1f}"
+               f" → {f['period_frames_end']:.1f} frames")
+    _record(context, "transition", new, message=message)
+    return message
+
+
+def _stretch(self, context, arm):
+    action = arm.animation_data.action
+    first, last = rig.action_frames(action)
+    motion = rig.to_motion(arm, action, (first, last))
+    report = tasks.stretch.run(motion, props.options_from(tasks.stretch.Options, self))
+    new = rig.write_action(arm, report.motions["stretched"], f"{action.name}_stretched", first)
+    _keep_facts(new, report)
+    rig_assign(arm, new)
+    f = report.facts
+    self._warnings = report.warnings
+    skate = f["feet"].get("skate_after")
+    message = f"{new.name}: {f['frames_in']} → {f['frames_out']} frames (factor {f['factor']:g})"
+    _record(context, "stretch", new, skate=-1.0 if skate is None else skate, message=message)
+    return message
+
+
+def rig_assign(arm, action) -> None:
+    """Make the new action the armature's active one (the source stays in the file, kept by a fake user)."""
+    old = arm.animation_data.action
+    if old is not None:
+        old.use_fake_user = True
+    rig.channels.assign(arm, action)
+
+
+COMMON = props.COMMON
+FindPhase = _task_operator("find_phase", "Find Phase", "The periodic motions of the active action (period, "
+                           "number of periods, excitation), listed in the panel", tasks.phase.Options, COMMON)
+ExtractCycle = _task_operator("extract_cycle", "Extract Cycle", "The typical cycle of the active action as a new, "
+                              "looping action named <action>_cycle", tasks.loop.Options, {**COMMON, **props.WHICH})
+BlendCycles = _task_operator("blend_cycles", "Blend Cycles", "Blend the cycles of the active action and other "
+                             "actions (weights) into a new looping action", tasks.blend.Options,
+                             {**props.WHICH, **props.OTHER})
+Transition = _task_operator("transition", "Transition", "A new action that starts as the active action's cycle "
+                            "and ends as the other action's", tasks.transition.Options, {**props.WHICH, **props.OTHER})
+Stretch = _task_operator("stretch", "Stretch", "The active action lengthened by a factor (time-frequency warping "
+                         "of its periodic part) as a new action", tasks.stretch.Options, {})
+FindPhase.work, ExtractCycle.work, BlendCycles.work = _find_phase, _extract_cycle, _blend_cycles
+Transition.work, Stretch.work = _transition, _stretch
+
+
+CLASSES = (FindPhase, ExtractCycle, BlendCycles, Transition, Stretch)
