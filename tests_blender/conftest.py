@@ -32,8 +32,9 @@ def _build_zip(out: Path) -> Path:
     given = os.environ.get("MOCYCLE_BLENDER_ZIP")
     if given:
         return Path(given)
-    subprocess.run([sys.executable, str(REPO / "blender" / "build_extension.py"), "--platform", "linux-x64",
-                    "--out", str(out)], check=True, stdout=subprocess.DEVNULL)
+    done = subprocess.run([sys.executable, str(REPO / "blender" / "build_extension.py"), "--platform", "linux-x64",
+                           "--out", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, f"building the extension failed:\n{done.stdout}\n{done.stderr}"
     (zip_path,) = out.glob("mocycle-*-linux_x64.zip")
     return zip_path
 

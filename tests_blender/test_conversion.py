@@ -4,6 +4,7 @@ rotation mode, a rotated, scaled, moved Y-up armature object) round-trip exactly
 import bpy
 import numpy as np
 import pytest
+
 from conftest import import_bvh, shared_path
 
 #: Blender's BVH importer (forward -Z, up Y, its defaults) maps a file's (x, y, z) to Blender's (x, -z, y)
@@ -62,7 +63,8 @@ def test_z_up_turning_walk_bvh(addon, scene, tmp_path):
 
 
 @pytest.mark.shared_data
-@pytest.mark.parametrize("parts", [("cmu", "01_01.bvh"), ("cmu-iclone", "07_01.bvh"), ("bandai", "dataset-1_walk_normal_001.bvh")])
+@pytest.mark.parametrize("parts", [("cmu", "01_01.bvh"), ("cmu-iclone", "07_01.bvh"),
+                                   ("bandai", "dataset-1_walk_normal_001.bvh")])
 def test_real_bvh(addon, scene, parts):
     arm, motion = check_bvh(addon, shared_path(*parts))
     assert max(roundtrip(addon, arm, motion)) <= 1e-6
@@ -117,6 +119,7 @@ def test_ordinary_rig_roundtrip_and_playback(addon, scene):
     rolled; quaternion, axis-angle and several Euler modes. The action written from a Motion reads back exactly
     and Blender's own pose evaluation puts every bone head where the Motion's forward kinematics do."""
     from mathutils import Matrix
+
     from mocycle.datasets import synthetic_walk
 
     walk = synthetic_walk(n_frames=90, fps=30).motion
@@ -152,7 +155,7 @@ def test_euler_modes_match_blender(addon, extension):
         q = addon.rig.basis_quats(mode, angles)
         for a, qq in zip(angles, q, strict=True):
             m = np.array(Euler(a, mode).to_quaternion())  # (w, x, y, z)
-            assert min(np.abs(m - qq[[3, 0, 1, 2]]).max(), np.abs(m + qq[[3, 0, 1, 2]]).max()) < 1e-6  # mathutils is float32
+            assert min(np.abs(m - qq[[3, 0, 1, 2]]).max(), np.abs(m + qq[[3, 0, 1, 2]]).max()) < 1e-6
         prop, back = addon.rig.mode_values(mode, q)
         assert np.allclose(np.abs(np.sum(addon.rig.basis_quats(mode, back) * q, axis=1)), 1.0)
 
