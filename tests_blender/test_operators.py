@@ -1,0 +1,219 @@
+"""Every operator on BVH takes imported with ``bpy.ops.import_anim.bvh``: new actions of the right length that
+loop (Blender's own evaluation, Cycles modifiers included), the options reaching the task, errors, undo."""
+
+import json
+
+import bpy
+import numpy as np
+import pytest
+
+from conftest import import_bvh, shared_path
+
+FPS = 30
+
+
+def heads(arm, frame) -> np.ndarray:
+    """World positions of every bone head at ``frame``, as Blender evaluates the armature."""
+    bpy.context.scene.frame_set(frame)
+    return np.array([np.array(arm.matrix_world @ pb.head) for pb in arm.pose.bones])
+
+
+def local_rotations(arm, frame) -> np.ndarray:
+    bpy.context.scene.frame_set(frame)
+    return np.array([np.array(pb.matrix_basis.to_quaternion()) for pb in arm.pose.bones])
+
+
+def size(arm) -> float:
+    return float(np.ptp(heads(arm, 1), axis=0).max())
+
+
+def facts(action) -> dict:
+    return json.loads(action["mocycle"])
+
+
+def write_take(tmp_path, name, make, **kw):
+    import mocycle
+
+    path = tmp_path / f"{name}.bvh"
+    mocycle.write(make(fps=FPS, **kw).motion, path)
+    return path
+
+
+@pytest.fixture
+def walk(scene, tmp_path):
+    """A synthetic walk (1 s period, 8 periods at 30 fps) imported from BVH: armature 'Walk', action 'Walk'."""
+    from mocycle.datasets import synthetic_walk
+
+    return import_bvh(write_take(tmp_path, "Walk", synthetic_walk, n_frames=240))
+
+
+@pytest.fixture
+def run_action(walk, tmp_path):
+    """A synthetic run (0.7 s) on the same skeleton: action 'Run' (its armature is deleted, the action kept)."""
+    from mocycle.datasets import synthetic_run
+
+    other = import_bvh(write_take(tmp_path, "Run", synthetic_run, n_frames=200))
+    action = other.animation_data.action
+    action.use_fake_user = True
+    bpy.data.objects.remove(other)
+    bpy.context.view_layer.objects.active = walk
+    walk.select_set(True)
+    return action
+
+
+def check_loop(arm, action, period_frames, cycles=1, inplace=True):
+    """The action is a clean loop: its length is the period (× cycles) within one frame, the pose after its last
+    frame is its first, and the Cycles modifiers carry that on beyond the keys."""
+    start, end = (int(round(x)) for x in action.frame_range)
+    length = end - start
+    f = facts(action)
+    assert length == f["cycle_frames"] * cycles
+    assert abs(length - period_frames * cycles) <= 1.0
+    assert action.use_cyclic
+    fcurves = bpy.context.active_object and addon_fcurves(arm, action)
+    assert fcurves and all(any(m.type == "CYCLES" for m in fc.modifiers) for fc in fcurves)
+    scale = size(arm)
+    if inplace:
+        jump = np.abs(heads(arm, end) - heads(arm, start)).max() / scale       # frame last + 1 == first
+        beyond = np.abs(heads(arm, end + 3) - heads(arm, start + 3)).max() / scale
+    else:  # the body loops; the root travels on
+        jump = np.abs(local_rotations(arm, end)[1:] - local_rotations(arm, start)[1:]).max()
+        beyond = np.abs(local_rotations(arm, end + 3)[1:] - local_rotations(arm, start + 3)[1:]).max()
+    print(f"\n{action.name}: {length} frames (period {period_frames:.2f}), seam pose difference {jump:.1e}")
+    assert jump <= 1e-5 and beyond <= 1e-5
+    return start, end
+
+
+def addon_fcurves(arm, action):
+    import sys
+
+    return sys.modules["bl_ext.user_default.mocycle"].channels.fcurves(arm, action)
+
+
+def test_find_phase(walk):
+    assert bpy.ops.mocycle.find_phase() == {"FINISHED"}
+    st = bpy.context.scene.mocycle
+    assert len(st.periodic) >= 1 and st.periodic_index == 0
+    assert st.periodic[0].period_frames == pytest.approx(FPS, rel=0.03)
+    assert st.periodic[0].n_periods == pytest.approx(8, abs=0.5)
+    assert st.last_task == "find_phase" and "periodic motion" in st.last_message
+
+
+def test_extract_cycle_loops(walk):
+    assert bpy.ops.mocycle.extract_cycle() == {"FINISHED"}
+    action = walk.animation_data.action
+    assert action.name == "Walk_cycle" and "Walk" in bpy.data.actions
+    f = facts(action)
+    assert f["period_frames"] == pytest.approx(FPS, abs=1.0)
+    check_loop(walk, action, f["period_frames"])
+    st = bpy.context.scene.mocycle
+    assert st.last_period == pytest.approx(f["period_frames"]) and st.last_seam >= 0 and st.last_skate >= 0
+
+
+def test_extract_cycle_root_motion_repeated(walk):
+    assert bpy.ops.mocycle.extract_cycle(root="motion", cycles=2) == {"FINISHED"}
+    action = walk.animation_data.action
+    f = facts(action)
+    start, end = check_loop(walk, action, f["period_frames"], cycles=2, inplace=False)
+    root = [heads(walk, k)[0] for k in (start, end, 2 * end - start)]
+    stride = np.linalg.norm(root[1] - root[0])
+    assert stride == pytest.approx(2 * np.linalg.norm(f["travel_per_cycle"]), rel=0.05)  # two cycles walked
+    assert np.abs((root[2] - root[1]) - (root[1] - root[0])).max() <= 1e-3 * stride  # and on beyond the keys
+
+
+def test_extract_cycle_options_reach_the_task(walk):
+    """Method, model, K, subsampling, frame range, the Pose Mode selection and the feet clean-up."""
+    walk.select_set(True)
+    bpy.ops.object.mode_set(mode="POSE")
+    legs = [pb for pb in walk.pose.bones if "Leg" in pb.name or "Foot" in pb.name]
+    for pb in walk.pose.bones:
+        flag = pb in legs
+        if hasattr(pb, "select"):
+            pb.select = flag
+        else:
+            pb.bone.select = flag
+    assert bpy.ops.mocycle.extract_cycle(method="harmonic", model="M2", harmonics="6", step=2,
+                                         use_frame_range=True, frame_start=31, frame_end=210, feet="lock",
+                                         root="motion") == {"FINISHED"}
+    bpy.ops.object.mode_set(mode="OBJECT")
+    f = facts(walk.animation_data.action)
+    assert f["model"] == "M2" and f["harmonics"] == 6
+    assert f["frames_in"] == 180
+    assert set(f["joints_used"].split(",")) == {pb.name for pb in legs}
+    assert f["feet"]["mode"] == "lock"
+    # the cycle is now the active action: one period, too short to find a cycle in, so it is refused
+    with pytest.raises(RuntimeError, match="no periodic motion"):
+        bpy.ops.mocycle.extract_cycle()
+    walk.animation_data.action = bpy.data.actions["Walk"]
+    assert bpy.ops.mocycle.extract_cycle(method="centroid") == {"FINISHED"}
+    assert facts(walk.animation_data.action)["method"] == "centroid"
+
+
+def test_which_periodic_motion_from_the_list(walk):
+    bpy.ops.mocycle.find_phase()
+    assert bpy.ops.mocycle.extract_cycle(which=0) == {"FINISHED"}
+    assert facts(walk.animation_data.action)["class"] == 0
+    with pytest.raises((RuntimeError, TypeError), match="which|class|periodic"):
+        bpy.ops.mocycle.extract_cycle(which=7)
+
+
+def test_blend_cycles(walk, run_action):
+    assert bpy.ops.mocycle.blend_cycles(other="Run", weights="0.5,0.5") == {"FINISHED"}
+    action = walk.animation_data.action
+    assert action.name == "Walk_blend"
+    f = facts(action)
+    assert 0.7 * FPS < f["period_frames"] < 1.0 * FPS  # between the run's and the walk's
+    check_loop(walk, action, f["period_frames"])
+
+
+def test_transition(walk, run_action):
+    assert bpy.ops.mocycle.transition(other="Run", cycles=3) == {"FINISHED"}
+    action = walk.animation_data.action
+    assert action.name == "Walk_to_Run"
+    start, end = (int(round(x)) for x in action.frame_range)
+    assert end - start + 1 == facts(action)["frames"]
+
+
+def test_stretch(walk):
+    assert bpy.ops.mocycle.stretch(factor=1.5) == {"FINISHED"}
+    action = walk.animation_data.action
+    assert action.name == "Walk_stretched"
+    start, end = (int(round(x)) for x in action.frame_range)
+    assert end - start + 1 == facts(action)["frames_out"] == 360
+
+
+def test_no_periodic_motion_is_refused(scene, tmp_path):
+    from mocycle.datasets import synthetic_nonperiodic
+
+    arm = import_bvh(write_take(tmp_path, "Wander", synthetic_nonperiodic, n_frames=240))
+    before = set(bpy.data.actions.keys())
+    with pytest.raises(RuntimeError, match="(?i)periodic"):
+        bpy.ops.mocycle.extract_cycle()
+    assert set(bpy.data.actions.keys()) == before and arm.animation_data.action.name == "Wander"
+
+
+def test_needs_an_armature(scene):
+    bpy.ops.object.add(type="EMPTY")
+    assert not bpy.ops.mocycle.extract_cycle.poll()
+
+
+def test_undo_restores_the_original(walk):
+    """Headless Blender keeps an undo stack: a step before, the operator called as the UI calls it (its own undo
+    step: ``bpy.ops`` pushes one only when asked, the second positional argument), then ``ed.undo``."""
+    bpy.ops.ed.undo_push(message="before mocycle")
+    assert bpy.ops.mocycle.extract_cycle("EXEC_DEFAULT", True) == {"FINISHED"}
+    assert bpy.data.objects["Walk"].animation_data.action.name == "Walk_cycle"
+    assert bpy.ops.ed.undo() == {"FINISHED"}
+    arm = bpy.data.objects["Walk"]  # undo reloads the data: old references are gone
+    assert arm.animation_data.action.name == "Walk"
+    assert "Walk_cycle" not in bpy.data.actions
+    assert bpy.context.scene.mocycle.last_task == ""
+
+
+@pytest.mark.shared_data
+def test_real_walk(scene):
+    """A CMU walk on the 100-joint Character Creator rig (60 fps): the loop's length is its period."""
+    arm = import_bvh(shared_path("cmu-iclone", "07_01.bvh"))
+    assert bpy.ops.mocycle.extract_cycle() == {"FINISHED"}
+    f = facts(arm.animation_data.action)
+    check_loop(arm, arm.animation_data.action, f["period_frames"])
