@@ -3,13 +3,14 @@
 #               (the core needs numpy, scipy, scikit-learn, ripser; ".[test]" also pulls the
 #               cli and plot extras, typer/rich and matplotlib, which the demo and the tests use)
 #   make test   lint with ruff, run the whole suite with numpy 2.x (.venv) and again
-#               with numpy 1.26 (.venv-numpy1, the line Blender bundles)
+#               with numpy 1.26 (.venv-numpy1, the line Blender bundles), then the Blender
+#               extension in headless Blender 5.0.1 and 4.2 LTS (make test-blender)
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV   := .venv
 BIN    := $(VENV)/bin
 NP1    := .venv-numpy1
 
-.PHONY: demo test test-numpy2 test-numpy1 lint bench clean
+.PHONY: demo test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender test-blender50 test-blender42
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -27,7 +28,7 @@ demo: $(VENV)/.installed
 	$(BIN)/mocycle demo --out out/demo
 
 lint: $(VENV)/.installed
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks blender tests_blender
 
 test-numpy2: $(VENV)/.installed
 	$(BIN)/python -c "import numpy; print('numpy', numpy.__version__)"
@@ -37,7 +38,7 @@ test-numpy1: $(NP1)/.installed
 	$(NP1)/bin/python -c "import numpy; print('numpy', numpy.__version__)"
 	$(NP1)/bin/python -m pytest -q -p no:cacheprovider
 
-test: lint test-numpy1 test-numpy2
+test: lint test-numpy1 test-numpy2 test-blender
 
 bench: $(VENV)/.installed
 	$(BIN)/python -m pip install --quiet -e ".[bench]"
@@ -49,5 +50,36 @@ bench: $(VENV)/.installed
 	$(BIN)/python benchmarks/keyframes.py
 	$(BIN)/python benchmarks/feet.py
 
+# --- Blender extension (docs/blender.md) ------------------------------------------------------------------
+# Headless Blender from PyPI (the bpy module, Python 3.11), one venv per animation API: 5.0.1 (slotted actions)
+# and 4.2 LTS (legacy action.fcurves); both with numpy 1.26, the numpy Blender brings. bpy links to X11/GL
+# client libraries: installed with apt-get when `import bpy` fails (a fresh root CI machine).
+BPY50 := .venv-bpy50
+BPY42 := .venv-bpy42
+BPY_LIBS := libx11-6 libxrender1 libxfixes3 libxi6 libxkbcommon0 libxext6 libxxf86vm1 libsm6 libgl1
+
+.venv-bpy%/.installed:
+	$(PYTHON) -m venv .venv-bpy$*
+	.venv-bpy$*/bin/python -m pip install --quiet --upgrade pip
+	.venv-bpy$*/bin/python -m pip install --quiet "bpy==$(if $(filter 50,$*),5.0.1,4.2.23)" "numpy>=1.26,<2" \
+		pytest setuptools wheel
+	.venv-bpy$*/bin/python -c "import bpy" 2>/dev/null || \
+		(apt-get update -qq && apt-get install -y -qq --no-install-recommends $(BPY_LIBS))
+	.venv-bpy$*/bin/python -c "import bpy, numpy; print('bpy', bpy.app.version_string, 'numpy', numpy.__version__)"
+	touch $@
+
+# dist/mocycle-<version>-<platform>.zip for linux-x64, windows-x64 and macos-arm64, with Blender's own
+# `extension build --split-platforms` (blender/build_extension.py says how)
+blender-extension: $(BPY50)/.installed
+	$(BPY50)/bin/python blender/build_extension.py
+
+test-blender50: $(BPY50)/.installed
+	cd tests_blender && ../$(BPY50)/bin/python -m pytest -q
+
+test-blender42: $(BPY42)/.installed
+	cd tests_blender && ../$(BPY42)/bin/python -m pytest -q
+
+test-blender: test-blender50 test-blender42
+
 clean:
-	rm -rf $(VENV) $(NP1) out .pytest_cache .ruff_cache
+	rm -rf $(VENV) $(NP1) $(BPY50) $(BPY42) out .pytest_cache .ruff_cache build dist
