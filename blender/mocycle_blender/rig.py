@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from mocycle import Motion, Skeleton
 from mocycle.errors import MocycleError
-from mocycle.rotations import continuous_euler, euler_to_quats
+from mocycle.rotations import continuous_euler, euler_to_quats, quat_conj, quat_multiply
 
 from . import channels
 
@@ -175,9 +175,9 @@ def to_motion(arm, action=None, frames: tuple[int, int] | None = None, fps: floa
             loc[:, j], animated = _read(curves, _path(b.name, "location"), 3, t, tuple(pb.location))
             if animated:
                 moving.add(b.name)
-    Rl = Rotation.from_quat(q_basis.reshape(-1, 4)).as_matrix().reshape(T, len(bones), 3, 3)
-    r = Rb[None] @ Rl @ np.swapaxes(Rb, 1, 2)[None]
-    r[:, 0] = R_O @ r[:, 0]
+    qb = Rotation.from_matrix(Rb).as_quat()  # (J, 4): quaternion products, no (T, J) matrices
+    r = quat_multiply(quat_multiply(qb[None], q_basis), quat_conj(qb)[None])
+    r[:, 0] = quat_multiply(Rotation.from_matrix(R_O).as_quat()[None], r[:, 0])
     rest_off = h - np.where(parents[:, None] >= 0, h[parents], 0.0)
     trans = s * (rest_off[None] + np.einsum("jab,tjb->tja", Rb, loc))
     trans[:, 0] = (s * (np.einsum("ab,tb->ta", Rb[0], loc[:, 0]) + h[0])) @ R_O.T + o
@@ -196,16 +196,15 @@ def to_basis(arm, motion: Motion) -> tuple[list, np.ndarray, np.ndarray]:
     idx = [motion.skeleton.names.index(n) for n in names]
     s, R_O, o = _object_frame(arm)
     Rb, h, parents = _rest(arm, bones)
-    r = motion.rotation_matrices()[:, idx]
+    r = motion.rotations[:, idx].copy()
     t = motion.translations[:, idx]
-    r[:, 0] = R_O.T @ r[:, 0]
-    RbT = np.swapaxes(Rb, 1, 2)
-    Rl = RbT[None] @ r @ Rb[None]
+    r[:, 0] = quat_multiply(quat_conj(Rotation.from_matrix(R_O).as_quat())[None], r[:, 0])
+    qb = Rotation.from_matrix(Rb).as_quat()
+    q = quat_multiply(quat_multiply(quat_conj(qb)[None], r), qb[None])
     rest_off = h - np.where(parents[:, None] >= 0, h[parents], 0.0)
     local = t / s - rest_off[None]
     local[:, 0] = ((t[:, 0] - o) @ R_O) / s - h[0]
     loc = np.einsum("jba,tjb->tja", Rb, local)
-    q = Rotation.from_matrix(Rl.reshape(-1, 3, 3)).as_quat().reshape(len(motion.rotations), len(bones), 4)
     return bones, q, loc
 
 
