@@ -29,7 +29,7 @@ ADDON = ROOT / "blender" / "mocycle_blender"
 PLATFORMS = {
     "linux-x64": ["manylinux_2_28_x86_64", "manylinux_2_17_x86_64", "manylinux2014_x86_64"],
     "windows-x64": ["win_amd64"],
-    "macos-arm64": ["macosx_14_0_arm64", "macosx_12_0_arm64", "macosx_11_0_arm64"],
+    "macos-arm64": ["macosx_12_0_arm64", "macosx_11_0_arm64"],  # not 14_0: scipy's Accelerate build needs macOS 14
 }
 #: what the core imports at run time (ripser's own requirements, persim and Cython, are not: persim only
 #: draws diagrams, Cython only builds); numpy comes with Blender
