@@ -93,7 +93,7 @@ def addon_fcurves(arm, action):
 def test_find_phase(walk):
     assert bpy.ops.mocycle.find_phase() == {"FINISHED"}
     st = bpy.context.scene.mocycle
-    assert len(st.periodic) >= 1 and st.periodic_index == 0
+    assert len(st.periodic) >= 1 and st.periodic_index == -1  # nothing picked yet
     assert st.periodic[0].period_frames == pytest.approx(FPS, rel=0.03)
     assert st.periodic[0].n_periods == pytest.approx(8, abs=0.5)
     assert st.last_task == "find_phase" and "periodic motion" in st.last_message

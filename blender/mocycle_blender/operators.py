@@ -122,7 +122,7 @@ def _find_phase(self, context, arm):
         item = st.periodic.add()
         item.period_frames, item.period_s, item.n_periods = c["period_frames"], c["period_s"], c["n_periods"]
         item.excitation = ", ".join(f"{s + first}-{e + first - 1}" for s, e in c["excitation"])
-    st.periodic_index = 0 if len(st.periodic) else -1
+    st.periodic_index = -1  # none picked: the task's own choice (the one covering most frames) until a click
     self._warnings = report.warnings
     if not st.periodic:
         message = f"{action.name}: no periodic motion ({report.facts['reason']})"

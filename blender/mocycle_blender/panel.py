@@ -31,7 +31,7 @@ def _button(layout, idname, text, group, options_cls, st, extra=()):
     props.copy_options(options_cls, group, op)
     for k in extra:
         if k == "which":
-            op.which = st.periodic_index if len(st.periodic) else -1
+            op.which = st.periodic_index if 0 <= st.periodic_index < len(st.periodic) else -1
         elif k == "other":
             op.other = st.other_action.name if st.other_action else ""
         else:
