@@ -10,7 +10,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 NP1    := .venv-numpy1
 
-.PHONY: demo test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender test-blender50 test-blender42
+.PHONY: demo test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender test-blender50 test-blender42 test-blender45
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -56,12 +56,15 @@ bench: $(VENV)/.installed
 # client libraries: installed with apt-get when `import bpy` fails (a fresh root CI machine).
 BPY50 := .venv-bpy50
 BPY42 := .venv-bpy42
+BPY_VERSION_50 := 5.0.1
+BPY_VERSION_45 := 4.5.15
+BPY_VERSION_42 := 4.2.23
 BPY_LIBS := libx11-6 libxrender1 libxfixes3 libxi6 libxkbcommon0 libxext6 libxxf86vm1 libsm6 libgl1
 
 .venv-bpy%/.installed:
 	$(PYTHON) -m venv .venv-bpy$*
 	.venv-bpy$*/bin/python -m pip install --quiet --upgrade pip
-	.venv-bpy$*/bin/python -m pip install --quiet "bpy==$(if $(filter 50,$*),5.0.1,4.2.23)" "numpy>=1.26,<2" \
+	.venv-bpy$*/bin/python -m pip install --quiet "bpy==$(BPY_VERSION_$*)" "numpy>=1.26,<2" \
 		pytest setuptools wheel
 	.venv-bpy$*/bin/python -c "import bpy" 2>/dev/null || \
 		(apt-get update -qq && apt-get install -y -qq --no-install-recommends $(BPY_LIBS))
@@ -81,5 +84,9 @@ test-blender42: $(BPY42)/.installed
 
 test-blender: test-blender50 test-blender42
 
+# not part of make test: 4.5 LTS, the first LTS with slotted actions (F-curves without group names)
+test-blender45: .venv-bpy45/.installed
+	cd tests_blender && ../.venv-bpy45/bin/python -m pytest -q
+
 clean:
-	rm -rf $(VENV) $(NP1) $(BPY50) $(BPY42) out .pytest_cache .ruff_cache build dist
+	rm -rf $(VENV) $(NP1) $(BPY50) $(BPY42) .venv-bpy45 out .pytest_cache .ruff_cache build dist
