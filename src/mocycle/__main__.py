@@ -20,9 +20,12 @@ def main() -> None:
 
 
 def _run() -> None:
+    from importlib.util import find_spec
+
     try:
-        import rich  # noqa: F401
         import typer  # noqa: F401
+        if find_spec("rich") is None:  # found, not imported: rich is loaded only when something is printed
+            raise ImportError("rich is missing", name="rich")
     except ImportError as exc:
         missing = exc.name or "typer"
         sys.stderr.write(f"mocycle: the command line needs the cli extra ({missing} is not installed): "

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from sklearn.decomposition import PCA
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError, NoPeriodicMotion
 from ..features import delay_embed, pose_matrix
 from ..motion import Motion
@@ -62,7 +62,7 @@ UNLIKE = 0.5
 #: A found period is one step of a two-step gait only if the legs' own period is this many times as long.
 HALF_RATIO = (1.8, 2.25)
 #: Default for ``min_periods``: a class must wind at least this often over the take.
-MIN_PERIODS = 1.2
+MIN_PERIODS = defaults.MIN_PERIODS
 
 
 def phase_features(motion: Motion, *, joints: str | Iterable[str] | None = None, pca: int | str | None = "auto",

@@ -31,7 +31,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
 from ..rotations import (
@@ -48,7 +48,7 @@ from ..rotations import (
 #: The paper's box filter and error window: 20 frames at 120 fps, in seconds.
 PAPER_WINDOW_S = 20.0 / 120.0
 #: The paper's Acceptable Swing Error.
-DEFAULT_THRESHOLD = 0.4
+DEFAULT_THRESHOLD = defaults.SWING_THRESHOLD
 
 #: Name patterns of small bones left out by default (fingers, toes, twist and helper bones, face).
 MINOR_JOINT_PATTERNS = (
