@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+from .errors import MocycleError
+
 INSTALL_HINT = "pip install 'mocycle[cli]'"
 
 
@@ -12,8 +14,16 @@ def main() -> None:
 
     ``mocycle.cli`` is light to import; its :func:`~mocycle.cli.guarded` installs the SIGINT/SIGTERM
     handlers before typer, rich, numpy and scipy are imported, so a signal at any moment ends the run with
-    one line and no traceback.
+    one line and no traceback.  Before that, BLAS and OpenMP are set to one thread (``MOCYCLE_THREADS``,
+    :mod:`mocycle.threads`) while numpy is not loaded yet, so that no worker thread starts.
     """
+    from .threads import pin_environment
+
+    try:
+        pin_environment()
+    except MocycleError as exc:  # a bad MOCYCLE_THREADS: a usage error
+        sys.stderr.write(f"mocycle: error: {exc}\n")
+        raise SystemExit(2) from None
     from .cli import guarded
 
     guarded(_run)

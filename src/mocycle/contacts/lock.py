@@ -41,6 +41,7 @@ from scipy.ndimage import maximum_filter1d, uniform_filter1d
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
+from ..threads import limit_threads
 from .detect import Contacts, ranges
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
@@ -283,6 +284,7 @@ def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
     return motion.replace(translations=trans)
 
 
+@limit_threads
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
               follow: bool = True, period: int | None = None) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..defaults import AMC_FPS
+from ..threads import limited
 
 if TYPE_CHECKING:
     from ..motion import Motion
@@ -65,6 +66,8 @@ class Recorder:
     times a part. On an exception the recorded warnings are issued again so the caller still sees them."""
 
     def __enter__(self) -> Recorder:
+        self._threads = limited()  # BLAS/OpenMP on MOCYCLE_THREADS threads (one by default)
+        self._threads.__enter__()
         self._catcher = warnings.catch_warnings(record=True)
         self._caught = self._catcher.__enter__()
         warnings.simplefilter("always")
@@ -80,6 +83,7 @@ class Recorder:
         if kind is not None:
             for w in kept:
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        self._threads.__exit__(kind, value, traceback)
         return False
 
     def part(self, label: str) -> _Part:
