@@ -37,7 +37,6 @@ joint's translation, so every bone keeps its length exactly.
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import maximum_filter1d, uniform_filter1d
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
@@ -224,6 +223,8 @@ def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weight
     if not need.any():
         return need
     width = 2 * max(1, n_blend) + 1
+    from scipy.ndimage import maximum_filter1d, uniform_filter1d  # only when feet are locked
+
     return uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
 
 

@@ -23,8 +23,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import fft as sp_fft
-from scipy.ndimage import uniform_filter1d
 
 from .. import _validate
 from ..errors import MocycleError
@@ -192,6 +190,21 @@ def local_maxima(x: np.ndarray) -> np.ndarray:
     return (starts[top] + ends[top]) // 2
 
 
+def moving_average(x: np.ndarray, size: int) -> np.ndarray:
+    """The mean of ``x`` ``(T,)`` over ``size`` samples about each one, the ends repeated beyond the edges:
+    ``scipy.ndimage.uniform_filter1d(x, size, mode="nearest")`` (window ``[i - size // 2, i + (size - 1) // 2]``),
+    by a cumulative sum; equal to it within rounding (the tests compare them), without importing
+    ``scipy.ndimage`` (0.05 s of every ``mocycle loop``)."""
+    x = np.asarray(x, dtype=np.float64)
+    size = int(size)
+    if x.size == 0 or size <= 1:
+        return x.copy()
+    padded = np.pad(x, (size // 2, size - 1 - size // 2), mode="edge")
+    level = padded.mean()  # summed about the mean: the running sums stay small, so do their rounding errors
+    sums = np.concatenate([[0.0], np.cumsum(padded - level)])
+    return (sums[size:] - sums[:-size]) / size + level
+
+
 def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_strength: float = 0.1) -> float:
     """The fundamental cycle (frames) of ``X`` (``(T,)`` or ``(T, D)``) by windowed circular autocorrelation.
 
@@ -235,8 +248,8 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
     A[:, np.ptp(A, axis=0) == 0.0] = 0.0  # exactly constant columns: remove the rounding left by centring
     window = periodic_hann(T)
     Y = A * window[:, None]
-    spectrum = sp_fft.rfft(Y, axis=0)
-    r = sp_fft.irfft(np.sum(np.abs(spectrum) ** 2, axis=1), n=T)
+    spectrum = np.fft.rfft(Y, axis=0)
+    r = np.fft.irfft(np.sum(np.abs(spectrum) ** 2, axis=1), n=T)
     if not r[0] > 0.0:
         return float("nan")
     r = r / r[0]
@@ -249,7 +262,7 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
     p = int(peaks[np.argmax(seg[peaks])])
     # Refine on r / (the window's own circular autocorrelation): the window's decay would pull the vertex
     # towards smaller lags by up to ~1 % of the period; the division undoes that bias for a stationary signal.
-    env = sp_fft.irfft(np.abs(sp_fft.rfft(window)) ** 2, n=T)
+    env = np.fft.irfft(np.abs(np.fft.rfft(window)) ** 2, n=T)
     q = np.arange(p - 2, p + 3) % T  # r is circular
     u = r[q] / env[q]
     c = 1 + int(np.argmax(u[1:4]))  # the largest of lags p-1, p, p+1
@@ -362,7 +375,7 @@ def excitation_regions(coords, window: int, threshold: float = 0.3, min_length: 
         return []
     d = _wrapped_diff(x)
     rate = np.concatenate([d[:1], 0.5 * (d[:-1] + d[1:]), d[-1:]])
-    smooth = np.abs(uniform_filter1d(rate, size=min(window, T), mode="nearest"))
+    smooth = np.abs(moving_average(rate, min(window, T)))
     ref = float(np.percentile(smooth, 90))
     if not ref > 0.0:
         return []
@@ -445,5 +458,5 @@ def repetition_distance(X, period: float, smooth: int = 1) -> np.ndarray:
     out[ok] = best[ok]
     if smooth > 1 and ok.any():
         filled = np.where(ok, out, np.nanmax(out[ok]))
-        out = np.where(ok, uniform_filter1d(filled, size=int(smooth), mode="nearest"), np.nan)
+        out = np.where(ok, moving_average(filled, int(smooth)), np.nan)
     return out
