@@ -38,7 +38,7 @@ _CHANNEL_NAMES = {c.lower(): c for c in ROTATION_CHANNELS + POSITION_CHANNELS}
 
 
 #: frames converted to quaternions at a time (keeps the temporaries small and in cache)
-BLOCK_FRAMES = 4096
+BLOCK_FRAMES = 1024
 
 
 def read_bvh(path: str | os.PathLike) -> Motion:
