@@ -220,7 +220,7 @@ class Motion:
         if T < 1:
             raise MocycleError("a motion needs at least one frame")
         # a NaN or infinite component makes the norm NaN or infinite: one (T, J) check instead of (T, J, 4)
-        norms = np.sqrt(np.einsum("...i,...i->...", rot, rot))[..., None]
+        norms = np.linalg.norm(rot, axis=-1, keepdims=True)
         if not np.all(np.isfinite(norms)) or np.any(norms < 1e-12):
             raise MocycleError("rotations contain NaN, infinite or zero quaternions")
         if copy or rot is not rotations or not rot.flags.writeable:

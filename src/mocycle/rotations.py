@@ -133,13 +133,8 @@ def euler_to_quats(angles: np.ndarray, order: str, degrees: bool = False) -> np.
         q = np.zeros(shape + (4,))
         q[..., 3] = 1.0
         return q
-    flip = None
-    if degrees:  # whole turns taken out first (exact in degrees): sin and cos are 2-3x faster within ±90°
-        turns = np.rint(angles.reshape(-1, k).T * (1.0 / 360.0))  # (k, n)
-        half = np.multiply(angles.reshape(-1, k).T - 360.0 * turns, np.pi / 360.0, order="C")
-        flip = np.sum(turns, axis=0) % 2 != 0  # each turn negates the axis's quaternion
-    else:  # (k, n) half angles, each axis contiguous in memory
-        half = np.multiply(angles.reshape(-1, k).T, 0.5, order="C")
+    # (k, n) half angles, each axis contiguous in memory
+    half = np.multiply(angles.reshape(-1, k).T, np.pi / 360.0 if degrees else 0.5, order="C")
     s, c = np.sin(half), np.cos(half)
     order = order.upper()
     comp: list[np.ndarray | None] = [None, None, None, c[0]]  # x, y, z, w; None: exactly zero
@@ -162,8 +157,6 @@ def euler_to_quats(angles: np.ndarray, order: str, degrees: bool = False) -> np.
     out = np.empty((half.shape[1], 4))
     for m in range(4):
         out[:, m] = 0.0 if comp[m] is None else comp[m]
-    if flip is not None and flip.any():
-        out[flip] *= -1.0
     return out.reshape(shape + (4,))
 
 
