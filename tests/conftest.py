@@ -3,9 +3,20 @@
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import pytest
+
+from mocycle import threads
+
+# BLAS and OpenMP on one thread (MOCYCLE_THREADS) for the whole suite and the commands it runs: set before
+# numpy loads when it has not yet, limited by threadpoolctl when a plugin loaded it first.
+threads.pin_environment()
+if "numpy" in sys.modules and threads.threads() is not None:  # pragma: no cover - depends on the plugins
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=threads.threads())
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("MOCYCLE_SHARED_DATA", REPO.parent / "shared" / "data"))

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+from .errors import MocycleError
+
 INSTALL_HINT = "pip install 'mocycle[cli]'"
 
 
@@ -12,17 +14,28 @@ def main() -> None:
 
     ``mocycle.cli`` is light to import; its :func:`~mocycle.cli.guarded` installs the SIGINT/SIGTERM
     handlers before typer, rich, numpy and scipy are imported, so a signal at any moment ends the run with
-    one line and no traceback.
+    one line and no traceback.  Before that, BLAS and OpenMP are set to one thread (``MOCYCLE_THREADS``,
+    :mod:`mocycle.threads`) while numpy is not loaded yet, so that no worker thread starts.
     """
+    from .threads import pin_environment
+
+    try:
+        pin_environment()
+    except MocycleError as exc:  # a bad MOCYCLE_THREADS: a usage error
+        sys.stderr.write(f"mocycle: error: {exc}\n")
+        raise SystemExit(2) from None
     from .cli import guarded
 
     guarded(_run)
 
 
 def _run() -> None:
+    from importlib.util import find_spec
+
     try:
-        import rich  # noqa: F401
         import typer  # noqa: F401
+        if find_spec("rich") is None:  # found, not imported: rich is loaded only when something is printed
+            raise ImportError("rich is missing", name="rich")
     except ImportError as exc:
         missing = exc.name or "typer"
         sys.stderr.write(f"mocycle: the command line needs the cli extra ({missing} is not installed): "

@@ -193,6 +193,8 @@ class Motion:
         offsets at every frame.
     frame_time : seconds per frame (> 0).
     root_positions : ``(T, 3)``; a shortcut that sets ``translations[:, 0]``.
+    copy : ``False`` hands the float64 ``rotations`` and ``translations`` arrays over to the motion, which then
+        normalises and freezes them in place instead of copying them (what the readers do: half the memory).
     """
 
     __slots__ = ("skeleton", "rotations", "translations", "frame_time")
@@ -204,6 +206,8 @@ class Motion:
         translations: np.ndarray | None = None,
         frame_time: float = 1 / 30,
         root_positions: np.ndarray | None = None,
+        *,
+        copy: bool = True,
     ):
         J = skeleton.n_joints
         rot = np.asarray(rotations, dtype=np.float64)
@@ -215,14 +219,22 @@ class Motion:
         T = rot.shape[0]
         if T < 1:
             raise MocycleError("a motion needs at least one frame")
-        norms = np.linalg.norm(rot, axis=-1, keepdims=True)
-        if not np.all(np.isfinite(rot)) or np.any(norms < 1e-12):
+        # a NaN or infinite component makes the norm NaN or infinite: one (T, J) check instead of (T, J, 4)
+        norms = np.empty(rot.shape[:-1] + (1,))
+        for f0 in range(0, T, 4096):  # in blocks of frames: numpy's norm makes a temporary as large as its input
+            norms[f0:f0 + 4096] = np.linalg.norm(rot[f0:f0 + 4096], axis=-1, keepdims=True)
+        if not np.all(np.isfinite(norms)) or np.any(norms < 1e-12):
             raise MocycleError("rotations contain NaN, infinite or zero quaternions")
-        rot = continuous_quats(rot / norms)
+        if copy or rot is not rotations or not rot.flags.writeable:
+            rot = rot / norms
+        else:  # the caller hands its float64 array over (readers): normalised in place, no copy
+            rot /= norms
+        rot = continuous_quats(rot, inplace=True)
         if translations is None:
             trans = np.broadcast_to(skeleton.offsets, (T, J, 3)).copy()
         else:
-            trans = np.array(translations, dtype=np.float64, copy=True)
+            trans = np.array(translations, dtype=np.float64, copy=True) if copy \
+                else np.asarray(translations, dtype=np.float64)
             if trans.shape != (T, J, 3):
                 raise MocycleError(f"translations must have shape ({T}, {J}, 3); got {trans.shape}")
         if root_positions is not None:
@@ -232,8 +244,9 @@ class Motion:
             trans[:, 0] = rp
         if not np.all(np.isfinite(trans)):
             raise MocycleError("translations contain NaN or infinite values")
-        if trans.size and np.abs(trans).max() > MAX_MAGNITUDE:
-            raise MocycleError(f"translations reach {np.abs(trans).max():.3g}, beyond ±{MAX_MAGNITUDE:g}")
+        reach = max(trans.max(), -trans.min()) if trans.size else 0.0
+        if reach > MAX_MAGNITUDE:
+            raise MocycleError(f"translations reach {reach:.3g}, beyond ±{MAX_MAGNITUDE:g}")
         frame_time = _validate.positive("frame_time", frame_time)
         if frame_time_problem(frame_time):
             raise MocycleError(frame_time_problem(frame_time))

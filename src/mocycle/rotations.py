@@ -30,17 +30,18 @@ from .errors import MocycleError
 TWO_PI = 2.0 * np.pi
 
 
-def continuous_quats(q: np.ndarray) -> np.ndarray:
+def continuous_quats(q: np.ndarray, inplace: bool = False) -> np.ndarray:
     """Flip quaternion signs so that consecutive frames have a non-negative dot product.
 
-    ``q``: ``(T, ..., 4)``.  Returns a new array.
+    ``q``: ``(T, ..., 4)``.  Returns a new array, or ``q`` itself flipped in place with ``inplace`` (a float64
+    array the caller owns).
     """
-    q = np.array(q, dtype=np.float64, copy=True)
+    q = q if inplace else np.array(q, dtype=np.float64, copy=True)
     if q.shape[0] < 2:
         return q
-    dots = np.sum(q[1:] * q[:-1], axis=-1)
-    flips = np.cumsum(dots < 0, axis=0) % 2
-    q[1:][flips.astype(bool)] *= -1.0
+    dots = np.einsum("...i,...i->...", q[1:], q[:-1])
+    flips = np.logical_xor.accumulate(dots < 0, axis=0)
+    q[1:][flips] *= -1.0
     return q
 
 
@@ -132,16 +133,31 @@ def euler_to_quats(angles: np.ndarray, order: str, degrees: bool = False) -> np.
         q = np.zeros(shape + (4,))
         q[..., 3] = 1.0
         return q
-    half = angles.reshape(-1, k).T * (np.pi / 360.0 if degrees else 0.5)  # (k, n)
+    # (k, n) half angles, each axis contiguous in memory
+    half = np.multiply(angles.reshape(-1, k).T, np.pi / 360.0 if degrees else 0.5, order="C")
     s, c = np.sin(half), np.cos(half)
     order = order.upper()
-    comp = [np.zeros(half.shape[1]) for _ in range(3)] + [c[0]]  # x, y, z, w
+    comp: list[np.ndarray | None] = [None, None, None, c[0]]  # x, y, z, w; None: exactly zero
     comp["XYZ".index(order[0])] = s[0]
     for i, axis in enumerate(order[1:], start=1):
-        # q ⊗ (sin·e_axis + cos) = cos·q + sin·(q ⊗ e_axis); q ⊗ e_axis permutes q's entries.
+        # q ⊗ (sin·e_axis + cos) = cos·q + sin·(q ⊗ e_axis); q ⊗ e_axis permutes q's entries (zeros skipped).
         perm, sign = _AXIS_PRODUCT[axis]
-        comp = [c[i] * comp[m] + sign[m] * s[i] * comp[perm[m]] for m in range(4)]
-    return np.stack(comp, axis=-1).reshape(shape + (4,))
+        new = []
+        for m in range(4):
+            a, b = comp[m], comp[perm[m]]
+            cos_a = None if a is None else c[i] * a
+            sin_b = None if b is None else s[i] * b
+            if sin_b is None:
+                new.append(cos_a)
+            elif cos_a is None:
+                new.append(sin_b if sign[m] > 0 else np.negative(sin_b, out=sin_b))
+            else:
+                new.append(np.add(cos_a, sin_b, out=cos_a) if sign[m] > 0 else np.subtract(cos_a, sin_b, out=cos_a))
+        comp = new
+    out = np.empty((half.shape[1], 4))
+    for m in range(4):
+        out[:, m] = 0.0 if comp[m] is None else comp[m]
+    return out.reshape(shape + (4,))
 
 
 # q ⊗ e for the pure unit quaternions e = x, y, z: entry permutation and signs.

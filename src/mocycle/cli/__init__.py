@@ -31,23 +31,21 @@ def _on_signal(signum, frame):
     raise Stopped(128 + signum)
 
 
-def _commands():
-    # Importing a command module registers its command; this order is the order in --help.
-    from . import info, convert, phase, loop, blend, stretch, swings, keyframes, demo  # noqa: F401, I001
-    from . import common
-
-    return common
-
-
 def __getattr__(name: str):
-    if name == "app":
-        return _commands().app
+    if name == "app":  # the typer app with every command registered (for tests and tools that walk it)
+        from . import common
+
+        common.load_commands()
+        return common.app
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def run() -> None:
-    """The command line itself (no signal handling: see :func:`main`)."""
-    _commands().app()
+    """The command line itself (no signal handling: see :func:`main`); each command's module is imported
+    when that command runs (:class:`~mocycle.cli.common.LazyGroup`)."""
+    from .common import app
+
+    app()
 
 
 def guarded(body=run) -> None:

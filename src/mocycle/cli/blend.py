@@ -5,12 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from .. import tasks
-from ..io import write
-from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line, write
 
 B = tasks.blend.Options
 T = tasks.transition.Options
@@ -59,6 +57,8 @@ def blend(
     write(report.motions["loop"], output)
     result = report.result
     if plot is not None:
+        import numpy as np
+
         from ..motion import concatenate
         from ..viz import plot_curves
 

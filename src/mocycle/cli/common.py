@@ -1,29 +1,93 @@
-"""What every ``mocycle`` sub-command shares: the typer app, consoles, exit codes, error handling."""
+"""What every ``mocycle`` sub-command shares: the typer app, consoles, exit codes, error handling.
+
+The app loads its commands lazily (:class:`LazyGroup`): ``mocycle --help`` lists them from :data:`COMMANDS`
+without importing their modules, and ``mocycle loop`` imports the loop command (and what it needs) only.
+"""
 
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import json
 import math
 import os
 import warnings
 from collections.abc import Callable, Mapping
-from functools import wraps
+from functools import cache, wraps
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
-from rich.console import Console
-from rich.markup import escape
+import typer.main
+from typer.core import TyperCommand, TyperGroup
 
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
-from ..tasks import TASKS
-from ..tasks.loop import parse_range  # noqa: F401  (convert uses it)
 from ..tasks.options import MISSING, Choice, flag_of
 
+#: sub-command -> (the module of ``mocycle.cli`` that defines it, the first paragraph of its help), in the
+#: order ``mocycle --help`` lists them.  tests/test_startup.py checks both against the commands themselves.
+COMMANDS = {
+    "info": ("info", "Frames, frame time, fps, duration, joints, channels, root travel and rotation ranges."),
+    "convert": ("convert", "Convert ASF/AMC to BVH, or rewrite a BVH (optionally a frame range, another fps)."),
+    "phase": ("phase", "Find periodic motions and the phase of every frame (persistent cohomology)."),
+    "loop": ("loop", "Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH."),
+    "blend": ("blend", "Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination)."),
+    "transition": ("blend", "A motion that starts as the first take's cycle and ends as the second's (paper 001 "
+                            "§4.5, a homotopy)."),
+    "stretch": ("stretch", "Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down."),
+    "swings": ("swings", "Segment a take into joint swings and holds; report playback error and compressed size."),
+    "search": ("swings", "Rank the takes of a folder by how alike their swings are to an example (query by "
+                         "example)."),
+    "edit": ("swings", "Scale the angle or the duration of one swing of one joint and write the edited motion."),
+    "compress": ("keyframes", "Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report "
+                              "error and size."),
+    "decompress": ("keyframes", "Rebuild a take from its keyframes; the keyframes come back exactly."),
+    "project": ("keyframes", "Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."),
+    "demo": ("demo", "Loop the built-in synthetic walk: write the take, its cycle (BVH) and the loop plot."),
+}
+
+
+def load_commands(names=None) -> None:
+    """Import the modules of the named commands (all by default); importing one registers its commands."""
+    for name in COMMANDS if names is None else names:
+        importlib.import_module(f"{__package__}.{COMMANDS[name][0]}")
+
+
+class LazyGroup(TyperGroup):
+    """The ``mocycle`` group: a command's module is imported when the command runs or shows its own help.
+
+    ``mocycle --help`` shows the first paragraph of each command's help from :data:`COMMANDS`, so it imports
+    none of them (nor numpy, scipy, scikit-learn); see ``docs/performance.md``.
+    """
+
+    def list_commands(self, ctx) -> list[str]:
+        return list(dict.fromkeys([*COMMANDS, *self.commands]))
+
+    def get_command(self, ctx, cmd_name: str):
+        if cmd_name not in self.commands and cmd_name in COMMANDS:
+            load_commands([cmd_name])
+            self.commands.update(typer.main.get_command(app).commands)
+        return self.commands.get(cmd_name)
+
+    def resolve_command(self, ctx, args):
+        if args and args[0] not in COMMANDS:  # a typo: with every command loaded typer suggests the near ones
+            for name in COMMANDS:
+                self.get_command(ctx, name)
+        return super().resolve_command(ctx, args)
+
+    def format_commands(self, ctx, formatter) -> None:
+        loaded = self.commands
+        self.commands = {name: loaded.get(name) or TyperCommand(name=name, help=COMMANDS[name][1])
+                         for name in self.list_commands(ctx)}
+        try:
+            super().format_commands(ctx, formatter)
+        finally:
+            self.commands = loaded
+
+
 app = typer.Typer(
+    cls=LazyGroup,
     name="mocycle",
     help="Turn raw motion capture into reusable animation.",
     no_args_is_help=True,
@@ -31,8 +95,33 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,  # plain click help: flags show as `--json`, not `--json <bool>`
 )
-out = Console(highlight=False)
-err = Console(stderr=True, highlight=False)
+
+
+class _Console:
+    """A rich ``Console`` made on first use: importing rich takes a tenth of a second that ``--help`` does
+    not need (``docs/performance.md``)."""
+
+    def __init__(self, **kwargs):
+        self._kwargs = kwargs
+        self._console = None
+
+    def __getattr__(self, name):
+        if self._console is None:
+            from rich.console import Console
+
+            self._console = Console(**self._kwargs)
+        return getattr(self._console, name)
+
+
+def escape(text: str) -> str:
+    """``text`` with rich markup escaped (``rich.markup.escape``)."""
+    from rich.markup import escape as rich_escape
+
+    return rich_escape(text)
+
+
+out = _Console(highlight=False)
+err = _Console(stderr=True, highlight=False)
 
 FORCE_HELP = "Allow an output to replace one of the input files."
 
@@ -40,16 +129,22 @@ EXIT_ERROR = 1
 EXIT_USAGE = 2  # a bad option value (typer/click use 2 for usage errors too)
 EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion, or its cycle is not a loop
 
-#: parameter names of the library -> the CLI flag that sets them (every task option, and a few library names)
-FLAGS = {f.name: flag_of(f) for task in TASKS.values() for f in dataclasses.fields(task.Options)}
-FLAGS.update({"n_harmonics": "--harmonics", "time_axis_method": "--time", "phase_step": "--step",
-              "n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles",
-              "window": "--window"})
+
+@cache
+def flags() -> dict[str, str]:
+    """Parameter names of the library -> the CLI flag that sets them (every task option, a few library names)."""
+    from ..tasks import TASKS
+
+    names = {f.name: flag_of(f) for task in TASKS.values() for f in dataclasses.fields(task.Options)}
+    names.update({"n_harmonics": "--harmonics", "time_axis_method": "--time", "phase_step": "--step",
+                  "n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles",
+                  "window": "--window"})
+    return names
 
 
 def option_message(exc: OptionError) -> str:
     """The error with the flag instead of the library's parameter name (``--cycles must be ...``)."""
-    return f"{FLAGS.get(exc.parameter, exc.parameter)} {exc.reason}"
+    return f"{flags().get(exc.parameter, exc.parameter)} {exc.reason}"
 
 
 def friendly(func: Callable) -> Callable:
@@ -212,6 +307,20 @@ def check_folder(folder: Path, option: str = "--out") -> None:
         raise MocycleError(f"{folder}: {option}: {probe} is not writable")
 
 
+def write(item, path: Path, **kwargs):
+    """:func:`mocycle.io.write`, imported on first use: the command modules stay light for ``--help``."""
+    from ..io import write as io_write
+
+    return io_write(item, path, **kwargs)
+
+
+def read(path, **kwargs):
+    """:func:`mocycle.io.read_motion`, imported on first use (see :func:`write`)."""
+    from ..io import read_motion
+
+    return read_motion(path, **kwargs)
+
+
 def write_text(path: Path, text: str | bytes, what: str = "file") -> Path:
     """Write an output through the atomic writer; an OS error becomes one clear MocycleError."""
     from ..io.atomic import atomic_write
@@ -229,6 +338,8 @@ def json_text(facts, indent: int | None = 2) -> str:
     ``json.dumps`` would write ``NaN``/``Infinity``, which JSON parsers refuse.  The paths of the values
     written as ``null`` are listed under ``"null_because_not_finite"`` (for a dict at the top).
     """
+    import numpy as np
+
     nulls: list[str] = []
 
     def clean(x, where: str):

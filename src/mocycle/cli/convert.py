@@ -7,10 +7,10 @@ from typing import Annotated
 
 import typer
 
+from ..defaults import AMC_FPS
 from ..errors import MocycleError
-from ..io import AMC_FPS, write
-from ..io import read_motion as read
-from .common import FORCE_HELP, app, check_output, friendly, out, parse_range
+from ..tasks.loop import parse_range
+from .common import FORCE_HELP, app, check_output, friendly, out, read, write
 
 
 @app.command()

@@ -6,17 +6,16 @@ import time
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from ..errors import MocycleError
-from ..io import read_motion as read
-from ..io import write
 from .common import (
     app,
     check_folder,
     friendly,
     out,
+    read,
+    write,
 )
 
 
@@ -41,6 +40,8 @@ def demo(
         raise MocycleError(f"{out_dir}: --out: cannot make the folder ({exc.strerror or exc})") from None
     source = write(take.motion, out_dir / "synthetic_walk.bvh")
     motion = read(source)
+    import numpy as np
+
     true_period = float(np.median(take.period_frames))
     out.print(f"[bold]{source}[/]: synthetic walk, {motion.n_frames} frames at {motion.fps:.6g} fps, 1° noise, "
               f"tempo +10 % over the take; true period {true_period:.1f} frames")

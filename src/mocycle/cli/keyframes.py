@@ -8,8 +8,19 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from ..io import write
-from .common import FORCE_HELP, app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import (
+    FORCE_HELP,
+    app,
+    check_output,
+    default,
+    flag,
+    friendly,
+    out,
+    print_json,
+    print_warnings,
+    timing_line,
+    write,
+)
 
 C = tasks.compress.Options
 P = tasks.project.Options

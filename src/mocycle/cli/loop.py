@@ -9,9 +9,8 @@ import typer
 
 from .. import tasks
 from ..errors import MocycleError
-from ..io import write
 from ..tasks.loop import METRIC_LABELS
-from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line, write
 
 O = tasks.loop.Options
 

@@ -8,8 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from ..io import write
-from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line, write
 
 O = tasks.stretch.Options
 

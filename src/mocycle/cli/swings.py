@@ -8,7 +8,6 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from ..io import write
 from .common import (
     FORCE_HELP,
     app,
@@ -21,6 +20,7 @@ from .common import (
     print_json,
     print_warnings,
     timing_line,
+    write,
     write_text,
 )
 

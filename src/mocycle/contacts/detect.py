@@ -24,7 +24,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import gaussian_filter1d
 
 from ..errors import MocycleError
 from ..motion import Motion
@@ -144,6 +143,8 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
     h = P @ up
     h = h - h.min(axis=0)
     sigma = smooth / motion.frame_time
+    from scipy.ndimage import gaussian_filter1d  # only when feet are locked
+
     Ps = gaussian_filter1d(P, sigma, axis=0, mode="nearest") if sigma >= 0.3 else P
     if motion.n_frames < 2:
         return h, np.zeros_like(h), np.zeros_like(h)

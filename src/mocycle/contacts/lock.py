@@ -37,10 +37,10 @@ joint's translation, so every bone keeps its length exactly.
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import maximum_filter1d, uniform_filter1d
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
+from ..threads import limit_threads
 from .detect import Contacts, ranges
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
@@ -223,6 +223,8 @@ def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weight
     if not need.any():
         return need
     width = 2 * max(1, n_blend) + 1
+    from scipy.ndimage import maximum_filter1d, uniform_filter1d  # only when feet are locked
+
     return uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
 
 
@@ -283,6 +285,7 @@ def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
     return motion.replace(translations=trans)
 
 
+@limit_threads
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
               follow: bool = True, period: int | None = None) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).

@@ -55,7 +55,6 @@ from dataclasses import dataclass, field
 from dataclasses import replace as dc_replace
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 from scipy.spatial.transform import Rotation
 
 from .. import _validate
@@ -63,6 +62,7 @@ from ..errors import MocycleError, NoPeriodicMotion, OptionError
 from ..limits import check_frames
 from ..motion import Motion, Skeleton
 from ..rotations import axis_rotations, mean_rotations, nearest_rotations
+from ..threads import limit_threads
 from .checks import check_loop
 from .extract import ROOT_MODES, Cycle, drifting_L, extract_cycle, loop_blocks, metric_features
 from .representation import CycleSpace
@@ -412,6 +412,7 @@ class BlendedCycle:
         }
 
 
+@limit_threads
 def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool = True, roll: bool = True,
                  labels: Sequence[str] | None = None, force: bool = False, **extract_options) -> BlendedCycle:
     """Paper 001 §4.5: the convex combination of the takes' cycles, a new loop.
@@ -505,6 +506,7 @@ class Transition:
         }
 
 
+@limit_threads
 def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str = "motion", *,
                align: bool = True, labels: Sequence[str] | None = None, force: bool = False,
                **extract_options) -> Transition:
@@ -553,6 +555,8 @@ def transition(a: Motion | Cycle, b: Motion | Cycle, cycles: int = 3, root: str 
     P = _blend_P([Pa, Pb], W, space.n_joints)
     L = _blend_L([La, Lb], W)
     if root == "motion":
+        from scipy.integrate import cumulative_trapezoid  # transitions only: not loaded by `mocycle loop`
+
         drift = np.outer(1 - w, loops[0].drift) + np.outer(w, loops[1].drift)   # (T, 4) per cycle
         turn = cumulative_trapezoid(drift[:, 3], phase, initial=0.0)
         Rt = axis_rotations(space.up, turn)                                      # (T, 3, 3)

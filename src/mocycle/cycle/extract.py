@@ -31,6 +31,7 @@ from ..motion import Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
 from ..rotations import axis_rotations, mean_rotations
+from ..threads import limit_threads
 from .differences import HALF, central_acceleration, central_velocity
 from .harmonic import MODELS, HarmonicRegression, max_harmonics
 from .representation import CycleSpace
@@ -411,6 +412,7 @@ def cycle_phase(motion: Motion, *, joints: str | Iterable[str] | None = None, cl
     return find_phase(motion, **options)
 
 
+@limit_threads
 def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n_harmonics: int | str = "auto",
                   time_axis_method: str = "smooth", *, joints: str | Iterable[str] | None = None,
                   classes: int | str = "auto", which: int | None = None, pca: int | str | None = "auto",

@@ -38,7 +38,7 @@ loop broken.
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import CubicSpline
+from scipy.linalg import solve_circulant
 
 from ..axes import vertical_axis
 from ..errors import MocycleError
@@ -51,9 +51,46 @@ from .seam import seam_ratios
 CONTACT_HEIGHT = 0.02  # of the body height
 
 
-def _spline(F: np.ndarray) -> CubicSpline:
+class PeriodicSpline:
+    """The periodic cubic spline through a cycle ``F`` ``(N, D)`` at positions ``0 .. N - 1`` (position ``N`` is
+    frame 0 again): ``spline(x, nu)`` gives the value (``nu=0``), first or second derivative at positions ``x``
+    ``(M,)`` -> ``(M, D)``, wrapped into ``[0, N)``.
+
+    The spline of ``scipy.interpolate.CubicSpline(range(N + 1), [*F, F[0]], bc_type="periodic")`` (the tests
+    compare them): on unit knots its second derivatives ``m`` solve the circulant system
+    ``m[i-1] + 4 m[i] + m[i+1] = 6 (F[i-1] - 2 F[i] + F[i+1])`` (``scipy.linalg.solve_circulant``).  Importing
+    ``scipy.interpolate`` loads ``scipy.optimize`` too, about 0.1 s of every ``mocycle loop``.
+    """
+
+    def __init__(self, F: np.ndarray):
+        F = np.asarray(F, dtype=np.float64)
+        N = F.shape[0]
+        column = np.zeros(N)
+        np.add.at(column, [0, 1 % N, -1 % N], [4.0, 1.0, 1.0])
+        self.F, self.N = F, N
+        self.m = solve_circulant(column, 6.0 * (np.roll(F, 1, axis=0) - 2.0 * F + np.roll(F, -1, axis=0)))
+
+    def __call__(self, x, nu: int = 0) -> np.ndarray:
+        x = np.mod(np.asarray(x, dtype=np.float64), self.N)
+        i = np.minimum(np.floor(x).astype(np.intp), self.N - 1)
+        j = (i + 1) % self.N
+        t = (x - i)[:, None]
+        y0, y1, m0, m1 = self.F[i], self.F[j], self.m[i], self.m[j]
+        b = (y1 - y0) - (2.0 * m0 + m1) / 6.0
+        c = m0 / 2.0
+        d = (m1 - m0) / 6.0
+        if nu == 0:
+            return y0 + t * (b + t * (c + t * d))
+        if nu == 1:
+            return b + t * (2.0 * c + 3.0 * t * d)
+        if nu == 2:
+            return 2.0 * c + 6.0 * t * d
+        raise ValueError(f"nu must be 0, 1 or 2; got {nu}")
+
+
+def _spline(F: np.ndarray) -> PeriodicSpline:
     """Periodic cubic spline through a cycle ``(N, D)`` on positions ``0 .. N``."""
-    return CubicSpline(np.arange(F.shape[0] + 1), np.vstack([F, F[:1]]), bc_type="periodic", axis=0)
+    return PeriodicSpline(F)
 
 
 def _rms(E: np.ndarray) -> float:

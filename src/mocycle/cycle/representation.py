@@ -28,12 +28,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
 from scipy.spatial.transform import Rotation
 
 from ..axes import heading_angles, horizontal_basis, up_in_parent_frame, vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
+from ..phase.period import moving_average
 from ..rotations import axis_rotations, continuous_quats, nearest_rotations
 
 
@@ -127,7 +127,7 @@ class CycleSpace:
         t = np.arange(psi.size, dtype=np.float64)
         line = np.polyval(np.polyfit(t, psi, 1), t) if psi.size > 1 else psi.copy()
         width = int(max(1, min(round(period), psi.size)))
-        return line + uniform_filter1d(psi - line, width, mode="nearest")
+        return line + moving_average(psi - line, width)
 
     def straighten(self, L: np.ndarray, period: float) -> np.ndarray:
         """``L (T, 4)`` with its path straightened: step ``t`` turned back by the heading trend's change

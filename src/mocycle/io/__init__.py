@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from pathlib import Path
 
 from ..errors import MocycleError, MotionFileError
@@ -183,12 +184,14 @@ def write(obj, path: str | os.PathLike) -> Path:
     """
     p = Path(path)
     suffix = _suffix(p, WRITE_SUFFIXES, "mocycle writes")
-    from ..swings.segment import Segmentation
-    from .mck import Compressed
-
-    fits = {Motion: (".bvh",), Compressed: (".mck",), Segmentation: (".mosw", ".json")}
+    # the kinds whose modules are loaded (an object of a kind whose module is not loaded cannot exist; so writing
+    # a motion does not import the keyframe and swing packages)
+    kinds = {"mocycle.motion.Motion": (".bvh",), "mocycle.io.mck.Compressed": (".mck",),
+             "mocycle.swings.segment.Segmentation": (".mosw", ".json")}
+    fits = {getattr(sys.modules.get(name.rsplit(".", 1)[0]), name.rsplit(".", 1)[1], None): suffixes
+            for name, suffixes in kinds.items()}
     for kind, suffixes in fits.items():
-        if isinstance(obj, kind):
+        if kind is not None and isinstance(obj, kind):
             if suffix not in suffixes:
                 raise MotionFileError(f"a {kind.__name__} is written as {' or '.join(suffixes)}", p)
             break

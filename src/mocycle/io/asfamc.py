@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..limits import MAX_MAGNITUDE, frame_time_problem
 from ..motion import EndSite, Motion, Skeleton
@@ -41,7 +41,7 @@ from ..motion import EndSite, Motion, Skeleton
 __all__ = ["AsfSkeleton", "parse_amc", "parse_asf", "read_amc", "read_asf", "read_asfamc"]
 
 #: Frame rate of AMC files, which do not store it (CMU captured at 120 fps).
-AMC_FPS = 120.0
+AMC_FPS = defaults.AMC_FPS
 
 ROOT = "root"
 ROOT_CHANNELS = ("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")

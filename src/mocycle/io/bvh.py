@@ -11,6 +11,12 @@ what was expected.
 Writing keeps each joint's channel order and the End Sites, writes the exact
 frame time and Euler angles that are continuous in time, and replaces the
 target file in one step (never a half-written file).
+
+:func:`read_bvh` reads the hierarchy line by line, then hands the file to numpy's C ``loadtxt`` (the
+floor for text numbers) and turns the channels into quaternions a block of frames at a time, so a read
+takes little more than ``loadtxt`` of the same numbers and peaks at about 3.5 times the float64 channel
+array (``docs/performance.md``).  When anything is off (a warning, an error, a line ``loadtxt`` cannot
+take), the whole file is parsed again the careful way (:func:`parse_bvh`), which says what is wrong where.
 """
 
 from __future__ import annotations
@@ -31,14 +37,70 @@ from .atomic import atomic_write
 _CHANNEL_NAMES = {c.lower(): c for c in ROTATION_CHANNELS + POSITION_CHANNELS}
 
 
+#: frames converted to quaternions at a time (keeps the temporaries small and in cache)
+BLOCK_FRAMES = 1024
+
+
 def read_bvh(path: str | os.PathLike) -> Motion:
     """Read a BVH file into a :class:`Motion` (see module notes for what is accepted)."""
     p = Path(path)
     try:
-        data = p.read_bytes()
+        fast = _read_plain(p)
+        if fast is None:  # something to warn about or refuse: the careful parse says what and where
+            return parse_bvh(p.read_bytes(), path=p)
     except OSError as exc:
         raise MotionFileError(f"cannot read file ({exc.strerror or exc})", p) from None
-    return parse_bvh(data, path=p)
+    skel, frames, frame_time, values = fast
+    quats, trans = _arrays_from_channels(skel, values)
+    del values, fast  # the channel array goes before the motion is made: lower peak memory
+    return _motion(skel, quats, trans, frame_time, p)
+
+
+def _read_plain(p: Path):
+    """A well-formed file read fast: the hierarchy from its lines, the frame rows by ``np.loadtxt(path)``.
+
+    Returns (skeleton, Frames: count, frame time, (T, C) values), or ``None`` when the file needs the careful
+    parse: a header error or warning, no channels, a row ``loadtxt`` refuses, or a value that is not finite
+    or beyond ``MAX_MAGNITUDE``.  The rows' count may differ from ``Frames:`` (the caller warns).
+    """
+    head = []
+    with open(p, "rb") as fh:
+        for raw in fh:
+            head.append(raw)
+            if raw.strip().lower().replace(b" ", b"").replace(b"\t", b"").startswith(b"frametime"):
+                break
+        else:
+            return None
+    lines = _decode(b"".join(head)).split("\n")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            skel, frames, frame_time, data_start = _parse_header(lines, p)
+        except MotionFileError:
+            return None
+    if caught or skel.n_channels == 0:
+        return None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # "input contained no data" and the like: the careful parse
+            values = np.loadtxt(p, dtype=np.float64, ndmin=2, comments=None, skiprows=data_start,
+                                encoding="latin-1")
+    except (ValueError, UserWarning):
+        return None
+    if values.shape[0] == 0 or values.shape[1] != skel.n_channels or not _plain_numbers(values):
+        return None
+    if frames is not None and frames != values.shape[0]:
+        warnings.warn(f"{p}: 'Frames: {frames}' but {values.shape[0]} frame rows follow; using the "
+                      f"{values.shape[0]} rows", MocycleWarning, stacklevel=3)
+    return skel, frames, frame_time, values
+
+
+def _plain_numbers(values: np.ndarray) -> bool:
+    """All finite and within ±MAX_MAGNITUDE (two reductions, no temporary array: NaN propagates)."""
+    if values.size == 0:
+        return True
+    high, low = values.max(), values.min()
+    return bool(np.isfinite(high) and np.isfinite(low) and max(high, -low) <= MAX_MAGNITUDE)
 
 
 def _decode(data: str | bytes) -> str:
@@ -244,8 +306,7 @@ def _parse_rows(lines: list[str], start: int, n_channels: int, path) -> np.ndarr
                 values = np.loadtxt(body, dtype=np.float64, ndmin=2, comments=None)
         except ValueError:
             values = None
-    if (values is None or values.shape[1] != n_channels or not np.all(np.isfinite(values))
-            or (values.size and np.abs(values).max() > MAX_MAGNITUDE)):
+    if values is None or values.shape[1] != n_channels or not _plain_numbers(values):
         _find_bad_row(body, start, n_channels, path)
     if values.shape[0] == 0:
         raise MotionFileError("no frame rows after 'Frame Time:'; expected at least one", path, len(lines))
@@ -297,23 +358,7 @@ def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motio
     """Parse BVH text (``str`` or ``bytes``) into a :class:`Motion`; ``path`` only names errors."""
     text = _decode(data)
     lines = text.split("\n")
-    first = next((i for i, ln in enumerate(lines) if ln.strip()), None)
-    if first is None:
-        raise MotionFileError("file is empty; expected 'HIERARCHY'", path, 1)
-    if lines[first].strip().upper() != "HIERARCHY":
-        raise MotionFileError(f"expected 'HIERARCHY', found {lines[first].strip()[:40]!r}", path, first + 1)
-    header = _Header(path)
-    motion_line = None
-    for i in range(first + 1, len(lines)):
-        if lines[i].strip().upper() == "MOTION":
-            motion_line = i
-            break
-        header.line(i + 1, lines[i])
-    if motion_line is None:
-        header.skeleton(len(lines))
-        raise MotionFileError("no MOTION section; expected 'MOTION' after the hierarchy", path, len(lines))
-    skel = header.skeleton(motion_line + 1)
-    frames, frame_time, data_start = _motion_header(lines, motion_line + 1, path)
+    skel, frames, frame_time, data_start = _parse_header(lines, path)
     if skel.n_channels == 0:  # nothing moves: the Frames: count is all there is
         if not frames or frames < 1:
             raise MotionFileError("the hierarchy declares no channels and 'Frames:' gives no count", path,
@@ -331,24 +376,72 @@ def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motio
     return _motion_from_channels(skel, values, frame_time, path)
 
 
+def _parse_header(lines: list[str], path) -> tuple[Skeleton, int | None, float, int]:
+    """The hierarchy and the MOTION header: (skeleton, Frames: count or None, frame time, first data line)."""
+    first = next((i for i, ln in enumerate(lines) if ln.strip()), None)
+    if first is None:
+        raise MotionFileError("file is empty; expected 'HIERARCHY'", path, 1)
+    if lines[first].strip().upper() != "HIERARCHY":
+        raise MotionFileError(f"expected 'HIERARCHY', found {lines[first].strip()[:40]!r}", path, first + 1)
+    header = _Header(path)
+    motion_line = None
+    for i in range(first + 1, len(lines)):
+        if lines[i].strip().upper() == "MOTION":
+            motion_line = i
+            break
+        header.line(i + 1, lines[i])
+    if motion_line is None:
+        header.skeleton(len(lines))
+        raise MotionFileError("no MOTION section; expected 'MOTION' after the hierarchy", path, len(lines))
+    skel = header.skeleton(motion_line + 1)
+    frames, frame_time, data_start = _motion_header(lines, motion_line + 1, path)
+    return skel, frames, frame_time, data_start
+
+
 def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float, path=None) -> Motion:
+    quats, trans = _arrays_from_channels(skel, values)
+    return _motion(skel, quats, trans, frame_time, path)
+
+
+def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Local quaternions ``(T, J, 4)`` and translations ``(T, J, 3)`` from the channel values ``(T, C)``.
+
+    Euler angles go to quaternions :data:`BLOCK_FRAMES` frames at a time, so no temporary is larger than a
+    block (and each stays in cache).
+    """
     T, J = values.shape[0], skel.n_joints
-    quats = np.zeros((T, J, 4))
-    quats[..., 3] = 1.0
-    trans = np.broadcast_to(skel.offsets, (T, J, 3)).copy()
+    quats = np.empty((T, J, 4))
+    trans = np.empty((T, J, 3))
+    trans[...] = skel.offsets
     by_order: dict[str, list[tuple[int, list[int]]]] = {}
+    still = []
     for j, (rot_cols, order, pos_cols, pos_axes) in enumerate(_channel_layout(skel)):
         if rot_cols:
             by_order.setdefault(order, []).append((j, rot_cols))
+        else:
+            still.append(j)
         if pos_cols:
             trans[:, j, pos_axes] = values[:, pos_cols]
+    quats[:, still] = (0.0, 0.0, 0.0, 1.0)
     for order, items in by_order.items():
         joints = [j for j, _ in items]
         cols = [c for _, cs in items for c in cs]
-        angles = values[:, cols].reshape(T, len(joints), len(order))
-        quats[:, joints] = euler_to_quats(angles, order, degrees=True)
+        if joints == list(range(joints[0], joints[-1] + 1)):  # a slice writes faster than a list of joints
+            joints = slice(joints[0], joints[-1] + 1)
+        if cols == list(range(cols[0], cols[-1] + 1)):
+            cols = slice(cols[0], cols[-1] + 1)
+        n = len(items)
+        for f0 in range(0, T, BLOCK_FRAMES):
+            f1 = min(T, f0 + BLOCK_FRAMES)
+            angles = values[f0:f1, cols].reshape(f1 - f0, n, len(order))
+            quats[f0:f1, joints] = euler_to_quats(angles, order, degrees=True)
+    return quats, trans
+
+
+def _motion(skel: Skeleton, quats: np.ndarray, trans: np.ndarray, frame_time: float, path) -> Motion:
+    """The motion, owning ``quats`` and ``trans`` (normalised and frozen in place, not copied)."""
     try:
-        return Motion(skel, quats, trans, frame_time)
+        return Motion(skel, quats, trans, frame_time, copy=False)
     except MocycleError as exc:
         raise MotionFileError(f"cannot build a motion from this file: {exc}", path) from None
 

@@ -47,6 +47,7 @@ from ..keyframes.temporal import SCHEMES as TEMPORAL_SCHEMES
 from ..keyframes.temporal import check_keys, interpolate_rotations
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion, Skeleton
+from ..threads import limit_threads
 
 MAGIC = b"MOCK\x01"
 SCHEMES = TEMPORAL_SCHEMES + ("spatial",)
@@ -298,6 +299,7 @@ def read_compressed(path: str | os.PathLike) -> Compressed:
     return Compressed.from_bytes(data, path)
 
 
+@limit_threads
 def compress(motion: Motion, ratio: float | str | None = "auto", count: int | None = None, select: str = "uniform",
              scheme: str = "slerp", projection: str = "mds", optimize: bool = False, seed: str = "mds",
              random_state: int = 0, space: PoseSpace | None = None) -> Compressed:

@@ -8,7 +8,7 @@
    normalisation, bone-length weights, PCA to a few dimensions, optional
    delay embedding;
 2. circular coordinates with the scale and the number of classes read from
-   the barcode (:class:`~mocycle.phase.cohomology.CircularCoordinates`);
+   the barcode (:class:`~mocycle.phase.cohomology.CohomologyFit`);
    when the whole body shows no periodic motion, the natural subsets (legs,
    then arms) are tried before giving up (``joints_used`` says which);
 3. per class: excitation regions, the unwrapped phase, the period from a
@@ -31,13 +31,13 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from sklearn.decomposition import PCA
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError, NoPeriodicMotion
 from ..features import delay_embed, pose_matrix
 from ..motion import Motion
-from .cohomology import MIN_FRAMES, CircularCoordinates
+from ..threads import limit_threads
+from .cohomology import MIN_FRAMES, CohomologyFit
 from .gait import leg_curves, legs_period, sides_swap
 from .period import (
     autocorrelation_period,
@@ -62,7 +62,7 @@ UNLIKE = 0.5
 #: A found period is one step of a two-step gait only if the legs' own period is this many times as long.
 HALF_RATIO = (1.8, 2.25)
 #: Default for ``min_periods``: a class must wind at least this often over the take.
-MIN_PERIODS = 1.2
+MIN_PERIODS = defaults.MIN_PERIODS
 
 
 def phase_features(motion: Motion, *, joints: str | Iterable[str] | None = None, pca: int | str | None = "auto",
@@ -92,10 +92,25 @@ def phase_features(motion: Motion, *, joints: str | Iterable[str] | None = None,
     if pca:
         pca = _validate.integer("pca", pca, 1)
         n = min(pca, X.shape[1], X.shape[0])
-        X = PCA(n_components=n, svd_solver="full").fit_transform(X)
+        X = principal_components(X, n)
     if delay:
         X = delay_embed(X, int(delay))
     return X
+
+
+def principal_components(X: np.ndarray, n: int) -> np.ndarray:
+    """The scores ``(T, n)`` of ``X`` ``(T, D)`` on its first ``n`` principal components.
+
+    What scikit-learn's ``PCA(n_components=n, svd_solver="full").fit_transform(X)`` returns, computed the same
+    way (centre, ``scipy.linalg.svd``, sign of each component set by its largest coefficient, ``U * S``)
+    without importing scikit-learn, which takes longer than a whole ``find_phase``.
+    """
+    from scipy.linalg import svd
+
+    Xc = X - X.mean(axis=0)
+    U, S, Vt = svd(Xc, full_matrices=False)
+    signs = np.sign(Vt[np.arange(Vt.shape[0]), np.argmax(np.abs(Vt), axis=1)])
+    return U[:, :n] * signs[:n] * S[:n]
 
 
 @dataclass(kw_only=True)
@@ -384,6 +399,7 @@ def _subsets(motion: Motion, joints) -> list[tuple[str | Iterable[str] | None, s
     return tries
 
 
+@limit_threads
 def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Iterable[str] | None = None,
                pca: int | str | None = "auto", delay: int = 2, n_landmarks: int = 120,
                scale: str | float = "auto", min_periods: float = MIN_PERIODS, rep: str = "expmap",
@@ -394,7 +410,7 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
     ``classes``: ``"auto"`` or how many; ``joints`` (``None``: the whole body, then legs, then arms until
     one shows a periodic motion), ``pca``, ``delay``, ``rep``, ``root``, ``normalize`` and ``weights``
     shape the input (:func:`phase_features`); ``n_landmarks``, ``scale`` and ``min_periods`` (how often a
-    coordinate must wind over the take to count, >= 1) go to :class:`CircularCoordinates`;
+    coordinate must wind over the take to count, >= 1) go to :class:`~.cohomology.CohomologyFit`;
     ``keep_features`` keeps the point cloud in ``result.features`` (for plots; off by default so results
     stay small).  An empty
     ``result.classes`` means no periodic motion; ``result.reason`` says why.
@@ -434,7 +450,7 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
     for subset, label in _subsets(motion, joints):
         X = phase_features(motion, joints=subset, pca=pca, delay=delay, rep=rep, root=root, normalize=normalize,
                            weights=weights)
-        estimator = CircularCoordinates(n_landmarks=n_landmarks, scale=scale, n_classes=classes,
+        estimator = CohomologyFit(n_landmarks=n_landmarks, scale=scale, n_classes=classes,
                                         min_cycles=float(min_periods)).fit(X)
         found = _separate(_distinct([_periodic_motion(estimator.coords_[:, k], c, motion.frame_time,
                                                       motion.n_frames) for k, c in enumerate(estimator.classes_)]), X)

@@ -32,6 +32,11 @@ chosen H1 class:
 The scale is taken late in the class's lifetime (paper 001 §4.3), and the
 number of classes can be read from the barcode (a gap between long bars and
 the rest), with the reason recorded.
+
+:class:`CohomologyFit` is the algorithm; :class:`~mocycle.phase.transformer.CircularCoordinates` (also
+importable from here) is the same as a scikit-learn transformer.  ``find_phase`` uses the former, so that
+finding a phase loads neither scikit-learn nor ripser's Python wrapper (which imports scikit-learn): about a
+second of start-up (``docs/performance.md``).
 """
 
 from __future__ import annotations
@@ -40,12 +45,9 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from ripser import ripser
 from scipy import sparse
 from scipy.sparse.linalg import lsqr
 from scipy.spatial.distance import cdist
-from sklearn.base import BaseEstimator, TransformerMixin
-from sklearn.utils.validation import check_array, check_is_fitted
 
 from .. import _validate
 from ..errors import DataError, MocycleError, MocycleWarning
@@ -54,9 +56,46 @@ from .period import autocorrelation_period
 PRIMES = (47, 43, 41, 37, 31, 29, 23, 19, 17, 13)
 MIN_FRAMES = 20
 
-# check_array's keyword for "NaN allowed" was renamed in scikit-learn 1.6 (force_all_finite -> ensure_all_finite)
-_ALLOW_NAN = ({"ensure_all_finite": "allow-nan"} if "ensure_all_finite" in check_array.__code__.co_varnames
-              else {"force_all_finite": "allow-nan"})
+
+def __getattr__(name: str):
+    if name == "CircularCoordinates":  # the scikit-learn transformer, imported with scikit-learn on first use
+        from .transformer import CircularCoordinates
+
+        return CircularCoordinates
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def rips_h1(dist: np.ndarray, prime: int) -> tuple[np.ndarray, list[np.ndarray]]:
+    """H1 of the Vietoris-Rips filtration of a distance matrix with Z/p coefficients, by ripser's compiled core.
+
+    ``dist``: ``(L, L)`` symmetric, zero diagonal.  Returns the bars ``(n, 2)`` (birth, death) and one cocycle
+    per bar, rows ``[i, j, value mod p]`` (landmark indices): what ``ripser.ripser(dist, distance_matrix=True,
+    maxdim=1, coeff=prime, do_cocycles=True)`` returns as ``dgms[1]`` and ``cocycles[1]``, from the same
+    compiled function (``pyRipser.doRipsFiltrationDM``) called the same way, without the wrapper's import of
+    scikit-learn.  Falls back to the wrapper when the core is not importable on its own or the diagonal is not
+    zero (the wrapper then goes through its sparse path).
+    """
+    try:
+        from pyRipser import doRipsFiltrationDM
+    except ImportError:  # pragma: no cover - a ripser build without the top-level extension
+        doRipsFiltrationDM = None
+    if doRipsFiltrationDM is None or np.any(np.diagonal(dist) != 0):  # pragma: no cover - see above
+        from ripser import ripser
+
+        result = ripser(dist, distance_matrix=True, maxdim=1, coeff=prime, do_cocycles=True)
+        return np.asarray(result["dgms"][1], dtype=float).reshape(-1, 2), list(result["cocycles"][1])
+    n = dist.shape[0]
+    row_grid, col_grid = np.meshgrid(np.arange(n), np.arange(n))
+    res = doRipsFiltrationDM(np.array(dist[row_grid > col_grid], dtype=np.float32), 1, np.inf, prime, True)
+    births_deaths = res["births_and_deaths_by_dim"]
+    bars = np.reshape(np.array(births_deaths[1]), [len(births_deaths[1]) // 2, 2]) if len(births_deaths) > 1 \
+        else np.zeros((0, 2))
+    cocycles = []
+    for ccl in (res["cocycles_by_dim"][1] if len(res["cocycles_by_dim"]) > 1 else []):
+        ccl = np.reshape(np.array(ccl, dtype=np.int64), [len(ccl) // 3, 3])
+        ccl[:, -1] = np.mod(ccl[:, -1], prime)
+        cocycles.append(ccl)
+    return np.asarray(bars, dtype=float).reshape(-1, 2), cocycles
 
 
 @dataclass(frozen=True)
@@ -269,8 +308,12 @@ def _reduce_basis(coords: np.ndarray, max_rounds: int = 10) -> np.ndarray:
     return basis
 
 
-class CircularCoordinates(TransformerMixin, BaseEstimator):
-    """Circle-valued coordinates of the points of X from persistent cohomology.
+class CohomologyFit:
+    """Circle-valued coordinates of the points of X from persistent cohomology (numpy, scipy and ripser only).
+
+    The parameters, ``fit``, ``transform`` and the fitted attributes of
+    :class:`~mocycle.phase.transformer.CircularCoordinates`, which adds scikit-learn's input checks and
+    estimator contract; ``fit`` here takes a 2-D float array of finite or NaN values as is.
 
     Parameters
     ----------
@@ -299,20 +342,6 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
     coords_ : ``(T, k)`` coordinates in ``[0, 1)`` (k = len(classes_), may be 0).
     reason_ : why these classes (which bars, which gap).
     landmarks_ : ``(L,)`` indices of the landmark points; ``cover_radius_`` their covering radius.
-
-    Examples
-    --------
-    Four turns around a noisy circle have one circular coordinate that winds four times:
-
-    >>> import numpy as np
-    >>> t = np.linspace(0, 4 * 2 * np.pi, 200, endpoint=False)
-    >>> X = np.c_[np.cos(t), np.sin(t)] + 0.01 * np.random.default_rng(0).normal(size=(200, 2))
-    >>> cc = CircularCoordinates().fit(X)
-    >>> cc.coords_.shape
-    (200, 1)
-    >>> turns = np.unwrap(2 * np.pi * cc.coords_[:, 0]) / (2 * np.pi)
-    >>> round(abs(float(turns[-1] - turns[0])))
-    4
     """
 
     def __init__(self, n_landmarks: int = 120, prime: int = 47, scale: str | float = "auto",
@@ -327,22 +356,16 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
         self.max_classes = max_classes
         self.min_cycles = min_cycles
 
-    # -- scikit-learn contract -------------------------------------------------
-    def __sklearn_tags__(self):  # scikit-learn >= 1.6
-        tags = super().__sklearn_tags__()
-        tags.input_tags.allow_nan = True  # fit drops columns with NaN or inf (with a warning)
-        return tags
-
-    def _more_tags(self):  # scikit-learn < 1.6
-        return {"allow_nan": True}
-
     # -- validation ----------------------------------------------------------
     def _check_X(self, X) -> np.ndarray:
-        """X as a dense 2-D float array of at least MIN_FRAMES rows (NaN/inf allowed: fit drops those columns).
+        """X as a 2-D float array of at least MIN_FRAMES rows (NaN/inf allowed: fit drops those columns)."""
+        X = np.asarray(X, dtype=np.float64)
+        if X.ndim != 2:
+            raise DataError(f"X must be a 2-D array (frames, features); got shape {X.shape}")
+        return self._check_frames(X)
 
-        scikit-learn's ``check_array`` makes the messages (sparse, complex, 1-D, empty input): ValueErrors.
-        """
-        X = check_array(X, dtype=np.float64, ensure_2d=True, ensure_min_samples=1, **_ALLOW_NAN)
+    @staticmethod
+    def _check_frames(X: np.ndarray) -> np.ndarray:
         if X.shape[0] < MIN_FRAMES:
             raise DataError(f"X must hold at least {MIN_FRAMES} frames (rows) for circular coordinates; "
                             f"got {X.shape[0]} sample(s)")
@@ -374,12 +397,11 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
         cover_radius = float(dist.min(axis=0).max())
         primes = [self.prime] + [p for p in PRIMES if p != self.prime]
         for prime in primes:
-            result = ripser(dist_ll, distance_matrix=True, maxdim=1, coeff=prime, do_cocycles=True)
-            barcode = np.asarray(result["dgms"][1], dtype=float).reshape(-1, 2)
+            barcode, cocycles = rips_h1(dist_ll, prime)
             finite = np.isfinite(barcode[:, 1])
             chosen, reason = choose_classes(barcode[finite], self.n_classes, self.min_ratio, self.max_classes)
             bars = np.flatnonzero(finite)[chosen]
-            classes, failed = self._make_classes(result, bars, prime, dist_ll, cover_radius)
+            classes, failed = self._make_classes(barcode, cocycles, bars, prime, dist_ll, cover_radius)
             if not failed:
                 break
         else:  # pragma: no cover - every prime failed
@@ -444,10 +466,10 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
         signs = np.array([c.sign for c in self.classes_])
         return np.mod((raw @ self.basis_) * signs, 1.0)
 
-    def _make_classes(self, result, bars, prime, dist_ll, r_cover):
+    def _make_classes(self, barcode, cocycles, bars, prime, dist_ll, r_cover):
         classes = []
         for bar in bars:
-            birth, death = result["dgms"][1][bar]
+            birth, death = barcode[bar]
             if self.scale == "auto":
                 alpha = birth + self.scale_fraction * (death - birth)
                 if alpha < 2 * r_cover:  # make the landmark balls cover every point, if the class allows
@@ -459,7 +481,7 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
                                        "of a chosen class")
             adjacent = dist_ll <= alpha
             np.fill_diagonal(adjacent, False)
-            Z = _lift(np.asarray(result["cocycles"][1][bar]), prime, dist_ll.shape[0])
+            Z = _lift(np.asarray(cocycles[bar]), prime, dist_ll.shape[0])
             if not _is_cocycle(Z, adjacent):
                 return classes, True
             w, zbar = _smooth(Z, adjacent)
@@ -477,9 +499,12 @@ class CircularCoordinates(TransformerMixin, BaseEstimator):
 
     def transform(self, X) -> np.ndarray:
         """Coordinates ``(N, k)`` in ``[0, 1)`` of new points from the fitted landmarks."""
-        check_is_fitted(self, "classes_")
-        X = check_array(X, dtype=np.float64, ensure_2d=True, **_ALLOW_NAN)
-        if X.shape[1] != self.n_features_in_:
+        if not hasattr(self, "classes_"):
+            raise MocycleError("this CohomologyFit is not fitted yet: call fit first")
+        return self._transform(np.asarray(X, dtype=np.float64))
+
+    def _transform(self, X: np.ndarray) -> np.ndarray:
+        if X.ndim != 2 or X.shape[1] != self.n_features_in_:
             raise DataError(f"X must have {self.n_features_in_} columns, as in fit; got shape {X.shape}")
         X = X[:, self.columns_used_]
         if not np.all(np.isfinite(X)):

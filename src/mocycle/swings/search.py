@@ -23,6 +23,7 @@ from scipy.signal import fftconvolve
 from ..errors import MocycleError, MocycleWarning
 from ..io import read_motion as read
 from ..motion import Motion
+from ..threads import limit_threads
 from .segment import DEFAULT_THRESHOLD, Segmentation, segment
 
 
@@ -137,6 +138,7 @@ class SwingIndex:
         return hits[:top]
 
 
+@limit_threads
 def build_index(folder: str | os.PathLike, pattern: str = "*.bvh", threshold: float = DEFAULT_THRESHOLD,
                 joints: str | None = None, rate_hz: float = 30.0, window_s: float = 1.0) -> SwingIndex:
     """Segment every take matching ``pattern`` in ``folder`` and keep its signature.

@@ -31,7 +31,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
 from ..rotations import (
@@ -44,11 +44,12 @@ from ..rotations import (
     rotvec_quat,
     twist_angles,
 )
+from ..threads import limit_threads
 
 #: The paper's box filter and error window: 20 frames at 120 fps, in seconds.
 PAPER_WINDOW_S = 20.0 / 120.0
 #: The paper's Acceptable Swing Error.
-DEFAULT_THRESHOLD = 0.4
+DEFAULT_THRESHOLD = defaults.SWING_THRESHOLD
 
 #: Name patterns of small bones left out by default (fingers, toes, twist and helper bones, face).
 MINOR_JOINT_PATTERNS = (
@@ -405,6 +406,7 @@ def translation_track(values: np.ndarray, tol: float) -> tuple[np.ndarray, np.nd
 
 
 # ---------------------------------------------------------------- entry point
+@limit_threads
 def segment(motion: Motion, threshold: float = DEFAULT_THRESHOLD, joints: str | Iterable[str] | None = None,
             window_s: float = PAPER_WINDOW_S, min_swing_s: float | None = None, still_deg_s: float = 20.0,
             max_hold_s: float | None = 0.5, translation_tol: float | None = None) -> Segmentation:

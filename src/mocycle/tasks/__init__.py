@@ -14,27 +14,25 @@ nothing deeper; :func:`schema` describes an Options class for forms and flags.
 
 from __future__ import annotations
 
-from . import (
-    blend,
-    compress,
-    decompress,
-    edit,
-    info,
-    loop,
-    phase,
-    project,
-    search,
-    stretch,
-    swings,
-    transition,
-)
+import importlib
+
 from .fields import AMC_FPS, SWING_THRESHOLD
 from .options import Options, option, schema
 from .report import Report
 
-#: task name -> its module (each has ``Options`` and ``run``)
-TASKS = {m.__name__.rsplit(".", 1)[1]: m for m in (info, phase, loop, blend, transition, stretch, swings, search,
-                                                     edit, compress, decompress, project)}
+#: the tasks, in the order front ends list them; each module is imported on first use (``tasks.loop``), so
+#: that a front end pays only for the task it runs (``docs/performance.md``)
+NAMES = ("info", "phase", "loop", "blend", "transition", "stretch", "swings", "search", "edit", "compress",
+         "decompress", "project")
+
+
+def __getattr__(name: str):
+    if name in NAMES:
+        return importlib.import_module(f"{__name__}.{name}")
+    if name == "TASKS":  # task name -> its module (each has ``Options`` and ``run``)
+        return {n: importlib.import_module(f"{__name__}.{n}") for n in NAMES}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = ["AMC_FPS", "SWING_THRESHOLD", "TASKS", "Options", "Report", "blend", "compress", "decompress", "edit",
            "info", "loop", "option", "phase", "project", "schema", "search", "stretch", "swings", "transition"]

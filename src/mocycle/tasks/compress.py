@@ -5,11 +5,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..motion import Motion
 from . import fields, keyframe_fields
 from .options import Choice, Real, option
 from .options import Options as _Options
-from .report import Recorder, Report, load
+from .report import Recorder, Report, is_motion, load
 
 SCHEME_CHOICES = ("linear", "hermite", "slerp", "rbf", "spatial")
 LABELS = {
@@ -52,7 +51,7 @@ def run(take, options: Options | None = None) -> Report:
         packed = compress(motion, count=density.count, select=o.select, scheme=o.scheme, projection=o.projection,
                           optimize=o.optimize, seed=o.seed_projection)
         rebuilt = packed.decompress()
-        is_bvh = not isinstance(take, Motion) and Path(take).suffix.lower() == ".bvh"
+        is_bvh = not is_motion(take) and Path(take).suffix.lower() == ".bvh"
         size = packed.size_report(Path(take).stat().st_size if is_bvh else None)
         facts = {"frames": motion.n_frames, "keyframes": packed.n_keyframes, "ratio": o.ratio,
                  "period_frames": density.period_frames, "keys_per_period": density.keys_per_period,

@@ -5,8 +5,6 @@ from __future__ import annotations
 import time
 import warnings
 
-import numpy as np
-
 from ..errors import MocycleError, MocycleWarning
 
 FEET_MODES = ("auto", "lock", "keep")
@@ -46,6 +44,8 @@ def clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
 
 def travels(motion) -> bool:
     """True when the take moves on: its travel joint goes farther than half the body height horizontally."""
+    import numpy as np
+
     from ..contacts import body_height, up_axis
 
     up = up_axis(motion)

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..io.asfamc import AMC_FPS
-from ..phase.analysis import MIN_PERIODS
-from ..swings.segment import DEFAULT_THRESHOLD as SWING_THRESHOLD
+from ..defaults import AMC_FPS, MIN_PERIODS, SWING_THRESHOLD
 from .options import Choice, Flag, Integer, Options, Real, Text, option
 
 __all__ = ["AMC_FPS", "CycleOptions", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay",

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import numpy as np
-
-from ..io.bvh import motion_channels
-from ..motion import Motion
 from . import fields
 from .options import Options as _Options
 from .report import Recorder, Report, load
+
+if TYPE_CHECKING:
+    from ..motion import Motion
 
 #: key -> (label, unit) of the figures a front end shows.
 LABELS = {
@@ -32,6 +32,10 @@ class Options(_Options):
 
 def motion_info(motion: Motion) -> dict:
     """The facts of a take, JSON-ready (see :data:`LABELS`)."""
+    import numpy as np
+
+    from ..io.bvh import motion_channels
+
     skel = motion.skeleton
     travel = motion.travel_joint
     root = motion.world_positions()[:, travel]

@@ -4,17 +4,21 @@
 from __future__ import annotations
 
 import os
+import sys
 import time
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from ..io import read_motion
-from ..io.asfamc import AMC_FPS
-from ..motion import Motion
+from ..defaults import AMC_FPS
+from ..threads import limited
 
-__all__ = ["Recorder", "Report", "load", "label_of"]
+if TYPE_CHECKING:
+    from ..motion import Motion
+
+__all__ = ["Recorder", "Report", "is_motion", "load", "label_of"]
 
 
 @dataclass(frozen=True)
@@ -62,6 +66,8 @@ class Recorder:
     times a part. On an exception the recorded warnings are issued again so the caller still sees them."""
 
     def __enter__(self) -> Recorder:
+        self._threads = limited()  # BLAS/OpenMP on MOCYCLE_THREADS threads (one by default)
+        self._threads.__enter__()
         self._catcher = warnings.catch_warnings(record=True)
         self._caught = self._catcher.__enter__()
         warnings.simplefilter("always")
@@ -77,6 +83,7 @@ class Recorder:
         if kind is not None:
             for w in kept:
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        self._threads.__exit__(kind, value, traceback)
         return False
 
     def part(self, label: str) -> _Part:
@@ -100,13 +107,22 @@ class _Part:
         return False
 
 
+def is_motion(item) -> bool:
+    """True for a :class:`~mocycle.motion.Motion`, without importing :mod:`mocycle.motion` (and numpy): when
+    that module is not loaded yet, no object can be a Motion."""
+    motion = sys.modules.get("mocycle.motion")
+    return motion is not None and isinstance(item, motion.Motion)
+
+
 def load(item: Motion | str | os.PathLike, amc_fps: float = AMC_FPS) -> Motion:
     """A task input: a :class:`Motion` as is, or a motion file read (``amc_fps``: AMC files only)."""
-    if isinstance(item, Motion):
+    if is_motion(item):
         return item
+    from ..io import read_motion
+
     return read_motion(item, fps=amc_fps)
 
 
 def label_of(item, k: int = 0) -> str:
     """How messages name an input: its path, or ``take k`` for a motion in memory."""
-    return f"take {k}" if isinstance(item, Motion) else str(Path(item)) if not isinstance(item, str) else item
+    return f"take {k}" if is_motion(item) else str(Path(item)) if not isinstance(item, str) else item

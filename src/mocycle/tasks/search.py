@@ -6,11 +6,10 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..motion import Motion
 from . import fields
 from .options import Integer, Real, Text, option
 from .options import Options as _Options
-from .report import Recorder, Report, label_of, load
+from .report import Recorder, Report, is_motion, label_of, load
 
 LABELS = {"indexed": ("takes indexed", ""), "results": ("matches: rank, score, offset (s), take", "")}
 
@@ -34,7 +33,7 @@ def run(query, folder: str | os.PathLike, options: Options | None = None) -> Rep
     with Recorder() as rec:
         motion = load(query, o.amc_fps)
         index = build_index(folder, pattern=o.pattern, threshold=o.threshold, window_s=o.window_s)
-        exclude = None if isinstance(query, Motion) else Path(query)
+        exclude = None if is_motion(query) else Path(query)
         hits = index.query(motion, top=o.top, exclude=exclude)
         facts = {"query": label_of(query), "indexed": len(index),
                  "results": [{"rank": k + 1, "path": str(h.path), "score": h.score, "offset_s": h.offset_s}

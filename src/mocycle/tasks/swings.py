@@ -6,10 +6,9 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..motion import Motion
 from . import fields
 from .options import Options as _Options
-from .report import Recorder, Report, load
+from .report import Recorder, Report, is_motion, load
 
 LABELS = {
     "joints": ("joints segmented", ""), "n_swings": ("swings", ""),
@@ -55,7 +54,7 @@ def run(source, options: Options | None = None) -> Report:
 
     o = options or Options()
     with Recorder() as rec:
-        if not isinstance(source, Motion) and Path(source).suffix.lower() == ".mosw":
+        if not is_motion(source) and Path(source).suffix.lower() == ".mosw":
             motion, seg = None, read_swings(source)
         else:
             motion = load(source, o.amc_fps)

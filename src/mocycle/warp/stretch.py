@@ -39,6 +39,7 @@ from ..features import pose_matrix
 from ..limits import check_frames
 from ..motion import JOINT_GROUPS, Motion, Skeleton, concatenate
 from ..phase.period import autocorrelation_period
+from ..threads import limit_threads
 from .lct import block_edges, ilct, lct
 
 __all__ = [
@@ -478,6 +479,7 @@ def _fade(warped: Motion, target: Motion, at_start: bool, n: int) -> Motion:
     return warped.replace(rotations=q, translations=t)
 
 
+@limit_threads
 def stretch_motion(motion: Motion, factor: float, window: str | int = "auto", force: bool = False,
                    phase=None) -> tuple[Motion, StretchReport]:
     """Lengthen (or shorten) a take by time-frequency warping its periodic part: paper 004 §6.

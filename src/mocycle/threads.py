@@ -1,0 +1,98 @@
+"""How many threads BLAS and OpenMP may use: one, unless ``MOCYCLE_THREADS`` says otherwise.
+
+mocycle's matrices are small (hundreds of frames, tens of joints): a second BLAS thread costs more in
+hand-overs than it saves, and on a busy machine its spinning worker stalls calls of 25 ms for up to a second
+(``docs/performance.md`` has the figures).  So BLAS and OpenMP run on one thread by default:
+
+* the command line sets ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS``, ``MKL_NUM_THREADS`` ... before numpy
+  loads (:func:`pin_environment`; a variable you set yourself is left alone), so no worker thread is even
+  started;
+* the library's long-running entry points (every task's ``run``, ``find_phase``, ``extract_cycle``,
+  ``blend_cycles``, ``stretch_motion``, ``segment``, ``compress`` ...) run under :func:`limited`, a
+  threadpoolctl limit, so a script that imported numpy itself gets the same.
+
+``MOCYCLE_THREADS=N`` allows N threads; ``MOCYCLE_THREADS=0`` (or ``auto``) leaves the libraries' own default
+(one per core).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+import threading
+
+from .errors import MocycleError
+
+__all__ = ["ENV", "LIBRARY_VARIABLES", "limit_threads", "limited", "pin_environment", "threads"]
+
+ENV = "MOCYCLE_THREADS"
+#: the variables BLAS and OpenMP builds read when they load
+LIBRARY_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
+                     "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+
+_inside = threading.local()
+
+
+def threads() -> int | None:
+    """The thread count for BLAS and OpenMP: ``$MOCYCLE_THREADS``, default 1; ``None`` for the libraries' own
+    default (``0`` or ``auto``)."""
+    text = os.environ.get(ENV, "").strip().lower()
+    if not text:
+        return 1
+    if text in ("0", "auto"):
+        return None
+    try:
+        n = int(text)
+    except ValueError:
+        n = -1
+    if n < 0:
+        raise MocycleError(f"{ENV} must be a number of threads (1, 2, ...) or 0/auto for the libraries' default; "
+                           f"got {text!r}")
+    return n
+
+
+def pin_environment() -> None:
+    """Set the BLAS/OpenMP thread variables to :func:`threads` where they are unset, for the libraries that read
+    them when they load: call before numpy is imported (``mocycle.__main__`` does, first thing)."""
+    n = threads()
+    if n is None:
+        return
+    for name in LIBRARY_VARIABLES:
+        os.environ.setdefault(name, str(n))
+
+
+@contextlib.contextmanager
+def limited():
+    """BLAS and OpenMP limited to :func:`threads` within the block (threadpoolctl); nested blocks cost nothing.
+
+    The limit is process-wide, like the libraries' own setting, and restored when the outer block ends.  It
+    acts on the libraries loaded when the block starts, so numpy's and scipy's BLAS are loaded first (the
+    core needs both anyway); an OpenMP library loaded later inside the block (scikit-learn's) follows the
+    environment (:func:`pin_environment`), and t-SNE limits itself.
+    """
+    n = threads()
+    if n is None or getattr(_inside, "depth", 0):
+        yield
+        return
+    import numpy  # noqa: F401  (load the BLAS libraries so that the limit reaches them)
+    import scipy.linalg  # noqa: F401
+    from threadpoolctl import threadpool_limits
+
+    _inside.depth = 1
+    try:
+        with threadpool_limits(limits=n):
+            yield
+    finally:
+        _inside.depth = 0
+
+
+def limit_threads(func):
+    """Decorator: run ``func`` :func:`limited` (a long-running library entry point)."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        with limited():
+            return func(*args, **kwargs)
+
+    return wrapper
