@@ -39,6 +39,7 @@ from ..features import pose_matrix
 from ..limits import check_frames
 from ..motion import JOINT_GROUPS, Motion, Skeleton, concatenate
 from ..phase.period import autocorrelation_period
+from ..rotations import axis_angle_quats, quat_conj, quat_exp, quat_log, quat_multiply
 from .lct import block_edges, ilct, lct
 
 __all__ = [
@@ -442,7 +443,7 @@ class _Placer:
         q = m.rotations.copy()
         t = m.translations.copy()
         j = self.travel
-        q[:, j] = (Rotation.from_matrix(R) * Rotation.from_quat(q[:, j])).as_quat()
+        q[:, j] = quat_multiply(axis_angle_quats(self.space.up, np.array([self.angle]))[0], q[:, j])
         t[:, j] = (t[:, j] - self.anchor) @ R.T + self.anchor + self.offset
         return m.replace(rotations=q, translations=t)
 
@@ -465,15 +466,14 @@ def _fade(warped: Motion, target: Motion, at_start: bool, n: int) -> Motion:
         return warped
     n = min(n, warped.n_frames)
     k = 0 if at_start else warped.n_frames - 1
-    diff = (Rotation.from_quat(target.rotations[0]) * Rotation.from_quat(warped.rotations[k]).inv()).as_rotvec()
+    d = quat_multiply(target.rotations[0], quat_conj(warped.rotations[k]))
+    diff = quat_log(d * np.where(d[:, 3:4] < 0, -1.0, 1.0))  # rotation vectors, angle <= π
     dt = target.translations[0] - warped.translations[k]
     w = _smooth(n) if at_start else _smooth(n)[::-1]
     rows = np.arange(n) if at_start else np.arange(warped.n_frames - n, warped.n_frames)
     q = warped.rotations.copy()
     t = warped.translations.copy()
-    J = warped.n_joints
-    fix = Rotation.from_rotvec((w[:, None, None] * diff[None]).reshape(-1, 3))
-    q[rows] = (fix * Rotation.from_quat(q[rows].reshape(-1, 4))).as_quat().reshape(n, J, 4)
+    q[rows] = quat_multiply(quat_exp(w[:, None, None] * diff[None]), q[rows])
     t[rows] += w[:, None, None] * dt[None]
     return warped.replace(rotations=q, translations=t)
 
