@@ -308,7 +308,7 @@ class Motion:
         for j in range(1, self.n_joints):
             p = parents[j]
             world_r[:, j] = world_r[:, p] @ local[:, j]
-            world_p[:, j] = world_p[:, p] + np.einsum("tab,tb->ta", world_r[:, p], self.translations[:, j])
+            world_p[:, j] = world_p[:, p] + (world_r[:, p] @ self.translations[:, j, :, None])[..., 0]
         return world_r, world_p
 
     def world_positions(self, end_sites: bool = False) -> np.ndarray:
