@@ -20,7 +20,8 @@ each size; per size, alternately: ``find_phase(motion)`` (everything: features, 
 ``CircularCoordinates`` on the prepared point cloud of ``benchmarks/phase.py`` and DREiMac's
 ``CircularCoords`` on the same cloud.  DREiMac 0.3 compiles its numba helpers again on every call; its
 *warm* time is the call minus numba's compile events.  Period error: the found period against the
-walk's true one (find_phase: its period; DREiMac: the slope of its unwrapped coordinate).
+walk's true one (find_phase: its period; DREiMac: the slope of its unwrapped coordinate); "equal or
+better" allows 0.05 percentage points.
 
 The last lines print each goal as a ratio with ``met`` / ``NOT met`` and the load average.
 """
@@ -52,6 +53,7 @@ SPEEDUP_GOAL = 2.0
 PHASE_GOAL = 5.0
 BIG = 30_000  # phase sizes from here on are timed once (a 100k-frame DREiMac run takes many seconds)
 LINEAR_EXPONENT = 1.05  # "linear": time grows at most like N^1.05 from 10k to 100k frames
+PERIOD_TIE = 0.05  # period errors (percent) this close count as equal
 
 JOBS = {  # name -> (job, take under --data)
     "loop iClone": ("loop", "cmu-iclone/07_01.bvh"),
@@ -256,8 +258,8 @@ def phase(sizes: list[int], repeats: int) -> list[tuple[str, float, float, bool]
             ratio = statistics.median(t["dm"]) / statistics.median(t["fp"])
             fp_err, dm_err = t["err"]
             goals.append((f"DREiMac warm / find_phase at {n} frames", ratio, PHASE_GOAL, ratio >= PHASE_GOAL))
-            goals.append((f"period error find_phase - DREiMac at {n} frames (%)", fp_err - dm_err, 0.0,
-                          fp_err <= dm_err + 1e-9))
+            goals.append((f"period error find_phase - DREiMac at {n} frames (%)", fp_err - dm_err, PERIOD_TIE,
+                          fp_err <= dm_err + PERIOD_TIE))
     return goals
 
 
