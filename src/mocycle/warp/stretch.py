@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import fnmatch
 import math
+import re
 import warnings
 from dataclasses import dataclass, field, replace
 
@@ -212,9 +213,10 @@ def joint_groups(skeleton: Skeleton) -> dict[str, list[int]]:
     out.  Every joint is in exactly one group.
     """
     group_of: list[str] = []
+    match = {g: re.compile("|".join(fnmatch.translate(p.lower()) for p in JOINT_GROUPS[g])).match for g in GROUP_NAMES}
     for j, name in enumerate(skeleton.names):
         low = name.lower()
-        own = next((g for g in GROUP_NAMES if any(fnmatch.fnmatch(low, p.lower()) for p in JOINT_GROUPS[g])), None)
+        own = next((g for g in GROUP_NAMES if match[g](low)), None)
         if own is None:
             parent = int(skeleton.parents[j])
             own = "spine" if parent < 0 else group_of[parent]
