@@ -98,3 +98,28 @@ def test_weighted_rotation_mean_checks_its_weights():
         weighted_rotation_mean(q, [1.0, -1.0])
     with pytest.raises(MocycleError, match="weights"):
         weighted_rotation_mean(q, [1.0])
+
+
+def test_nearest_rotations_match_the_svd_without_it():
+    from mocycle.rotations import nearest_rotations, svd_nearest_rotations
+
+    rng = np.random.default_rng(5)
+    R = Rotation.random(2000, random_state=6).as_matrix()
+    for noise in (0.0, 1e-3, 0.3, 0.8):
+        M = R * rng.uniform(0.3, 1.2, (2000, 1, 1)) + noise * rng.normal(size=(2000, 3, 3))
+        assert np.abs(nearest_rotations(M) - svd_nearest_rotations(M)).max() < 1e-12
+    flipped = -R[:5]  # det -1: no polar iteration reaches a rotation, the SVD answers
+    assert np.allclose(nearest_rotations(flipped), svd_nearest_rotations(flipped), atol=1e-12)
+    assert np.linalg.det(nearest_rotations(flipped)) == pytest.approx(np.ones(5))
+    assert nearest_rotations(np.zeros((0, 3, 3))).shape == (0, 3, 3)
+
+
+def test_matrix_quats_and_mean_rotations_match_scipy():
+    from mocycle.rotations import matrix_quats, mean_rotations
+
+    R = Rotation.random(5000, random_state=7)
+    assert np.abs(matrix_quats(R.as_matrix()) - Rotation.from_matrix(R.as_matrix()).as_quat()).max() < 1e-14
+    near = Rotation.from_rotvec(0.3 * Rotation.random(600, random_state=8).as_rotvec()).as_quat().reshape(40, 15, 4)
+    ours = mean_rotations(near)
+    theirs = np.stack([Rotation.from_quat(near[:, j]).mean().as_quat() for j in range(15)])
+    assert np.abs(ours - theirs).max() < 1e-12

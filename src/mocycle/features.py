@@ -42,7 +42,18 @@ from . import _validate
 from .axes import heading_angles, horizontal_basis, up_in_parent_frame, vertical_axis
 from .errors import MocycleError, OptionError
 from .motion import Motion
-from .rotations import continuous_euler, continuous_rotvec, euler_to_quats, mean_rotations, quat_exp
+from .rotations import (
+    axis_angle_quats,
+    continuous_euler,
+    continuous_rotvec,
+    euler_to_quats,
+    matrix_quats,
+    mean_rotations,
+    nearest_rotations,
+    quat_conj,
+    quat_exp,
+    quat_multiply,
+)
 
 REPS = ("euler", "expmap", "quatlog", "rotmat")
 ROOTS = ("keep", "velocity", "heading", "drop")
@@ -133,11 +144,10 @@ class PoseDecoder:
             if self.rep == "expmap":
                 quats[:, js] = quat_exp(block)
             elif self.rep == "quatlog":
-                rel = Rotation.from_quat(quat_exp(2.0 * block).reshape(-1, 4))
-                ref = Rotation.from_quat(np.broadcast_to(self.reference[js], (T, n, 4)).reshape(-1, 4))
-                quats[:, js] = (ref * rel).as_quat().reshape(T, n, 4)
+                ref = self.reference[js] / np.linalg.norm(self.reference[js], axis=-1, keepdims=True)
+                quats[:, js] = quat_multiply(ref, quat_exp(2.0 * block))
             else:
-                quats[:, js] = Rotation.from_matrix(block.reshape(-1, 3, 3)).as_quat().reshape(T, n, 4)
+                quats[:, js] = matrix_quats(nearest_rotations(block.reshape(T, n, 3, 3)))
         if self.root == "keep":
             trans[:, self.travel] = raw[:, col: col + 3]
         elif self.root == "velocity":
@@ -189,13 +199,14 @@ class HeadingFrame:
 
     def tilt(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
         """The travel joint's rotation without its heading ``(T, 4)`` and the unwrapped heading ``(T,)`` rad."""
-        R = Rotation.from_quat(motion.rotations[:, self.travel])
-        psi = heading_angles(R.apply(self.forward), self.e1, self.e2)
-        return (self._about_up(-psi) * R).as_quat(), psi
+        q = motion.rotations[:, self.travel]
+        psi = heading_angles(Rotation.from_quat(q).apply(self.forward), self.e1, self.e2)
+        return quat_multiply(axis_angle_quats(self.up, -psi), q), psi
 
     def turn(self, quats: np.ndarray, angles: np.ndarray) -> np.ndarray:
         """Tilt quaternions ``(T, 4)`` turned to the headings ``angles`` ``(T,)`` rad."""
-        return (self._about_up(angles) * Rotation.from_quat(quats)).as_quat()
+        q = np.asarray(quats, dtype=np.float64)
+        return quat_multiply(axis_angle_quats(self.up, angles), q / np.linalg.norm(q, axis=-1, keepdims=True))
 
     def to_local(self, v: np.ndarray, angles: np.ndarray) -> np.ndarray:
         """Vectors ``(T, 3)`` of the parent frame in the heading frames at ``angles`` ``(T,)``."""
@@ -229,10 +240,8 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
     elif rep == "expmap":
         parts.append(continuous_rotvec(motion.rotations[:, js]).reshape(T, -1))
     elif rep == "quatlog":
-        n = len(js)
-        ref = Rotation.from_quat(np.broadcast_to(reference[js], (T, n, 4)).reshape(-1, 4))
-        rel = (ref.inv() * Rotation.from_quat(motion.rotations[:, js].reshape(-1, 4))).as_quat()
-        rel = rel.reshape(T, n, 4)
+        ref = reference[js] / np.linalg.norm(reference[js], axis=-1, keepdims=True)
+        rel = quat_multiply(quat_conj(ref), motion.rotations[:, js])
         parts.append(0.5 * continuous_rotvec(rel).reshape(T, -1))
     else:
         parts.append(Rotation.from_quat(motion.rotations[:, js].reshape(-1, 4)).as_matrix().reshape(T, -1))

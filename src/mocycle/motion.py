@@ -17,6 +17,7 @@ Conventions
 from __future__ import annotations
 
 import fnmatch
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
@@ -150,11 +151,8 @@ class Skeleton:
                 chosen.add(self.names.index(pat))
                 continue
             globs = JOINT_GROUPS.get(pat.lower(), [pat])
-            hits = [
-                j
-                for j, n in enumerate(self.names)
-                if any(fnmatch.fnmatch(n.lower(), g.lower()) for g in globs)
-            ]
+            match = re.compile("|".join(fnmatch.translate(g.lower()) for g in globs)).match  # one regex, all globs
+            hits = [j for j, n in enumerate(self.names) if match(n.lower())]
             if not hits:
                 raise MocycleError(
                     f"no joint matches {pat!r}; joints are: {', '.join(self.names)}"
@@ -323,7 +321,7 @@ class Motion:
         for j in range(1, self.n_joints):
             p = parents[j]
             world_r[:, j] = world_r[:, p] @ local[:, j]
-            world_p[:, j] = world_p[:, p] + np.einsum("tab,tb->ta", world_r[:, p], self.translations[:, j])
+            world_p[:, j] = world_p[:, p] + (world_r[:, p] @ self.translations[:, j, :, None])[..., 0]
         return world_r, world_p
 
     def world_positions(self, end_sites: bool = False) -> np.ndarray:

@@ -12,8 +12,10 @@ Quaternions are ``(x, y, z, w)`` arrays (scipy's order), matrices ``(..., 3, 3)`
   :func:`quat_log` / :func:`quat_exp`, :func:`euler_to_quats`, :func:`axis_angle_quats`,
   :func:`twist_angles`, :func:`quat_angles` (geodesic), :func:`slerp`; single rotations:
   :func:`rotvec_quat`, :func:`quat_rotvec`.
-* **Matrices**: :func:`axis_rotations` (about one axis), :func:`nearest_rotations` (SVD),
-  :func:`fast_nearest_rotation` (Newton polar iterations), :func:`angle_to_nearest_rotation`.
+* **Matrices**: :func:`axis_rotations` (about one axis), :func:`nearest_rotations` (Newton polar
+  iterations, :func:`fast_nearest_rotation`; :func:`svd_nearest_rotations` the SVD reference),
+  :func:`matrix_quats` (of exact rotations, without scipy's orthogonality checks),
+  :func:`angle_to_nearest_rotation`.
 * **Means**: :func:`mean_rotations` (per joint over time, scipy), :func:`weighted_rotation_mean`
   (weighted chordal mean of many sets at once), :func:`mean_quat` (nearby quaternions).
 """
@@ -39,9 +41,10 @@ def continuous_quats(q: np.ndarray, inplace: bool = False) -> np.ndarray:
     q = q if inplace else np.array(q, dtype=np.float64, copy=True)
     if q.shape[0] < 2:
         return q
-    dots = np.einsum("...i,...i->...", q[1:], q[:-1])
-    flips = np.logical_xor.accumulate(dots < 0, axis=0)
-    q[1:][flips] *= -1.0
+    dots = np.einsum("t...k,t...k->t...", q[1:], q[:-1])
+    flips = np.cumsum(dots < 0, axis=0) % 2
+    if flips.any():
+        q[1:] *= (1.0 - 2.0 * flips)[..., None]  # a multiply, not a scatter: 4x faster on long takes
     return q
 
 
@@ -219,8 +222,11 @@ def quat_exp(rotvecs: np.ndarray) -> np.ndarray:
     return Rotation.from_rotvec(r.reshape(-1, 3)).as_quat().reshape(*shape, 4)
 
 
-def nearest_rotations(M: np.ndarray) -> np.ndarray:
-    """Project ``(..., 3, 3)`` matrices onto the nearest rotations (Frobenius; SVD, determinant +1)."""
+def svd_nearest_rotations(M: np.ndarray) -> np.ndarray:
+    """Project ``(..., 3, 3)`` matrices onto the nearest rotations (Frobenius) by SVD, determinant +1.
+
+    The reference method; :func:`nearest_rotations` gives the same matrices faster and falls back on this
+    one only where its iterations do not apply."""
     U, _, Vt = np.linalg.svd(np.asarray(M, dtype=np.float64))
     d = np.where(np.linalg.det(U @ Vt) < 0, -1.0, 1.0)
     U = U.copy()
@@ -228,10 +234,53 @@ def nearest_rotations(M: np.ndarray) -> np.ndarray:
     return U @ Vt
 
 
+def nearest_rotations(M: np.ndarray) -> np.ndarray:
+    """Project ``(..., 3, 3)`` matrices onto the nearest rotations (Frobenius, determinant +1).
+
+    The orthogonal polar factor by scaled Newton iterations (:func:`fast_nearest_rotation`, run until
+    it converges); matrices with ``det <= 0`` or that do not converge go to the SVD
+    (:func:`svd_nearest_rotations`).  The same matrices as the SVD within about 1e-12, several
+    times faster on many small matrices.
+    """
+    return fast_nearest_rotation(M)
+
+
+def matrix_quats(R: np.ndarray) -> np.ndarray:
+    """Quaternions ``(..., 4)`` of rotation matrices ``(..., 3, 3)`` (Markley's method, as scipy's
+    ``Rotation.from_matrix`` on orthogonal input: the largest of ``x, y, z, w`` comes out positive).
+
+    ``R`` must already be a rotation (e.g. from :func:`nearest_rotations`); no orthogonalisation here.
+    """
+    R = np.asarray(R, dtype=np.float64)
+    shape = R.shape[:-2]
+    a, b, c, d, e, f, g, h, i = np.moveaxis(R.reshape(-1, 9), -1, 0)
+    tr = a + e + i
+    choice = np.argmax(np.stack([a, e, i, tr]), axis=0)
+    q = np.empty((a.size, 4))
+    for k, comps in enumerate((
+        (1 - tr + 2 * a, d + b, g + c, h - f),
+        (d + b, 1 - tr + 2 * e, h + f, c - g),
+        (g + c, h + f, 1 - tr + 2 * i, d - b),
+        (h - f, c - g, d - b, 1 + tr),
+    )):
+        rows = choice == k
+        if rows.any():
+            q[rows] = np.stack([v[rows] for v in comps], axis=-1)
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    return q.reshape(*shape, 4)
+
+
 def mean_rotations(quats: np.ndarray) -> np.ndarray:
-    """Mean rotation of each joint over time: ``(T, J, 4)`` -> ``(J, 4)`` (scipy's ``Rotation.mean``)."""
+    """Mean rotation of each joint over time: ``(T, J, 4)`` -> ``(J, 4)``.
+
+    scipy's ``Rotation.mean`` (the top eigenvector of ``mean(q qᵀ)``, Markley et al. 2007) for all joints
+    in one batched ``eigh``."""
     q = np.asarray(quats, dtype=np.float64)
-    return np.stack([Rotation.from_quat(q[:, j]).mean().as_quat() for j in range(q.shape[1])])
+    if q.shape[0] == 0:
+        raise MocycleError("the mean of no rotations is undefined")
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    K = np.einsum("tji,tjk->jik", q, q) / q.shape[0]
+    return np.linalg.eigh(K)[1][..., -1]
 
 
 def weighted_rotation_mean(quats: np.ndarray, weights) -> np.ndarray:
@@ -248,7 +297,7 @@ def weighted_rotation_mean(quats: np.ndarray, weights) -> np.ndarray:
     w = w / w.sum()
     R = Rotation.from_quat(q.reshape(-1, 4)).as_matrix().reshape(*q.shape[:-1], 3, 3)
     M = np.tensordot(w, R, axes=1)
-    return Rotation.from_matrix(nearest_rotations(M).reshape(-1, 3, 3)).as_quat().reshape(*q.shape[1:])
+    return matrix_quats(nearest_rotations(M))
 
 
 def axis_rotations(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
@@ -322,22 +371,30 @@ def slerp(qa: np.ndarray, qb: np.ndarray, u: np.ndarray) -> np.ndarray:
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
-def fast_nearest_rotation(M: np.ndarray, iterations: int = 8) -> np.ndarray:
-    """Same result as :func:`nearest_rotations`, by scaled Newton polar iterations ``X ← (γX + X⁻ᵀ/γ) / 2``.
+def fast_nearest_rotation(M: np.ndarray, max_iterations: int = 30, tol: float = 1e-10) -> np.ndarray:
+    """Same result as :func:`svd_nearest_rotations`, by scaled Newton polar iterations ``X ← (γX + X⁻ᵀ/γ) / 2``.
 
-    Written on the nine matrix entries as separate arrays (closed-form 3×3 inverse),
-    several times faster than batched SVD; matrices with ``det <= 0`` or that do not
-    converge go to the SVD.
+    Written on the nine matrix entries as separate arrays (closed-form 3×3 inverse), several times
+    faster than batched SVD.  Iterates until no entry moves by more than ``tol``, then once more
+    (the convergence is quadratic, so the last step leaves about ``tol²``); matrices with
+    ``det <= 0``, or not orthonormal to 1e-12 after ``max_iterations``, go to the SVD.
     """
     M = np.asarray(M, dtype=np.float64)
     shape = M.shape
     flat = M.reshape(-1, 9)
-    scale = np.linalg.norm(flat, axis=1) / np.sqrt(3.0)
+    if flat.shape[0] == 0:
+        return M.copy()
+    scale = np.sqrt(np.einsum("ij,ij->i", flat, flat) / 3.0)
     x = flat / np.where(scale > 0, scale, 1.0)[:, None]
-    bad = ~(np.linalg.det(x.reshape(-1, 3, 3)) > 1e-6)
-    x[bad] = np.eye(3).ravel()  # these go to the SVD below
-    x = list(x.T)  # 9 arrays (N,)
-    for _ in range(iterations):
+    a, b, c, d, e, f, g, h, i = x.T
+    bad = ~(a * (e * i - f * h) + b * (f * g - d * i) + c * (d * h - e * g) > 1e-6)
+    if bad.any():
+        x[bad] = np.eye(3).ravel()  # these go to the SVD below
+    X = x
+    active = np.arange(X.shape[0])  # the matrices still moving; the others are left out of later steps
+    x = list(X.T)  # 9 arrays (n_active,)
+    last = np.zeros(X.shape[0], dtype=bool)  # one more step after settling
+    for _ in range(max_iterations):
         a, b, c, d, e, f, g, h, i = x
         # cofactor matrix (= det · X⁻ᵀ)
         C = [e * i - f * h, f * g - d * i, d * h - e * g,
@@ -346,12 +403,32 @@ def fast_nearest_rotation(M: np.ndarray, iterations: int = 8) -> np.ndarray:
         det = np.maximum(a * C[0] + b * C[1] + c * C[2], 1e-300)
         gam = det ** (-1.0 / 3.0)
         k = 1.0 / (gam * det)
-        x = [0.5 * (gam * xv + k * cv) for xv, cv in zip(x, C, strict=True)]
-    X = np.stack(x, axis=1).reshape(-1, 3, 3)
-    err = np.abs(np.einsum("nji,njk->nik", X, X) - np.eye(3)).max(axis=(1, 2))
-    bad |= ~(err < 1e-9)
+        new = [0.5 * (gam * xv + k * cv) for xv, cv in zip(x, C, strict=True)]
+        move = np.abs(new[0] - x[0])
+        for nv, xv in zip(new[1:], x[1:], strict=True):
+            np.maximum(move, np.abs(nv - xv), out=move)
+        done = last[active]
+        last[active] = move < tol
+        if done.all():
+            X[active] = np.stack(new, axis=1)
+            break
+        if done.any():
+            X[active[done]] = np.stack([v[done] for v in new], axis=1)
+            keep = ~done
+            active = active[keep]
+            new = [v[keep] for v in new]
+        x = new
+    else:
+        X[active] = np.stack(x, axis=1)
+    cols = [X[:, 0::3], X[:, 1::3], X[:, 2::3]]  # XᵀX - I, entry by entry: 1e-12 or to the SVD
+    err = np.zeros(X.shape[0])
+    for m in range(3):
+        for n in range(m, 3):
+            np.maximum(err, np.abs(np.einsum("ij,ij->i", cols[m], cols[n]) - (m == n)), out=err)
+    bad |= ~(err < 1e-12)
+    X = X.reshape(-1, 3, 3)
     if np.any(bad):
-        X[bad] = nearest_rotations(flat[bad].reshape(-1, 3, 3))
+        X[bad] = svd_nearest_rotations(flat[bad].reshape(-1, 3, 3))
     return X.reshape(shape)
 
 

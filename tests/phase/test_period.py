@@ -301,3 +301,16 @@ def test_bad_parameters_raise():
         excitation_regions(u % 1, window=3, threshold=-1.0)
     with pytest.raises(MocycleError, match="min_rate"):
         excitation_regions(u % 1, window=3, min_rate=float("nan"))
+
+
+def test_autocorrelation_period_of_a_long_take_is_the_cycle_not_a_multiple():
+    """Over 50 000 frames the window hardly decays across a few cycles; the level maxima at 120, 180, ...
+    frames must not win over the cycle of 60 frames by noise (they did on 5 of these 6 seeds)."""
+    T = 50_000
+    t = np.arange(T)
+    for seed in range(6):
+        rng = np.random.default_rng(seed)
+        ph = t / 60.0 + 0.02 * np.cumsum(rng.normal(size=T)) / np.sqrt(T)
+        X = np.c_[np.sin(2 * np.pi * ph), np.cos(2 * np.pi * ph) + 0.3 * np.sin(4 * np.pi * ph),
+                  np.sin(6 * np.pi * ph)] + 0.3 * rng.normal(size=(T, 3))
+        assert autocorrelation_period(X, min_lag=8) == pytest.approx(60.0, abs=0.1)

@@ -28,13 +28,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..axes import heading_angles, horizontal_basis, up_in_parent_frame, vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
 from ..phase.period import moving_average
-from ..rotations import axis_rotations, continuous_quats, nearest_rotations
+from ..rotations import axis_rotations, continuous_quats, matrix_quats, nearest_rotations
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -174,7 +173,7 @@ class CycleSpace:
             raise MocycleError(f"expected P ({N}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
         R = nearest_rotations(P[:, : 9 * J].reshape(N, J, 3, 3))
         R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
-        quats = continuous_quats(Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat().reshape(N, J, 4))
+        quats = continuous_quats(matrix_quats(R))
         trans = np.broadcast_to(self.static_translations, (N, J, 3)).copy()
         if self.moving:
             trans[:, list(self.moving)] = P[:, 9 * J:].reshape(N, len(self.moving), 3)

@@ -84,15 +84,20 @@ def pose_distance_matrix(quats: np.ndarray, weights: np.ndarray, other: np.ndarr
     w = np.asarray(weights, dtype=np.float64)
     joints = moving_joints(np.concatenate([q, o]) if other is not None else q)
     D = np.zeros((q.shape[0], o.shape[0]))
+    dot = np.empty_like(D)
     for j in joints:
         if w[j] == 0:
             continue
-        dot = np.abs(q[:, j] @ o[:, j].T)
+        np.matmul(q[:, j], o[:, j].T, out=dot)  # in place from here on: no (T, M) temporaries per joint
+        np.abs(dot, out=dot)
         np.minimum(dot, 1.0, out=dot)
-        D += (2.0 * w[j]) * np.arccos(dot)
+        np.arccos(dot, out=dot)
+        dot *= 2.0 * w[j]
+        D += dot
     if other is None:
         np.fill_diagonal(D, 0.0)
-        D = 0.5 * (D + D.T)
+        D += D.T  # numpy buffers the overlapping operand
+        D *= 0.5
     return D
 
 

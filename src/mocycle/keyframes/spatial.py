@@ -30,6 +30,7 @@ from ..errors import MocycleError
 from ..rotations import (
     angle_to_nearest_rotation,
     fast_nearest_rotation,
+    matrix_quats,
     nearest_rotation_angle_entries,
     nearest_rotations,
 )
@@ -122,7 +123,7 @@ class BackProjection:
         out = self.raw(p)
         q = np.broadcast_to(self.rest, (N, self.n_joints, 4)).copy()
         R = fast_nearest_rotation(out[:, : 9 * n].reshape(N, n, 3, 3))
-        q[:, self.joints] = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat().reshape(N, n, 4)
+        q[:, self.joints] = matrix_quats(R)
         return q, (out[:, 9 * n: 9 * n + 3] if self.has_root else None)
 
 

@@ -24,7 +24,7 @@ from scipy.spatial.transform import Rotation
 from .. import _validate
 from ..errors import MocycleError
 from ..motion import Skeleton
-from ..rotations import continuous_euler, euler_to_quats, nearest_rotations, slerp
+from ..rotations import continuous_euler, euler_to_quats, matrix_quats, nearest_rotations, slerp
 
 SCHEMES = ("linear", "hermite", "slerp", "rbf")
 
@@ -66,7 +66,7 @@ def interpolate_rotations(skeleton: Skeleton, key_idx, key_quats: np.ndarray, n_
         R = Rotation.from_quat(kq.reshape(-1, 4)).as_matrix().reshape(len(idx), J * 9)
         f = RBFInterpolator(idx[:, None].astype(np.float64), R, kernel="linear", degree=1)
         M = f(t[:, None]).reshape(n_frames, J, 3, 3)
-        out = Rotation.from_matrix(nearest_rotations(M).reshape(-1, 3, 3)).as_quat().reshape(n_frames, J, 4)
+        out = matrix_quats(nearest_rotations(M))
     else:
         out = np.empty((n_frames, J, 4))
         groups: dict[str, list[int]] = {}

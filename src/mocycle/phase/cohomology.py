@@ -201,8 +201,10 @@ def greedy_permutation(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     idx = np.zeros(n, dtype=np.int64)
     dist = np.empty((n, N))
     nearest = np.full(N, np.inf)
+    diff = np.empty_like(X)
     for i in range(n):
-        dist[i] = np.sqrt(np.einsum("nd,nd->n", X - X[idx[i]], X - X[idx[i]]))
+        np.subtract(X, X[idx[i]], out=diff)
+        np.sqrt(np.einsum("nd,nd->n", diff, diff), out=dist[i])
         np.minimum(nearest, dist[i], out=nearest)
         if i + 1 < n:
             idx[i + 1] = int(np.argmax(nearest))
@@ -226,15 +228,16 @@ def _lift(cocycle: np.ndarray, prime: int, L: int) -> np.ndarray:
 def _is_cocycle(Z: np.ndarray, adjacent: np.ndarray) -> bool:
     """True when ``Z`` sums to zero around every triangle of the graph ``adjacent``.
 
-    Only triangles through a vertex touched by the cocycle can fail, so only
-    those vertices are visited.
+    ``Z`` holds small integers, so the sum over every triangle ``a-b-c`` of ``(z_ab + z_bc + z_ca)²``,
+    one entry per edge ``a-c``, is exact in floating point: expanded, it is a few matrix products.
     """
-    for b in np.flatnonzero(np.any(Z != 0, axis=1)):
-        around = Z[:, b][:, None] + Z[b, :][None, :] + Z.T  # z(a,b) + z(b,c) + z(c,a) at [a, c]
-        mask = adjacent[:, b][:, None] & adjacent[b, :][None, :] & adjacent
-        if np.any(around[mask] != 0):
-            return False
-    return True
+    A = adjacent.astype(np.float64)
+    B = A * Z  # z on the edges
+    B2 = B * Z
+    Zca = Z.T  # z(c, a) at [a, c]
+    # Σ_b A_ab A_bc (z_ab + z_bc + z_ca)² at [a, c]
+    S = B2 @ A + A @ B2 + (A @ A) * Zca**2 + 2.0 * (B @ B) + 2.0 * (B @ A + A @ B) * Zca
+    return not np.any(S[adjacent] != 0)
 
 
 def _smooth(Z: np.ndarray, adjacent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -261,13 +264,17 @@ def _extend(dist: np.ndarray, w: np.ndarray, zbar: np.ndarray, radius: float) ->
     ``dist``: ``(L, N)`` landmark-to-point distances.  Points farther than
     ``radius`` from every landmark take the coordinate of the nearest one.
     """
-    phi = np.maximum(radius - dist, 0.0)
-    total = phi.sum(axis=0)
+    # Only the (landmark, point) pairs closer than the radius weigh: sums over those pairs (bincount), not
+    # (L, N) temporaries, which made the time grow faster than N on long takes.
+    near_l, near_n = np.nonzero(dist < radius)
+    phi = radius - dist[near_l, near_n]
+    N = dist.shape[1]
+    total = np.bincount(near_n, phi, minlength=N)
     nearest = np.argmin(dist, axis=0)
     theta = w[nearest].copy()
     ok = total > 0
-    j = nearest[ok]
-    theta[ok] += np.einsum("ln,nl->n", phi[:, ok] / total[ok], zbar[j])
+    moved = np.bincount(near_n, phi * zbar[nearest[near_n], near_l], minlength=N)
+    theta[ok] += moved[ok] / total[ok]
     return theta
 
 

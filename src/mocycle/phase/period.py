@@ -205,6 +205,10 @@ def moving_average(x: np.ndarray, size: int) -> np.ndarray:
     return (sums[size:] - sums[:-size]) / size + level
 
 
+#: Autocorrelation maxima (fractions of ``r(0)``) this close to the highest count as level with it.
+PEAK_TIE = 0.02
+
+
 def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_strength: float = 0.1) -> float:
     """The fundamental cycle (frames) of ``X`` (``(T,)`` or ``(T, D)``) by windowed circular autocorrelation.
 
@@ -212,9 +216,10 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
     ``r(k) = sum_n w(n)x(n) w((n+k) mod T) x((n+k) mod T)`` (circular, no zero padding, by FFT), summed over
     columns and divided by ``r(0)``.  The window favours the smallest period: ``r`` decays with the lag, so the
     first multiple of the cycle gives the highest maximum.  The period is the lag of the highest local maximum
-    in ``[min_lag, max_lag]`` (default ``max_lag = T // 2``), refined to sub-frame precision by a parabola
-    through the peak and its two neighbours of ``r(k)`` divided by the window's own autocorrelation (which
-    removes the window's pull towards shorter lags).
+    in ``[min_lag, max_lag]`` (default ``max_lag = T // 2``; a maximum within :data:`PEAK_TIE` of the
+    highest at a whole fraction of its lag is taken instead, which matters on long takes), refined to
+    sub-frame precision by a parabola through the peak and its two neighbours of ``r(k)`` divided by the
+    window's own autocorrelation (which removes the window's pull towards shorter lags).
 
     Columns with a NaN or infinite value are dropped; constant columns contribute nothing.  Returns NaN when no
     column is usable, when the signal is constant, or when no maximum reaches ``min_strength * r(0)`` (white
@@ -260,6 +265,14 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
     if peaks.size == 0:
         return float("nan")
     p = int(peaks[np.argmax(seg[peaks])])
+    # On long takes the window hardly decays over a few cycles, so the maxima at the cycle and at its
+    # multiples are level and noise picks among them: a maximum within PEAK_TIE of the highest, at a lag the
+    # highest is a whole multiple (>= 2) of, is the cycle (on short takes the decay keeps it highest anyway)
+    level = peaks[(seg[peaks] >= seg[p] - PEAK_TIE) & (peaks < p)]
+    times = p / np.maximum(level, 1)
+    whole = (np.round(times) >= 2) & (np.abs(times / np.maximum(np.round(times), 1) - 1) <= 0.1)
+    if whole.any():
+        p = int(level[whole][0])
     # Refine on r / (the window's own circular autocorrelation): the window's decay would pull the vertex
     # towards smaller lags by up to ~1 % of the period; the division undoes that bias for a stationary signal.
     env = np.fft.irfft(np.abs(np.fft.rfft(window)) ** 2, n=T)

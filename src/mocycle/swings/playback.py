@@ -11,30 +11,53 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from scipy.spatial.transform import Rotation, Slerp
+from scipy.spatial.transform import Rotation
 
 from .. import _validate
 from ..errors import MocycleError
 from ..io.bvh import _channel_layout, motion_channels
 from ..motion import Motion
-from ..rotations import quat_angles, rotvec_quat
-from .segment import Segmentation
+from ..rotations import quat_angles, quat_exp, quat_multiply, rotvec_quat, slerp
+from .segment import Segmentation, swing_angles
 
 PROFILES = ("hermite", "linear")
 
 
-def joint_quats(seg: Segmentation, j: int, profile: str = "hermite") -> np.ndarray:
-    """Played-back local rotations ``(T, 4)`` of joint ``j``."""
-    T, dt = seg.n_frames, seg.frame_time
-    swings = seg.swings_of(j)
+def _swing_table(swings: list, frame_time: float, profile: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every swing's rotations at each of its frames ``start..end``, all swings at once: which swing
+    ``(m,)``, frame ``(m,)`` and quaternion ``(m, 4)``, in the order of ``swings`` (then of frames)."""
+    if not swings:
+        return np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros((0, 4))
+    start = np.array([s.start for s in swings])
+    count = np.array([s.end for s in swings]) - start + 1
+    owner = np.repeat(np.arange(len(swings)), count)
+    frames = start[owner] + np.arange(owner.size) - np.repeat(np.cumsum(count) - count, count)
+
+    def each(name: str) -> np.ndarray:
+        return np.array([getattr(s, name) for s in swings], dtype=np.float64)[owner]
+
+    theta = swing_angles(frames, each("start"), each("end"), each("start_angle"), each("end_angle"),
+                         each("start_speed"), each("end_speed"), frame_time, profile)
+    axis = np.array([s.axis for s in swings], dtype=np.float64)[owner]
+    half = 0.5 * theta
+    turn = np.concatenate([np.sin(half)[:, None] * axis, np.cos(half)[:, None]], axis=1)
+    base = quat_exp(np.array([s.base for s in swings], dtype=np.float64))[owner]
+    return owner, frames, quat_multiply(turn, base)
+
+
+def _play_joint(seg: Segmentation, j: int, swings: list, table) -> np.ndarray:
+    """Joint ``j``'s rotations ``(T, 4)`` from its ``swings`` (in time order) and their :func:`_swing_table`."""
+    T = seg.n_frames
+    owner, frames, q = table
+    index = np.arange(len(swings))
+    first = np.searchsorted(owner, index)
+    last = np.searchsorted(owner, index, side="right") - 1
     keys: dict[float, np.ndarray] = {}
-    for s in swings:
-        ends = s.quats(np.array([s.start, s.end], dtype=float), dt, profile)
-        keys.setdefault(float(s.start), ends[0])
-        keys.setdefault(float(s.end), ends[1])
+    for k, s in enumerate(swings):
+        keys.setdefault(float(s.start), q[first[k]])
+        keys.setdefault(float(s.end), q[last[k]])
     for h in seg.holds_of(j):
         keys.setdefault(0.5 * (h.start + h.end), rotvec_quat(np.asarray(h.mean)))
-    frames = np.arange(T, dtype=float)
     if not keys:
         out = np.zeros((T, 4))
         out[:, 3] = 1.0
@@ -42,12 +65,20 @@ def joint_quats(seg: Segmentation, j: int, profile: str = "hermite") -> np.ndarr
         out = np.repeat(next(iter(keys.values()))[None, :], T, axis=0)
     else:
         times = np.array(sorted(keys))
-        rots = Rotation.from_quat(np.stack([keys[t] for t in times]))
-        out = Slerp(times, rots)(np.clip(frames, times[0], times[-1])).as_quat()
-    for s in swings:
-        idx = np.arange(s.start, s.end + 1)
-        out[idx] = s.quats(idx.astype(float), dt, profile)
+        kq = np.stack([keys[t] for t in times])
+        kq /= np.linalg.norm(kq, axis=1, keepdims=True)
+        at = np.clip(np.arange(T, dtype=float), times[0], times[-1])
+        seg_of = np.clip(np.searchsorted(times, at, side="right") - 1, 0, len(times) - 2)
+        u = (at - times[seg_of]) / (times[seg_of + 1] - times[seg_of])
+        out = slerp(kq[seg_of], kq[seg_of + 1], u)  # shortest arc between keys, as scipy's Slerp
+    out[frames] = q  # inside a swing its own curve; where swings overlap the later one wins
     return out
+
+
+def joint_quats(seg: Segmentation, j: int, profile: str = "hermite") -> np.ndarray:
+    """Played-back local rotations ``(T, 4)`` of joint ``j``."""
+    swings = seg.swings_of(j)
+    return _play_joint(seg, j, swings, _swing_table(swings, seg.frame_time, profile))
 
 
 def playback(seg: Segmentation, profile: str = "hermite") -> Motion:
@@ -67,7 +98,15 @@ def playback(seg: Segmentation, profile: str = "hermite") -> Motion:
     """
     _validate.choice("profile", profile, PROFILES)
     T, J = seg.n_frames, seg.skeleton.n_joints
-    quats = np.stack([joint_quats(seg, j, profile) for j in range(J)], axis=1)
+    swings = sorted(seg.swings, key=lambda s: (s.joint, s.start))  # as swings_of, all joints at once
+    owner, frames, q = _swing_table(swings, seg.frame_time, profile)
+    joint_of = np.array([s.joint for s in swings], dtype=int)
+    bounds = np.searchsorted(joint_of, np.arange(J + 1))
+    quats = np.empty((T, J, 4))
+    for j in range(J):
+        a, b = bounds[j], bounds[j + 1]
+        rows = slice(np.searchsorted(owner, a), np.searchsorted(owner, b))
+        quats[:, j] = _play_joint(seg, j, swings[a:b], (owner[rows] - a, frames[rows], q[rows]))
     trans = np.empty((T, J, 3))
     frames = np.arange(T)
     for j in range(J):

@@ -60,6 +60,24 @@ MINOR_JOINT_PATTERNS = (
 
 
 # ---------------------------------------------------------------- records
+def swing_angles(frames, start, end, start_angle, end_angle, start_speed, end_speed, frame_time: float,
+                 profile: str = "hermite") -> np.ndarray:
+    """``θ`` (radians) of swings at (fractional) ``frames``: the cubic Hermite from ``start_angle`` to
+    ``end_angle`` with the end speeds (rad/s), or the paper's linear ramp.  Every argument but
+    ``frame_time`` and ``profile`` is a number or an array (broadcast), so many swings go at once."""
+    start = np.asarray(start, dtype=np.float64)
+    span = np.maximum(np.asarray(end, dtype=np.float64) - start, 1)
+    u = np.clip((np.asarray(frames, dtype=np.float64) - start) / span, 0.0, 1.0)
+    if profile == "linear":
+        return start_angle + (end_angle - start_angle) * u
+    dur = span * frame_time
+    h00 = 2 * u**3 - 3 * u**2 + 1
+    h10 = u**3 - 2 * u**2 + u
+    h01 = -2 * u**3 + 3 * u**2
+    h11 = u**3 - u**2
+    return h00 * start_angle + h10 * dur * start_speed + h01 * end_angle + h11 * dur * end_speed
+
+
 @dataclass(frozen=True, kw_only=True)
 class Swing:
     """One geodesic swing of one joint: ``q(t) = Rot(axis, θ(t)) ⊗ base`` for frames ``start..end``.
@@ -89,17 +107,8 @@ class Swing:
 
     def angles(self, frames: np.ndarray, frame_time: float, profile: str = "hermite") -> np.ndarray:
         """``θ`` (radians) at (fractional) ``frames`` inside the swing: cubic Hermite or the paper's linear."""
-        span = max(self.end - self.start, 1)
-        u = np.clip((np.asarray(frames, dtype=np.float64) - self.start) / span, 0.0, 1.0)
-        if profile == "linear":
-            return self.start_angle + (self.end_angle - self.start_angle) * u
-        dur = span * frame_time
-        h00 = 2 * u**3 - 3 * u**2 + 1
-        h10 = u**3 - 2 * u**2 + u
-        h01 = -2 * u**3 + 3 * u**2
-        h11 = u**3 - u**2
-        return (h00 * self.start_angle + h10 * dur * self.start_speed + h01 * self.end_angle
-                + h11 * dur * self.end_speed)
+        return swing_angles(frames, self.start, self.end, self.start_angle, self.end_angle, self.start_speed,
+                            self.end_speed, frame_time, profile)
 
     def quats(self, frames: np.ndarray, frame_time: float, profile: str = "hermite") -> np.ndarray:
         """Local rotations ``(n, 4)`` (x, y, z, w) of the swing at ``frames``."""

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import fnmatch
 import math
+import re
 import warnings
 from dataclasses import dataclass, field, replace
 
@@ -39,6 +40,7 @@ from ..features import pose_matrix
 from ..limits import check_frames
 from ..motion import JOINT_GROUPS, Motion, Skeleton, concatenate
 from ..phase.period import autocorrelation_period
+from ..rotations import axis_angle_quats, quat_conj, quat_exp, quat_log, quat_multiply
 from ..threads import limit_threads
 from .lct import block_edges, ilct, lct
 
@@ -212,9 +214,10 @@ def joint_groups(skeleton: Skeleton) -> dict[str, list[int]]:
     out.  Every joint is in exactly one group.
     """
     group_of: list[str] = []
+    match = {g: re.compile("|".join(fnmatch.translate(p.lower()) for p in JOINT_GROUPS[g])).match for g in GROUP_NAMES}
     for j, name in enumerate(skeleton.names):
         low = name.lower()
-        own = next((g for g in GROUP_NAMES if any(fnmatch.fnmatch(low, p.lower()) for p in JOINT_GROUPS[g])), None)
+        own = next((g for g in GROUP_NAMES if match[g](low)), None)
         if own is None:
             parent = int(skeleton.parents[j])
             own = "spine" if parent < 0 else group_of[parent]
@@ -443,7 +446,7 @@ class _Placer:
         q = m.rotations.copy()
         t = m.translations.copy()
         j = self.travel
-        q[:, j] = (Rotation.from_matrix(R) * Rotation.from_quat(q[:, j])).as_quat()
+        q[:, j] = quat_multiply(axis_angle_quats(self.space.up, np.array([self.angle]))[0], q[:, j])
         t[:, j] = (t[:, j] - self.anchor) @ R.T + self.anchor + self.offset
         return m.replace(rotations=q, translations=t)
 
@@ -466,15 +469,14 @@ def _fade(warped: Motion, target: Motion, at_start: bool, n: int) -> Motion:
         return warped
     n = min(n, warped.n_frames)
     k = 0 if at_start else warped.n_frames - 1
-    diff = (Rotation.from_quat(target.rotations[0]) * Rotation.from_quat(warped.rotations[k]).inv()).as_rotvec()
+    d = quat_multiply(target.rotations[0], quat_conj(warped.rotations[k]))
+    diff = quat_log(d * np.where(d[:, 3:4] < 0, -1.0, 1.0))  # rotation vectors, angle <= π
     dt = target.translations[0] - warped.translations[k]
     w = _smooth(n) if at_start else _smooth(n)[::-1]
     rows = np.arange(n) if at_start else np.arange(warped.n_frames - n, warped.n_frames)
     q = warped.rotations.copy()
     t = warped.translations.copy()
-    J = warped.n_joints
-    fix = Rotation.from_rotvec((w[:, None, None] * diff[None]).reshape(-1, 3))
-    q[rows] = (fix * Rotation.from_quat(q[rows].reshape(-1, 4))).as_quat().reshape(n, J, 4)
+    q[rows] = quat_multiply(quat_exp(w[:, None, None] * diff[None]), q[rows])
     t[rows] += w[:, None, None] * dt[None]
     return warped.replace(rotations=q, translations=t)
 
