@@ -315,7 +315,8 @@ def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weight
     if not need.any():
         return need
     width = 2 * max(1, n_blend) + 1
-    return uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
+    delta = uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
+    return np.where(delta > 1e-9 * contacts.body, delta, 0.0)  # no round-off tails: untouched frames stay exact
 
 
 def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
