@@ -79,6 +79,26 @@ def planted(motion, contacts) -> float:
     return worst
 
 
+def fast_share(motion) -> float:
+    """The share of ``motion``'s skate from frame steps where the joint moves faster than one body height per
+    second: a swing foot passing low, or a heel landing at speed, not a planted foot gliding."""
+    from mocycle.contacts import body_height, find_feet, up_axis
+    from mocycle.contacts.skate import SKATE_HEIGHT
+
+    up = up_axis(motion)
+    body = body_height(motion, up)
+    joints = [j for f in find_feet(motion.skeleton) for j in f.contact_joints]
+    P = motion.world_positions()[:, joints]
+    h = P @ up
+    h = h - h.min(axis=0)
+    step = np.diff(P, axis=0)
+    speed = np.linalg.norm(step - (step @ up)[..., None] * up, axis=-1) / motion.frame_time
+    hm = 0.5 * (h[1:] + h[:-1])
+    H = SKATE_HEIGHT * body
+    c = np.where(hm < H, 2.0 - 2.0 ** (hm / H), 0.0) * speed
+    return float(c[speed > body].sum() / max(c.sum(), 1e-300))
+
+
 def seam_ratio(cycle, feet) -> float:
     m = cycle.repeat(2, root="inplace")
     q = m.rotations[:, leg_joints(feet)]
@@ -192,6 +212,7 @@ def loops(args) -> None:
         con = detect_contacts(ext)
         locked = lock_feet(ext, con)  # bones and held feet checked on the whole repeated take
         row = dict(take=path.name, s_in=s_in, s_fit=s_fit, s_out=s_out, ratio=s_out / s_in,
+                   fast=fast_share(motion[frames[0]:frames[-1] + 1]),
                    step_before=largest_leg_step(before), step_after=largest_leg_step(after),
                    bones=bone_error(ext, locked), planted=planted(locked, con), seam=seam_ratio(cleaned, contacts.feet),
                    seam_fit=seam_ratio(cycle, contacts.feet),
@@ -211,6 +232,8 @@ def loops(args) -> None:
     print(f"median skate: input {statistics.median(r['s_in'] for r in rows):.2f}, fitted "
           f"{statistics.median(r['s_fit'] for r in rows):.2f}, locked {statistics.median(r['s_out'] for r in rows):.2f}"
           f" units/s; median locked/input {statistics.median(ratios):.2f} (goal <= 0.5)")
+    print(f"share of the input's skate from steps faster than 1 body height/s (swing feet passing low, heels "
+          f"landing at speed; not a planted foot): median {statistics.median(r['fast'] for r in rows):.0%}")
     print(f"takes whose locked loop skates more than the input: {len(worse)} (goal 0) {' '.join(worse[:12])}")
     print(f"takes with a leg step > 1.5x before: {len(pops)} (goal 0) {' '.join(pops[:12])}")
     print(f"largest bone-length change: {max(r['bones'] for r in rows):.1e} (goal 1e-9); largest contact-joint "

@@ -1,5 +1,6 @@
 import json
 
+import numpy as np
 from typer.testing import CliRunner
 
 from mocycle.cli import app
@@ -71,3 +72,35 @@ def test_stretch_and_transition_lock_travelling_output(tmp_path):
     result = runner.invoke(app, ["transition", str(a), str(b), "-o", str(out), "--cycles", "2", "--json"])
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout)["feet"]["mode"] == "lock"
+
+
+def test_decompress_keeps_the_keyframes_by_default_and_locks_the_feet_when_asked(tmp_path):
+    from mocycle.contacts import detect_contacts, ranges
+    from mocycle.io import read_bvh
+    from mocycle.keyframes import read_compressed
+
+    src, mck = _walk(tmp_path), tmp_path / "walk.mck"
+    assert runner.invoke(app, ["compress", str(src), "-o", str(mck)]).exit_code == 0
+    keys = read_compressed(mck).key_idx
+    kept, locked = tmp_path / "kept.bvh", tmp_path / "locked.bvh"
+    result = runner.invoke(app, ["decompress", str(mck), "-o", str(kept), "--json"])
+    assert result.exit_code == 0, result.output
+    facts = json.loads(result.stdout)
+    assert facts["feet"]["mode"] == "keep" and facts["keyframes_exact"] is True
+    result = runner.invoke(app, ["decompress", str(mck), "-o", str(locked), "--json", "--feet", "lock"])
+    assert result.exit_code == 0, result.output
+    facts = json.loads(result.stdout)
+    assert facts["feet"]["mode"] == "lock" and facts["keyframes_exact"] is False
+    assert facts["feet"]["skate_after"] < facts["feet"]["skate_before"]
+    a, b = read_bvh(kept), read_bvh(locked)
+    orig = read_bvh(src)
+    same = lambda x, y: np.abs(np.sum(x * y, axis=-1)).min() > 1 - 1e-9  # noqa: E731  (q and -q alike)
+    assert same(a.rotations[keys], orig.rotations[keys])          # keep: the keyframes come back exactly
+    assert not same(b.rotations[keys], orig.rotations[keys])      # lock: some keyframe near a contact changed
+    # locked: each contact of the rebuilt take is held still (to the BVH's printed precision)
+    con = detect_contacts(a)
+    W = b.world_positions()
+    for c, j in enumerate(con.joints):
+        for s, e in ranges(con.mask[:, c]):
+            assert np.abs(W[s:e, j] - W[s, j]).max() < 1e-3
+    assert runner.invoke(app, ["decompress", str(mck), "-o", str(locked), "--feet", "slide"]).exit_code == 2

@@ -123,3 +123,37 @@ def test_skate_counts_feet_gliding_on_the_floor():
     per = skate(moving, per_joint=True)
     assert set(per) == {"LeftFoot", "LeftToeBase", "RightFoot", "RightToeBase"}
     assert find_feet(still.skeleton)[0].side == "left"
+
+
+def test_far_from_its_holds_a_leg_is_unchanged():
+    """With one contact per foot kept, the legs far from it (beyond the low frames, the blend and the
+    swing bridge) keep their rotations exactly, and the held joints stand still to 1e-6."""
+    from mocycle.contacts.detect import Contacts
+    from mocycle.contacts.lock import BLEND_SECONDS, EXTEND_SECONDS
+
+    m = _slid_walk()
+    con = detect_contacts(m)
+    mask = np.zeros_like(con.mask)
+    for c in range(mask.shape[1]):
+        rs = [r for r in con.joint_ranges(c) if r[0] > m.n_frames // 3]
+        s, e = rs[0]
+        mask[s:e, c] = True
+    one = Contacts(con.feet, con.joints, con.foot_of, mask, con.up, con.body, con.frame_time)
+    out = lock_feet(m, one, follow=False)
+    W = out.world_positions()
+    for c, j in enumerate(one.joints):
+        for s, e in one.joint_ranges(c):
+            assert np.abs(W[s:e, j] - W[s, j]).max() < 1e-6
+    reach = int(round((EXTEND_SECONDS + BLEND_SECONDS) * m.fps)) + 1
+    lowered = ~np.all(out.translations == m.translations, axis=(1, 2))
+    checked = 0
+    for f, foot in enumerate(one.feet):
+        near = np.zeros(m.n_frames, bool)
+        for s, e in one.foot_ranges(f):
+            near[max(0, s - reach):e + reach] = True
+        free = ~near & ~lowered
+        leg = [foot.hip, foot.knee, foot.ankle]
+        assert np.array_equal(out.rotations[free][:, leg], m.rotations[free][:, leg])
+        checked += free.sum()
+        assert not np.array_equal(out.rotations[near][:, leg], m.rotations[near][:, leg])
+    assert checked > m.n_frames  # most frames of both legs are checked

@@ -23,6 +23,7 @@ from .common import (
 )
 
 C = tasks.compress.Options
+D = tasks.decompress.Options
 P = tasks.project.Options
 
 
@@ -83,15 +84,24 @@ def compress(
 def decompress(
     path: Annotated[Path, typer.Argument(help="A .mck file written by 'mocycle compress'.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh file to write.")],
+    feet: Annotated[str, flag(D, "feet")] = default(D, "feet"),
+    foot_joints: Annotated[str | None, flag(D, "foot_joints")] = default(D, "foot_joints"),
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
-    """Rebuild a take from its keyframes; the keyframes come back exactly."""
+    """Rebuild a take from its keyframes; the keyframes come back exactly (unless --feet lock)."""
     check_output(output, [path], force, ".bvh", "--output")
-    report = tasks.decompress.run(path)
+    report = tasks.decompress.run(path, D(feet=feet, foot_joints=foot_joints))
     print_warnings(report)
     write(report.motions["motion"], output)
     r = report.facts
+    if as_json:
+        print_json({**r, "seconds": report.seconds})
+        return
     out.print(f"{output}: {r['frames']} frames rebuilt from {r['keyframes']} keyframes ({r['scheme']})")
+    if r["feet"]["mode"] == "lock":
+        out.print(f"  feet locked: skate {r['feet']['skate_before']:.4g} -> {r['feet']['skate_after']:.4g} units/s "
+                  "(the keyframes near contacts changed with them)")
 
 
 @app.command()

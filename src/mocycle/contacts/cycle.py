@@ -1,12 +1,12 @@
 """Foot locking for loops: contacts that cross the seam are one contact, and the cleaned cycle still loops.
 
-A cycle of ``N`` frames is repeated three times with its root motion (each
+A cycle of ``N`` frames is repeated four times with its root motion (each
 repeat moved on by the travel and turned by the turn per cycle), contacts are
-found and locked on those ``3N`` frames, and the middle ``N`` frames are read
-back into the cycle's own space, moved back by one cycle.  Everything the
-clean-up does depends only on the frames around it (contacts, their means,
-the blend windows and the root lowering reach less than a cycle), so the
-middle cycle is cleaned exactly as its neighbours are: frame ``N`` of the
+found and locked on those ``4N`` frames, and the second repeat's ``N`` frames
+are read back into the cycle's own space, moved back by one cycle.  Everything
+the clean-up does depends only on the frames around it (contacts, their means,
+the low frames, the swing bridges and the root lowering reach less than a
+cycle), so that cycle is cleaned exactly as its neighbours are: frame ``N`` of the
 cleaned loop is frame 0 moved on by exactly the travel per cycle, the held
 feet of consecutive cycles are exactly one travel apart, and the in-place
 loop (the travel taken out at a constant rate) slides a held foot back at

@@ -6,25 +6,30 @@
    repeated loop, so the travel is kept): in single support the stance foot
    then stands still with no change to the legs at all.
 2. **Holds.** Each contact of a contact joint is held at one point in world
-   space: at the joint's lowest height during the contact (so its lowest
-   level does not change) and horizontally at its mean position, or at one of
-   its positions during the contact when that needs less lowering of the root.
-   The toe of a foot whose ankle and toe are both held is held at the ankle's
-   point plus the foot vector in the middle of their overlap, so a rigid foot
-   meets both holds exactly.  Over ``blend`` seconds before and after each
-   contact (at most half the gap to the next) the hold is cross-faded with
-   the joint's own path by a smoothstep, so corrections grow and fade.
-3. **Ankle goals.** The held ankle; while only the toe is held, the ankle
-   moved with the toe (the foot keeps its orientation and pivots on the
-   ball), and where that is beyond the leg's reach the heel lifts (the foot
-   turns about the held toe) until it is within reach.
-4. **Root lowering.** Where an ankle goal is still farther from its hip than
-   ``reach`` of the leg's length, the root goes down along the vertical
+   space: at the joint's lowest height during the contact and horizontally at
+   its mean position, or at one of its positions during the contact when that
+   needs less lowering of the root.  The toe of a foot whose ankle and toe are
+   both held is held at the ankle's point plus the foot vector in the middle
+   of their overlap, so a rigid foot meets both holds exactly.  While only one
+   of the foot's joints is held, the other is carried with it rigidly (the
+   foot keeps its own roll), and where a held toe leaves the ankle beyond the
+   leg's reach the heel lifts (the foot turns about the toe).
+3. **Low frames around a contact.** Before and after each contact, while the
+   joint is still within ``EXTEND_HEIGHT`` of the held height and within
+   ``EXTEND_DISTANCE`` of the held point (at most ``EXTEND_SECONDS``), it is
+   held horizontally and keeps its own vertical path: a heel coming down or a
+   toe lifting away moves straight down or up instead of gliding on the floor.
+4. **Swings.** Between two holds of a joint (a gap of at most
+   ``BRIDGE_SECONDS``) the correction goes from the one hold's to the next's
+   by a smoothstep, so a swing foot keeps the shape of its world path, only
+   shifted; longer gaps and the ends of a take fade the correction out over
+   ``blend`` seconds.  Goals off the holds are kept within the leg's reach.
+5. **Root lowering.** Where a held ankle goal is still farther from its hip
+   than ``reach`` of the leg's length, the root goes down along the vertical
    (smoothed over the blend window so it never jumps and is never less than
-   needed); a free leg that is bent keeps its foot where it was, a straight
-   one rides down with the root (bending a straight leg by a few millimetres
-   takes a large knee angle: a pop).
-5. **Two-bone IK.** The knee bends about the normal of the hip-knee-ankle
+   needed); every foot keeps its goal in the world, so a swing foot does not
+   dip with the root.
+6. **Two-bone IK.** The knee bends about the normal of the hip-knee-ankle
    plane until the hip-ankle distance is right, then the thigh swings by the
    smallest rotation that puts the ankle on its goal (the knee stays in the
    leg's plane, only turned with it); the foot keeps its world orientation,
@@ -45,9 +50,14 @@ from .detect import Contacts, ranges
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
 REACH = 0.995        # of hip-knee plus knee-ankle: farther goals lower the root
-# hip-ankle distance over leg length: a free leg rides down with the root above STRAIGHT, keeps its foot below BENT
-STRAIGHT, BENT = 0.999, 0.98
 DISTANCE_WEIGHT = 1.0  # a hold this much farther from the mean weighs like the same lowering of the root
+EXTEND_SECONDS = 0.2   # a hold reaches at most this far beyond its contact while the joint stays low
+EXTEND_HEIGHT = 0.025  # of the body height above the held height: "low" (the contact detector's height)
+EXTEND_DISTANCE = 0.03  # of the body height: "near" the held point horizontally (farther: no early plant)
+BRIDGE_SECONDS = 0.6   # a gap between holds this short (a swing) is bridged; longer ones fade over the blend
+#: how firmly a contact joint is held on a frame: its own contact, its foot's other joint's contact (carried
+#: rigidly), its own low frames around a contact (held horizontally), the other joint's low frames
+HELD, FOLLOW, LOW, FOLLOW_LOW = 4, 3, 2, 1
 
 
 def _smoothstep(x: np.ndarray) -> np.ndarray:
@@ -128,18 +138,87 @@ def _best_hold(path: np.ndarray, offsets: np.ndarray, hips: np.ndarray, R: np.nd
     return cands[0] if need[0] <= need[k] + 1e-6 * body else cands[k]
 
 
-def _toward(correction: np.ndarray, w: np.ndarray, up: np.ndarray) -> np.ndarray:
-    """``correction`` ``(T, 3)`` scaled by the hold weight ``w`` ``(T,)``; a downward part by ``w**3``, so a
-    heel still coming down (or already lifting) is not pulled to the floor while it moves fast."""
-    vert = correction @ up
-    wv = np.where(vert < 0, w ** 3, w)
-    return w[:, None] * (correction - np.outer(vert, up)) + np.outer(wv * vert, up)
+def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up: np.ndarray, low: float,
+               near: float, n_extend: int) -> tuple[np.ndarray, np.ndarray]:
+    """Corrections ``(T, 3)`` (NaN where not held) and levels ``(T,)`` of one contact joint's own holds.
+
+    In each contact the correction takes the joint to its target (level ``HELD``).  Around it, while the
+    joint stays within ``low`` of the target's height and within ``near`` of it horizontally (at most
+    ``n_extend`` frames and a third of the gap to the neighbour contact), it is held horizontally and
+    keeps its own vertical path, shifted as at the contact's edge (level ``LOW``).
+    """
+    T = path.shape[0]
+    corr = np.full((T, 3), np.nan)
+    level = np.zeros(T, dtype=int)
+    rs = ranges(mask)
+    height = path @ up
+    for k, ((a, b), target) in enumerate(zip(rs, targets, strict=True)):
+        corr[a:b] = target - path[a:b]
+        level[a:b] = HELD
+        n_before = n_extend if k == 0 else min(n_extend, (a - rs[k - 1][1]) // 3)
+        n_after = n_extend if k + 1 == len(rs) else min(n_extend, (rs[k + 1][0] - b) // 3)
+        top = target @ up + low
+        for frames, edge in ((range(a - 1, max(0, a - n_before) - 1, -1), a),
+                             (range(b, min(T, b + n_after)), b - 1)):
+            lift = corr[edge] @ up
+            for t in frames:
+                c = target - path[t]
+                if height[t] >= top or np.linalg.norm(c - (c @ up) * up) > near:
+                    break
+                corr[t] = c + (lift - c @ up) * up
+                level[t] = LOW
+    return corr, level
 
 
-def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: float):
-    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and the foot's hold weight ``(T,)`` (0: free)."""
+def _follow(corr: np.ndarray, level: np.ndarray, other: np.ndarray, other_level: np.ndarray) -> None:
+    """Where the other contact joint of the same foot holds and this one does not (as strongly), this one
+    moves with it: the foot is carried rigidly (in place, levels ``FOLLOW`` and ``FOLLOW_LOW``)."""
+    for own, theirs in ((FOLLOW, HELD), (FOLLOW_LOW, LOW)):
+        m = (other_level == theirs) & (level < own)
+        corr[m] = other[m]
+        level[m] = own
+
+
+def _bridge(corr: np.ndarray, n_bridge: int, n_fade: int) -> np.ndarray:
+    """Fill the NaN frames of ``corr`` ``(T, 3)``: a gap of at most ``n_bridge`` frames between two held
+    frames goes from one correction to the other by a smoothstep; a longer gap, or one at an end of the
+    take, fades each side's correction to zero over ``n_fade`` frames."""
+    out = corr.copy()
+    T = corr.shape[0]
+    for p, q in ranges(np.isnan(corr[:, 0])):
+        t = np.arange(p, q)
+        c0 = corr[p - 1] if p > 0 else None
+        c1 = corr[q] if q < T else None
+        if c0 is not None and c1 is not None and q - p <= n_bridge:
+            out[p:q] = c0 + np.outer(_smoothstep((t - p + 1) / (q - p + 1)), c1 - c0)
+            continue
+        out[p:q] = 0.0
+        if c0 is not None:
+            out[p:q] += np.outer(_smoothstep((p + n_fade - t) / (n_fade + 1)), c0)
+        if c1 is not None:
+            out[p:q] += np.outer(_smoothstep((t - (q - 1 - n_fade)) / (n_fade + 1)), c1)
+    return out
+
+
+def _into_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """``corr`` ``(T, 3)`` shortened (toward ``base``, which is within reach) so that ``base + corr`` is
+    within ``R`` ``(T,)`` of ``hips``."""
+    d = base - hips
+    aa = np.sum(corr * corr, axis=1)
+    bb = 2 * np.sum(d * corr, axis=1)
+    cc = np.sum(d * d, axis=1) - R ** 2
+    far = np.sum((d + corr) ** 2, axis=1) > R ** 2
+    disc = np.maximum(bb ** 2 - 4 * aa * cc, 0.0)
+    s = np.where(far & (aa > 0), (-bb + np.sqrt(disc)) / (2 * np.maximum(aa, 1e-300)), 1.0)
+    return corr * np.clip(s, 0.0, 1.0)[:, None]
+
+
+def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
+                reach: float):
+    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and ``(T,)`` True where the foot is held."""
     foot = contacts.feet[f]
     up, body = contacts.up, contacts.body
+    low, near = EXTEND_HEIGHT * body, EXTEND_DISTANCE * body
     cols = {contacts.joints[c]: c for c, g in enumerate(contacts.foot_of) if g == f}
     a, hips, R = W[:, foot.ankle], W[:, foot.hip], _reach(W, foot, reach)
     ma = contacts.mask[:, cols[foot.ankle]]
@@ -147,7 +226,7 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
     mt = contacts.mask[:, cols[foot.toe]] if foot.toe is not None else np.zeros_like(ma)
     rt = ranges(mt)
     t = W[:, foot.toe] if foot.toe is not None else a
-    # each ankle contact with the toe contacts it overlaps most: one rigid-foot hold
+    # each toe contact with the ankle contact it overlaps most: one rigid-foot hold
     partner = {}
     for i, (s, e) in enumerate(rt):
         overlaps = [min(e, y) - max(s, x) for x, y in ra]
@@ -164,11 +243,27 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
                 frames.append(only)
                 offsets.append((t[mid] - a[mid]) - (t[only] - a[only]))
         fr, off = np.concatenate(frames), np.concatenate(offsets)
-        held_a.append(_best_hold(a[s:e], off, hips[fr], R[fr], up, body)
-                      if fr.size else a[s:e].mean(axis=0))
-    w_a, hold_a = _holds(ma, held_a, n_blend)
-    if foot.toe is None:
-        return a + _toward(hold_a - a, w_a, up), None, w_a
+        held_a.append(_best_hold(a[s:e], off, hips[fr], R[fr], up, body))
+    corr_a, level_a = _own_holds(a, ma, held_a, up, low, near, n_extend)
+    corr_t = None
+    if foot.toe is not None:
+        corr_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low,
+                            near, n_extend)
+    soft = (level_a > 0) & (level_a < FOLLOW)
+    corr_a[soft] = _into_reach(a[soft], corr_a[soft], hips[soft], R[soft])
+    corr_a = _bridge(corr_a, n_bridge, n_fade)
+    free = level_a == 0
+    corr_a[free] = _into_reach(a[free], corr_a[free], hips[free], R[free])
+    changed = np.any(corr_a != 0, axis=1)
+    if corr_t is None:
+        return a + corr_a, None, level_a >= FOLLOW, changed
+    corr_t = _bridge(corr_t, n_bridge, n_fade)
+    return a + corr_a, t + corr_t, level_a >= FOLLOW, changed | np.any(corr_t != 0, axis=1)
+
+
+def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend):
+    """The toe's corrections (NaN where not held); the ankle's (``corr_a``, ``level_a``) updated in place
+    where it follows the held toe (heel lifted where the leg cannot reach)."""
     held_t = []
     for i, (s, e) in enumerate(rt):
         if i in partner:  # a rigid foot can meet both holds: toe = held ankle + foot vector
@@ -177,21 +272,18 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_blend: int, reach: 
         else:
             fr = np.arange(s, e)
             held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
-    w_t, hold_t = _holds(mt, held_t, n_blend)
-    wa, wt = w_a[:, None], w_t[:, None]
-    goal_a = a + _toward(hold_a - a, w_a, up) + (1.0 - wa) * _toward(hold_t - t, w_t, up)
-    goal_t = goal_a + t - a + _toward(hold_t - (goal_a + t - a), w_t, up)
-    # while the toe is held harder than the ankle, put the ankle on the sphere of foot length around the toe
-    length = np.linalg.norm(t - a, axis=1, keepdims=True)
-    on_sphere = goal_t - length * _normalize(goal_t - goal_a)
-    den = 1.0 - wa * wt
-    lam = np.where(den > 1e-12, wt * (1.0 - wa) / np.maximum(den, 1e-12), 0.0)
-    goal_a = goal_a + lam * (on_sphere - goal_a)
+    corr_t, level_t = _own_holds(t, mt, held_t, up, low, near, n_extend)
+    _follow(corr_a, level_a, corr_t, level_t)
+    _follow(corr_t, level_t, corr_a, level_a)
     # a held toe with the ankle out of the leg's reach: the heel lifts (the foot turns about the toe) until
     # the ankle is back within reach, rather than the root going down
-    lifted = _within_reach(goal_a, goal_t, length[:, 0], hips, R)
-    goal_a = goal_a + lam * (lifted - goal_a)
-    return goal_a, goal_t, np.maximum(w_a, w_t)
+    on_toe = level_a == FOLLOW
+    if on_toe.any():
+        length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
+        goal_t = t[on_toe] + corr_t[on_toe]
+        lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
+        corr_a[on_toe] = lifted - a[on_toe]
+    return corr_t
 
 
 def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray, r2: np.ndarray) -> np.ndarray:
@@ -225,7 +317,8 @@ def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weight
     width = 2 * max(1, n_blend) + 1
     from scipy.ndimage import maximum_filter1d, uniform_filter1d  # only when feet are locked
 
-    return uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
+    delta = uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
+    return np.where(delta > 1e-9 * contacts.body, delta, 0.0)  # no round-off tails: untouched frames stay exact
 
 
 def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
@@ -305,26 +398,23 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         if np.abs(shift).max() > 0:
             motion = _move_travel(motion, Rw, shift)
             Rw, W = motion.world_transforms()
-    goals, toe_goals, active = [], [], []
+    n_extend = int(round(EXTEND_SECONDS / motion.frame_time))
+    n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
+    goals, toe_goals, held, changed = [], [], [], []
     for f in range(len(contacts.feet)):
-        g, gt, act = _foot_goals(W, contacts, f, n_blend, reach)
+        g, gt, h, ch = _foot_goals(W, contacts, f, n_extend, n_bridge, n_blend, reach)
         goals.append(g)
         toe_goals.append(gt)
-        active.append(act)
-    delta = _lowering(W, contacts, goals, active, reach, n_blend)
+        held.append(h)
+        changed.append(ch)
+    delta = _lowering(W, contacts, goals, held, reach, n_blend)
     lowered = delta > 0
-    if lowered.any():
-        # a free leg that is bent keeps its foot where it was; a straight one rides down with the root
-        for f, foot in enumerate(contacts.feet):
-            H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
-            stretch = np.linalg.norm(A - H, axis=1) / (np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1))
-            keep = _smoothstep((STRAIGHT - stretch) / (STRAIGHT - BENT))
-            goals[f] = goals[f] - ((1.0 - active[f]) * (1.0 - keep) * delta)[:, None] * contacts.up
+    if lowered.any():  # every foot keeps its goal in the world: a swing foot does not dip with the root
         motion = _move_travel(motion, Rw, -np.outer(delta, contacts.up))
         Rw, W = motion.world_transforms()
     local = motion.rotation_matrices().copy()
-    for foot, g, gt, act in zip(contacts.feet, goals, toe_goals, active, strict=True):
-        t = np.flatnonzero((act > 0) | lowered)
+    for foot, g, gt, ch in zip(contacts.feet, goals, toe_goals, changed, strict=True):
+        t = np.flatnonzero(ch | lowered)
         if t.size == 0:
             continue
         H, K, A, G = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle], g[t]
@@ -351,8 +441,8 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, J, 4)
     # frames and joints not touched keep their exact quaternions
     touched = np.zeros((T, J), bool)
-    for foot, act in zip(contacts.feet, active, strict=True):
-        touched[np.ix_((act > 0) | lowered, [foot.hip, foot.knee, foot.ankle])] = True
+    for foot, ch in zip(contacts.feet, changed, strict=True):
+        touched[np.ix_(ch | lowered, [foot.hip, foot.knee, foot.ankle])] = True
     quats = np.where(touched[..., None], quats, motion.rotations)
     sign = np.where(np.sum(quats * motion.rotations, axis=-1, keepdims=True) < 0, -1.0, 1.0)
     return motion.replace(rotations=quats * sign)
