@@ -44,7 +44,7 @@ EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion, or its cyc
 FLAGS = {f.name: flag_of(f) for task in TASKS.values() for f in dataclasses.fields(task.Options)}
 FLAGS.update({"n_harmonics": "--harmonics", "time_axis_method": "--time", "phase_step": "--step",
               "n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles",
-              "window": "--window"})
+              "window": "--window", "gltf_scale": "--gltf-scale", "gltf_up": "--gltf-up"})
 
 
 def option_message(exc: OptionError) -> str:
@@ -220,6 +220,48 @@ def write_text(path: Path, text: str | bytes, what: str = "file") -> Path:
         return atomic_write(path, text)
     except OSError as exc:
         raise MocycleError(f"{path}: cannot write the {what} ({exc.strerror or exc})") from None
+
+
+# ------------------------------------------------------------ motion outputs (.bvh or .glb)
+#: the files a command that writes motion writes
+MOTION_OUTPUTS = (".bvh", ".glb")
+GLTF_SCALE = typer.Option(
+    "--gltf-scale", metavar="<auto|m|cm|mm|in|cmu|METRES>",
+    help=".glb outputs: metres per motion unit, a unit name, or auto (the unit that makes the body about 1.7 m).")
+GLTF_UP = typer.Option("--gltf-up", metavar="<auto|y|z|-z|...>",
+                       help=".glb outputs: the motion's vertical, turned onto glTF's +Y (auto: detected).")
+CLOSING_FRAME = typer.Option(
+    "--closing-frame/--no-closing-frame",
+    help="End the loop with a copy of its first frame (moved on by a cycle with --root motion), as players that "
+         "loop over the keys need; default: on for .glb, off for .bvh.")
+
+
+def check_motion_output(path: Path | None, inputs=(), force: bool = False, option: str = "--output",
+                        gltf_scale: str = "auto", gltf_up: str = "auto") -> None:
+    """:func:`check_output` for a motion output (.bvh or .glb) and its glTF options, before any work."""
+    from ..io.gltf import check_options
+
+    check_output(path, inputs, force, MOTION_OUTPUTS, option)
+    check_options(gltf_scale, gltf_up)
+
+
+def write_motion(report, role: str, path: Path, gltf_scale: str = "auto", gltf_up: str = "auto",
+                 closing_frame: bool | None = None):
+    """Write ``report.motions[role]`` to ``path`` (.bvh or .glb) and return the motion written.  A .glb gets
+    the clip of :func:`mocycle.tasks.clips.clip_of` named after the file; a loop gets its closing frame when
+    ``closing_frame`` (``None``: for .glb only)."""
+    from ..io import write
+    from ..tasks.clips import LOOP_TASKS, clip_of, closed_loop, cycle_of
+
+    glb = path.suffix.lower() == ".glb"
+    closing = report.task in LOOP_TASKS and (glb if closing_frame is None else closing_frame)
+    motion = report.motions[role]
+    if closing:
+        facts = clip_of(report, role, path.stem)
+        motion = closed_loop(cycle_of(report, role), facts.cycles, facts.root, motion)
+    clip = clip_of(report, role, path.stem, closing) if glb else None
+    write(motion, path, clip=clip, gltf_scale=gltf_scale, gltf_up=gltf_up)
+    return motion
 
 
 # ------------------------------------------------------------ output

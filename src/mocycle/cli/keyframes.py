@@ -8,8 +8,22 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from ..io import write
-from .common import FORCE_HELP, app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line
+from .common import (
+    FORCE_HELP,
+    GLTF_SCALE,
+    GLTF_UP,
+    app,
+    check_motion_output,
+    check_output,
+    default,
+    flag,
+    friendly,
+    out,
+    print_json,
+    print_warnings,
+    timing_line,
+    write_motion,
+)
 
 C = tasks.compress.Options
 P = tasks.project.Options
@@ -71,14 +85,16 @@ def compress(
 @friendly
 def decompress(
     path: Annotated[Path, typer.Argument(help="A .mck file written by 'mocycle compress'.")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh file to write.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh or .glb file to write.")],
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
+    gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
     """Rebuild a take from its keyframes; the keyframes come back exactly."""
-    check_output(output, [path], force, ".bvh", "--output")
+    check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
     report = tasks.decompress.run(path)
     print_warnings(report)
-    write(report.motions["motion"], output)
+    write_motion(report, "motion", output, gltf_scale, gltf_up)
     r = report.facts
     out.print(f"{output}: {r['frames']} frames rebuilt from {r['keyframes']} keyframes ({r['scheme']})")
 
