@@ -9,7 +9,15 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 NP1    := .venv-numpy1
 
-.PHONY: demo test test-numpy2 test-numpy1 lint bench clean
+.PHONY: demo test test-numpy2 test-numpy1 lint bench clean js
+
+# the glTF tests' JavaScript side (Khronos glTF validator, three.js): tests/js/package-lock.json
+JS := tests/js
+$(JS)/node_modules/.installed: $(JS)/package-lock.json
+	cd $(JS) && npm ci --no-audit --no-fund
+	touch $@
+
+js: $(JS)/node_modules/.installed
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -29,11 +37,11 @@ demo: $(VENV)/.installed
 lint: $(VENV)/.installed
 	$(BIN)/ruff check src tests benchmarks
 
-test-numpy2: $(VENV)/.installed
+test-numpy2: $(VENV)/.installed $(JS)/node_modules/.installed
 	$(BIN)/python -c "import numpy; print('numpy', numpy.__version__)"
 	$(BIN)/python -m pytest -q
 
-test-numpy1: $(NP1)/.installed
+test-numpy1: $(NP1)/.installed $(JS)/node_modules/.installed
 	$(NP1)/bin/python -c "import numpy; print('numpy', numpy.__version__)"
 	$(NP1)/bin/python -m pytest -q -p no:cacheprovider
 
@@ -50,4 +58,4 @@ bench: $(VENV)/.installed
 	$(BIN)/python benchmarks/feet.py
 
 clean:
-	rm -rf $(VENV) $(NP1) out .pytest_cache .ruff_cache
+	rm -rf $(VENV) $(NP1) out .pytest_cache .ruff_cache $(JS)/node_modules
