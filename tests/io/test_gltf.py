@@ -103,6 +103,24 @@ def test_three_plays_what_mocycle_computes(tmp_path, case):
     assert error <= TOLERANCE, error
 
 
+def test_many_joints_and_a_single_frame(tmp_path):
+    """Over 256 joints (16-bit joint indices in the mesh) and a one-frame motion are valid glTF too."""
+    from scipy.spatial.transform import Rotation
+
+    n = 300
+    chain = Skeleton([f"j{i}" for i in range(n)], [-1, *range(n - 1)], np.tile([0.0, 0.6, 0.0], (n, 1)),
+                     [("Zrotation", "Xrotation", "Yrotation")] * n)
+    q = Rotation.from_rotvec(np.random.default_rng(0).normal(size=(4 * n, 3)) * 0.02).as_quat().reshape(4, n, 4)
+    motion = Motion(chain, q, None, 1 / 30)
+    report = run_js(write_gltf(motion, tmp_path / "chain.glb"), [0.0, 0.05])
+    assert_valid(report)
+    assert report["bones"] == n and fk_error(report, motion, [0, between(motion, 1, 0.5)]) <= TOLERANCE
+    one = synthetic_walk(n_frames=30).motion[5:6]
+    report = run_js(write_gltf(one, tmp_path / "one.glb"), [0.0])
+    assert_valid(report)
+    assert report["clip"]["duration"] == 0 and fk_error(report, one, [0]) <= TOLERANCE
+
+
 def test_units_and_axes(tmp_path):
     walk = synthetic_walk(n_frames=30).motion  # centimetres, Y up
     assert gltf_frame(walk).unit == "cm"
@@ -117,6 +135,16 @@ def test_units_and_axes(tmp_path):
     assert gltf_frame(scaled(walk, 0.01 / 0.0254)).unit == "in"
     assert gltf_frame(scaled(walk, 0.01 / UNITS["cmu"])).unit == "cmu"
     assert gltf_frame(scaled(walk, 10)).unit == "mm"
+    # Bandai's rig: a static joint_Root at the room's origin above the Hips, which walk 4 m away
+    sk = walk.skeleton
+    rooted = Skeleton(("joint_Root", *sk.names), [-1, *(sk.parents + 1)], np.vstack([[0, 0, 0], sk.offsets]),
+                      [("Xposition", "Yposition", "Zposition"), *sk.channels],
+                      [EndSite(e.parent + 1, e.offset, e.name) for e in sk.end_sites])
+    q = np.concatenate([np.tile([0, 0, 0, 1.0], (walk.n_frames, 1, 1)), walk.rotations], axis=1)
+    t = np.concatenate([np.zeros((walk.n_frames, 1, 3)), walk.translations], axis=1)
+    t[:, 1] += [400.0, 0, 0]
+    far = Motion(rooted, q, t, walk.frame_time)
+    assert gltf_frame(far).body_size == pytest.approx(gltf_frame(walk).body_size)
     # the node positions the file holds are in metres, Y up: the hips stand about 1 m high
     js = run_js(write_gltf(to_z_up(walk), tmp_path / "z.glb"), [0.0])
     assert 0.7 < js["positions"][0]["0"][1] < 1.2

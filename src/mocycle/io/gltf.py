@@ -83,10 +83,16 @@ class GltfFrame:
 
 def body_size(motion: Motion) -> float:
     """The body's size in motion units: the largest extent of the rest pose (a T-pose's height or arm span)
-    or of the median frame's pose, whichever is larger (End Sites included)."""
-    rest = Motion.rest(motion.skeleton).world_positions(end_sites=True)[0]
-    step = max(1, motion.n_frames // 50)
-    poses = motion[::step].world_positions(end_sites=True)
+    or of the median frame's pose, whichever is larger; the travel joint and the joints and End Sites below
+    it (a static ``joint_Root`` left behind at the room's origin is no part of the body)."""
+    sk = motion.skeleton
+    parents = list(sk.parents) + [site.parent for site in sk.end_sites]
+    travel, below = motion.travel_joint, []
+    for i, p in enumerate(parents):  # parents come first
+        if i == travel or (p >= 0 and p in below):
+            below.append(i)
+    rest = Motion.rest(sk).world_positions(end_sites=True)[0, below]
+    poses = motion[::max(1, motion.n_frames // 50)].world_positions(end_sites=True)[:, below]
     moving = float(np.median(np.ptp(poses, axis=1).max(axis=1)))
     return max(float(np.ptp(rest, axis=0).max()), moving)
 
