@@ -332,3 +332,22 @@ def test_real_root_motion_loop(tmp_path):
                                                                      * 0.01, rel=1e-6)
     if facts["feet"]["mode"] == "lock":
         assert set(meta["foot_contacts"]) == set(facts["feet"]["contacts"])
+
+
+def test_without_pygltflib_one_clear_error_before_any_work(tmp_path, monkeypatch):
+    import importlib.util
+    import sys
+
+    src = mocycle.write(synthetic_walk(n_frames=120).motion, tmp_path / "walk.bvh")
+    find_spec = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "pygltflib" else
+                        find_spec(name, *a))
+    ran = []
+    monkeypatch.setattr(mocycle.tasks.loop, "run", lambda *a, **k: ran.append(1))
+    result = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.glb")])
+    assert result.exit_code == 1 and "pip install 'mocycle[gltf]'" in result.stderr
+    assert not ran and not (tmp_path / "x.glb").exists()
+    monkeypatch.setitem(sys.modules, "pygltflib", None)  # import pygltflib fails
+    with pytest.raises(MocycleError, match=r"mocycle\[gltf\]"):
+        mocycle.write(mocycle.read(src), tmp_path / "y.glb")
+    assert not (tmp_path / "y.glb").exists()

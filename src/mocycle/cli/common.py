@@ -239,10 +239,14 @@ CLOSING_FRAME = typer.Option(
 def check_motion_output(path: Path | None, inputs=(), force: bool = False, option: str = "--output",
                         gltf_scale: str = "auto", gltf_up: str = "auto") -> None:
     """:func:`check_output` for a motion output (.bvh or .glb) and its glTF options, before any work."""
+    import importlib.util
+
     from ..io.gltf import check_options
 
     check_output(path, inputs, force, MOTION_OUTPUTS, option)
     check_options(gltf_scale, gltf_up)
+    if path is not None and path.suffix.lower() == ".glb" and importlib.util.find_spec("pygltflib") is None:
+        raise MocycleError(f"{path}: writing .glb files needs pygltflib: pip install 'mocycle[gltf]'")
 
 
 def write_motion(report, role: str, path: Path, gltf_scale: str = "auto", gltf_up: str = "auto",
