@@ -14,6 +14,8 @@ NP1    := .venv-numpy1
 # the glTF tests' JavaScript side (Khronos glTF validator, three.js): tests/js/package-lock.json
 JS := tests/js
 $(JS)/node_modules/.installed: $(JS)/package-lock.json
+	command -v npm >/dev/null || (apt-get update && apt-get install -y nodejs npm) \
+		|| { echo "the glTF tests need Node.js 18+ and npm (apt-get install nodejs npm)"; exit 1; }
 	cd $(JS) && npm ci --no-audit --no-fund
 	touch $@
 
