@@ -251,19 +251,12 @@ def check_motion_output(path: Path | None, inputs=(), force: bool = False, optio
 
 def write_motion(report, role: str, path: Path, gltf_scale: str = "auto", gltf_up: str = "auto",
                  closing_frame: bool | None = None):
-    """Write ``report.motions[role]`` to ``path`` (.bvh or .glb) and return the motion written.  A .glb gets
-    the clip of :func:`mocycle.tasks.clips.clip_of` named after the file; a loop gets its closing frame when
-    ``closing_frame`` (``None``: for .glb only)."""
+    """Write ``report.motions[role]`` to ``path`` (.bvh or .glb) as :func:`mocycle.tasks.clips.for_output`
+    says (a .glb loop: clip ``<stem>_loop`` with its closing frame); returns the motion written."""
     from ..io import write
-    from ..tasks.clips import LOOP_TASKS, clip_of, closed_loop, cycle_of
+    from ..tasks.clips import for_output
 
-    glb = path.suffix.lower() == ".glb"
-    closing = report.task in LOOP_TASKS and (glb if closing_frame is None else closing_frame)
-    motion = report.motions[role]
-    if closing:
-        facts = clip_of(report, role, path.stem)
-        motion = closed_loop(cycle_of(report, role), facts.cycles, facts.root, motion)
-    clip = clip_of(report, role, path.stem, closing) if glb else None
+    motion, clip = for_output(report, role, path, closing_frame)
     write(motion, path, clip=clip, gltf_scale=gltf_scale, gltf_up=gltf_up)
     return motion
 

@@ -4,16 +4,20 @@ formats that name clips and keep loop facts (glTF), and the loops' closing frame
 A loop of ``N`` frames per cycle is written without its closing frame (frame ``N`` would equal frame 0, the
 BVH way); players that loop over a clip's key range (glTF engines, three.js) need the closing frame to play
 whole periods: :func:`closed_loop` adds it, moved on by a cycle's travel and turn with root motion.
+:func:`for_output` is what every front end writes: the motion (with the closing frame for .glb loops) and
+its clip.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
+from pathlib import Path
 
 from ..clip import Clip
 from ..motion import Motion, concatenate
 
-__all__ = ["LOOP_TASKS", "clip_of", "closed_loop", "cycle_of"]
+__all__ = ["LOOP_TASKS", "clip_of", "closed_loop", "cycle_of", "for_output"]
 
 #: the tasks whose output motion is a seamless loop (clip ``<name>_loop``)
 LOOP_TASKS = ("loop", "blend")
@@ -82,3 +86,21 @@ def _seam(facts: Mapping) -> dict:
     """The seam figures (pose and velocity jumps, × median step) of a loop's or a blend's facts."""
     seam = facts.get("seam") or facts.get("metrics") or {}
     return {k: seam[k] for k in ("seam_pose", "seam_velocity") if k in seam}
+
+
+def for_output(report, role: str, path: str | os.PathLike, closing_frame: bool | None = None):
+    """What to write for ``report.motions[role]`` at ``path``: ``(motion, clip)``.
+
+    A ``.glb`` gets the clip of :func:`clip_of` named after the file's stem (``None`` for other formats);
+    a loop gets its closing frame when ``closing_frame`` is true, or, when it is ``None``, for ``.glb``
+    outputs only (glTF players wrap at the last key; BVH loops keep the mocycle convention, frame N not
+    written).  Write them with ``mocycle.write(motion, path, clip=clip)``.
+    """
+    p = Path(path)
+    glb = p.suffix.lower() == ".glb"
+    closing = report.task in LOOP_TASKS and (glb if closing_frame is None else bool(closing_frame))
+    motion = report.motions[role]
+    if closing:
+        facts = clip_of(report, role, p.stem)
+        motion = closed_loop(cycle_of(report, role), facts.cycles, facts.root, motion)
+    return motion, (clip_of(report, role, p.stem, closing) if glb else None)
