@@ -10,7 +10,17 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 NP1    := .venv-numpy1
 
-.PHONY: demo test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender test-blender50 test-blender42 test-blender45
+.PHONY: demo test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender test-blender50 test-blender42 test-blender45 js
+
+# the glTF tests' JavaScript side (Khronos glTF validator, three.js): tests/js/package-lock.json
+JS := tests/js
+$(JS)/node_modules/.installed: $(JS)/package-lock.json
+	command -v npm >/dev/null || (apt-get update && apt-get install -y nodejs npm) \
+		|| { echo "the glTF tests need Node.js 18+ and npm (apt-get install nodejs npm)"; exit 1; }
+	cd $(JS) && npm ci --no-audit --no-fund
+	touch $@
+
+js: $(JS)/node_modules/.installed
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -30,11 +40,11 @@ demo: $(VENV)/.installed
 lint: $(VENV)/.installed
 	$(BIN)/ruff check src tests benchmarks blender tests_blender
 
-test-numpy2: $(VENV)/.installed
+test-numpy2: $(VENV)/.installed $(JS)/node_modules/.installed
 	$(BIN)/python -c "import numpy; print('numpy', numpy.__version__)"
 	$(BIN)/python -m pytest -q
 
-test-numpy1: $(NP1)/.installed
+test-numpy1: $(NP1)/.installed $(JS)/node_modules/.installed
 	$(NP1)/bin/python -c "import numpy; print('numpy', numpy.__version__)"
 	$(NP1)/bin/python -m pytest -q -p no:cacheprovider
 
@@ -89,4 +99,4 @@ test-blender45: .venv-bpy45/.installed
 	cd tests_blender && ../.venv-bpy45/bin/python -m pytest -q
 
 clean:
-	rm -rf $(VENV) $(NP1) $(BPY50) $(BPY42) .venv-bpy45 out .pytest_cache .ruff_cache build dist
+	rm -rf $(VENV) $(NP1) $(BPY50) $(BPY42) .venv-bpy45 out .pytest_cache .ruff_cache build dist $(JS)/node_modules

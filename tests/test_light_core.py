@@ -17,12 +17,13 @@ import pytest
 
 import mocycle
 
-FORBIDDEN = ("typer", "rich", "click", "matplotlib", "dask", "distributed", "starlette", "uvicorn", "bpy")
+FORBIDDEN = ("typer", "rich", "click", "matplotlib", "dask", "distributed", "starlette", "uvicorn", "bpy",
+             "pygltflib")
 REQUIRED = ("numpy", "scipy", "sklearn", "ripser", "threadpoolctl", "joblib")
 CORE = ["mocycle", "mocycle.errors", "mocycle.io", "mocycle.io.mck", "mocycle.io.mosw", "mocycle.motion",
         "mocycle.rotations", "mocycle.axes", "mocycle.features", "mocycle.datasets", "mocycle.phase",
         "mocycle.cycle", "mocycle.warp", "mocycle.swings", "mocycle.keyframes", "mocycle.tasks",
-        "mocycle.viz", "mocycle.viz.data"]
+        "mocycle.viz", "mocycle.viz.data", "mocycle.io.gltf", "mocycle.clip", "mocycle.tasks.clips"]
 
 _PROBE = r"""
 import json, sys, traceback

@@ -65,7 +65,7 @@ def test_bad_options_exit_2_with_one_message(tmp_path):
         assert message in result.stderr and result.stderr.count("error:") == 1, (extra, result.stderr)
         assert not out.exists()
     result = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.txt")])
-    assert result.exit_code == 1 and "must name a .bvh file" in result.stderr
+    assert result.exit_code == 1 and "must name a .bvh or .glb file" in result.stderr
     result = runner.invoke(app, ["loop", str(tmp_path / "missing.bvh"), "-o", str(tmp_path / "x.bvh")])
     assert result.exit_code == 1 and "missing.bvh" in result.stderr
 

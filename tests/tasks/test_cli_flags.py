@@ -16,7 +16,8 @@ from mocycle.tasks.options import MISSING, flag_of
 COMMANDS = {name: name for name in tasks.TASKS}
 
 #: flags of the CLI that are no task option: where to write, how to print, what to draw.
-FRONT_END_FLAGS = {"--json", "--output", "--plot", "--playback", "--feet-plot", "--force", "--help"}
+FRONT_END_FLAGS = {"--json", "--output", "--plot", "--playback", "--feet-plot", "--force", "--help",
+                   "--gltf-scale", "--gltf-up", "--closing-frame"}
 
 
 def _command(name: str):

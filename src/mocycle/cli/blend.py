@@ -8,7 +8,22 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line, write
+from .common import (
+    CLOSING_FRAME,
+    GLTF_SCALE,
+    GLTF_UP,
+    app,
+    check_motion_output,
+    check_output,
+    default,
+    flag,
+    friendly,
+    out,
+    print_json,
+    print_warnings,
+    timing_line,
+    write_motion,
+)
 
 B = tasks.blend.Options
 T = tasks.transition.Options
@@ -19,7 +34,7 @@ PLOT_HELP = "Write a PNG: the most moving joint curves of the blend and of the i
 @friendly
 def blend(
     paths: Annotated[list[Path], typer.Argument(help="Two or more .bvh (or .amc) takes on one skeleton.")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The blended loop as a .bvh file.")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The blended loop as a .bvh or .glb file.")],
     weights: Annotated[str | None, flag(B, "weights")] = default(B, "weights"),
     root: Annotated[str, flag(B, "root")] = default(B, "root"),
     cycles: Annotated[int, flag(B, "cycles")] = default(B, "cycles"),
@@ -39,6 +54,9 @@ def blend(
     force: Annotated[bool, flag(B, "force")] = default(B, "force"),
     feet: Annotated[str, flag(B, "feet")] = default(B, "feet"),
     foot_joints: Annotated[str | None, flag(B, "foot_joints")] = default(B, "foot_joints"),
+    closing_frame: Annotated[bool | None, CLOSING_FRAME] = None,
+    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
+    gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
     """Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).
 
@@ -47,14 +65,14 @@ def blend(
     Exit code 0 on success, 3 when a take holds no periodic motion or its cycle fails a loop check (see
     mocycle loop; --force uses it anyway), 1 for bad input, 2 for a bad option.
     """
-    check_output(output, paths, force, ".bvh", "--output")
+    check_motion_output(output, paths, force, "--output", gltf_scale, gltf_up)
     check_output(plot, paths, force, ".png", "--plot")
     options = B(weights=weights, root=root, cycles=cycles, method=method, model=model, harmonics=harmonics,
                 align=align, joints=joints, classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods,
                 amc_fps=amc_fps, force=force, feet=feet, foot_joints=foot_joints)
     report = tasks.blend.run(paths, options)
     print_warnings(report)
-    write(report.motions["loop"], output)
+    written = write_motion(report, "loop", output, gltf_scale, gltf_up, closing_frame)
     result = report.result
     if plot is not None:
         import numpy as np
@@ -71,7 +89,8 @@ def blend(
             for p, c, off in zip(paths, result.inputs, result.phase_offsets, strict=True)]
         plot_curves([(label, m, np.arange(m.n_frames) / m.n_frames) for label, m in loops], plot,
                     title=f"blend of {len(paths)} takes", xlabel="phase (cycles)")
-    facts = {"files": [str(p) for p in paths], "output": str(output), **report.facts, "seconds": report.seconds}
+    facts = {"files": [str(p) for p in paths], "output": str(output), **report.facts, "frames_out": written.n_frames,
+             "closing_frame": written.n_frames != report.motions["loop"].n_frames, "seconds": report.seconds}
     if as_json:
         print_json(facts)
         return
@@ -97,7 +116,7 @@ def blend(
 def transition(
     first: Annotated[Path, typer.Argument(help="The take to start as (.bvh or .amc).")],
     second: Annotated[Path, typer.Argument(help="The take to end as, on the same skeleton.")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The transition as a .bvh file.")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The transition as a .bvh or .glb file.")],
     cycles: Annotated[int, flag(T, "cycles")] = default(T, "cycles"),
     root: Annotated[str, flag(T, "root")] = default(T, "root"),
     method: Annotated[str, flag(T, "method")] = default(T, "method"),
@@ -116,6 +135,8 @@ def transition(
     force: Annotated[bool, flag(T, "force")] = default(T, "force"),
     feet: Annotated[str, flag(T, "feet")] = default(T, "feet"),
     foot_joints: Annotated[str | None, flag(T, "foot_joints")] = default(T, "foot_joints"),
+    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
+    gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
@@ -123,14 +144,14 @@ def transition(
     integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion or its
     cycle fails a loop check (see mocycle loop), 1 for bad input, 2 for a bad option.
     """
-    check_output(output, [first, second], force, ".bvh", "--output")
+    check_motion_output(output, [first, second], force, "--output", gltf_scale, gltf_up)
     check_output(plot, [first, second], force, ".png", "--plot")
     options = T(cycles=cycles, root=root, method=method, model=model, harmonics=harmonics, joints=joints,
                 classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods, amc_fps=amc_fps,
                 force=force, feet=feet, foot_joints=foot_joints)
     report = tasks.transition.run([first, second], options)
     print_warnings(report)
-    write(report.motions["transition"], output)
+    write_motion(report, "transition", output, gltf_scale, gltf_up)
     if plot is not None:
         from ..viz import plot_curves
 

@@ -138,7 +138,7 @@ def flags() -> dict[str, str]:
     names = {f.name: flag_of(f) for task in TASKS.values() for f in dataclasses.fields(task.Options)}
     names.update({"n_harmonics": "--harmonics", "time_axis_method": "--time", "phase_step": "--step",
                   "n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles",
-                  "window": "--window"})
+                  "window": "--window", "gltf_scale": "--gltf-scale", "gltf_up": "--gltf-up"})
     return names
 
 
@@ -329,6 +329,45 @@ def write_text(path: Path, text: str | bytes, what: str = "file") -> Path:
         return atomic_write(path, text)
     except OSError as exc:
         raise MocycleError(f"{path}: cannot write the {what} ({exc.strerror or exc})") from None
+
+
+# ------------------------------------------------------------ motion outputs (.bvh or .glb)
+#: the files a command that writes motion writes
+MOTION_OUTPUTS = (".bvh", ".glb")
+GLTF_SCALE = typer.Option(
+    "--gltf-scale", metavar="<auto|m|cm|mm|in|cmu|METRES>",
+    help=".glb outputs: metres per motion unit, a unit name, or auto (the unit that makes the body about 1.7 m).")
+GLTF_UP = typer.Option("--gltf-up", metavar="<auto|y|z|-z|...>",
+                       help=".glb outputs: the motion's vertical, turned onto glTF's +Y (auto: detected).")
+CLOSING_FRAME = typer.Option(
+    "--closing-frame/--no-closing-frame",
+    help="End the loop with a copy of its first frame (moved on by a cycle with --root motion), as players that "
+         "loop over the keys need; default: on for .glb, off for .bvh.")
+
+
+def check_motion_output(path: Path | None, inputs=(), force: bool = False, option: str = "--output",
+                        gltf_scale: str = "auto", gltf_up: str = "auto") -> None:
+    """:func:`check_output` for a motion output (.bvh or .glb) and its glTF options, before any work."""
+    import importlib.util
+
+    from ..io.gltf import check_options
+
+    check_output(path, inputs, force, MOTION_OUTPUTS, option)
+    check_options(gltf_scale, gltf_up)
+    if path is not None and path.suffix.lower() == ".glb" and importlib.util.find_spec("pygltflib") is None:
+        raise MocycleError(f"{path}: writing .glb files needs pygltflib: pip install 'mocycle[gltf]'")
+
+
+def write_motion(report, role: str, path: Path, gltf_scale: str = "auto", gltf_up: str = "auto",
+                 closing_frame: bool | None = None):
+    """Write ``report.motions[role]`` to ``path`` (.bvh or .glb) as :func:`mocycle.tasks.clips.for_output`
+    says (a .glb loop: clip ``<stem>_loop`` with its closing frame); returns the motion written."""
+    from ..io import write
+    from ..tasks.clips import for_output
+
+    motion, clip = for_output(report, role, path, closing_frame)
+    write(motion, path, clip=clip, gltf_scale=gltf_scale, gltf_up=gltf_up)
+    return motion
 
 
 # ------------------------------------------------------------ output

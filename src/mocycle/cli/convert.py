@@ -10,24 +10,26 @@ import typer
 from ..defaults import AMC_FPS
 from ..errors import MocycleError
 from ..tasks.loop import parse_range
-from .common import FORCE_HELP, app, check_output, friendly, out, read, write
+from .common import FORCE_HELP, GLTF_SCALE, GLTF_UP, app, check_motion_output, friendly, out, read, write
 
 
 @app.command()
 @friendly
 def convert(
     paths: Annotated[list[Path], typer.Argument(
-        help="Input then output: IN.bvh OUT.bvh, or SKELETON.asf MOTION.amc OUT.bvh.")],
+        help="Input then output: IN.bvh OUT.bvh, or SKELETON.asf MOTION.amc OUT.bvh (or OUT.glb).")],
     fps: Annotated[float | None, typer.Option(
         help="Resample the output to this frame rate (slerp; the first and last frame's times are kept).")] = None,
     amc_fps: Annotated[float, typer.Option(
         help="Frame rate of AMC input files, which do not store it (CMU: 120).")] = AMC_FPS,
     frame_range: Annotated[str | None, typer.Option("--range", help="Keep frames START:STOP.")] = None,
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
+    gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
-    """Convert ASF/AMC to BVH, or rewrite a BVH (optionally a frame range, another fps)."""
+    """Convert ASF/AMC to BVH or glTF (.glb), or rewrite a BVH (optionally a frame range, another fps)."""
     if len(paths) in (2, 3):
-        check_output(paths[-1], paths[:-1], force, ".bvh", "the output")
+        check_motion_output(paths[-1], paths[:-1], force, "the output", gltf_scale, gltf_up)
     if len(paths) == 2:
         motion = read(paths[0], fps=amc_fps)
     elif len(paths) == 3:
@@ -38,13 +40,11 @@ def convert(
     else:
         raise MocycleError("expected IN OUT.bvh or SKELETON.asf MOTION.amc OUT.bvh")
     target = paths[-1]
-    if target.suffix.lower() != ".bvh":
-        raise MocycleError(f"{target}: the output must be a .bvh file")
     start, stop = parse_range(frame_range, motion.n_frames)
     motion = motion[start:stop]
     if fps is not None:
         motion = motion.resample(fps)
-    write(motion, target)
+    write(motion, target, gltf_scale=gltf_scale, gltf_up=gltf_up)
     out.print(f"wrote {target}: {motion.n_frames} frames, {motion.n_joints} joints, {motion.fps:.6g} fps",
               soft_wrap=True)
 

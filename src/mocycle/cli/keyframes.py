@@ -10,7 +10,10 @@ import typer
 from .. import tasks
 from .common import (
     FORCE_HELP,
+    GLTF_SCALE,
+    GLTF_UP,
     app,
+    check_motion_output,
     check_output,
     default,
     flag,
@@ -19,7 +22,7 @@ from .common import (
     print_json,
     print_warnings,
     timing_line,
-    write,
+    write_motion,
 )
 
 C = tasks.compress.Options
@@ -83,17 +86,19 @@ def compress(
 @friendly
 def decompress(
     path: Annotated[Path, typer.Argument(help="A .mck file written by 'mocycle compress'.")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh file to write.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="The .bvh or .glb file to write.")],
     feet: Annotated[str, flag(D, "feet")] = default(D, "feet"),
     foot_joints: Annotated[str | None, flag(D, "foot_joints")] = default(D, "foot_joints"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
+    gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
     """Rebuild a take from its keyframes; the keyframes come back exactly (unless --feet lock)."""
-    check_output(output, [path], force, ".bvh", "--output")
+    check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
     report = tasks.decompress.run(path, D(feet=feet, foot_joints=foot_joints))
     print_warnings(report)
-    write(report.motions["motion"], output)
+    write_motion(report, "motion", output, gltf_scale, gltf_up)
     r = report.facts
     if as_json:
         print_json({**r, "seconds": report.seconds})

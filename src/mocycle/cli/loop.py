@@ -10,7 +10,22 @@ import typer
 from .. import tasks
 from ..errors import MocycleError
 from ..tasks.loop import METRIC_LABELS
-from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line, write
+from .common import (
+    CLOSING_FRAME,
+    GLTF_SCALE,
+    GLTF_UP,
+    app,
+    check_motion_output,
+    check_output,
+    default,
+    flag,
+    friendly,
+    out,
+    print_json,
+    print_warnings,
+    timing_line,
+    write_motion,
+)
 
 O = tasks.loop.Options
 
@@ -19,7 +34,7 @@ O = tasks.loop.Options
 @friendly
 def loop(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The cycle as a .bvh file.")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The cycle as a .bvh or .glb file.")],
     method: Annotated[str, flag(O, "method")] = default(O, "method"),
     model: Annotated[str, flag(O, "model")] = default(O, "model"),
     harmonics: Annotated[str, flag(O, "harmonics")] = default(O, "harmonics"),
@@ -45,13 +60,19 @@ def loop(
         help="Write a PNG of the contacts: each ankle and toe's height and speed over two cycles, before (dashed) "
              "and after locking (with --class all: OUT.classK.png).")] = None,
     foot_joints: Annotated[str | None, flag(O, "foot_joints")] = default(O, "foot_joints"),
+    closing_frame: Annotated[bool | None, CLOSING_FRAME] = None,
+    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
+    gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
-    """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH.
+    """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH or glTF.
+
+    A .glb output holds the clip OUT_loop (Godot loops clips so named) with the closing frame, and the loop's
+    facts in its extras (docs/formats.md).
 
     Exit code 0 on success, 3 when the take holds no periodic motion or its cycle fails a loop check
     (the reason is printed; --force writes it anyway), 1 for bad input, 2 for a bad option.
     """
-    check_output(output, [path], force, ".bvh", "--output")
+    check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
     check_output(plot, [path], force, ".png", "--plot")
     check_output(feet_plot, [path], force, ".png", "--feet-plot")
     options = O(method=method, model=model, harmonics=harmonics, root=root, frame_range=frame_range, step=step,
@@ -70,8 +91,10 @@ def loop(
     shown = []
     for facts, cycle in zip(loops, cycles_made, strict=True):  # every cycle was made and checked before writing
         k = facts["class"]
-        target = output.with_suffix(f".class{k}.bvh") if everything else output
-        write(report.motions[f"loop.class{k}" if everything else "loop"], target)
+        target = output.with_suffix(f".class{k}{output.suffix}") if everything else output
+        role = f"loop.class{k}" if everything else "loop"
+        written = write_motion(report, role, target, gltf_scale, gltf_up, closing_frame)
+        closing = report.motions[role].n_frames != written.n_frames
         images = []
         if feet_plot is not None:
             extra = report.extras[f"loop.class{k}" if everything else "loop"]
@@ -83,6 +106,7 @@ def loop(
             images.append(plot.with_suffix(f".class{k}.png") if everything else plot)
             plot_loop(report.motions["input"], cycle, images[-1],
                       title=f"{path.name}: {method}{' ' + model if method == 'harmonic' else ''}")
+        facts = {**facts, "frames_out": written.n_frames, "closing_frame": closing}
         shown.append(({"file": str(path), "output": str(target), **facts, "seconds": report.seconds,
                        "metrics_seconds": report.timings_s["metrics"]}, images))
     if as_json:

@@ -8,7 +8,21 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import app, check_output, default, flag, friendly, out, print_json, print_warnings, timing_line, write
+from .common import (
+    GLTF_SCALE,
+    GLTF_UP,
+    app,
+    check_motion_output,
+    check_output,
+    default,
+    flag,
+    friendly,
+    out,
+    print_json,
+    print_warnings,
+    timing_line,
+    write_motion,
+)
 
 O = tasks.stretch.Options
 
@@ -18,7 +32,7 @@ O = tasks.stretch.Options
 def stretch(
     path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
     factor: Annotated[float, flag(O, "factor")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The .bvh file to write.")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The .bvh or .glb file to write.")],
     window: Annotated[str, flag(O, "window_frames")] = default(O, "window_frames"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(
@@ -27,6 +41,8 @@ def stretch(
     force: Annotated[bool, flag(O, "force")] = default(O, "force"),
     feet: Annotated[str, flag(O, "feet")] = default(O, "feet"),
     foot_joints: Annotated[str | None, flag(O, "foot_joints")] = default(O, "foot_joints"),
+    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
+    gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
 
@@ -38,12 +54,12 @@ def stretch(
     keeps its mean velocity. Exit code 3 when the take has no periodic motion
     (--force warps it whole anyway), 1 for bad input, 2 for a bad option.
     """
-    check_output(output, [path], force, ".bvh", "--output")
+    check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
     check_output(plot, [path], force, ".png", "--plot")
     report = tasks.stretch.run(path, O(factor=factor, window_frames=window, amc_fps=amc_fps, force=force, feet=feet,
                                        foot_joints=foot_joints))
     print_warnings(report)
-    write(report.motions["stretched"], output)
+    write_motion(report, "stretched", output, gltf_scale, gltf_up)
     if plot is not None:
         from ..viz import plot_curves
 

@@ -10,7 +10,10 @@ import typer
 from .. import tasks
 from .common import (
     FORCE_HELP,
+    GLTF_SCALE,
+    GLTF_UP,
     app,
+    check_motion_output,
     check_output,
     default,
     flag,
@@ -20,7 +23,7 @@ from .common import (
     print_json,
     print_warnings,
     timing_line,
-    write,
+    write_motion,
     write_text,
 )
 
@@ -40,20 +43,22 @@ def swings(
     output: Annotated[Path | None, typer.Option(
         "-o", "--output", help="Write the swings: .json (records) or .mosw (compact binary file).")] = None,
     playback_path: Annotated[Path | None, typer.Option(
-        "--playback", help="Write the motion rebuilt from the swings as BVH.")] = None,
+        "--playback", help="Write the motion rebuilt from the swings as .bvh or .glb.")] = None,
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: one row per joint, swings as numbered bars in time (the numbers edit --swing takes).")]
     = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(S, "amc_fps")] = default(S, "amc_fps"),
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
+    gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
     """Segment a take into joint swings and holds; report playback error and compressed size.
 
     The table lists each joint's swing indices (0-based, in time order): what `mocycle edit --swing` takes.
     """
     check_output(output, [path], force, (".json", ".mosw"), "--output")
-    check_output(playback_path, [path], force, ".bvh", "--playback")
+    check_motion_output(playback_path, [path], force, "--playback", gltf_scale, gltf_up)
     check_output(plot, [path], force, ".png", "--plot")
     report = tasks.swings.run(path, S(threshold=threshold, joints=joints, amc_fps=amc_fps))
     print_warnings(report)
@@ -68,7 +73,7 @@ def swings(
             write_text(output, encode(seg), "swings file")
         written.append(f"{output} ({seg.n_swings} swings)")
     if playback_path is not None:
-        write(report.motions["playback"], playback_path)
+        write_motion(report, "playback", playback_path, gltf_scale, gltf_up)
         written.append(f"{playback_path} (motion rebuilt from the swings)")
     if plot is not None:
         from ..viz.swings import plot_swings
@@ -139,7 +144,7 @@ def edit(
     path: Annotated[Path, typer.Argument(help="A .bvh or .amc file.")],
     joint: Annotated[str, flag(E, "joint")],
     swing: Annotated[int, flag(E, "swing")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="Edited motion (.bvh).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Edited motion (.bvh or .glb).")],
     angle_scale: Annotated[float, flag(E, "angle_scale")] = default(E, "angle_scale"),
     duration_scale: Annotated[float, flag(E, "duration_scale")] = default(E, "duration_scale"),
     threshold: Annotated[float, flag(E, "threshold")] = default(E, "threshold"),
@@ -147,14 +152,16 @@ def edit(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(E, "amc_fps")] = default(E, "amc_fps"),
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
+    gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
     """Scale the angle or the duration of one swing of one joint and write the edited motion."""
-    check_output(output, [path], force, ".bvh", "--output")
+    check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
     options = E(joint=joint, swing=swing, angle_scale=angle_scale, duration_scale=duration_scale,
                 threshold=threshold, joints=joints, amc_fps=amc_fps)
     report = tasks.edit.run(path, options)
     print_warnings(report)
-    write(report.motions["edited"], output)
+    write_motion(report, "edited", output, gltf_scale, gltf_up)
     r = report.facts
     if as_json:
         print_json({**r, "output": str(output), "seconds": report.seconds})

@@ -6,6 +6,7 @@ One way in and one way out, chosen by the file's suffix:
 suffix     holds                                       :func:`read` returns / :func:`write` takes
 =========  ==========================================  =======================================
 ``.bvh``   a motion (:mod:`.bvh`)                      :class:`~mocycle.motion.Motion`
+``.glb``   a motion as binary glTF (:mod:`.gltf`)      :class:`~mocycle.motion.Motion` (write only)
 ``.amc``   a CMU motion, skeleton in an ``.asf``       :class:`~mocycle.motion.Motion` (read only)
 ``.mck``   a keyframe-compressed take (:mod:`.mck`)    :class:`~mocycle.io.mck.Compressed`
 ``.mosw``  joint swings, compact (:mod:`.mosw`)        :class:`~mocycle.swings.Segmentation`
@@ -30,12 +31,14 @@ from .asfamc import AMC_FPS, read_amc, read_asf, read_asfamc
 from .atomic import atomic_write
 from .bvh import parse_bvh, read_bvh, write_bvh
 
-__all__ = ["AMC_FPS", "READ_SUFFIXES", "WRITE_SUFFIXES", "parse_bvh", "read", "read_amc", "read_asf", "read_asfamc",
-           "read_bvh", "read_motion", "write", "write_bvh"]
+__all__ = ["AMC_FPS", "MOTION_WRITE_SUFFIXES", "READ_SUFFIXES", "WRITE_SUFFIXES", "parse_bvh", "read", "read_amc",
+           "read_asf", "read_asfamc", "read_bvh", "read_motion", "write", "write_bvh"]
 
 MOTION_SUFFIXES = (".bvh", ".amc")
 READ_SUFFIXES = (".bvh", ".amc", ".mck", ".mosw", ".json")
-WRITE_SUFFIXES = (".bvh", ".mck", ".mosw", ".json")
+WRITE_SUFFIXES = (".bvh", ".glb", ".mck", ".mosw", ".json")
+#: the files a Motion is written as
+MOTION_WRITE_SUFFIXES = (".bvh", ".glb")
 
 
 def _suffix(p: Path, known: tuple[str, ...], what: str) -> str:
@@ -150,15 +153,19 @@ def _read_json(p: Path):
         raise MotionFileError(str(exc), p) from None
 
 
-def write(obj, path: str | os.PathLike) -> Path:
+def write(obj, path: str | os.PathLike, *, clip=None, gltf_scale: float | str = "auto", gltf_up=None) -> Path:
     """Write ``obj`` to ``path`` in the format its suffix names, atomically (no half-written file).
 
     Parameters
     ----------
-    obj : a :class:`Motion` (``.bvh``), a :class:`~mocycle.io.mck.Compressed` take (``.mck``), a
+    obj : a :class:`Motion` (``.bvh`` or ``.glb``), a :class:`~mocycle.io.mck.Compressed` take (``.mck``), a
         :class:`~mocycle.swings.Segmentation` (``.mosw`` or ``.json``), or any result with a
         ``to_dict()`` (``.json``).
     path : the file to write.
+    clip : ``.glb`` only (other formats have no place for it): the animation clip's name and loop facts, a
+        :class:`~mocycle.clip.Clip` or a name (default: the file's stem).
+    gltf_scale, gltf_up : ``.glb`` only: metres per motion unit (or ``"auto"``, or a unit name) and the
+        motion's vertical (``None``: detected); see :func:`mocycle.io.gltf.gltf_frame`.
 
     Returns
     -------
@@ -180,13 +187,13 @@ def write(obj, path: str | os.PathLike) -> Path:
     >>> mocycle.write(synthetic_walk(n_frames=60).motion, folder / "walk.mosw")
     Traceback (most recent call last):
     ...
-    mocycle.errors.MotionFileError: .../walk.mosw: a Motion is written as .bvh
+    mocycle.errors.MotionFileError: .../walk.mosw: a Motion is written as .bvh or .glb
     """
     p = Path(path)
     suffix = _suffix(p, WRITE_SUFFIXES, "mocycle writes")
     # the kinds whose modules are loaded (an object of a kind whose module is not loaded cannot exist; so writing
     # a motion does not import the keyframe and swing packages)
-    kinds = {"mocycle.motion.Motion": (".bvh",), "mocycle.io.mck.Compressed": (".mck",),
+    kinds = {"mocycle.motion.Motion": MOTION_WRITE_SUFFIXES, "mocycle.io.mck.Compressed": (".mck",),
              "mocycle.swings.segment.Segmentation": (".mosw", ".json")}
     fits = {getattr(sys.modules.get(name.rsplit(".", 1)[0]), name.rsplit(".", 1)[1], None): suffixes
             for name, suffixes in kinds.items()}
@@ -198,10 +205,17 @@ def write(obj, path: str | os.PathLike) -> Path:
     else:
         if suffix != ".json" or not callable(getattr(obj, "to_dict", None)):
             raise MotionFileError(f"cannot write a {type(obj).__name__} as {suffix}: mocycle writes a Motion as "
-                                  f".bvh, a Compressed take as .mck, swings as .mosw or .json, results with "
+                                  f".bvh or .glb, a Compressed take as .mck, swings as .mosw or .json, results with "
                                   f"to_dict() as .json", p)
     if suffix == ".bvh":
         return write_bvh(obj, p)
+    if suffix == ".glb":
+        from ..clip import Clip
+        from .gltf import write_gltf
+
+        if isinstance(clip, str):
+            clip = Clip(name=clip)
+        return write_gltf(obj, p, clip=clip, scale=gltf_scale, up=gltf_up)
     if suffix == ".mck":
         return obj.save(p)
     if suffix == ".mosw":
