@@ -1,0 +1,88 @@
+"""The dask.distributed side of a batch: a LocalCluster (one single-threaded worker process per core) or an
+existing scheduler, BLAS pinned to one thread in every worker, one future per take.
+
+A worker that dies mid-take loses nothing: the scheduler gives its takes to another worker (dask's own
+retry; a take that kills ``distributed.scheduler.allowed-failures`` + 1 workers is reported as an error).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Callable, Iterable
+from contextlib import ExitStack
+
+from distributed import Client, LocalCluster, as_completed
+from distributed.client import FutureCancelledError
+from distributed.diagnostics.plugin import WorkerPlugin
+from distributed.scheduler import KilledWorker
+
+from .discover import Take
+from .take import Job, message_of, process
+
+__all__ = ["OneBlasThread", "default_workers", "run_takes"]
+
+#: how long to wait for a scheduler's workers, seconds
+CONNECT_TIMEOUT_S = 60
+
+
+def default_workers() -> int:
+    """One worker per core this process may use."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+class OneBlasThread(WorkerPlugin):
+    """Pins BLAS/OpenMP to one thread in the worker (threadpoolctl), whatever started it: each worker runs
+    one take at a time, so more threads only fight over the cores."""
+
+    name = "mocycle-one-blas-thread"
+
+    def setup(self, worker):
+        from threadpoolctl import threadpool_limits
+
+        threadpool_limits(1)
+
+
+def run_takes(job: Job, takes: Iterable[Take], on_row: Callable[[dict], None], *, scheduler: str | None = None,
+              workers: int | None = None) -> dict:
+    """Run ``process(job, take)`` for every take on dask; ``on_row(row)`` as each one finishes (any order).
+
+    scheduler : the address of a running scheduler (``tcp://host:8786``); ``None``: a LocalCluster here.
+    workers : LocalCluster: its number of workers (default: one per core, at most one per take); with a
+        scheduler: wait until that many workers are connected (default 1).
+    Returns how the batch ran: ``{"engine", "scheduler", "workers"}``.
+    """
+    takes = list(takes)
+    with ExitStack() as stack:
+        if scheduler is None:
+            n = workers or max(1, min(default_workers(), len(takes)))
+            cluster = stack.enter_context(LocalCluster(
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                silence_logs=logging.ERROR, env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+                                                 "MKL_NUM_THREADS": "1"}))
+            client = stack.enter_context(Client(cluster))
+        else:
+            client = stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT_S))
+            client.wait_for_workers(workers or 1, timeout=CONNECT_TIMEOUT_S)
+        client.register_plugin(OneBlasThread())
+        n_workers = len(client.scheduler_info()["workers"])
+        futures = {client.submit(process, job, take, key=f"mocycle-{job.command}-{i}-{job.options_hash}",
+                                 pure=False): take for i, take in enumerate(takes)}
+        for future in as_completed(futures):
+            take = futures[future]
+            try:
+                row = future.result()
+            except (KilledWorker, FutureCancelledError) as exc:  # the take itself kills workers
+                row = lost_row(job, take, f"the take killed its workers ({message_of(exc)})")
+            on_row(row)
+        return {"engine": "dask.distributed", "scheduler": client.scheduler.address, "workers": n_workers}
+
+
+def lost_row(job: Job, take: Take, message: str) -> dict:
+    """The row of a take no worker could finish (status ``error``)."""
+    return {"file": str(take.source), "rel": str(take.rel), "status": "error", "message": message, "figures": {},
+            "seconds": None, "wall_seconds": None, "outputs": [], "warnings": [], "facts": None, "worker": None,
+            "options_hash": job.options_hash, "record": None}
