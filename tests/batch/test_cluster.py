@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -83,16 +84,17 @@ def cluster(tmp_path_factory):
                       "--no-dashboard", "--local-directory", where / f"w{k}", "--death-timeout", "60"),
                 env=ENV, cwd=where, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         yield address, procs[1:]
-    finally:
-        for p in reversed(procs):
-            if p.poll() is None:
-                p.send_signal(signal.SIGTERM)
-        for p in reversed(procs):
-            try:
-                p.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait()
+    finally:  # the workers first, then the scheduler
+        for group in (procs[1:], procs[:1]):
+            for p in group:
+                if p.poll() is None:
+                    p.send_signal(signal.SIGTERM)
+            for p in group:
+                try:
+                    p.wait(timeout=20)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait()
         assert all(p.returncode is not None for p in procs)
 
 
@@ -126,35 +128,46 @@ def test_a_local_batch_processes_every_take(library, local_run):
     assert len((out / "results.csv").read_text().splitlines()) == 8
 
 
-def test_resume_keeps_everything_but_the_errors(library, local_run, tmp_path):
-    out, _ = local_run
-    r = batch("loop", library, "-o", out, "--workers", "1", "--harmonics", "8", "--resume", "--json")
+def test_resume_starts_no_cluster_when_every_take_is_fresh(library, local_run, tmp_path):
+    out = tmp_path / "out"
+    shutil.copytree(local_run[0], out)  # copy2: the times stay, so the copies are as fresh as the originals
+    r = batch("loop", library / "walks", library / "run.bvh", "-o", out, "--harmonics", "8", "--resume", "--json")
     assert r.returncode == 0, r.stderr
     summary = json.loads(r.stdout)
-    assert (summary["takes"], summary["resumed"], summary["error"]) == (7, 6, 1)
-    rows = rows_of(out)
-    assert [rel for rel, row in rows.items() if not row["resumed"]] == ["other/broken.bvh"]
+    assert (summary["takes"], summary["resumed"], summary["ok"], summary["engine"]) == (4, 4, 4, None)
+    assert all(row["resumed"] for row in rows_of(out).values())
 
 
 def test_a_scheduler_gives_the_same_results_as_a_local_run(library, local_run, cluster, tmp_path):
     address, workers = cluster
-    r = batch("loop", library, "-o", tmp_path, "--scheduler", address, "--workers", "2", "--harmonics", "8")
-    assert r.returncode == 0, r.stderr
+    from typer.testing import CliRunner
+
+    from mocycle.cli import app
+
+    r = CliRunner().invoke(app, ["batch", "loop", str(library), "-o", str(tmp_path), "--scheduler", address,
+                                 "--workers", "2", "--harmonics", "8"])
+    assert r.exit_code == 0, r.output
     local, remote = rows_of(local_run[0]), rows_of(tmp_path)
     assert sorted(local) == sorted(remote)
     for rel in local:
         _same(local[rel], remote[rel])
         for a, b in zip(local[rel]["outputs"], remote[rel]["outputs"], strict=True):
-            x, y = mocycle.read(a), mocycle.read(b)
+            assert a == b  # relative to the output folder
+            x, y = mocycle.read(local_run[0] / a), mocycle.read(tmp_path / b)
             assert np.allclose(x.rotations, y.rotations, atol=1e-9)
-    assert {row["worker"] for row in remote.values()} <= {None} | {w for w in _workers(address)}
+    assert len({row["worker"] for row in remote.values()}) == 2  # both workers took takes
 
 
-def _workers(address: str) -> set[str]:
+def _rescheduled(address: str) -> list[str]:
+    """The takes the scheduler took back from a worker that left while running them."""
     from distributed import Client
 
+    def lost(dask_scheduler):
+        return sorted({str(t[0]) for t in dask_scheduler.transition_log
+                       if str(t[0]).startswith("mocycle-") and t[1] == "processing" and t[2] == "released"})
+
     with Client(address, timeout=30) as client:
-        return set(client.scheduler_info()["workers"])
+        return client.run_on_scheduler(lost)
 
 
 def test_a_worker_killed_mid_run_loses_no_take(library, cluster, tmp_path):
@@ -177,5 +190,6 @@ def test_a_worker_killed_mid_run_loses_no_take(library, cluster, tmp_path):
     assert proc.returncode == 0, stderr
     rows = rows_of(tmp_path)
     assert sorted(rows) == ["run.bvh", "walks/walk0.bvh", "walks/walk1.bvh", "walks/walk2.bvh"]
-    assert all(row["status"] == "ok" and Path(row["outputs"][0]).exists() for row in rows.values()), rows
+    assert all(row["status"] == "ok" and (tmp_path / row["outputs"][0]).exists() for row in rows.values()), rows
     assert "4 takes: 4 ok" in stdout
+    assert _rescheduled(address), "no take was running on the killed worker: nothing was tested"

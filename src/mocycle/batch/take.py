@@ -109,13 +109,13 @@ def process(job: Job, take: Take) -> dict:
             row["status"], row["message"] = status_of(exc), message_of(exc)
     row["warnings"] += [str(w.message) for w in caught if not issubclass(w.category, DeprecationWarning)
                         and str(w.message) not in row["warnings"]]
-    row["outputs"] = [str(p) for p in written]
+    row["outputs"] = [p.relative_to(job.outdir).as_posix() for p in written]
     record = job.record_path(take)
-    _remove_stale(record, set(row["outputs"]))
+    _remove_stale(job.outdir, record, set(row["outputs"]))
     row["wall_seconds"] = time.perf_counter() - t0
     row["worker"] = _worker_name()
     row["options_hash"] = job.options_hash
-    row["record"] = str(record)
+    row["record"] = record.relative_to(job.outdir).as_posix()
     record.parent.mkdir(parents=True, exist_ok=True)
     atomic_write(record, json_text(row))
     return row
@@ -145,13 +145,15 @@ def _write_outputs(job: Job, command, take: Take, report, write) -> list[Path]:
     return [target]
 
 
-def _remove_stale(record: Path, keep: set[str]) -> None:
-    """Remove the outputs the previous record of this take lists that this run did not write."""
+def _remove_stale(outdir: Path, record: Path, keep: set[str]) -> None:
+    """Remove the outputs the previous record of this take lists (relative to ``outdir``) that this run did not
+    write; nothing outside ``outdir``."""
     try:
         old = json.loads(record.read_text(encoding="utf-8"))
         for name in old.get("outputs", []):
-            if name not in keep:
-                Path(name).unlink(missing_ok=True)
+            path = (outdir / name).resolve()
+            if name not in keep and outdir in path.parents:
+                path.unlink(missing_ok=True)
     except (OSError, ValueError, AttributeError):
         pass
 
@@ -167,7 +169,7 @@ def fresh_record(job: Job, take: Take) -> dict | None:
         row = json.loads(record.read_text(encoding="utf-8"))
         if row.get("options_hash") != job.options_hash or row.get("status") not in STATUSES[:3]:
             return None
-        made = [record] + [Path(p) for p in row.get("outputs", [])]
+        made = [record] + [job.outdir / p for p in row.get("outputs", [])]
         oldest_output = min(p.stat().st_mtime for p in made)
         newest_input = max(p.stat().st_mtime for p in take.inputs())
     except (OSError, ValueError, AttributeError, TypeError):
