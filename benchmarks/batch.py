@@ -1,0 +1,127 @@
+"""Throughput of ``mocycle batch loop`` (issue 16) against one process per take and against the bare compute.
+
+    python benchmarks/batch.py [--data DIR] [--takes N] [--workers N]
+
+Over the Bandai Namco takes of ../shared/data/bandai (all of them, or the first N), three ways, in one run:
+
+* **shell loop**: ``for f in ...; do mocycle loop "$f" -o OUT; done`` in bash, one process per take (what a
+  user does today): per-take time = wall / takes;
+* **batch**: ``mocycle batch loop DIR -o OUT`` (LocalCluster, one single-threaded worker per core), the whole
+  command from start to exit: per-take time = wall / takes;
+* **in-process**: ``mocycle.tasks.loop.run`` on every take in this process, BLAS on one thread, after one
+  warm-up take: per-take time = the sum of the wall times / takes (one core).
+
+Goals: batch <= 0.5x the shell loop, and within 1.3x of the in-process time. The machine's load average is
+printed before each part (other jobs share the cores; the ratios are measured in the same run). Exit 0 either
+way: a benchmark, not a test.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shlex
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+from threadpoolctl import threadpool_limits
+
+HERE = Path(__file__).resolve().parent
+DATA = HERE.parent.parent / "shared" / "data" / "bandai"
+
+
+def load() -> str:
+    return "load average " + " ".join(f"{x:.2f}" for x in os.getloadavg()) + f" on {os.cpu_count()} cores"
+
+
+def mocycle_command() -> list[str]:
+    return [sys.executable, "-m", "mocycle"]
+
+
+def shell_loop(files: list[Path], out: Path) -> float:
+    cmd = " ".join(map(shlex.quote, mocycle_command()))
+    script = "".join(f"{cmd} loop {shlex.quote(str(f))} -o {shlex.quote(str(out / f.name))} >/dev/null 2>&1; "
+                     for f in files)
+    t0 = time.perf_counter()
+    subprocess.run(["bash", "-c", script], check=False)
+    return time.perf_counter() - t0
+
+
+def batch(folder: Path, out: Path, workers: int | None) -> tuple[float, str]:
+    args = [*mocycle_command(), "batch", "loop", str(folder), "-o", str(out), "--json"]
+    args += ["--workers", str(workers)] if workers else []
+    t0 = time.perf_counter()
+    r = subprocess.run(args, capture_output=True, text=True, check=False)
+    wall = time.perf_counter() - t0
+    if r.returncode != 0:
+        raise SystemExit(f"mocycle batch failed ({r.returncode}): {r.stderr.strip()}")
+    return wall, r.stdout
+
+
+def in_process(files: list[Path]) -> tuple[float, dict]:
+    from mocycle import tasks
+    from mocycle.batch.take import status_of
+    from mocycle.errors import MocycleError
+
+    options = tasks.loop.Options()
+    statuses: dict[str, int] = {}
+    with threadpool_limits(1), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            tasks.loop.run(files[0], options)  # warm-up: imports, first calls
+        except MocycleError:
+            pass
+        total = 0.0
+        for f in files:
+            t0 = time.perf_counter()
+            try:
+                tasks.loop.run(f, options)
+                status = "ok"
+            except MocycleError as exc:
+                status = status_of(exc)
+            total += time.perf_counter() - t0
+            statuses[status] = statuses.get(status, 0) + 1
+    return total, statuses
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--data", type=Path, default=DATA, help="folder of .bvh takes (default: the Bandai set)")
+    parser.add_argument("--takes", type=int, default=None, help="only the first N takes")
+    parser.add_argument("--workers", type=int, default=None, help="batch workers (default: one per core)")
+    args = parser.parse_args()
+    files = sorted(args.data.glob("*.bvh"))[: args.takes]
+    if not files:
+        raise SystemExit(f"no .bvh files in {args.data} (the shared data is not here)")
+    n = len(files)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        folder = tmp / "in"
+        folder.mkdir()
+        for f in files:  # the batch reads exactly these takes
+            (folder / f.name).symlink_to(f.resolve())
+        print(f"{n} takes from {args.data}; mocycle loop with its default options")
+        print(f"in-process  ({load()})", flush=True)
+        compute, statuses = in_process(files)
+        print(f"  {compute:.2f} s, {compute / n:.3f} s per take; statuses {statuses}")
+        print(f"batch       ({load()})", flush=True)
+        wall_batch, summary = batch(folder, tmp / "batch", args.workers)
+        s = json.loads(summary)
+        print(f"  {wall_batch:.2f} s, {wall_batch / n:.3f} s per take; {s['workers']} workers; ok {s['ok']}, "
+              f"no periodic motion {s['no-periodic-motion']}, refused {s['refused']}, error {s['error']}; "
+              f"{s['task_seconds']:.2f} s in the tasks")
+        print(f"shell loop  ({load()})", flush=True)
+        wall_shell = shell_loop(files, tmp / "shell")
+        print(f"  {wall_shell:.2f} s, {wall_shell / n:.3f} s per take")
+    print(f"after       ({load()})")
+    print(f"batch / shell loop: {wall_batch / wall_shell:.2f}x (goal <= 0.5x)")
+    print(f"batch / in-process: {wall_batch / compute:.2f}x (goal <= 1.3x)")
+
+
+if __name__ == "__main__":
+    main()
