@@ -156,6 +156,17 @@ def test_a_scheduler_gives_the_same_results_as_a_local_run(library, local_run, c
             x, y = mocycle.read(local_run[0] / a), mocycle.read(tmp_path / b)
             assert np.allclose(x.rotations, y.rotations, atol=1e-9)
     assert len({row["worker"] for row in remote.values()}) == 2  # both workers took takes
+    from distributed import Client
+
+    def pools():
+        from threadpoolctl import threadpool_info
+
+        return [(p["internal_api"], p["num_threads"]) for p in threadpool_info()]
+
+    with Client(address, timeout=30) as client:  # no nanny set the variables: the batch's plugin pinned them
+        threads = client.run(pools)
+    assert len(threads) == 2 and all(apis for apis in threads.values()), threads
+    assert all(n == 1 for apis in threads.values() for _, n in apis), threads
 
 
 def _rescheduled(address: str) -> list[str]:

@@ -34,16 +34,33 @@ def default_workers() -> int:
         return os.cpu_count() or 1
 
 
+#: the thread counts BLAS and OpenMP read when they load
+ONE_THREAD_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
 class OneBlasThread(WorkerPlugin):
-    """Pins BLAS/OpenMP to one thread in the worker (threadpoolctl), whatever started it: each worker runs
-    one take at a time, so more threads only fight over the cores."""
+    """Pins BLAS and OpenMP to one thread in the worker, whatever started it (a nanny sets the variables,
+    ``dask worker --no-nanny`` does not): each worker runs one take at a time, so more threads only fight
+    over the cores. The variables cover the libraries loaded later; the task layer is imported first (numpy,
+    scipy, scikit-learn, ripser load their thread pools) and then ``threadpool_limits(1)`` pins the pools
+    already there. The import also takes the start-up cost out of the first take's time."""
 
     name = "mocycle-one-blas-thread"
 
     def setup(self, worker):
-        from threadpoolctl import threadpool_limits
+        os.environ.update(ONE_THREAD_ENV)
+        pin_threads()
 
-        threadpool_limits(1)
+
+def pin_threads() -> None:
+    """Load the libraries the tasks use and limit every BLAS/OpenMP pool loaded so far to one thread."""
+    import scipy.linalg  # noqa: F401  (scipy's own BLAS)
+    import sklearn.utils  # noqa: F401  (scikit-learn's OpenMP)
+    from threadpoolctl import threadpool_limits
+
+    import mocycle.tasks  # noqa: F401
+
+    threadpool_limits(1)
 
 
 def run_takes(job: Job, takes: Iterable[Take], on_row: Callable[[dict], None], *, scheduler: str | None = None,
@@ -61,8 +78,7 @@ def run_takes(job: Job, takes: Iterable[Take], on_row: Callable[[dict], None], *
             n = workers or max(1, min(default_workers(), len(takes)))
             cluster = stack.enter_context(LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=logging.ERROR, env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
-                                                 "MKL_NUM_THREADS": "1"}))
+                silence_logs=logging.ERROR, env=ONE_THREAD_ENV))
             client = stack.enter_context(Client(cluster))
         else:
             client = stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT_S))
