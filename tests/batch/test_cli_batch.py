@@ -91,3 +91,19 @@ def test_the_bar_counts_done_and_not_ok():
     task = bar.progress.tasks[0]
     assert (task.completed, task.total, task.fields["failed"]) == (3, 4, 1)
     assert "3/4" in text.getvalue() and "not ok 1" in text.getvalue()
+
+
+def test_no_scheduler_is_a_failed_run(take, tmp_path):
+    import socket
+
+    import dask
+
+    with socket.socket() as s:  # a free port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    with dask.config.set({"distributed.comm.timeouts.connect": "2s"}):
+        r = CliRunner().invoke(app, ["batch", "info", str(take), "-o", str(tmp_path / "out"), "--scheduler",
+                                     f"tcp://127.0.0.1:{port}"])
+    assert r.exit_code == 1, r.output
+    assert f"the batch stopped (on the dask scheduler at tcp://127.0.0.1:{port})" in r.stderr
+    assert not (tmp_path / "out" / "results.csv").exists()

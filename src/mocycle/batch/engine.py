@@ -17,13 +17,15 @@ from distributed.client import FutureCancelledError
 from distributed.diagnostics.plugin import WorkerPlugin
 from distributed.scheduler import KilledWorker
 
+from ..errors import MocycleError
 from .discover import Take
 from .take import Job, message_of, process
 
 __all__ = ["OneBlasThread", "default_workers", "run_takes"]
 
-#: how long to wait for a scheduler's workers, seconds
-CONNECT_TIMEOUT_S = 60
+#: how long to wait for a scheduler's workers, seconds (the connection itself: dask's
+#: ``distributed.comm.timeouts.connect``, e.g. ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT=5s``)
+WORKERS_TIMEOUT_S = 60
 
 
 def default_workers() -> int:
@@ -72,7 +74,14 @@ def run_takes(job: Job, takes: Iterable[Take], on_row: Callable[[dict], None], *
         scheduler: wait until that many workers are connected (default 1).
     Returns how the batch ran: ``{"engine", "scheduler", "workers"}``.
     """
-    takes = list(takes)
+    try:
+        return _run(job, list(takes), on_row, scheduler, workers)
+    except (OSError, TimeoutError, FutureCancelledError) as exc:  # no scheduler, the cluster went away, no disk
+        where = f"the dask scheduler at {scheduler}" if scheduler else "a local dask cluster"
+        raise MocycleError(f"the batch stopped (on {where}): {type(exc).__name__}: {exc}") from None
+
+
+def _run(job: Job, takes: list[Take], on_row, scheduler: str | None, workers: int | None) -> dict:
     with ExitStack() as stack:
         if scheduler is None:
             n = workers or max(1, min(default_workers(), len(takes)))
@@ -81,8 +90,8 @@ def run_takes(job: Job, takes: Iterable[Take], on_row: Callable[[dict], None], *
                 silence_logs=logging.ERROR, env=ONE_THREAD_ENV))
             client = stack.enter_context(Client(cluster))
         else:
-            client = stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT_S))
-            client.wait_for_workers(workers or 1, timeout=CONNECT_TIMEOUT_S)
+            client = stack.enter_context(Client(scheduler))
+            client.wait_for_workers(workers or 1, timeout=WORKERS_TIMEOUT_S)
         client.register_plugin(OneBlasThread())
         n_workers = len(client.scheduler_info()["workers"])
         futures = {client.submit(process, job, take, key=f"mocycle-{job.command}-{i}-{job.options_hash}",
@@ -91,7 +100,7 @@ def run_takes(job: Job, takes: Iterable[Take], on_row: Callable[[dict], None], *
             take = futures[future]
             try:
                 row = future.result()
-            except (KilledWorker, FutureCancelledError) as exc:  # the take itself kills workers
+            except KilledWorker as exc:  # the take itself kills workers
                 row = lost_row(job, take, f"the take killed its workers ({message_of(exc)})")
             on_row(row)
         return {"engine": "dask.distributed", "scheduler": client.scheduler.address, "workers": n_workers}
