@@ -48,6 +48,7 @@ bench: $(VENV)/.installed
 	$(BIN)/python benchmarks/swings.py
 	$(BIN)/python benchmarks/keyframes.py
 	$(BIN)/python benchmarks/feet.py
+	$(BIN)/python benchmarks/batch.py
 
 clean:
 	rm -rf $(VENV) $(NP1) out .pytest_cache .ruff_cache

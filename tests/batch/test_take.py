@@ -21,6 +21,12 @@ def walk_file(tmp_path_factory):
     return mocycle.write(synthetic_walk(n_frames=150, fps=30).motion, folder / "walk.bvh")
 
 
+@pytest.fixture(scope="module")
+def short_walk(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("short")
+    return mocycle.write(synthetic_walk(n_frames=90, fps=30).motion, folder / "walk.bvh")
+
+
 def _take(path: Path) -> Take:
     return Take(source=path.resolve(), rel=Path(path.name))
 
@@ -119,3 +125,19 @@ def test_output_suffixes_per_command():
         check_suffix(COMMANDS["loop"], ".mck")
     with pytest.raises(MocycleError, match="leave --suffix out"):
         check_suffix(COMMANDS["phase"], ".json")
+
+
+@pytest.mark.parametrize("command, options, suffix, outputs", [
+    ("info", {}, None, []), ("phase", {}, None, []), ("loop", {"which": "all"}, ".bvh", ["walk.class0.bvh"]),
+    ("swings", {}, ".json", ["walk.json"]), ("compress", {}, ".mck", ["walk.mck"]),
+    ("stretch", {"factor": 1.5}, ".bvh", ["walk.bvh"])])
+def test_every_command_writes_its_output_and_figures(tmp_path, short_walk, command, options, suffix, outputs):
+    job = Job(command=command, options=tasks.TASKS[command].Options(**options), outdir=tmp_path, suffix=suffix)
+    row = process(job, _take(short_walk))
+    assert row["status"] == "ok", row["message"]
+    assert row["outputs"] == outputs and all((tmp_path / p).exists() for p in outputs)
+    assert set(row["figures"]) == set(COMMANDS[command].figures)
+    assert all(v is not None for v in row["figures"].values()), row["figures"]
+    for p in outputs:
+        assert mocycle.read(tmp_path / p) is not None  # a whole file mocycle reads back
+    assert (tmp_path / f"walk.{command}.json").exists()
