@@ -80,3 +80,14 @@ def test_two_takes_with_the_same_outputs_are_refused(tmp_path):
     (tmp_path / "walk.amc").write_text("x")
     with pytest.raises(MocycleError, match="would write the same outputs"):
         find_takes([tmp_path])
+
+
+def test_linked_takes_keep_the_name_they_are_given(tmp_path):
+    root = _tree(tmp_path / "in")
+    links = tmp_path / "links"
+    links.mkdir()
+    (links / "mine.bvh").symlink_to(root / "a" / "walk.bvh")
+    assert rels(find_takes([links])) == ["mine.bvh"]
+    assert rels(find_takes([str(links / "*.bvh")])) == ["mine.bvh"]
+    takes = find_takes([links / "mine.bvh", root / "a" / "walk.bvh"])  # one file named twice is one take
+    assert len(takes) == 1

@@ -76,7 +76,7 @@ class _Quiet:
 def _refuse_overwriting_inputs(job: Job, takes: list[Take]) -> None:
     from ..errors import MocycleError
 
-    sources = {t.source for t in takes}
+    sources = {t.source.resolve() for t in takes}
     for take in takes:
         for path in ([take.output(job.outdir, job.suffix)] if job.suffix else []) + [job.record_path(take)]:
             if path.resolve() in sources:

@@ -59,6 +59,11 @@ def _root_of_pattern(pattern: str) -> Path:
     return Path(*head) if head else Path(".")
 
 
+def _abs(p) -> Path:
+    """The absolute, normalised path, symbolic links kept (a linked take keeps the name the user gave it)."""
+    return Path(os.path.abspath(p))
+
+
 def _inside(p: Path, folder: Path | None) -> bool:
     return folder is not None and (p == folder or folder in p.parents)
 
@@ -79,23 +84,23 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
     """
     if not inputs:
         raise MocycleError("no inputs: name files, folders or glob patterns")
-    skip = Path(outdir).resolve() if outdir is not None else None
+    skip = _abs(outdir) if outdir is not None else None
     found: list[tuple[Path, Path]] = []  # (file, root)
     for item in map(str, inputs):
         p = Path(item)
         if p.is_dir():
-            root = p.resolve()
-            files = [f for f in sorted(root.rglob("*")) if _is_take(f) and not _inside(f.resolve(), skip)
+            root = _abs(p)
+            files = [f for f in sorted(root.rglob("*")) if _is_take(f) and not _inside(f, skip)
                      and not any(part.startswith(".") for part in f.relative_to(root).parts)]
             if not files:
                 raise MocycleError(f"{item}: no .bvh or .amc files in this folder")
         elif p.exists():
             if p.suffix.lower() not in TAKE_SUFFIXES:
                 raise MocycleError(f"{item}: not a take; batch reads {' and '.join(TAKE_SUFFIXES)} files")
-            root, files = p.resolve().parent, [p.resolve()]
+            root, files = _abs(p).parent, [_abs(p)]
         elif _magic(item):
-            root = _root_of_pattern(item).resolve()
-            files = [Path(f).resolve() for f in sorted(glob.glob(item, recursive=True))]
+            root = _abs(_root_of_pattern(item))
+            files = [_abs(f) for f in sorted(glob.glob(item, recursive=True))]
             files = [f for f in files if _is_take(f) and not _inside(f, skip)]
             if not files:
                 raise MocycleError(f"{item}: the pattern matches no .bvh or .amc file")
@@ -105,8 +110,8 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
     base = Path(os.path.commonpath([str(root) for _, root in found]))
     takes, seen = {}, set()
     for f, _ in found:
-        if f not in seen:
-            seen.add(f)
+        if f.resolve() not in seen:  # the same file named twice (or through a link) is one take
+            seen.add(f.resolve())
             takes[f] = Take(source=f, rel=f.relative_to(base))
     out = sorted(takes.values(), key=lambda t: str(t.rel))
     stems: dict[Path, Take] = {}
