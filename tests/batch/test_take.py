@@ -141,3 +141,23 @@ def test_every_command_writes_its_output_and_figures(tmp_path, short_walk, comma
     for p in outputs:
         assert mocycle.read(tmp_path / p) is not None  # a whole file mocycle reads back
     assert (tmp_path / f"walk.{command}.json").exists()
+
+
+def test_a_take_that_fails_part_way_leaves_none_of_its_outputs(tmp_path, short_walk, monkeypatch):
+    import mocycle.batch.take as take_module
+    import mocycle.io
+
+    out = tmp_path / "out"
+    monkeypatch.setattr(take_module, "motion_targets", lambda report, target: {
+        "loop": target, "input": target.with_suffix(".second.bvh")})  # two motions to write
+    real_write = mocycle.io.write
+
+    def write(obj, path):
+        if "second" in str(path):
+            raise OSError(28, "No space left on device")
+        return real_write(obj, path)
+
+    monkeypatch.setattr(mocycle.io, "write", write)
+    row = process(_job(tmp_path), _take(short_walk))
+    assert row["status"] == "error" and "No space left on device" in row["message"]
+    assert sorted(p.name for p in out.iterdir()) == ["walk.loop.json"]  # the first loop went too

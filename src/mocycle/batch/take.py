@@ -104,9 +104,12 @@ def process(job: Job, take: Take) -> dict:
             if job.command == "phase" and not report.facts["classes"]:
                 row["status"], row["message"] = "no-periodic-motion", report.facts["reason"]
             else:
-                written = _write_outputs(job, command, take, report, write)
+                _write_outputs(job, command, take, report, write, written)
         except Exception as exc:  # one bad take never stops the batch: its row says what happened
             row["status"], row["message"] = status_of(exc), message_of(exc)
+            for path in written:  # a take that failed part-way leaves none of its outputs
+                path.unlink(missing_ok=True)
+            written = []
     row["warnings"] += [str(w.message) for w in caught if not issubclass(w.category, DeprecationWarning)
                         and str(w.message) not in row["warnings"]]
     row["outputs"] = [p.relative_to(job.outdir).as_posix() for p in written]
@@ -131,18 +134,17 @@ def _figures(command, facts) -> dict:
     return out
 
 
-def _write_outputs(job: Job, command, take: Take, report, write) -> list[Path]:
+def _write_outputs(job: Job, command, take: Take, report, write, written: list[Path]) -> None:
+    """Write the take's outputs; ``written`` gets each file as soon as it is whole."""
     if command.writes is None:
-        return []
+        return
     target = take.output(job.outdir, job.suffix)
     target.parent.mkdir(parents=True, exist_ok=True)
     if command.writes == "motion":
-        targets = motion_targets(report, target)
-        for role, path in targets.items():
-            write(report.motions[role], path)
-        return list(targets.values())
-    write(report.result, target)  # a Compressed take (.mck) or a Segmentation (.mosw / .json)
-    return [target]
+        for role, path in motion_targets(report, target).items():
+            written.append(write(report.motions[role], path))
+        return
+    written.append(write(report.result, target))  # a Compressed take (.mck) or a Segmentation (.mosw / .json)
 
 
 def _remove_stale(outdir: Path, record: Path, keep: set[str]) -> None:
