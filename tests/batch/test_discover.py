@@ -89,5 +89,6 @@ def test_linked_takes_keep_the_name_they_are_given(tmp_path):
     (links / "mine.bvh").symlink_to(root / "a" / "walk.bvh")
     assert rels(find_takes([links])) == ["mine.bvh"]
     assert rels(find_takes([str(links / "*.bvh")])) == ["mine.bvh"]
-    takes = find_takes([links / "mine.bvh", root / "a" / "walk.bvh"])  # one file named twice is one take
-    assert len(takes) == 1
+    both = find_takes([links / "mine.bvh", root / "a" / "walk.bvh"])  # another name: a take with its own output
+    assert rels(both) == ["in/a/walk.bvh", "links/mine.bvh"]
+    assert rels(find_takes([links, links / "mine.bvh"])) == ["mine.bvh"]  # one path named twice is one take

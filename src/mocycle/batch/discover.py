@@ -108,11 +108,9 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
             raise MocycleError(f"{item}: no such file or folder")
         found += [(f, root) for f in files]
     base = Path(os.path.commonpath([str(root) for _, root in found]))
-    takes, seen = {}, set()
-    for f, _ in found:
-        if f.resolve() not in seen:  # the same file named twice (or through a link) is one take
-            seen.add(f.resolve())
-            takes[f] = Take(source=f, rel=f.relative_to(base))
+    takes = {}
+    for f, _ in found:  # the same path named twice is one take; links of other names are takes of their own
+        takes.setdefault(f, Take(source=f, rel=f.relative_to(base)))
     out = sorted(takes.values(), key=lambda t: str(t.rel))
     stems: dict[Path, Take] = {}
     for t in out:
