@@ -59,6 +59,7 @@ bench: $(VENV)/.installed
 	$(BIN)/python benchmarks/swings.py
 	$(BIN)/python benchmarks/keyframes.py
 	$(BIN)/python benchmarks/feet.py
+	$(BIN)/python benchmarks/batch.py
 
 # --- Blender extension (docs/blender.md) ------------------------------------------------------------------
 # Headless Blender from PyPI (the bpy module, Python 3.11), one venv per animation API: 5.0.1 (slotted actions)

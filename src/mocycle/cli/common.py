@@ -42,8 +42,11 @@ COMMANDS = {
     "edit": ("swings", "Scale the angle or the duration of one swing of one joint and write the edited motion."),
     "compress": ("keyframes", "Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report "
                               "error and size."),
-    "decompress": ("keyframes", "Rebuild a take from its keyframes; the keyframes come back exactly."),
+    "decompress": ("keyframes", "Rebuild a take from its keyframes; the keyframes come back exactly (unless --feet "
+                                "lock)."),
     "project": ("keyframes", "Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."),
+    "batch": ("batch", "Run one command over many takes on dask.distributed; a row per take in "
+                       "OUTDIR/results.csv and .json."),
     "demo": ("demo", "Loop the built-in synthetic walk: write the take, its cycle (BVH) and the loop plot."),
 }
 

@@ -1,0 +1,117 @@
+"""What ``mocycle batch`` does per command: the output it writes for a take and the figures a results row
+shows (a few of the task report's ``facts``; the whole facts go to ``results.json``)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import MocycleError
+
+__all__ = ["COMMANDS", "Command", "check_suffix"]
+
+#: the suffixes ``mocycle.write`` writes that do not hold a motion (every other one it writes does)
+_NOT_MOTION = (".mck", ".mosw", ".json")
+
+
+@dataclass(frozen=True)
+class Command:
+    """A task as batch runs it.
+
+    name : the task (``mocycle.tasks.<name>``).
+    writes : what goes to ``OUTDIR/<rel><suffix>``: ``"motion"`` (the report's motions), ``"compressed"``
+        (the ``.mck`` take), ``"swings"`` (the segmentation) or ``None`` (the per-take JSON record only).
+    suffix : the default output suffix.
+    figures : results column -> how to read it from the report's facts.
+    """
+
+    name: str
+    writes: str | None
+    suffix: str | None
+    figures: Mapping[str, Callable[[Mapping], object]]
+
+    def suffixes(self) -> tuple[str, ...]:
+        """The output suffixes this command can write (asked of ``mocycle.io`` at run time, so a new motion
+        format of ``mocycle.write`` is one for batch too)."""
+        from ..io import WRITE_SUFFIXES
+
+        if self.writes == "motion":
+            return tuple(s for s in WRITE_SUFFIXES if s not in _NOT_MOTION)
+        if self.writes == "swings":
+            return (".mosw", ".json")
+        if self.writes == "compressed":
+            return (".mck",)
+        return ()
+
+
+def check_suffix(command: Command, suffix: str | None) -> str | None:
+    """The output suffix for ``command`` (``None`` when it writes only its record); one clear error when
+    ``suffix`` is not one it writes."""
+    if suffix is None:
+        return command.suffix
+    suffix = suffix.lower() if suffix.startswith(".") else "." + suffix.lower()
+    allowed = command.suffixes()
+    if not allowed:
+        raise MocycleError(f"--suffix: batch {command.name} writes no file but its record (<take>.{command.name}"
+                           f".json); leave --suffix out")
+    if suffix not in allowed:
+        raise MocycleError(f"--suffix: batch {command.name} writes {' or '.join(allowed)}; got {suffix}")
+    return suffix
+
+
+def _first_class(facts: Mapping, key: str):
+    classes = facts.get("classes") or []
+    return classes[0][key] if classes else None
+
+
+def _loop(facts: Mapping) -> Mapping:
+    """The first loop's facts (``--which all`` reports a list of loops)."""
+    return facts["loops"][0] if "loops" in facts else facts
+
+
+def _skate(facts: Mapping):
+    """Foot skate of the cycle written, units/s: after locking when the feet were locked, else as fitted."""
+    f = _loop(facts)
+    locked = f["feet"].get("skate_after") if isinstance(f.get("feet"), Mapping) else None
+    return locked if locked is not None else f["metrics"]["skate"]
+
+
+COMMANDS: dict[str, Command] = {c.name: c for c in (
+    Command("info", None, None, {
+        "frames": lambda f: f["frames"], "fps": lambda f: f["fps"], "duration_s": lambda f: f["duration_s"],
+        "joints": lambda f: f["joints"], "root_displacement": lambda f: f["root_displacement"]}),
+    Command("phase", None, None, {
+        "frames": lambda f: f["frames"], "fps": lambda f: f["fps"], "classes": lambda f: len(f["classes"]),
+        "period_frames": lambda f: _first_class(f, "period_frames"),
+        "periods": lambda f: _first_class(f, "n_periods"),
+        "autocorrelation_period_frames": lambda f: f["autocorrelation_period_frames"]}),
+    Command("loop", "motion", ".bvh", {
+        "period_frames": lambda f: _loop(f)["period_frames"], "periods": lambda f: _loop(f)["n_periods"],
+        "cycle_frames": lambda f: _loop(f)["cycle_frames"],
+        "seam_pose": lambda f: _loop(f)["metrics"]["seam_pose"],
+        "seam_velocity": lambda f: _loop(f)["metrics"]["seam_velocity"],
+        "foot_skate": _skate}),
+    Command("swings", "swings", ".mosw", {
+        "frames": lambda f: f["frames"], "swings": lambda f: f["n_swings"],
+        "per_angle_error_deg": lambda f: f["per_angle_error_deg"], "compressed_bytes": lambda f: f["compressed_bytes"],
+        "ratio_bvh": lambda f: f["ratio_bvh"]}),
+    Command("compress", "compressed", ".mck", {
+        "frames": lambda f: f["frames"], "keyframes": lambda f: f["keyframes"],
+        "keys_per_period": lambda f: f["keys_per_period"],
+        "error_per_frame_per_joint": lambda f: f["error_per_frame_per_joint"],
+        "compressed_bytes": lambda f: f["compressed_bytes"], "real_ratio": lambda f: f["real_ratio"]}),
+    Command("stretch", "motion", ".bvh", {
+        "factor": lambda f: f["factor"], "frames_in": lambda f: f["frames_in"], "frames_out": lambda f: f["frames_out"],
+        "periodic_regions": lambda f: len(f["periodic_regions"])}),
+)}
+
+
+def motion_targets(report, target: Path) -> dict[str, Path]:
+    """The motions a report holds that batch writes, by role, and where: ``loop`` -> ``target``; with
+    ``--which all`` ``loop.classK`` -> ``<target stem>.classK<suffix>``; ``stretched`` -> ``target``."""
+    roles = [r for r in report.motions if r == "stretched" or r == "loop" or r.startswith("loop.class")]
+    out = {}
+    for role in roles:
+        out[role] = target if "." not in role else target.with_suffix(f".{role.split('.', 1)[1]}{target.suffix}")
+    return out

@@ -1,0 +1,110 @@
+"""``mocycle batch``: one command over many takes, on dask.distributed (the work is in :mod:`mocycle.batch`).
+
+The options of COMMAND are the flags of its task's ``Options`` (the same flags as ``mocycle COMMAND``,
+derived from the same fields); the front-end flags of the single commands (``--json``, ``--plot``, their
+``-o``) are not: batch has its own ``-o`` (the output folder) and ``--suffix``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Annotated
+
+import click
+import typer
+
+from .. import tasks
+from ..errors import MocycleError
+from ..tasks.options import MISSING, Flag, flag_of
+from .common import EXIT_USAGE, app, err, friendly, out, print_json
+
+#: the commands batch runs (the ones that take one file)
+BATCH_COMMANDS = ("info", "phase", "loop", "swings", "compress", "stretch")
+
+
+def options_parser(command: str) -> click.Command:
+    """A click command that reads INPUTS and the flags of ``tasks.<command>.Options`` (each field's flag,
+    its help; on/off fields as flags, ``--no-X`` for the ones on by default)."""
+    params: list[click.Parameter] = [click.Argument(["inputs"], nargs=-1)]
+    for f in dataclasses.fields(tasks.TASKS[command].Options):
+        name = flag_of(f)
+        if isinstance(f.metadata.get("check"), Flag):
+            decl = f"{name}/--no-{name[2:]}" if f.default is True else name
+            params.append(click.Option([decl, f.name], is_flag=True, default=f.default, help=f.metadata["help"]))
+        else:
+            params.append(click.Option([name, f.name], required=f.default is MISSING, help=f.metadata["help"]))
+    return click.Command(f"mocycle batch {command}", params=params, add_help_option=False)
+
+
+def parse_command_line(args: list[str]):
+    """``COMMAND INPUTS... [options of COMMAND]`` -> (command, inputs, Options); a usage error says what
+    is wrong (an unknown command or flag, a missing value) and exits 2."""
+    if not args or args[0] not in BATCH_COMMANDS:
+        got = f"; got {args[0]!r}" if args else ""
+        raise click.UsageError(f"COMMAND must be one of {', '.join(BATCH_COMMANDS)}{got}")
+    command, rest = args[0], list(args[1:])
+    parser = options_parser(command)
+    ctx = parser.make_context(parser.name, rest, resilient_parsing=False)
+    given = {k: v for k, v in ctx.params.items() if k != "inputs"
+             and ctx.get_parameter_source(k) == click.core.ParameterSource.COMMANDLINE}
+    options = tasks.TASKS[command].Options(**given)  # an OptionError names the flag (exit 2)
+    return command, list(ctx.params["inputs"]), options
+
+
+@app.command(context_settings={"ignore_unknown_options": True})
+@friendly
+def batch(
+    args: Annotated[list[str], typer.Argument(
+        metavar="ARGS", show_default=False,
+        help="COMMAND INPUTS... [options of COMMAND]: COMMAND is info, phase, loop, swings, compress or stretch; "
+             "INPUTS are .bvh/.amc files, folders "
+             "(searched recursively) or glob patterns; then any flag of 'mocycle COMMAND' that sets an option "
+             "of the task (e.g. --harmonics 5, --root motion, --factor 2).")],
+    outdir: Annotated[Path, typer.Option("--output", "-o", help="The output folder: the outputs mirror the input "
+                                                                "tree; results.csv and results.json go here.")],
+    suffix: Annotated[str | None, typer.Option(
+        help="Output suffix for the takes (default: .bvh for loop and stretch, .mck for compress, .mosw for "
+             "swings; any motion format 'mocycle.write' writes for loop and stretch).")] = None,
+    resume: Annotated[bool, typer.Option(
+        "--resume", help="Keep the takes whose record and outputs are newer than their input and were made "
+                         "with the same options; run the rest (and the ones that ended in error).")] = False,
+    scheduler: Annotated[str | None, typer.Option(
+        help="Address of a running dask scheduler (tcp://host:8786); default: a LocalCluster here. Workers "
+             "must see the inputs and the output folder at the same paths.")] = None,
+    workers: Annotated[int | None, typer.Option(
+        min=1, help="LocalCluster: number of worker processes (default one per core); with --scheduler: wait "
+                    "for this many workers.")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON (no progress).")] = False,
+):
+    """Run one command over many takes on dask.distributed; a row per take in OUTDIR/results.csv and .json.
+
+    Each take is one call of the task in a single-threaded worker process; its status is ok,
+    no-periodic-motion, refused (a cycle that fails its loop checks) or error, with the message. One bad
+    take never stops the batch: the exit code is 0 when every take was processed whatever its status, 1
+    when the run itself failed (bad inputs, no scheduler), 2 for a bad option. Beside each take's outputs
+    goes its record OUTDIR/<take>.<COMMAND>.json (status, figures, the task's whole report).
+    """
+    try:
+        command, inputs, options = parse_command_line(args)
+    except click.UsageError as exc:
+        err.print(f"[bold red]error:[/] {exc.format_message()}", markup=True, soft_wrap=True)
+        raise typer.Exit(EXIT_USAGE) from None
+    if not inputs:
+        raise MocycleError(f"batch {command}: no INPUTS (files, folders or glob patterns)")
+    from ..batch import run_batch
+    from ..batch.progress import progress_for
+
+    progress = None if as_json else (lambda total, resumed: progress_for(err, total, resumed))
+    rows, run = run_batch(command, inputs, outdir, options, suffix=suffix, resume=resume, scheduler=scheduler,
+                          workers=workers, progress=progress)
+    if as_json:
+        print_json(run)
+        return
+    out.print(f"{run['takes']} takes: {run['ok']} ok, {run['no-periodic-motion']} no periodic motion, "
+              f"{run['refused']} refused, {run['error']} error" + (f", {run['resumed']} kept (--resume)"
+                                                                     if run["resumed"] else ""))
+    if run["engine"]:
+        out.print(f"  {run['workers']} worker(s) at {run['scheduler']}; {run['wall_seconds']:.2f} s wall, "
+                  f"{run['task_seconds']:.2f} s in the tasks", soft_wrap=True)
+    out.print(f"wrote {Path(outdir) / 'results.csv'} and results.json", soft_wrap=True)
