@@ -34,6 +34,7 @@ def _on_signal(signum, frame):
 def _commands():
     # Importing a command module registers its command; this order is the order in --help.
     from . import info, convert, phase, loop, blend, stretch, swings, keyframes, demo  # noqa: F401, I001
+    from . import studio, report  # noqa: F401, I001
     from . import common
 
     return common
