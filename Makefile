@@ -9,7 +9,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 NP1    := .venv-numpy1
 
-.PHONY: demo test test-numpy2 test-numpy1 lint bench clean
+.PHONY: demo test test-numpy2 test-numpy1 lint bench clean chromium
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -37,7 +37,11 @@ test-numpy1: $(NP1)/.installed
 	$(NP1)/bin/python -c "import numpy; print('numpy', numpy.__version__)"
 	$(NP1)/bin/python -m pytest -q -p no:cacheprovider
 
-test: lint test-numpy1 test-numpy2
+# the studio's browser tests drive Debian's chromium through Playwright (never `playwright install`)
+chromium:
+	@command -v chromium >/dev/null 2>&1 || { apt-get update -qq && apt-get install -y -qq chromium; }
+
+test: lint chromium test-numpy1 test-numpy2
 
 bench: $(VENV)/.installed
 	$(BIN)/python -m pip install --quiet -e ".[bench]"
