@@ -8,6 +8,8 @@ import traceback
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
+from ..errors import MocycleError
+
 
 @dataclass
 class Job:
@@ -58,7 +60,7 @@ class Jobs:
             job.progress = 1.0
         except Exception as exc:  # the page shows the message; the server keeps serving
             job.status, job.error = "failed", str(exc) or type(exc).__name__
-            if not isinstance(exc, ValueError):
+            if not isinstance(exc, (ValueError, MocycleError)):
                 traceback.print_exc()
 
     def get(self, job_id: str) -> Job | None:
