@@ -16,11 +16,11 @@ pytest.importorskip("starlette")
 pytest.importorskip("uvicorn")
 pytest.importorskip("playwright")
 
-from browser import CHROMIUM, chromium, served, watch_console  # noqa: E402
 from mocycle import read  # noqa: E402
 from mocycle.io.bvh import parse_bvh  # noqa: E402
 from mocycle.keyframes import BackProjection, joint_weights, pose_distance_matrix  # noqa: E402
 from mocycle.studio.app import create_app  # noqa: E402
+from mocycle.studio.testing import CHROMIUM, chromium, served, watch_console  # noqa: E402
 
 if not os.path.exists(CHROMIUM):
     pytest.skip(f"{CHROMIUM} is absent (make chromium installs Debian's chromium)", allow_module_level=True)
@@ -103,9 +103,9 @@ def test_a_stroke_becomes_an_animation_that_follows_it(session, library, tmp_pat
     page, errors, _ = session
     open_take(page, "wander.bvh")
     half = 120
-    path = np.array([page.evaluate(f"window.__studio.framePixel({i})") for i in range(0, half, 3)])
-    marks = np.array([page.evaluate(f"window.__studio.markerPixel({k})") for k in range(len(page.evaluate(
-        "window.__studio.keys")))])
+    path = np.array(page.evaluate(f"[...Array({half}).keys()].filter((i) => i % 3 === 0)"
+                                   ".map((i) => window.__studio.framePixel(i))"))
+    marks = np.array(page.evaluate("window.__studio.markers.map((_, k) => window.__studio.markerPixel(k))"))
     # a press on a marker drags it: the stroke starts at the first point clear of every marker
     clear = np.linalg.norm(path[:, None] - marks[None], axis=2).min(axis=1) > 12
     path = path[int(np.argmax(clear)):].tolist()

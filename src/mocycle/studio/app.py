@@ -56,6 +56,7 @@ class Studio:
         self.strokes: dict[str, dict] = {}
         self._stroke_ids = itertools.count(1)
         self._planes: dict[tuple, tuple[bytes, dict]] = {}
+        self._motions: dict[str, bytes] = {}
         self._relayout: dict[str, str] = {}  # take id -> its running relayout job
         self._lock = threading.Lock()
         if analyse:
@@ -82,6 +83,16 @@ class Studio:
         if take_id not in self.takes:
             raise KeyError(take_id)
         return self.takes[take_id]
+
+    def motion_bytes(self, take: Take) -> bytes:
+        """The take's payload, made once."""
+        with self._lock:
+            data = self._motions.get(take.id)
+        if data is None:
+            data = motion_payload(take.motion(self.amc_fps), {"name": take.name})
+            with self._lock:
+                self._motions[take.id] = data
+        return data
 
     # ------------------------------------------------------------ the review: loops with options
     def loop_job(self, take: Take, options: dict):
@@ -201,8 +212,7 @@ def create_app(paths=(), *, studio: Studio | None = None, amc_fps: float = tasks
 
     async def take_motion(request):
         take = st.take(request.path_params["id"])
-        motion = await run_in_threadpool(take.motion, st.amc_fps)
-        data = await run_in_threadpool(motion_payload, motion, {"name": take.name})
+        data = await run_in_threadpool(st.motion_bytes, take)
         return Response(data, media_type=BINARY)
 
     async def loop(request):

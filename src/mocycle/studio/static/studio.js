@@ -148,7 +148,7 @@ async function loadPlane() {
     S.pose.setMarkers(S.markers);
     S.planeView.setData(P, S.keys, S.markers);
     S.strokeId = null; $("export").removeAttribute("href"); $("export").classList.add("disabled");
-    $("plane-status").textContent = `${plane.header.projection}, ${S.keys.length} keyframes, stress ${fmt(plane.header.stress, 1)}`;
+    $("plane-status").textContent = `${plane.header.projection}, ${S.keys.length} keyframes, stress ${plane.header.stress == null ? "–" : Number(plane.header.stress).toPrecision(3)}`;
   } catch (e) { $("plane-status").textContent = e.message; }
 }
 

@@ -1,5 +1,5 @@
-"""Debian's chromium driven by Playwright, and the studio served on a free port in a thread (for the tests,
-the screenshots and the latency benchmark)."""
+"""Drive the studio in Debian's chromium through Playwright, the studio served on a free port in a thread: what the
+tests, the screenshots and the latency benchmark share (Playwright and uvicorn are imported when used)."""
 
 from __future__ import annotations
 
