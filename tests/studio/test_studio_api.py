@@ -129,3 +129,44 @@ def test_options_schema_for_the_forms(client):
     o = client.get("/api/options").json()
     assert "centroid" in o["loop"]["properties"]["method"]["enum"]
     assert "tsne" in o["plane"]["properties"]["projection"]["enum"]
+
+
+def _env():
+    import os
+    import sys
+
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+
+
+def test_the_command_serves_the_library_and_stops_on_sigterm(library):
+    import signal
+    import subprocess
+    import sys
+
+    import httpx
+
+    proc = subprocess.Popen([sys.executable, "-m", "mocycle", "studio", str(library), "--no-browser", "--port", "0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=_env())
+    try:
+        line = proc.stdout.readline()
+        assert line.startswith("mocycle studio on http://127.0.0.1:"), line + proc.stderr.read()
+        url = line.split()[3]
+        assert {t["name"] for t in httpx.get(url + "api/takes", timeout=30).json()["takes"]} == {"walk.bvh",
+                                                                                                 "wander.bvh"}
+        assert 'data-testid="plane"' in httpx.get(url, timeout=30).text
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(30)
+
+
+def test_the_command_refuses_what_it_cannot_read(tmp_path):
+    import subprocess
+    import sys
+
+    (tmp_path / "notes.txt").write_text("x")
+    cases = ((tmp_path / "missing", "no such file or folder"), (tmp_path / "notes.txt", "not a motion file"),
+             (tmp_path, "no motion files"))
+    for arg, message in cases:
+        r = subprocess.run([sys.executable, "-m", "mocycle", "studio", str(arg), "--no-browser"], capture_output=True,
+                           text=True, env=_env())
+        assert r.returncode == 1 and message in r.stderr and r.stderr.count("\n") == 1, r.stderr

@@ -24,6 +24,7 @@ def serve(application, host: str, port: int, open_browser: bool, ready=None) -> 
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
     try:
         sock.bind((host, port))
+        sock.listen(128)  # connections wait in the queue until uvicorn serves them
     except OSError as exc:
         raise MocycleError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
     url = f"http://{host if ':' not in host else f'[{host}]'}:{sock.getsockname()[1]}/"
