@@ -64,6 +64,30 @@ def next_frame_latency(page, n=30):
       return out; }}""")
 
 
+def finished_latency(page, n=30):
+    """Scrub updates driven from the page, timed until the GPU (SwiftShader: the CPU) finished drawing."""
+    return page.evaluate(f"""() => {{
+      const S = window.__studio, out = [], T = S.player.main.header.frames, gl = S.viewer.renderer.getContext();
+      for (let i = 0; i < {n}; i++) {{
+        const t0 = performance.now();
+        S.player.setFrame((i * 37) % T);
+        gl.finish();
+        out.push(performance.now() - t0);
+      }}
+      return out; }}""")
+
+
+def idle_frame_interval(page, n=30):
+    """Intervals between animation frames with nothing to draw (the page's own frame cadence)."""
+    return page.evaluate(f"""async () => {{
+      const out = []; let last = await new Promise((r) => requestAnimationFrame(r));
+      for (let i = 0; i < {n}; i++) {{
+        const now = await new Promise((r) => requestAnimationFrame(r));
+        out.push(now - last); last = now;
+      }}
+      return out; }}""")
+
+
 def stroke(page, frames, pause_ms=20):
     path = np.array(page.evaluate("(frames) => frames.map((i) => window.__studio.framePixel(i))", list(frames)))
     marks = np.array(page.evaluate("window.__studio.markers.map((_, k) => window.__studio.markerPixel(k))"))
@@ -128,7 +152,9 @@ def main() -> None:
             page.mouse.move(box["x"] + 5 + (box["width"] - 10) * i / 59, y)
         page.mouse.up()
         print(f"pose update while scrubbing (event -> rendered): {stats(page.evaluate('window.__studio.stats.scrub'))}")
+        print(f"scrub update -> drawn (gl.finish):               {stats(finished_latency(page))}")
         print(f"scrub update -> next animation frame:            {stats(next_frame_latency(page))}")
+        print(f"animation frame interval, nothing redrawn:       {stats(idle_frame_interval(page))}")
         # -- hovering and drawing on the plane
         plane = page.locator('[data-testid="plane"]').bounding_box()
         page.evaluate("window.__studio.stats.hover.length = 0; window.__studio.stats.draw.length = 0")
@@ -162,6 +188,9 @@ def main() -> None:
             open_take(page, real.name)
             print(f"{real.name} (100 joints): opened with its plane in {time.perf_counter() - t:.1f} s; first render "
                   f"{page.evaluate('window.__studio.stats.firstRender_ms').pop()['ms']:.0f} ms")
+            if args.shots:
+                page.wait_for_timeout(1500)
+                page.screenshot(path=str(args.shots / "iclone.png"))
             page.evaluate("window.__studio.stats.hover.length = 0")
             for i in range(40):
                 page.mouse.move(plane["x"] + plane["width"] * (0.2 + 0.6 * i / 39), plane["y"] + plane["height"] * 0.4)

@@ -98,7 +98,7 @@ export class Viewer {
     const sun = new THREE.DirectionalLight(0xffffff, 1.6);
     sun.position.set(3, 6, 4);
     this.scene.add(sun);
-    const grid = floorGrid(20, 0.5);
+    const grid = floorGrid(12, 0.5);
     this.scene.add(grid);
     this.grid = grid;
     this.figures = {};
