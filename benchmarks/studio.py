@@ -172,6 +172,10 @@ def main() -> None:
             page.wait_for_timeout(800)
             page.screenshot(path=str(args.shots / "authoring.png"))
             page.locator('[data-testid="plane"]').screenshot(path=str(args.shots / "plane.png"))
+            open_take(page, "wander_240.bvh")
+            stroke(page, range(0, 120, 3), pause_ms=25)
+            page.wait_for_timeout(800)
+            page.locator('[data-testid="plane"]').screenshot(path=str(args.shots / "plane-wander.png"))
             page.select_option("#layout", "overlay")
             open_take(page, "walk_1000.bvh")
             page.wait_for_function("document.getElementById('loop-status').textContent.startsWith('loop ')",

@@ -26,7 +26,7 @@ export class Plane {
   // points: Float32Array (T × 2); keys: keyframe indices; markers: [[x, y]] (their places)
   setData(points, keys, markers, refit = true) {
     this.points = points; this.keys = keys.slice(); this.markers = markers.map((m) => m.slice());
-    if (refit || !this.view) this.fit();
+    if (refit || !this.view) { this.fit(); this.drawn = null; this.hover = null; }
     this.draw();
   }
 

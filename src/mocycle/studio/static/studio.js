@@ -91,6 +91,7 @@ async function runLoop() {
   const id = S.take;
   if (!id) return;
   $("loop-status").textContent = "looping…";
+  $("metrics").innerHTML = "";
   $("loop-bvh").removeAttribute("href");
   try {
     const job = await json(`/api/takes/${id}/loop`, formValues($("loop-options")));
