@@ -170,3 +170,22 @@ def test_the_command_refuses_what_it_cannot_read(tmp_path):
         r = subprocess.run([sys.executable, "-m", "mocycle", "studio", str(arg), "--no-browser"], capture_output=True,
                            text=True, env=_env())
         assert r.returncode == 1 and message in r.stderr and r.stderr.count("\n") == 1, r.stderr
+
+
+def test_report_of_a_take_without_loop_and_bad_outputs(library, tmp_path):
+    import subprocess
+    import sys
+
+    out = tmp_path / "wander.html"
+    r = subprocess.run([sys.executable, "-m", "mocycle", "report", str(library / "wander.bvh"), "-o", str(out)],
+                       capture_output=True, text=True, env=_env())
+    assert r.returncode == 0 and "warning: no loop in the report: no periodic motion" in r.stderr, r.stderr
+    import json
+
+    text = out.read_text()
+    data = json.loads(text.split('<script id="report-data" type="application/json">')[1].split("</script>")[0])
+    assert "loop" not in data and data["reason"].startswith("no periodic motion") and data["take"]
+    bad = subprocess.run([sys.executable, "-m", "mocycle", "report", str(library / "walk.bvh"), "-o",
+                          str(tmp_path / "r.txt")], capture_output=True, text=True, env=_env())
+    assert bad.returncode == 1 and "must name a .html or .htm file" in bad.stderr
+    assert not (tmp_path / "r.txt").exists()

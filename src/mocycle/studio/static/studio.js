@@ -179,13 +179,15 @@ async function sendStroke(points, times) {
 
 async function relayout() {
   const id = S.take;
-  if (S.relayoutJob) json(`/api/jobs/${S.relayoutJob}`, undefined, "DELETE").catch(() => {});
+  const previous = S.relayoutJob;
+  S.relayoutJob = null;
+  if (previous) json(`/api/jobs/${previous}`, undefined, "DELETE").catch(() => {});
   $("relayout-progress").value = 0; $("relayout-box").classList.add("busy");
   try {
     const job = await json(`/api/takes/${id}/relayout`, { keyframes: S.keys, markers: S.markers, optimize: $("plane-optimize").checked });
     S.relayoutJob = job.id;
-    const j = await waitJob(job, (s) => { $("relayout-progress").value = s.progress; });
-    if (S.relayoutJob !== job.id || S.take !== id) return;
+    const j = await waitJob(job, (s) => { if (S.relayoutJob === job.id) $("relayout-progress").value = s.progress; });
+    if (S.relayoutJob !== job.id || S.take !== id) return;  // a newer drag took over (its box stays)
     S.relayoutJob = null;
     if (j.status === "done") {
       const pts = Float32Array.from(j.result.points.flat());
@@ -193,7 +195,7 @@ async function relayout() {
       S.relayouts = (S.relayouts || 0) + 1;
       $("plane-status").textContent = `re-laid out (RBFP + Algorithm 12: error ${fmt(j.result.error_before, 3)} → ${fmt(j.result.error_after, 3)}, ${fmt(j.result.seconds)} s)`;
     } else $("plane-status").textContent = `re-layout ${j.status}${j.error ? ": " + j.error : ""}`;
-  } finally { $("relayout-box").classList.remove("busy"); }
+  } finally { if (!S.relayoutJob) $("relayout-box").classList.remove("busy"); }
 }
 
 function planeHandlers() {
