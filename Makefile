@@ -10,7 +10,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 NP1    := .venv-numpy1
 
-.PHONY: demo test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender test-blender50 test-blender42 test-blender45 js
+.PHONY: demo test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender test-blender50 test-blender42 test-blender45 js chromium
 
 # the glTF tests' JavaScript side (Khronos glTF validator, three.js): tests/js/package-lock.json
 JS := tests/js
@@ -48,7 +48,11 @@ test-numpy1: $(NP1)/.installed $(JS)/node_modules/.installed
 	$(NP1)/bin/python -c "import numpy; print('numpy', numpy.__version__)"
 	$(NP1)/bin/python -m pytest -q -p no:cacheprovider
 
-test: lint test-numpy1 test-numpy2 test-blender
+# the studio's browser tests drive Debian's chromium through Playwright (never `playwright install`)
+chromium:
+	@command -v chromium >/dev/null 2>&1 || { apt-get update -qq && apt-get install -y -qq chromium; }
+
+test: lint chromium test-numpy1 test-numpy2 test-blender
 
 bench: $(VENV)/.installed
 	$(BIN)/python -m pip install --quiet -e ".[bench]"

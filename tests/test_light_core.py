@@ -22,7 +22,7 @@ FORBIDDEN = ("typer", "rich", "click", "matplotlib", "dask", "distributed", "sta
 REQUIRED = ("numpy", "scipy", "sklearn", "ripser", "threadpoolctl", "joblib")
 CORE = ["mocycle", "mocycle.errors", "mocycle.io", "mocycle.io.mck", "mocycle.io.mosw", "mocycle.motion",
         "mocycle.rotations", "mocycle.axes", "mocycle.features", "mocycle.datasets", "mocycle.phase",
-        "mocycle.cycle", "mocycle.warp", "mocycle.swings", "mocycle.keyframes", "mocycle.tasks",
+        "mocycle.cycle", "mocycle.warp", "mocycle.swings", "mocycle.keyframes", "mocycle.tasks", "mocycle.tasks.author",
         "mocycle.viz", "mocycle.viz.data", "mocycle.io.gltf", "mocycle.clip", "mocycle.tasks.clips"]
 
 _PROBE = r"""

@@ -47,6 +47,10 @@ COMMANDS = {
     "project": ("keyframes", "Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."),
     "batch": ("batch", "Run one command over many takes on dask.distributed; a row per take in "
                        "OUTDIR/results.csv and .json."),
+    "studio": ("studio", "Review loops on a library of takes and author new motion on the spatial-keyframe plane, "
+                         "in the browser."),
+    "report": ("report", "Write one HTML file (viewer, the take beside its loop repeated with root motion, phase "
+                         "strip, metrics) that opens offline in a browser: to mail or attach to a ticket."),
     "demo": ("demo", "Loop the built-in synthetic walk: write the take, its cycle (BVH) and the loop plot."),
 }
 

@@ -4,7 +4,8 @@ from .cycle import lock_cycle
 from .detect import Contacts, detect_contacts, ranges
 from .feet import Foot, body_height, find_feet, up_axis
 from .lock import lock_feet
+from .plant import floor_height, foot_points, plant_lowest_foot
 from .skate import largest_leg_step, skate
 
-__all__ = ["Contacts", "Foot", "body_height", "detect_contacts", "find_feet", "largest_leg_step", "lock_cycle",
-           "lock_feet", "ranges", "skate", "up_axis"]
+__all__ = ["Contacts", "Foot", "body_height", "detect_contacts", "find_feet", "floor_height", "foot_points",
+           "largest_leg_step", "lock_cycle", "lock_feet", "plant_lowest_foot", "ranges", "skate", "up_axis"]

@@ -6,6 +6,7 @@ Igarashi back-projection and Algorithm 12 (:mod:`.spatial`); ``compress``, ``Com
 and the ``.mck`` file are in :mod:`mocycle.io.mck`.
 """
 
+from .authoring import author_motion, relayout, resample_stroke
 from .density import KeyDensity, keyframe_density, rhythm_period
 from .distance import (
     error_per_frame_per_joint,
@@ -22,12 +23,12 @@ from .spatial import BackProjection, OptimizeResult, nearest_rotation, optimize_
 from .temporal import interpolate_rotations, slerp
 
 __all__ = [
-    "METHODS", "ONE_STEP", "PROJECTIONS", "SCHEMES", "TWO_STEP", "BackProjection", "Compressed", "KeyDensity",
-    "OptimizeResult", "PoseSpace", "compress", "error_per_frame_per_joint", "frame_errors", "interpolate_rotations",
-    "joint_weights", "keyframe_count", "keyframe_density", "nearest_rotation", "optimize_projection",
-    "pose_distance", "pose_distance_matrix", "pose_vectors", "project_one_step", "read_compressed",
-    "reconstruct_spatial", "rhythm_period", "select_keyframes", "select_pb", "select_rols", "select_scs",
-    "select_uniform", "slerp", "spatial_layout", "stress",
+    "BackProjection", "Compressed", "KeyDensity", "METHODS", "ONE_STEP", "OptimizeResult", "PROJECTIONS",
+    "PoseSpace", "SCHEMES", "TWO_STEP", "author_motion", "compress", "error_per_frame_per_joint", "frame_errors",
+    "interpolate_rotations", "joint_weights", "keyframe_count", "keyframe_density", "nearest_rotation",
+    "optimize_projection", "pose_distance", "pose_distance_matrix", "pose_vectors", "project_one_step",
+    "read_compressed", "reconstruct_spatial", "relayout", "resample_stroke", "rhythm_period", "select_keyframes",
+    "select_pb", "select_rols", "select_scs", "select_uniform", "slerp", "spatial_layout", "stress",
 ]
 
 # compress/Compressed live in mocycle.io.mck, which itself imports this package's modules:

@@ -161,7 +161,8 @@ class OptimizeResult:
 
 def optimize_projection(points: np.ndarray, key_idx, quats: np.ndarray, weights: np.ndarray,
                         alpha: float = 0.5, delta: float = 0.5, max_passes: int = 60,
-                        max_shrinks: int = 4, grow: float = 1.5, min_spread: float = 0.01) -> OptimizeResult:
+                        max_shrinks: int = 4, grow: float = 1.5, min_spread: float = 0.01,
+                        stop=None, progress=None) -> OptimizeResult:
     """Algorithm 12: move each non-key frame's 2-D point downhill in back-projection error.
 
     Parameters
@@ -176,6 +177,9 @@ def optimize_projection(points: np.ndarray, key_idx, quats: np.ndarray, weights:
     min_spread : joints whose keyframe rotations all lie within this angle (radians) of the first keyframe's
         are left out of the error while optimising (they back-project to nearly the same rotation anywhere;
         on the 100-joint CMU/iClone rig this halves the work).
+    stop : ``stop()`` is asked before each pass; ``True`` ends the optimisation there (the points so far are
+        returned, every one no worse than where it started).
+    progress : ``progress(fraction)`` is told the fraction of ``max_passes`` done after each pass.
     """
     P = np.array(points, dtype=np.float64, copy=True)
     q = np.asarray(quats, dtype=np.float64)
@@ -216,7 +220,7 @@ def optimize_projection(points: np.ndarray, key_idx, quats: np.ndarray, weights:
     passes = 0
     for passes in range(1, max_passes + 1):  # noqa: B007
         rows = np.flatnonzero(shrinks < max_shrinks)
-        if rows.size == 0:
+        if rows.size == 0 or (stop is not None and stop()):
             break
         cur = P[free[rows]]
         e0 = e[rows]
@@ -243,4 +247,6 @@ def optimize_projection(points: np.ndarray, key_idx, quats: np.ndarray, weights:
         moved[rows] |= better
         shrinks[rows] += ~better
         r[rows] = np.where(better, grow * r[rows], 0.5 * r[rows])
+        if progress is not None:
+            progress(passes / max_passes)
     return OptimizeResult(P, e_start, float(e.mean()), passes, int(moved.sum()))

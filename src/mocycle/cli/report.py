@@ -1,0 +1,50 @@
+"""``mocycle report``: one self-contained HTML page of a take and its loop (viewer, phase strip, metrics)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .. import tasks
+from ..errors import NoPeriodicMotion
+from ..io.atomic import atomic_write
+from .common import FORCE_HELP, app, check_output, default, err, flag, friendly, out, print_warnings
+
+L = tasks.loop.Options
+
+
+@app.command()
+@friendly
+def report(
+    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="The .html file to write.")],
+    method: Annotated[str, flag(L, "method")] = default(L, "method"),
+    model: Annotated[str, flag(L, "model")] = default(L, "model"),
+    root: Annotated[str, flag(L, "root")] = "motion",
+    cycles: Annotated[int, typer.Option("--cycles", help="Repeat the cycle this many times in the viewer.")] = 3,
+    feet: Annotated[str, flag(L, "feet")] = default(L, "feet"),
+    amc_fps: Annotated[float, flag(L, "amc_fps")] = default(L, "amc_fps"),
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+):
+    """Write one HTML file (viewer, the take beside its loop repeated with root motion, phase strip, metrics)
+    that opens offline in a browser: to mail or attach to a ticket.
+
+    A loop that fails a check is still shown, with the failed checks named (and a warning here); a take
+    without periodic motion gets a page with the take and the reason.
+    """
+    check_output(output, [path], force, (".html", ".htm"), "--output")
+    from ..studio.report import build_report
+
+    take = tasks.info.run(path, tasks.info.Options(amc_fps=amc_fps)).motions["motion"]
+    options = L(method=method, model=model, root=root, cycles=cycles, feet=feet, amc_fps=amc_fps, force=True)
+    loop_report, reason = None, None
+    try:
+        loop_report = tasks.loop.run(take, options)
+        print_warnings(loop_report)
+    except NoPeriodicMotion as exc:
+        reason = str(exc)
+        err.print(f"[yellow]warning:[/] no loop in the report: {reason}", markup=True, soft_wrap=True)
+    atomic_write(output, build_report(path.name, take, loop_report, reason))
+    out.print(f"wrote {output}", soft_wrap=True)

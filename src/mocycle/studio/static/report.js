@@ -1,0 +1,41 @@
+// mocycle report: the take and its loop in one self-contained page (data inline).
+import { Viewer } from "mocycle/viewer.js";
+import { Player } from "mocycle/player.js";
+import { decode } from "mocycle/payload.js";
+
+const $ = (id) => document.getElementById(id);
+const fmt = (v, d = 2) => (v == null || !isFinite(v) ? "–" : Number(v).toFixed(d));
+
+function fromBase64(text) {
+  const bytes = Uint8Array.from(atob(text), (c) => c.charCodeAt(0));
+  return decode(bytes.buffer);
+}
+
+export function startReport(data) {
+  const S = (window.__studio = { ready: false, stats: { scrub: [], hover: [], draw: [], strokes: [], firstRender_ms: [] } });
+  const viewer = new Viewer($("viewer"));
+  const player = new Player(viewer, { play: $("play"), scrub: $("scrub"), label: $("frame"), strip: $("phase") }, S.stats);
+  S.viewer = viewer; S.player = player;
+  player.setMain(fromBase64(data.take), "take");
+  if (data.loop) {
+    player.setLoop(fromBase64(data.loop));
+    player.setPhase(data.phase, data.excitation);
+  }
+  $("layout").addEventListener("change", () => player.setLayout($("layout").value));
+  $("follow").addEventListener("change", () => { viewer.follow = $("follow").checked; });
+  const rows = [];
+  if (data.summary) {
+    const l = data.summary, m = data.metrics;
+    rows.push(["period", `${fmt(l.period_frames, 1)} frames (${fmt(l.period_s)} s)`], ["loop", `${l.cycle_frames} frames`],
+      ["seam jump, pose / velocity", `${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} × median step`],
+      ["foot skate, loop / take", `${fmt(l.skate)} / ${fmt(l.input_skate)} units/s`],
+      ["template error", `${fmt(m.template_error, 4)} rad`], ["jerk, loop / take", fmt(m.jerk_ratio)],
+      ["failed checks", data.failed_checks.map((c) => `${c.check}: ${c.reason}`).join("; ") || "none"]);
+    for (const [k, v] of Object.entries(data.options)) rows.push([k, v ?? "–"]);
+    for (const w of data.warnings) rows.push(["warning", w]);
+  } else rows.push(["no loop", data.reason || ""]);
+  const esc = (s) => String(s).replace(/[&<>]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;" }[c]));
+  $("metrics").innerHTML = `<h2>${esc(data.title)}</h2><table>${rows.map(([k, v]) => `<tr><th>${esc(k)}</th><td>${esc(v)}</td></tr>`).join("")}</table>`;
+  player.play();
+  S.ready = true;
+}

@@ -1,0 +1,243 @@
+// mocycle studio: the library, the review (viewer, loop, phase strip, options) and the authoring plane.
+import { Viewer } from "mocycle/viewer.js";
+import { Player } from "mocycle/player.js";
+import { Plane } from "mocycle/plane.js";
+import { PosePlane } from "mocycle/spatial.js";
+import { fetchPayload } from "mocycle/payload.js";
+
+const $ = (id) => document.getElementById(id);
+const S = (window.__studio = { ready: false, stats: { scrub: [], hover: [], draw: [], strokes: [], firstRender_ms: [] } });
+
+async function json(url, body, method) {
+  const r = await fetch(url, body === undefined ? { method: method || "GET" } :
+    { method: method || "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
+  const out = await r.json();
+  if (!r.ok) throw new Error(out.error || `${url}: ${r.status}`);
+  return out;
+}
+
+function status(text, isError = false) { const el = $("status"); el.textContent = text; el.classList.toggle("error", isError); }
+const fmt = (v, d = 2) => (v == null || !isFinite(v) ? "–" : Number(v).toFixed(d));
+
+// ---------------------------------------------------------------- library
+function renderLibrary(data) {
+  $("progress").value = data.total ? data.done / data.total : 1;
+  $("progress-label").textContent = `analysed ${data.done} / ${data.total}`;
+  const list = $("takes");
+  for (const t of data.takes) {
+    let row = list.querySelector(`[data-id="${t.id}"]`);
+    if (!row) {
+      row = document.createElement("div");
+      row.className = "take"; row.dataset.id = t.id; row.dataset.testid = "take";
+      row.setAttribute("data-testid", "take");
+      row.addEventListener("click", () => openTake(t.id));
+      list.appendChild(row);
+    }
+    row.classList.toggle("current", t.id === S.take);
+    const f = t.facts || {};
+    const loops = t.loops.map((l) => `<li>period ${fmt(l.period_s)} s (${fmt(l.period_frames, 1)} fr) · seam ${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} · skate ${fmt(l.skate)}${l.failed_checks.length ? ` · <span class="bad">${l.failed_checks.join(", ")}</span>` : ""}</li>`).join("");
+    const state = t.status === "done" ? "" : t.status === "failed" ? `<span class="bad">${t.error}</span>` : `<span class="busy">${t.status}…</span>`;
+    row.innerHTML = `<div class="name">${t.name}</div>
+      <div class="facts">${f.frames ?? "…"} frames · ${fmt(f.fps, 0)} fps · ${t.status === "done" ? `${t.loops.length} periodic motion${t.loops.length === 1 ? "" : "s"}` : ""} ${state}</div>
+      <ul class="loops">${loops}${t.reason ? `<li class="muted">no loop: ${t.reason}</li>` : ""}</ul>`;
+  }
+}
+
+async function pollLibrary() {
+  try {
+    const data = await json("/api/takes");
+    renderLibrary(data);
+    S.library = data;
+    setTimeout(pollLibrary, data.done < data.total ? 600 : 4000);
+  } catch (e) { status(e.message, true); setTimeout(pollLibrary, 4000); }
+}
+
+// ---------------------------------------------------------------- review
+async function openTake(id) {
+  const t0 = performance.now();
+  S.take = id;
+  document.querySelectorAll(".take").forEach((r) => r.classList.toggle("current", r.dataset.id === id));
+  status("loading the take…");
+  const motion = await fetchPayload(`/api/takes/${id}/motion`);
+  if (S.take !== id) return;
+  S.player.setLoop(null); S.player.setPhase(null, null);
+  S.player.setMain(motion, "take");
+  S.stats.firstRender_ms.push({ frames: motion.header.frames, ms: performance.now() - t0 });
+  S.motion = motion;
+  $("take-name").textContent = motion.header.name;
+  status("");
+  S.player.play();
+  runLoop();
+  loadPlane();
+}
+
+function formValues(form) {
+  const out = {};
+  for (const el of form.querySelectorAll("[name]")) out[el.name] = el.type === "checkbox" ? el.checked : el.value;
+  return out;
+}
+
+async function waitJob(job, onProgress) {
+  S.jobs = S.jobs || {};
+  for (;;) {
+    const j = await json(`/api/jobs/${job.id}`);
+    if (onProgress) onProgress(j);
+    if (["done", "failed", "cancelled"].includes(j.status)) return j;
+    await new Promise((r) => setTimeout(r, 150));
+  }
+}
+
+async function runLoop() {
+  const id = S.take;
+  if (!id) return;
+  $("loop-status").textContent = "looping…";
+  $("metrics").innerHTML = "";
+  $("loop-bvh").removeAttribute("href");
+  try {
+    const job = await json(`/api/takes/${id}/loop`, formValues($("loop-options")));
+    const j = await waitJob(job);
+    if (S.take !== id) return;
+    if (j.status !== "done") { $("loop-status").textContent = j.error || j.status; return; }
+    const loop = await fetchPayload(`/api/jobs/${j.id}/motion`);
+    if (S.take !== id) return;
+    S.player.setLoop(loop);
+    S.player.setPhase(j.result.phase, j.result.excitation);
+    const l = j.result.loop;
+    $("loop-status").textContent = `loop ${l.cycle_frames} frames · period ${fmt(l.period_s)} s · ${fmt(j.result.seconds)} s`;
+    $("metrics").innerHTML = `<table><tr><th>period</th><td>${fmt(l.period_frames, 1)} frames (${fmt(l.period_s)} s)</td></tr>
+      <tr><th>seam jump, pose / velocity</th><td>${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} × median step</td></tr>
+      <tr><th>foot skate, loop / take</th><td>${fmt(l.skate)} / ${fmt(l.input_skate)} units/s</td></tr>
+      <tr><th>failed checks</th><td>${l.failed_checks.join(", ") || "none"}</td></tr>
+      ${j.result.warnings.map((w) => `<tr><th>warning</th><td>${w}</td></tr>`).join("")}</table>`;
+    $("loop-bvh").href = `/api/jobs/${j.id}/loop.bvh`;
+  } catch (e) { $("loop-status").textContent = e.message; S.player.setLoop(null); }
+}
+
+function buildOptions(schema) {
+  const form = $("loop-options");
+  const defaults = { root: "motion", cycles: 3 };
+  for (const name of ["method", "model", "root", "feet"]) {
+    const p = schema.loop.properties[name];
+    const sel = document.createElement("select");
+    sel.name = name; sel.title = p.description;
+    for (const v of p.enum) sel.add(new Option(v, v, false, v === (defaults[name] ?? p.default)));
+    const label = document.createElement("label"); label.append(name + " ", sel);
+    $("loop-fields").appendChild(label);
+  }
+  const plane = schema.plane.properties;
+  for (const name of ["projection", "select"]) {
+    const sel = $(`plane-${name}`);
+    for (const v of plane[name].enum) sel.add(new Option(v, v, false, v === plane[name].default));
+    sel.title = plane[name].description;
+  }
+}
+
+// ---------------------------------------------------------------- authoring plane
+async function loadPlane() {
+  const id = S.take;
+  const q = new URLSearchParams({ projection: $("plane-projection").value, select: $("plane-select").value,
+                                  ratio: $("plane-ratio").value, optimize: $("plane-optimize").checked ? "1" : "0" });
+  $("plane-status").textContent = "projecting…";
+  try {
+    const plane = await fetchPayload(`/api/takes/${id}/plane?${q}`);
+    if (S.take !== id) return;
+    S.plane = plane;
+    S.pose = new PosePlane(plane);
+    S.keys = plane.header.keyframes.slice();
+    const P = plane.arrays.points;
+    S.markers = S.keys.map((k) => [P[2 * k], P[2 * k + 1]]);
+    S.pose.setMarkers(S.markers);
+    S.planeView.setData(P, S.keys, S.markers);
+    S.strokeId = null; $("export").removeAttribute("href"); $("export").classList.add("disabled");
+    $("plane-status").textContent = `${plane.header.projection}, ${S.keys.length} keyframes, stress ${plane.header.stress == null ? "–" : Number(plane.header.stress).toPrecision(3)}`;
+  } catch (e) { $("plane-status").textContent = e.message; }
+}
+
+function showPoseAt(x, y, list) {
+  if (!S.pose) return;
+  const t0 = performance.now();
+  S.player.showPose(S.pose.pose(x, y), S.plane.header);
+  S.stats[list].push(performance.now() - t0);
+}
+
+async function sendStroke(points, times) {
+  const id = S.take;
+  const body = { keyframes: S.keys, markers: S.markers, points, times_s: times };
+  $("plane-status").textContent = "authoring…";
+  try {
+    const t0 = performance.now();
+    const r = await json(`/api/takes/${id}/strokes`, body);
+    const motion = await fetchPayload(`/api/strokes/${r.id}/motion`);
+    S.stats.strokes.push({ frames: r.frames, server_ms: r.server_ms, round_trip_ms: performance.now() - t0 });
+    S.strokeId = r.id;
+    S.player.setMain(motion, "authored");
+    S.player.play();
+    $("export").href = `/api/strokes/${r.id}.bvh`; $("export").classList.remove("disabled");
+    $("plane-status").textContent = `authored ${r.frames} frames (${fmt(r.duration_s)} s) · server ${fmt(r.server_ms, 0)} ms`;
+  } catch (e) { $("plane-status").textContent = e.message; }
+}
+
+async function relayout() {
+  const id = S.take;
+  const previous = S.relayoutJob;
+  S.relayoutJob = null;
+  if (previous) json(`/api/jobs/${previous}`, undefined, "DELETE").catch(() => {});
+  $("relayout-progress").value = 0; $("relayout-box").classList.add("busy");
+  try {
+    const job = await json(`/api/takes/${id}/relayout`, { keyframes: S.keys, markers: S.markers, optimize: $("plane-optimize").checked });
+    S.relayoutJob = job.id;
+    const j = await waitJob(job, (s) => { if (S.relayoutJob === job.id) $("relayout-progress").value = s.progress; });
+    if (S.relayoutJob !== job.id || S.take !== id) return;  // a newer drag took over (its box stays)
+    S.relayoutJob = null;
+    if (j.status === "done") {
+      const pts = Float32Array.from(j.result.points.flat());
+      S.planeView.setData(pts, S.keys, S.markers, false);
+      S.relayouts = (S.relayouts || 0) + 1;
+      $("plane-status").textContent = `re-laid out (RBFP + Algorithm 12: error ${fmt(j.result.error_before, 3)} → ${fmt(j.result.error_after, 3)}, ${fmt(j.result.seconds)} s)`;
+    } else $("plane-status").textContent = `re-layout ${j.status}${j.error ? ": " + j.error : ""}`;
+  } finally { if (!S.relayoutJob) $("relayout-box").classList.remove("busy"); }
+}
+
+function planeHandlers() {
+  return {
+    hover: (x, y) => showPoseAt(x, y, "hover"),
+    leave: () => { if (S.player.main) S.player.setMain(S.player.main, S.player.kind); },
+    strokePoint: (x, y) => showPoseAt(x, y, "draw"),
+    stroke: (points, times) => sendStroke(points, times),
+    markerMoved: (k, x, y) => { S.markers[k] = [x, y]; S.pose.setMarkers(S.markers); showPoseAt(x, y, "draw"); },
+    markerDropped: () => relayout(),
+    markerClicked: (k) => {
+      if (S.keys.length <= 4) { $("plane-status").textContent = "at least 4 keyframes stay"; return; }
+      const rows = S.keys.map((_, i) => i).filter((i) => i !== k);
+      S.pose.keep(rows);
+      S.keys = rows.map((i) => S.keys[i]); S.markers = rows.map((i) => S.markers[i]);
+      S.pose.setMarkers(S.markers);
+      S.planeView.setData(S.planeView.points, S.keys, S.markers, false);
+      relayout();
+    },
+  };
+}
+
+export async function startStudio() {
+  try {
+    const viewer = new Viewer($("viewer"));
+    S.viewer = viewer;
+    S.player = new Player(viewer, { play: $("play"), scrub: $("scrub"), label: $("frame"), strip: $("phase") }, S.stats);
+    S.planeView = new Plane($("plane"), planeHandlers());
+    buildOptions(await json("/api/options"));
+    $("loop-options").addEventListener("submit", (e) => { e.preventDefault(); runLoop(); });
+    $("layout").addEventListener("change", () => S.player.setLayout($("layout").value));
+    $("follow").addEventListener("change", () => { viewer.follow = $("follow").checked; });
+    $("plane-form").addEventListener("submit", (e) => { e.preventDefault(); loadPlane(); });
+    $("cancel-relayout").addEventListener("click", () => { if (S.relayoutJob) json(`/api/jobs/${S.relayoutJob}`, undefined, "DELETE"); });
+    $("grid-toggle").addEventListener("click", () => $("takes").classList.toggle("grid"));
+    // test and measurement hooks
+    S.planePixel = (x, y) => { const r = $("plane").getBoundingClientRect(); const [px, py] = S.planeView.toPixel(x, y); return [r.left + px, r.top + py]; };
+    S.framePixel = (i) => S.planePixel(S.planeView.points[2 * i], S.planeView.points[2 * i + 1]);
+    S.markerPixel = (k) => S.planePixel(...S.markers[k]);
+    S.mainPose = () => Array.from(viewer.figures.main.last);
+    await pollLibrary();
+    if (S.library && S.library.takes.length) await openTake(S.library.takes[0].id);
+    S.ready = true;
+  } catch (e) { status(e.message, true); console.error(e); }
+}
