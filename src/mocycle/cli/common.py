@@ -29,9 +29,11 @@ from ..tasks.options import MISSING, Choice, flag_of
 #: order ``mocycle --help`` lists them.  tests/test_startup.py checks both against the commands themselves.
 COMMANDS = {
     "info": ("info", "Frames, frame time, fps, duration, joints, channels, root travel and rotation ranges."),
-    "convert": ("convert", "Convert ASF/AMC to BVH, or rewrite a BVH (optionally a frame range, another fps)."),
+    "convert": ("convert", "Convert ASF/AMC to BVH or glTF (.glb), or rewrite a BVH (optionally a frame range, "
+                           "another fps)."),
     "phase": ("phase", "Find periodic motions and the phase of every frame (persistent cohomology)."),
-    "loop": ("loop", "Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH."),
+    "loop": ("loop", "Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH or "
+                     "glTF."),
     "blend": ("blend", "Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination)."),
     "transition": ("blend", "A motion that starts as the first take's cycle and ends as the second's (paper 001 "
                             "§4.5, a homotopy)."),
