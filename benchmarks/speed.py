@@ -299,7 +299,9 @@ def main(argv: list[str] | None = None) -> None:
             sys.path.insert(0, str(compute.parent))
             import speed_compute
 
-            speed_compute.main([a for a in (argv if argv is not None else sys.argv[1:])])
+            # only the options speed_compute knows: its sections and the shared data folder
+            speed_compute.main(["--only", ",".join(x for x in chosen if x in ("rotation", "phase")),
+                                "--data", str(args.data)])
         else:
             print("\n## Rotation maths, Phase at scale: benchmarks/speed_compute.py is not here yet")
     print(f"\n{load()}")
