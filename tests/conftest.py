@@ -8,15 +8,22 @@ from pathlib import Path
 
 import pytest
 
-from mocycle import threads
+try:
+    from mocycle import threads
+except ModuleNotFoundError:  # tests_blender loads this file for its helpers before the extension brings mocycle
+    threads = None
 
 # BLAS and OpenMP on one thread (MOCYCLE_THREADS) for the whole suite and the commands it runs: set before
 # numpy loads when it has not yet, limited by threadpoolctl when a plugin loaded it first.
-threads.pin_environment()
-if "numpy" in sys.modules and threads.threads() is not None:  # pragma: no cover - depends on the plugins
-    from threadpoolctl import threadpool_limits
+if threads is not None:
+    threads.pin_environment()
+    if "numpy" in sys.modules and threads.threads() is not None:  # pragma: no cover - depends on the plugins
+        from threadpoolctl import threadpool_limits
 
-    threadpool_limits(limits=threads.threads())
+        threadpool_limits(limits=threads.threads())
+else:
+    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(name, "1")
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("MOCYCLE_SHARED_DATA", REPO.parent / "shared" / "data"))
