@@ -142,8 +142,8 @@ def run_dionysus(X: np.ndarray) -> np.ndarray:
     return np.mod(np.asarray(values, dtype=float), 1.0)
 
 
-def dreimac_compile_seconds(X: np.ndarray) -> tuple[float, float]:
-    """(seconds of one DREiMac run, seconds of it spent in numba compilation).
+def timed_dreimac(X: np.ndarray) -> tuple[float, float, np.ndarray | None]:
+    """(seconds of one DREiMac run, seconds of it spent in numba compilation, its coordinate in cycles).
 
     DREiMac 0.3 defines its ``@jit`` helpers inside ``get_coordinates``' callees, so numba compiles them
     again on every call; numba's ``numba:compile`` events measure that part.
@@ -152,7 +152,7 @@ def dreimac_compile_seconds(X: np.ndarray) -> tuple[float, float]:
 
     with event.install_recorder("numba:compile") as rec:
         t0 = time.perf_counter()
-        run_dreimac(X)
+        coord = run_dreimac(X)
         total = time.perf_counter() - t0
     depth, start, compiling = 0, 0.0, 0.0
     for ts, ev in rec.buffer:  # nested compilations count once
@@ -162,6 +162,12 @@ def dreimac_compile_seconds(X: np.ndarray) -> tuple[float, float]:
         else:
             depth -= 1
             compiling += ts - start if depth == 0 else 0.0
+    return total, compiling, coord
+
+
+def dreimac_compile_seconds(X: np.ndarray) -> tuple[float, float]:
+    """(seconds of one DREiMac run, seconds of it spent in numba compilation): :func:`timed_dreimac`."""
+    total, compiling, _ = timed_dreimac(X)
     return total, compiling
 
 

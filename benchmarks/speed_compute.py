@@ -182,23 +182,10 @@ def rotation(data: Path, repeats: int, rev: str) -> list[tuple[str, float, float
 # -- phase --------------------------------------------------------------------------------------------------------
 def dreimac_warm(X: np.ndarray) -> tuple[float, np.ndarray | None]:
     """(seconds of a DREiMac call minus its numba compilation, its coordinate in cycles)."""
-    from numba.core import event
-
     sys.path.insert(0, str(HERE))
     import phase as bench_phase
 
-    with event.install_recorder("numba:compile") as rec:
-        t0 = time.perf_counter()
-        coord = bench_phase.run_dreimac(X)
-        total = time.perf_counter() - t0
-    depth, start, compiling = 0, 0.0, 0.0
-    for ts, ev in rec.buffer:  # nested compilations count once
-        if ev.is_start:
-            depth += 1
-            start = ts if depth == 1 else start
-        else:
-            depth -= 1
-            compiling += ts - start if depth == 0 else 0.0
+    total, compiling, coord = bench_phase.timed_dreimac(X)
     return total - compiling, coord
 
 
