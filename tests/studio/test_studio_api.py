@@ -79,12 +79,83 @@ def test_loop_job_with_options_and_its_bvh(client):
     j = wait(client, job)
     assert j["status"] == "done", j
     assert j["result"]["options"]["method"] == "centroid" and len(j["result"]["phase"]) == 240
+    assert j["result"]["frames_out"] == 2 * j["result"]["loop"]["cycle_frames"] and not j["result"]["forced"]
     header, arrays = unpack(client.get(f"/api/jobs/{j['id']}/motion").content)
-    assert header["frames"] == j["result"]["frames_out"] == 2 * j["result"]["loop"]["cycle_frames"]
-    bvh = parse_bvh(client.get(f"/api/jobs/{j['id']}/loop.bvh").text)
-    assert bvh.n_frames == header["frames"]
+    assert header["frames"] == 240 and not header["forced"]  # the viewer's loop: one frame per take frame
+    r = client.get(f"/api/jobs/{j['id']}/loop.bvh")
+    assert 'filename="walk_loop.bvh"' in r.headers["content-disposition"]
+    assert parse_bvh(r.text).n_frames == j["result"]["frames_out"]  # as mocycle loop writes it
     bad = client.post(f"/api/takes/{tid}/loop", json={"method": "nonsense"})
     assert bad.status_code == 400 and "method" in bad.json()["error"]
+
+
+def _glb_clip(data: bytes, tmp_path):
+    """The one animation of a GLB file: its name and duration (seconds, its last key time)."""
+    pygltflib = pytest.importorskip("pygltflib")
+    path = tmp_path / "x.glb"
+    path.write_bytes(data)
+    gl = pygltflib.GLTF2().load(str(path))
+    (anim,) = gl.animations
+    times = gl.accessors[anim.samplers[0].input]
+    return anim.name, times.max[0]
+
+
+def test_loop_and_authored_animation_download_as_glb(client, tmp_path):
+    """The GLB the studio gives is what ``mocycle loop -o walk_loop.glb`` writes: clip ``walk_loop``, closing
+    frame included, so the clip lasts cycles × cycle frames / fps."""
+    tid = next(t["id"] for t in client.get("/api/takes").json()["takes"] if t["name"] == "walk.bvh")
+    j = wait(client, client.post(f"/api/takes/{tid}/loop", json={"root": "motion", "cycles": 3}).json())
+    assert j["status"] == "done", j
+    r = client.get(f"/api/jobs/{j['id']}/loop.glb")
+    assert r.status_code == 200 and r.headers["content-type"] == "model/gltf-binary" and r.content[:4] == b"glTF"
+    assert 'filename="walk_loop.glb"' in r.headers["content-disposition"]
+    name, duration = _glb_clip(r.content, tmp_path)
+    assert name == "walk_loop"
+    assert duration == pytest.approx(3 * j["result"]["loop"]["cycle_frames"] / 60, abs=1e-4)
+    assert client.get(f"/api/jobs/{j['id']}/loop.fbx").status_code == 404
+    wander = next(t["id"] for t in client.get("/api/takes").json()["takes"] if t["name"] == "wander.bvh")
+    header, arrays = unpack(client.get(f"/api/takes/{wander}/plane", params={"optimize": 0}).content)
+    key, pts = header["keyframes"], arrays["points"].astype(float)
+    s = client.post(f"/api/takes/{wander}/strokes", json={
+        "keyframes": key, "markers": pts[key].tolist(), "points": pts[:90].tolist(),
+        "times_s": (np.arange(90) / 60).tolist(), "feet": "keep"}).json()
+    r = client.get(f"/api/strokes/{s['id']}.glb")
+    assert r.status_code == 200 and f'filename="wander_authored_{s["id"]}.glb"' in r.headers["content-disposition"]
+    name, duration = _glb_clip(r.content, tmp_path)
+    assert name == f"wander_authored_{s['id']}" and duration == pytest.approx((s["frames"] - 1) / 60, abs=1e-4)
+
+
+def test_the_viewers_loop_is_in_step_with_the_take_and_walks_on(client):
+    """The loop the viewer plays: at take frame f the cycle frame of the take's phase there (so an overlay
+    shows differences, not an offset), in its pass of the cycle repeated with root motion, placed at the take."""
+    from mocycle import read
+
+    take = next(t for t in client.get("/api/takes").json()["takes"] if t["name"] == "walk.bvh")
+    j = wait(client, client.post(f"/api/takes/{take['id']}/loop", json={"root": "motion"}).json())
+    _, arrays = unpack(client.get(f"/api/jobs/{j['id']}/motion").content)
+    loop = arrays["positions"].astype(float)
+    walk = read(take["path"])
+    pos = walk.world_positions(end_sites=True)
+    t = walk.travel_joint
+
+    def pose_gap(a, b):  # mean distance of the points about the travel joint
+        return np.linalg.norm((a - a[:, t:t + 1]) - (b - b[:, t:t + 1]), axis=2).mean()
+
+    period = j["result"]["loop"]["cycle_frames"]
+    aligned = pose_gap(loop, pos)
+    for off in (period // 4, period // 2):  # a loop out of step by a quarter or half a cycle looks different
+        assert aligned < 0.2 * pose_gap(np.roll(loop, off, axis=0), pos)
+    frames = np.array(j["result"]["view"]["loop_frame"])
+    assert frames.shape == (240,) and np.all((frames >= 0) & (frames < period))
+    steps = np.diff(frames)
+    assert np.all((np.abs(steps - 1) < 0.3) | (steps < -period + 2))  # one cycle frame per frame, wrapping
+    travel = np.linalg.norm(loop[-1, t] - loop[0, t])
+    assert travel > 0.8 * np.linalg.norm(pos[-1, t] - pos[0, t])  # walks on with its root motion
+    assert np.linalg.norm(loop[:, t] - pos[:, t], axis=1).max() < 0.1 * take_height(pos)
+
+
+def take_height(pos):
+    return np.ptp(pos[..., 1])
 
 
 def test_plane_stroke_export_and_relayout(client):

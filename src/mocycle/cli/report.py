@@ -23,27 +23,29 @@ def report(
     method: Annotated[str, flag(L, "method")] = default(L, "method"),
     model: Annotated[str, flag(L, "model")] = default(L, "model"),
     root: Annotated[str, flag(L, "root")] = "motion",
-    cycles: Annotated[int, typer.Option("--cycles", help="Repeat the cycle this many times in the viewer.")] = 3,
     feet: Annotated[str, flag(L, "feet")] = default(L, "feet"),
     amc_fps: Annotated[float, flag(L, "amc_fps")] = default(L, "amc_fps"),
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
-    """Write one HTML file (viewer, the take beside its loop repeated with root motion, phase strip, metrics)
+    """Write one HTML file (viewer, the take beside its loop: in step with the take's phase and repeated with
+    root motion over the whole take; phase strip, metrics)
     that opens offline in a browser: to mail or attach to a ticket.
 
-    A loop that fails a check is still shown, with the failed checks named (and a warning here); a take
-    without periodic motion gets a page with the take and the reason.
+    A loop that fails its checks is refused as by ``mocycle loop``: the reason is printed, exit code 3, no file
+    written; --force writes the report anyway, with the failed checks in a banner at the top.  A take without
+    periodic motion gets a page with the take and the reason (and a warning).
     """
     check_output(output, [path], force, (".html", ".htm"), "--output")
     from ..studio.report import build_report
 
-    take = tasks.info.run(path, tasks.info.Options(amc_fps=amc_fps)).motions["motion"]
-    options = L(method=method, model=model, root=root, cycles=cycles, feet=feet, amc_fps=amc_fps, force=True)
+    options = L(method=method, model=model, root=root, feet=feet, amc_fps=amc_fps, force=force)
     loop_report, reason = None, None
     try:
-        loop_report = tasks.loop.run(take, options)
+        loop_report = tasks.loop.run(path, options)  # LoopRefused (exit 3, nothing written) unless --force
+        take = loop_report.motions["input"]
         print_warnings(loop_report)
     except NoPeriodicMotion as exc:
+        take = tasks.info.run(path, tasks.info.Options(amc_fps=amc_fps)).motions["motion"]
         reason = str(exc)
         err.print(f"[yellow]warning:[/] no loop in the report: {reason}", markup=True, soft_wrap=True)
     atomic_write(output, build_report(path.name, take, loop_report, reason))

@@ -11,16 +11,24 @@ Routes (``{id}``: a take, ``{job}``: a background job, ``{stroke}``: an authored
     POST /api/takes/{id}/relayout        markers moved: RBFP seed + Algorithm 12 (a job, cancellable)
     POST /api/takes/{id}/strokes         ``tasks.author``: a drawn stroke becomes an animation
     GET  /api/strokes/{stroke}/motion    the authored animation (binary payload)
-    GET  /api/strokes/{stroke}.bvh       ... as BVH on the take's skeleton
-    GET  /api/jobs/{job}                 a job's status and progress (and its result when done)
+    GET  /api/strokes/{stroke}.bvh|.glb  ... as BVH or glTF binary on the take's skeleton
+    GET  /api/jobs/{job}                 a job's status and progress (and its result when done or refused)
     DELETE /api/jobs/{job}               cancel it
-    GET  /api/jobs/{job}/motion, /api/jobs/{job}/loop.bvh   a loop job's motion
+    GET  /api/jobs/{job}/motion          a loop job's loop as the viewer plays it (phase-aligned with the take)
+    GET  /api/jobs/{job}/loop.bvh|.glb   a loop job's loop as ``mocycle loop -o NAME_loop.bvh|.glb`` writes it
+
+A loop that fails its checks is refused as ``mocycle loop`` refuses it (``tasks.loop`` raises
+``LoopRefused``): the job's status is ``refused`` with the reason, and its motion and files answer 409.  The
+request's ``force: true`` passes ``force`` on: the loop is made, its failed checks are listed in the job's
+result, and the files are named ``NAME_loop.forced.*`` with an ``X-Mocycle-Failed-Checks`` header.
 """
 
 from __future__ import annotations
 
 import contextlib
 import itertools
+import re
+import tempfile
 import threading
 import time
 from pathlib import Path
@@ -33,15 +41,16 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from .. import tasks
-from ..errors import MocycleError, NoPeriodicMotion, OptionError
-from ..io.bvh import format_bvh
+from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from ..tasks import author
 from .jobs import Jobs
 from .library import Take, find_takes, loop_summary
 from .payload import motion_payload, plane_payload
+from .review import loop_view
 
 STATIC = Path(__file__).parent / "static"
 BINARY = "application/octet-stream"
+DOWNLOADS = {".bvh": "text/plain", ".glb": "model/gltf-binary"}
 MAX_STROKES = 64  # authored animations kept in memory per server (oldest dropped)
 
 
@@ -71,6 +80,8 @@ class Studio:
             take.facts = {"frames": motion.n_frames, "fps": motion.fps, "duration_s": motion.duration,
                           "joints": motion.n_joints}
             try:
+                # force: every periodic motion's figures, also of a loop that is refused; loop_summary marks it
+                # refused from the same failed checks that make tasks.loop refuse it without force
                 report = tasks.loop.run(motion, tasks.loop.Options(which="all", force=True))
                 take.loops = [loop_summary(loop) for loop in report.facts["loops"]]
             except NoPeriodicMotion as exc:
@@ -96,19 +107,32 @@ class Studio:
 
     # ------------------------------------------------------------ the review: loops with options
     def loop_job(self, take: Take, options: dict):
+        """``tasks.loop`` with the form's options; ``force`` as ``mocycle loop --force`` (without it a loop that
+        fails its checks ends the job as ``refused``, see :class:`~.jobs.Jobs`)."""
         opts = {k: options[k] for k in ("method", "model", "root", "feet", "cycles") if options.get(k) not in
                 (None, "")}
-        o = tasks.loop.Options(force=True, **opts)  # an OptionError here is the caller's 400
+        force = options.get("force", False)
+        if not isinstance(force, bool):
+            raise ValueError(f"force must be true or false; got {force!r}")
+        o = tasks.loop.Options(force=force, **opts)  # an OptionError here is the caller's 400
 
         def work(job):
-            report = tasks.loop.run(take.motion(self.amc_fps), o)
+            try:
+                report = tasks.loop.run(take.motion(self.amc_fps), o)
+            except LoopRefused as exc:  # the message names the take as the library lists it
+                memory = "take 0: "  # how tasks name a motion given in memory
+                text = str(exc)
+                raise LoopRefused(f"{take.name}: {text[len(memory):]}" if text.startswith(memory) else text,
+                                  exc.failed) from None
             cycle = report.result
             f = report.facts
             phase = np.asarray(cycle.periodic.coords, dtype=np.float64)
-            return {"report": report, "facts": {
+            view, view_facts = loop_view(report)
+            return {"report": report, "view": view, "take": take, "facts": {
                 "loop": loop_summary(f), "options": o.to_dict(), "warnings": list(report.warnings),
+                "failed_checks": f["failed_checks"], "forced": bool(f["failed_checks"]),
                 "frames_out": f["frames_out"], "phase": phase.round(4).tolist(), "excitation": f["excitation"],
-                "seconds": report.seconds}}
+                "view": view_facts, "seconds": report.seconds}}
 
         return self.interactive.submit("loop", work)
 
@@ -152,7 +176,8 @@ class Studio:
         report = author.run((take.motion(self.amc_fps), body), author.Options(**opts, amc_fps=self.amc_fps))
         sid = f"s{next(self._stroke_ids)}"
         with self._lock:
-            self.strokes[sid] = {"take": take.id, "motion": report.motions["authored"], "facts": report.facts}
+            self.strokes[sid] = {"take": take.id, "motion": report.motions["authored"], "report": report,
+                                 "facts": report.facts}
             while len(self.strokes) > MAX_STROKES:
                 self.strokes.pop(next(iter(self.strokes)))
         facts = {k: v for k, v in report.facts.items() if k != "trajectory"}
@@ -173,6 +198,8 @@ def _guard(handler):
             return await handler(request)
         except KeyError as exc:
             return _error(404, f"not found: {exc.args[0] if exc.args else ''}")
+        except LoopRefused as exc:
+            return _error(409, str(exc))
         except OptionError as exc:
             return _error(400, f"{exc.parameter} {exc.reason}")
         except (MocycleError, ValueError, TypeError) as exc:
@@ -181,8 +208,28 @@ def _guard(handler):
     return wrapped
 
 
-def _download(text: str, name: str) -> Response:
-    return Response(text, media_type="text/plain", headers={"Content-Disposition": f'attachment; filename="{name}"'})
+def _file_name(text: str) -> str:
+    """``text`` as a plain file name (letters, digits, ``._-``)."""
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("._") or "take"
+
+
+def motion_file(report, role: str, name: str, suffix: str) -> bytes:
+    """``report.motions[role]`` as ``mocycle loop -o NAME.bvh|.glb`` writes it (``tasks.clips.for_output``:
+    a .glb loop holds the clip ``NAME`` ending in ``_loop``, with its closing frame), as bytes."""
+    from ..io import write
+    from ..tasks.clips import for_output
+
+    with tempfile.TemporaryDirectory(prefix="mocycle-studio-") as folder:
+        path = Path(folder) / f"{name}{suffix}"
+        motion, clip = for_output(report, role, path)
+        write(motion, path, clip=clip)
+        return path.read_bytes()
+
+
+def _download(data, name: str, headers: dict | None = None) -> Response:
+    media = DOWNLOADS.get(Path(name).suffix, BINARY)
+    return Response(data, media_type=media, headers={"Content-Disposition": f'attachment; filename="{name}"',
+                                                     **(headers or {})})
 
 
 async def _body(request: Request) -> dict:
@@ -245,11 +292,18 @@ def create_app(paths=(), *, studio: Studio | None = None, amc_fps: float = tasks
         data = await run_in_threadpool(motion_payload, s["motion"], {"name": "authored"})
         return Response(data, media_type=BINARY)
 
-    async def stroke_bvh(request):
-        sid = request.path_params["stroke"]
+    def _suffix(request) -> str:
+        suffix = "." + request.path_params["suffix"]
+        if suffix not in DOWNLOADS:
+            raise KeyError(request.url.path)
+        return suffix
+
+    async def stroke_file(request):
+        sid, suffix = request.path_params["stroke"], _suffix(request)
         s = st.strokes[sid]
-        name = Path(st.take(s["take"]).name).stem
-        return _download(await run_in_threadpool(format_bvh, s["motion"]), f"{name}.authored.{sid}.bvh")
+        name = f"{_file_name(Path(st.take(s['take']).name).stem)}_authored_{sid}"
+        data = await run_in_threadpool(motion_file, s["report"], "authored", name, suffix)
+        return _download(data, name + suffix)
 
     def _job(request):
         job = st.interactive.get(request.path_params["job"]) or st.analysis.get(request.path_params["job"])
@@ -260,7 +314,7 @@ def create_app(paths=(), *, studio: Studio | None = None, amc_fps: float = tasks
     async def job_status(request):
         job = _job(request)
         out = job.to_dict()
-        if job.status == "done" and isinstance(job.result, dict):
+        if job.status in ("done", "refused") and isinstance(job.result, dict):
             out["result"] = job.result.get("facts")
         return JSONResponse(out)
 
@@ -269,20 +323,29 @@ def create_app(paths=(), *, studio: Studio | None = None, amc_fps: float = tasks
         job.cancel_event.set()
         return JSONResponse(job.to_dict())
 
-    def _loop_motion(request):
+    def _loop_job(request):
         job = _job(request)
+        if job.kind == "loop" and job.status == "refused":
+            raise LoopRefused(f"{job.error} (ask again with force)")
         if job.status != "done" or job.kind != "loop":
             raise ValueError(f"job {job.id} has no loop ({job.status})")
-        return job.result["report"].motions["loop"]
+        return job.result
 
     async def job_motion(request):
-        motion = _loop_motion(request)
-        data = await run_in_threadpool(motion_payload, motion, {"name": "loop"})
+        result = _loop_job(request)
+        data = await run_in_threadpool(motion_payload, result["view"], {
+            "name": "loop", "forced": result["facts"]["forced"]})
         return Response(data, media_type=BINARY)
 
-    async def job_bvh(request):
-        motion = _loop_motion(request)
-        return _download(await run_in_threadpool(format_bvh, motion), f"loop.{request.path_params['job']}.bvh")
+    async def job_file(request):
+        result = _loop_job(request)
+        suffix = _suffix(request)
+        name = f"{_file_name(Path(result['take'].name).stem)}_loop"
+        data = await run_in_threadpool(motion_file, result["report"], "loop", name, suffix)
+        failed = [c["check"] for c in result["facts"]["failed_checks"]]
+        if failed:  # forced: the file's name and a header say so
+            return _download(data, f"{name}.forced{suffix}", {"X-Mocycle-Failed-Checks": ", ".join(failed)})
+        return _download(data, name + suffix)
 
     g = _guard
     routes = [
@@ -295,11 +358,11 @@ def create_app(paths=(), *, studio: Studio | None = None, amc_fps: float = tasks
         Route("/api/takes/{id}/relayout", g(relayout), methods=["POST"]),
         Route("/api/takes/{id}/strokes", g(stroke), methods=["POST"]),
         Route("/api/strokes/{stroke}/motion", g(stroke_motion)),
-        Route("/api/strokes/{stroke}.bvh", g(stroke_bvh)),
+        Route("/api/strokes/{stroke}.{suffix:str}", g(stroke_file)),
         Route("/api/jobs/{job}", g(job_status)),
         Route("/api/jobs/{job}", g(job_cancel), methods=["DELETE"]),
         Route("/api/jobs/{job}/motion", g(job_motion)),
-        Route("/api/jobs/{job}/loop.bvh", g(job_bvh)),
+        Route("/api/jobs/{job}/loop.{suffix:str}", g(job_file)),
         Mount("/static", StaticFiles(directory=STATIC), name="static"),
     ]
     @contextlib.asynccontextmanager

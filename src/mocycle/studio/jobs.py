@@ -8,12 +8,14 @@ import traceback
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
-from ..errors import MocycleError
+from ..errors import LoopRefused, MocycleError
 
 
 @dataclass
 class Job:
-    """One piece of background work: ``status`` queued → running → done / failed / cancelled."""
+    """One piece of background work: ``status`` queued → running → done / failed / cancelled, or refused (its
+    work raised :class:`~mocycle.errors.LoopRefused`: ``error`` is the reason, ``result["facts"]`` the failed
+    checks)."""
 
     id: str
     kind: str
@@ -58,6 +60,10 @@ class Jobs:
             job.result = fn(job)
             job.status = "cancelled" if job.cancelled() else "done"
             job.progress = 1.0
+        except LoopRefused as exc:  # a result that fails its own checks: refused, with the reason
+            job.status, job.error = "refused", str(exc)
+            job.result = {"facts": {"refused": True, "reason": str(exc),
+                                    "failed_checks": [f.to_dict() for f in exc.failed]}}
         except Exception as exc:  # the page shows the message; the server keeps serving
             job.status, job.error = "failed", str(exc) or type(exc).__name__
             if not isinstance(exc, (ValueError, MocycleError)):

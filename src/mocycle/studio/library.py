@@ -67,11 +67,14 @@ class Take:
 
 
 def loop_summary(loop: dict) -> dict:
-    """The figures the library shows for one loop (from ``tasks.loop`` facts)."""
+    """The figures the library shows for one loop (from ``tasks.loop`` facts).  ``refused``: the loop failed
+    checks (``failed_checks``, the ones ``tasks.loop`` refuses it for without ``force``); ``refusal``: why."""
     m = loop.get("metrics", {})
+    failed = loop.get("failed_checks", [])
     return {"class": loop["class"], "period_frames": loop["period_frames"],
             "period_s": loop["period_frames"] / loop["fps"], "cycle_frames": loop["cycle_frames"],
             "seam_pose": m.get("seam_pose"), "seam_velocity": m.get("seam_velocity"),
             "skate": m.get("skate"), "input_skate": m.get("input_skate"),
-            "failed_checks": [c.get("check", c.get("name", "")) for c in loop.get("failed_checks", [])],
+            "failed_checks": [c.get("check", c.get("name", "")) for c in failed],
+            "refused": bool(failed), "refusal": "; ".join(f"{c['check']}: {c['reason']}" for c in failed) or None,
             "excitation": loop.get("excitation")}

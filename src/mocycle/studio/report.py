@@ -43,14 +43,18 @@ def _data_url(text: str) -> str:
 
 
 def build_report(title: str, take, loop_report=None, reason: str | None = None) -> str:
-    """The HTML text: ``take`` (a Motion) and, when there is one, the ``tasks.loop`` report of its loop."""
+    """The HTML text: ``take`` (a Motion) and, when there is one, the ``tasks.loop`` report of its loop (a loop
+    with failed checks, made with ``force``, is shown under a banner naming them)."""
     from .library import loop_summary
 
     data: dict = {"title": title, "take": base64.b64encode(motion_payload(take, {"name": title})).decode(),
                   "reason": reason}
     if loop_report is not None:
+        from .review import loop_view
+
         facts = loop_report.facts
-        data.update(loop=base64.b64encode(motion_payload(loop_report.motions["loop"], {"name": "loop"})).decode(),
+        view, _ = loop_view(loop_report)  # phase-aligned with the take, repeated with root motion
+        data.update(loop=base64.b64encode(motion_payload(view, {"name": "loop"})).decode(),
                     summary=loop_summary(facts), metrics=facts["metrics"], options={
                         k: facts.get(k) for k in ("method", "model", "harmonics", "time_axis", "root", "cycles")},
                     phase=[round(float(v), 4) for v in loop_report.result.periodic.coords],
@@ -86,7 +90,8 @@ main {{ grid-template-columns: minmax(420px, 1fr) 360px; }}
       <option value="loop">loop only</option></select></label>
       <label><input id="follow" type="checkbox" checked> follow</label></form>
   </section>
-  <section id="metrics" data-testid="metrics"></section>
+  <section><div id="banner" class="banner" data-testid="banner" hidden></div>
+    <div id="metrics" data-testid="metrics"></div></section>
 </main>
 <script id="report-data" type="application/json">{payload}</script>
 <script type="module">

@@ -76,13 +76,9 @@ export class Player {
     const fig = this.viewer.figures;
     fig.main.setPose(this.posesAt(this.main, f));
     if (this.loop && fig.loop) {
-      // the loop (its cycles with root motion) starts each pass where the take is at that moment
-      const L = this.loop.header, M = this.main.header;
-      const lf = Math.round((f / M.fps) * L.fps), lt = lf % L.frames;
-      const f0 = Math.min(Math.round(((lf - lt) / L.fps) * M.fps), M.frames - 1);
-      const a = this.posesAt(this.main, f0), b = this.posesAt(this.loop, 0), tm = M.travel * 3, tl = L.travel * 3;
-      fig.loop.shift([a[tm] - b[tl], a[tm + 1] - b[tl + 1], a[tm + 2] - b[tl + 2]]);
-      fig.loop.setPose(this.posesAt(this.loop, lt));
+      // the loop as the server placed it: frame f is the cycle frame whose phase is the take's at f, in its
+      // pass of the cycle repeated with root motion (studio/review.py)
+      fig.loop.setPose(this.posesAt(this.loop, Math.min(f, this.loop.header.frames - 1)));
       fig.loop.visible(this.kind === "take" && this.mode !== "take");
     }
     this.viewer.track("main");

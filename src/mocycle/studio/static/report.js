@@ -34,6 +34,13 @@ export function startReport(data) {
     for (const [k, v] of Object.entries(data.options)) rows.push([k, v ?? "–"]);
     for (const w of data.warnings) rows.push(["warning", w]);
   } else rows.push(["no loop", data.reason || ""]);
+  if (data.failed_checks && data.failed_checks.length) {
+    // made with --force: the page says first that this loop fails its checks
+    const b = $("banner");
+    b.hidden = false;
+    b.textContent = `FORCED: this loop fails its checks (${data.failed_checks.map((c) => c.check).join(", ")}) ` +
+      "and is shown only because the report was made with --force: " + data.failed_checks.map((c) => `${c.check}: ${c.reason}`).join("; ");
+  }
   const esc = (s) => String(s).replace(/[&<>]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;" }[c]));
   $("metrics").innerHTML = `<h2>${esc(data.title)}</h2><table>${rows.map(([k, v]) => `<tr><th>${esc(k)}</th><td>${esc(v)}</td></tr>`).join("")}</table>`;
   player.play();

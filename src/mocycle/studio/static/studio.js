@@ -18,6 +18,7 @@ async function json(url, body, method) {
 
 function status(text, isError = false) { const el = $("status"); el.textContent = text; el.classList.toggle("error", isError); }
 const fmt = (v, d = 2) => (v == null || !isFinite(v) ? "–" : Number(v).toFixed(d));
+const esc = (s) => String(s ?? "").replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
 
 // ---------------------------------------------------------------- library
 function renderLibrary(data) {
@@ -35,11 +36,13 @@ function renderLibrary(data) {
     }
     row.classList.toggle("current", t.id === S.take);
     const f = t.facts || {};
-    const loops = t.loops.map((l) => `<li>period ${fmt(l.period_s)} s (${fmt(l.period_frames, 1)} fr) · seam ${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} · skate ${fmt(l.skate)}${l.failed_checks.length ? ` · <span class="bad">${l.failed_checks.join(", ")}</span>` : ""}</li>`).join("");
-    const state = t.status === "done" ? "" : t.status === "failed" ? `<span class="bad">${t.error}</span>` : `<span class="busy">${t.status}…</span>`;
-    row.innerHTML = `<div class="name">${t.name}</div>
+    // a loop that fails its checks is refused (as mocycle loop refuses it): its status and the reason
+    const loops = t.loops.map((l) => `<li class="${l.refused ? "refused" : "ok"}" data-state="${l.refused ? "refused" : "ok"}"${l.refused ? ` title="${esc(l.refusal)}"` : ""}>${l.refused ? `<span class="bad">refused (${esc(l.failed_checks.join(", "))})</span> · ` : ""}period ${fmt(l.period_s)} s (${fmt(l.period_frames, 1)} fr) · seam ${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} · skate ${fmt(l.skate)}${l.refused ? `<div class="reason">${esc(l.refusal)}</div>` : ""}</li>`).join("");
+    const state = t.status === "done" ? "" : t.status === "failed" ? `<span class="bad">${esc(t.error)}</span>` : `<span class="busy">${t.status}…</span>`;
+    row.dataset.state = t.status !== "done" ? t.status : !t.loops.length ? "no-loop" : t.loops.some((l) => !l.refused) ? "ok" : "refused";
+    row.innerHTML = `<div class="name">${esc(t.name)}</div>
       <div class="facts">${f.frames ?? "…"} frames · ${fmt(f.fps, 0)} fps · ${t.status === "done" ? `${t.loops.length} periodic motion${t.loops.length === 1 ? "" : "s"}` : ""} ${state}</div>
-      <ul class="loops">${loops}${t.reason ? `<li class="muted">no loop: ${t.reason}</li>` : ""}</ul>`;
+      <ul class="loops">${loops}${t.reason ? `<li class="muted">no loop: ${esc(t.reason)}</li>` : ""}</ul>`;
   }
 }
 
@@ -82,35 +85,59 @@ async function waitJob(job, onProgress) {
   for (;;) {
     const j = await json(`/api/jobs/${job.id}`);
     if (onProgress) onProgress(j);
-    if (["done", "failed", "cancelled"].includes(j.status)) return j;
+    if (["done", "failed", "cancelled", "refused"].includes(j.status)) return j;
     await new Promise((r) => setTimeout(r, 150));
   }
+}
+
+function setDownloads(prefix, base) {
+  for (const ext of ["bvh", "glb"]) {
+    const a = $(`${prefix}-${ext}`);
+    if (base) a.href = `${base}.${ext}`; else a.removeAttribute("href");
+  }
+}
+
+function loopState(state, html) {
+  const el = $("loop-status");
+  el.dataset.state = state; el.innerHTML = html;
+  el.classList.toggle("bad", state === "refused" || state === "forced");
 }
 
 async function runLoop() {
   const id = S.take;
   if (!id) return;
-  $("loop-status").textContent = "looping…";
+  loopState("running", "looping…");
   $("metrics").innerHTML = "";
-  $("loop-bvh").removeAttribute("href");
+  setDownloads("loop", null);
   try {
     const job = await json(`/api/takes/${id}/loop`, formValues($("loop-options")));
     const j = await waitJob(job);
     if (S.take !== id) return;
-    if (j.status !== "done") { $("loop-status").textContent = j.error || j.status; return; }
+    S.loopJob = j;
+    if (j.status === "refused") {
+      // refused as mocycle loop refuses it: no loop shown, nothing to download unless asked with force
+      S.player.setLoop(null); S.player.setPhase(null, null);
+      loopState("refused", `refused: ${esc(j.error)} <button id="loop-force" type="button" data-testid="force-loop">Show and download anyway (force)</button>`);
+      $("loop-force").addEventListener("click", () => { $("loop-options").elements.force.checked = true; runLoop(); });
+      $("metrics").innerHTML = `<table>${j.result.failed_checks.map((c) => `<tr><th>failed check: ${esc(c.check)}</th><td>${esc(c.reason)}</td></tr>`).join("")}</table>`;
+      return;
+    }
+    if (j.status !== "done") { loopState("failed", esc(j.error || j.status)); S.player.setLoop(null); return; }
     const loop = await fetchPayload(`/api/jobs/${j.id}/motion`);
     if (S.take !== id) return;
     S.player.setLoop(loop);
     S.player.setPhase(j.result.phase, j.result.excitation);
-    const l = j.result.loop;
-    $("loop-status").textContent = `loop ${l.cycle_frames} frames · period ${fmt(l.period_s)} s · ${fmt(j.result.seconds)} s`;
+    const l = j.result.loop, failed = j.result.failed_checks;
+    const text = `loop ${l.cycle_frames} frames · period ${fmt(l.period_s)} s · ${fmt(j.result.seconds)} s`;
+    if (failed.length) loopState("forced", `FORCED: this loop fails its checks (${esc(failed.map((c) => c.check).join(", "))}) and is shown because you asked · ${text}`);
+    else loopState("ok", text);
     $("metrics").innerHTML = `<table><tr><th>period</th><td>${fmt(l.period_frames, 1)} frames (${fmt(l.period_s)} s)</td></tr>
       <tr><th>seam jump, pose / velocity</th><td>${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} × median step</td></tr>
       <tr><th>foot skate, loop / take</th><td>${fmt(l.skate)} / ${fmt(l.input_skate)} units/s</td></tr>
-      <tr><th>failed checks</th><td>${l.failed_checks.join(", ") || "none"}</td></tr>
-      ${j.result.warnings.map((w) => `<tr><th>warning</th><td>${w}</td></tr>`).join("")}</table>`;
-    $("loop-bvh").href = `/api/jobs/${j.id}/loop.bvh`;
-  } catch (e) { $("loop-status").textContent = e.message; S.player.setLoop(null); }
+      <tr><th>failed checks</th><td class="${failed.length ? "bad" : ""}">${failed.map((c) => `${esc(c.check)}: ${esc(c.reason)}`).join("; ") || "none"}</td></tr>
+      ${j.result.warnings.map((w) => `<tr><th>warning</th><td>${esc(w)}</td></tr>`).join("")}</table>`;
+    setDownloads("loop", `/api/jobs/${j.id}/loop`);
+  } catch (e) { loopState("failed", esc(e.message)); S.player.setLoop(null); }
 }
 
 function buildOptions(schema) {
@@ -148,7 +175,7 @@ async function loadPlane() {
     S.markers = S.keys.map((k) => [P[2 * k], P[2 * k + 1]]);
     S.pose.setMarkers(S.markers);
     S.planeView.setData(P, S.keys, S.markers);
-    S.strokeId = null; $("export").removeAttribute("href"); $("export").classList.add("disabled");
+    S.strokeId = null; for (const id of ["export", "export-glb"]) { $(id).removeAttribute("href"); $(id).classList.add("disabled"); }
     $("plane-status").textContent = `${plane.header.projection}, ${S.keys.length} keyframes, stress ${plane.header.stress == null ? "–" : Number(plane.header.stress).toPrecision(3)}`;
   } catch (e) { $("plane-status").textContent = e.message; }
 }
@@ -172,7 +199,8 @@ async function sendStroke(points, times) {
     S.strokeId = r.id;
     S.player.setMain(motion, "authored");
     S.player.play();
-    $("export").href = `/api/strokes/${r.id}.bvh`; $("export").classList.remove("disabled");
+    $("export").href = `/api/strokes/${r.id}.bvh`; $("export-glb").href = `/api/strokes/${r.id}.glb`;
+    for (const id of ["export", "export-glb"]) $(id).classList.remove("disabled");
     $("plane-status").textContent = `authored ${r.frames} frames (${fmt(r.duration_s)} s) · server ${fmt(r.server_ms, 0)} ms`;
   } catch (e) { $("plane-status").textContent = e.message; }
 }

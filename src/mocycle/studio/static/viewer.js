@@ -15,7 +15,6 @@ export class Figure {
     this.group.quaternion.setFromUnitVectors(new THREE.Vector3(...header.up), UP);
     this.group.scale.setScalar(s);
     this.group.position.y = -header.floor * s;
-    this.base = this.group.position.clone();
     this.offset = new THREE.Group();
     this.offset.add(this.group);
     const radius = 0.022 / s;
@@ -53,14 +52,6 @@ export class Figure {
   }
 
   visible(v) { this.offset.visible = v; }
-
-  // move the figure by (dx, dy, dz) file units along the floor (the vertical part is dropped)
-  shift(d) {
-    const up = this.header.up, along = d[0] * up[0] + d[1] * up[1] + d[2] * up[2];
-    const v = new THREE.Vector3(d[0] - along * up[0], d[1] - along * up[1], d[2] - along * up[2]);
-    v.applyQuaternion(this.group.quaternion).multiplyScalar(this.group.scale.x);
-    this.group.position.copy(this.base).add(v);
-  }
 
   dispose(viewer) {
     viewer.scene.remove(this.offset);

@@ -1,0 +1,77 @@
+"""The loop as the review shows it beside the take: phase-aligned, repeated with root motion, placed at the take.
+
+:func:`loop_view` reads the loop task's own results (no new analysis): the cycle's ``positions`` (where each
+frame of the take falls in the cycle, from the phase), the library's ``Cycle.repeat`` (each repeat moved on by
+the travel and turn per cycle) and the cycle space's ``encode``/``decode`` (root path and heading as ``L``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..rotations import axis_rotations
+
+
+def cycle_frames(cycle, n_frames: int) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
+    """Where each of the take's ``n_frames`` frames falls in the repeated cycle: ``(u, segments)``.
+
+    ``u (T,)``: cycle frames, unwrapped within each excited region (``u mod N`` is the cycle frame whose
+    phase is the take's at that frame, from ``cycle.positions``); outside the regions the count goes on at
+    the loop's own rate (``N / period_frames`` cycle frames per frame) from the nearest region before (or,
+    before the first region, back from it).  ``segments``: ``(start, stop, anchor)`` frame ranges, one per
+    excited region, ``anchor`` its first frame: where the loop is placed at the take."""
+    N = cycle.n_frames
+    regions = list(cycle.axis.regions)
+    u = np.full(n_frames, np.nan)
+    at = 0
+    for s, e in regions:
+        pos = np.asarray(cycle.positions[at: at + (e - s)], dtype=np.float64)
+        at += e - s
+        u[s:e] = np.unwrap(pos * (2 * np.pi / N)) * (N / (2 * np.pi))
+    rate = N / cycle.period_frames
+    segments = []
+    for i, (s, e) in enumerate(regions):
+        start = 0 if i == 0 else s
+        stop = regions[i + 1][0] if i + 1 < len(regions) else n_frames
+        u[start:s] = u[s] - (s - np.arange(start, s)) * rate
+        u[e:stop] = u[e - 1] + (np.arange(e, stop) - (e - 1)) * rate
+        segments.append((start, stop, s))
+    return u, segments
+
+
+def loop_view(report):
+    """The loop of a ``tasks.loop`` report as a Motion with the take's frames: frame ``f`` is the cycle frame
+    whose phase matches the take's at ``f`` (linear between cycle frames), in the pass of the cycle repeated
+    (``report.facts["root"]``: ``motion`` moves on by the travel and turn per cycle as ``Cycle.repeat``
+    does).  Placement: at each excited region's first frame the loop's travel joint is put where the take's
+    is along the floor and turned to its heading; ``inplace`` loops follow the take's travel joint along the
+    floor every frame.  Returns ``(motion, facts)``, facts with ``loop_frame`` (``u mod N`` per frame) and
+    ``segments``."""
+    take, cycle, root = report.motions["input"], report.result, report.facts["root"]
+    space, N, T = cycle.space, cycle.n_frames, report.motions["input"].n_frames
+    u, segments = cycle_frames(cycle, T)
+    index = np.empty(T)
+    for start, stop, _ in segments:  # each region's passes counted from the first repeat
+        index[start:stop] = u[start:stop] - N * np.floor(u[start:stop].min() / N)
+    view = cycle.repeat(int(np.floor(index.max() / N)) + 2, root=root)
+    Pv, Lv = space.encode(view)
+    i0 = np.floor(index).astype(int)
+    a = (index - i0)[:, None]
+    P = (1 - a) * Pv[i0] + a * Pv[i0 + 1]
+    L = (1 - a) * Lv[i0] + a * Lv[i0 + 1]
+    _, Lt = space.encode(take)
+    up = space.up
+    for start, stop, anchor in segments:
+        turn = Lt[anchor, 3] - L[anchor, 3]
+        R = axis_rotations(up, np.array([turn]))[0]
+        pivot = L[anchor, :3].copy()
+        move = Lt[anchor, :3] - pivot
+        move -= (move @ up) * up  # along the floor: the loop keeps its own height
+        L[start:stop, :3] = (L[start:stop, :3] - pivot) @ R.T + pivot + move
+        L[start:stop, 3] += turn
+    if root == "inplace":
+        gap = Lt[:, :3] - L[:, :3]
+        L[:, :3] += gap - np.outer(gap @ up, up)
+    facts = {"loop_frame": np.round(np.mod(u, N), 3).tolist(), "segments": [list(s) for s in segments],
+             "cycle_frames": N, "root": root}
+    return space.decode(P, L), facts

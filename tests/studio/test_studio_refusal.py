@@ -1,0 +1,150 @@
+"""A loop that fails its checks is refused by the studio and by ``mocycle report`` as ``mocycle loop`` refuses it
+(exit 3 / a ``refused`` job with the reason, nothing to download), unless asked with force.
+
+The refused take is a 500-frame walk whose phase is replaced by the phase of a walk 1.5 times slower (the
+period found is wrong, as on CMU's basketball take; tests/cycle/test_checks.py): its cycle fits the take about
+4 times worse than a plain cut and fails the ``fit`` check."""
+
+from __future__ import annotations
+
+import os
+import warnings
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import mocycle.cli.report  # noqa: F401  (registers the command)
+import mocycle.cycle.extract as extract_module
+from mocycle import write
+from mocycle.cli import app
+from mocycle.datasets import synthetic_walk
+from mocycle.phase import find_phase
+
+pytest.importorskip("starlette")
+pytest.importorskip("httpx")
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    from starlette.testclient import TestClient  # noqa: E402
+
+from mocycle.studio.app import create_app  # noqa: E402
+from mocycle.studio.payload import unpack  # noqa: E402
+
+REFUSED_FRAMES = 500
+
+
+@pytest.fixture(scope="module")
+def refused_library(tmp_path_factory):
+    """``walk.bvh`` (a loop) and ``limp.bvh`` (its loop fails the fit check); the phase of 500-frame motions is
+    the wrong one while the module runs."""
+    folder = tmp_path_factory.mktemp("refused")
+    write(synthetic_walk(n_frames=240).motion, folder / "walk.bvh")
+    write(synthetic_walk(n_frames=REFUSED_FRAMES, noise_deg=1.0, seed=1).motion, folder / "limp.bvh")
+    wrong = find_phase(synthetic_walk(n_frames=REFUSED_FRAMES, period_s=1.5, noise_deg=1.0, seed=4).motion)
+    real = extract_module.find_phase
+
+    def phase(motion, *args, **kwargs):
+        return wrong if motion.n_frames == REFUSED_FRAMES else real(motion, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(extract_module, "find_phase", phase)
+        yield folder
+
+
+def test_report_refuses_with_exit_3_and_writes_nothing_unless_forced(refused_library, tmp_path):
+    out = tmp_path / "limp.html"
+    r = CliRunner().invoke(app, ["report", str(refused_library / "limp.bvh"), "-o", str(out)])
+    assert r.exit_code == 3, r.output
+    assert "error:" in r.output and "limp.bvh" in r.output and "not a loop" in r.output and "fit:" in r.output
+    assert "--force" in r.output and not out.exists() and not list(tmp_path.iterdir())
+    r = CliRunner().invoke(app, ["report", str(refused_library / "limp.bvh"), "-o", str(out), "--force"])
+    assert r.exit_code == 0 and "warning:" in r.output and "fit" in r.output and out.exists()
+    import json
+
+    text = out.read_text()
+    data = json.loads(text.split('<script id="report-data" type="application/json">')[1].split("</script>")[0])
+    assert [c["check"] for c in data["failed_checks"]] == ["fit"] and "plain cut" in data["failed_checks"][0]["reason"]
+    assert 'id="banner"' in text
+
+
+def wait(client, job, timeout=120.0):
+    import time
+
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout:
+        j = client.get(f"/api/jobs/{job['id']}").json()
+        if j["status"] not in ("queued", "running"):
+            return j
+        time.sleep(0.05)
+    raise AssertionError(f"job {job} did not finish")
+
+
+@pytest.mark.filterwarnings("ignore:.*kept although it fails:UserWarning")
+def test_the_api_refuses_without_force_and_gives_with_force(refused_library):
+    with TestClient(create_app([refused_library])) as client:
+        tid = next(t["id"] for t in client.get("/api/takes").json()["takes"] if t["name"] == "limp.bvh")
+        j = wait(client, client.post(f"/api/takes/{tid}/loop", json={"root": "motion"}).json())
+        assert j["status"] == "refused" and j["error"].startswith("limp.bvh: not a loop (fit:")
+        assert [c["check"] for c in j["result"]["failed_checks"]] == ["fit"]
+        for path in ("motion", "loop.bvh", "loop.glb"):
+            r = client.get(f"/api/jobs/{j['id']}/{path}")
+            assert r.status_code == 409 and "not a loop" in r.json()["error"] and "force" in r.json()["error"]
+        f = wait(client, client.post(f"/api/takes/{tid}/loop", json={"root": "motion", "force": True}).json())
+        assert f["status"] == "done" and f["result"]["forced"]
+        assert [c["check"] for c in f["result"]["failed_checks"]] == ["fit"]
+        header, arrays = unpack(client.get(f"/api/jobs/{f['id']}/motion").content)
+        assert header["forced"] and arrays["positions"].shape[0] == REFUSED_FRAMES
+        r = client.get(f"/api/jobs/{f['id']}/loop.bvh")
+        assert r.status_code == 200 and 'filename="limp_loop.forced.bvh"' in r.headers["content-disposition"]
+        assert r.headers["x-mocycle-failed-checks"] == "fit"
+        assert client.post(f"/api/takes/{tid}/loop", json={"force": "yes"}).status_code == 400
+        # the library marks the loop refused, with the reason; the good walk is not
+        for _ in range(600):
+            data = client.get("/api/takes").json()
+            if data["done"] == data["total"]:
+                break
+            import time
+
+            time.sleep(0.1)
+        takes = {t["name"]: t for t in data["takes"]}
+        (limp,) = takes["limp.bvh"]["loops"]
+        assert limp["refused"] and limp["failed_checks"] == ["fit"] and "plain cut" in limp["refusal"]
+        assert not any(loop["refused"] for loop in takes["walk.bvh"]["loops"])
+
+
+def test_the_page_shows_a_refused_loop_as_refused(refused_library, tmp_path):
+    """The library row and the review say refused with the reason, nothing is downloadable; the force button
+    shows the loop marked FORCED and downloads it as ``limp_loop.forced.bvh``."""
+    pytest.importorskip("uvicorn")
+    pytest.importorskip("playwright")
+    from mocycle.studio.testing import CHROMIUM, chromium, served, watch_console
+
+    if not os.path.exists(CHROMIUM):
+        pytest.skip(f"{CHROMIUM} is absent (make chromium installs Debian's chromium)")
+    with served(create_app([refused_library])) as url, chromium() as browser:
+        page = browser.new_page(viewport={"width": 1400, "height": 900}, accept_downloads=True)
+        errors = watch_console(page)
+        page.goto(url)
+        page.wait_for_function("window.__studio && window.__studio.ready", timeout=60_000)
+        page.wait_for_function("window.__studio.library && window.__studio.library.done === 2", timeout=120_000)
+        row = page.locator('[data-testid="take"]', has_text="limp.bvh")
+        page.wait_for_function("document.querySelector('[data-testid=take][data-state=refused]')", timeout=10_000)
+        assert "refused (fit)" in row.inner_text() and "plain cut" in row.inner_text()
+        assert page.locator('[data-testid="take"]', has_text="walk.bvh").get_attribute("data-state") == "ok"
+        row.click()
+        status = page.locator('[data-testid="loop-status"]')
+        page.wait_for_function("document.getElementById('loop-status').dataset.state === 'refused'", timeout=120_000)
+        assert "refused: limp.bvh: not a loop (fit:" in status.inner_text()
+        assert page.locator('[data-testid="loop-bvh"]').get_attribute("href") is None
+        assert page.locator('[data-testid="loop-glb"]').get_attribute("href") is None
+        assert not page.evaluate("!!window.__studio.player.loop")
+        page.screenshot(path=str(tmp_path / "refused.png"))
+        page.locator('[data-testid="force-loop"]').click()
+        page.wait_for_function("document.getElementById('loop-status').dataset.state === 'forced'", timeout=120_000)
+        assert "FORCED" in status.inner_text() and "fit" in status.inner_text()
+        assert page.evaluate("!!window.__studio.player.loop")
+        with page.expect_download() as download:
+            page.locator('[data-testid="loop-bvh"]').click()
+        assert download.value.suggested_filename == "limp_loop.forced.bvh"
+        assert np.isfinite(page.evaluate("window.__studio.player.loop.arrays.positions[0]"))
+        assert not errors, errors
