@@ -2,9 +2,10 @@
 
     python benchmarks/studio.py [--shots docs/studio] [--real]
 
-Serves the studio on generated takes (a 1000-frame walk, a 240-frame wandering take; with ``--real`` also
-a CMU/iClone take of ../shared/data, 100 joints) and drives Debian's chromium (headless, SwiftShader WebGL,
-no GPU) through Playwright.  Measured in the page with ``performance.now()``:
+Serves the studio on generated takes (a 1000-frame walk, a 240-frame wandering take, a 500-frame walk read
+with the phase of a slower walk so that its loop is refused, as in tests/studio/test_studio_refusal.py; with
+``--real`` also a CMU/iClone take of ../shared/data, 100 joints) and drives Debian's chromium (headless,
+SwiftShader WebGL, no GPU) through Playwright.  Measured in the page with ``performance.now()``:
 
 * time to first render: click on the take in the library -> its motion fetched, decoded and drawn;
 * pose update while scrubbing: the slider's input event -> pose set and ``renderer.render`` returned;
@@ -29,8 +30,10 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "src"))
 
+import mocycle.cycle.extract as extract_module  # noqa: E402
 from mocycle import write  # noqa: E402
 from mocycle.datasets import synthetic_nonperiodic, synthetic_walk  # noqa: E402
+from mocycle.phase import find_phase  # noqa: E402
 from mocycle.studio.app import create_app  # noqa: E402
 from mocycle.studio.testing import chromium, served, watch_console  # noqa: E402
 
@@ -113,6 +116,12 @@ def main() -> None:
     folder = Path(tempfile.mkdtemp(prefix="mocycle-studio-"))
     write(synthetic_walk(n_frames=1000).motion, folder / "walk_1000.bvh")
     write(synthetic_nonperiodic(n_frames=240).motion, folder / "wander_240.bvh")
+    # a take whose loop is refused (fit check): a walk given the phase of a walk 1.5 times slower, the period
+    # found wrong as on CMU's basketball take (the shared walks all pass their checks)
+    write(synthetic_walk(n_frames=500, noise_deg=1.0, seed=1).motion, folder / "limp_500.bvh")
+    wrong = find_phase(synthetic_walk(n_frames=500, period_s=1.5, noise_deg=1.0, seed=4).motion)
+    real_phase = extract_module.find_phase
+    extract_module.find_phase = lambda m, *a, **k: wrong if m.n_frames == 500 else real_phase(m, *a, **k)
     paths = [folder]
     real = REPO.parent / "shared" / "data" / "cmu-iclone" / "07_01.bvh"
     if args.real and real.exists():
@@ -180,9 +189,25 @@ def main() -> None:
             open_take(page, "walk_1000.bvh")
             page.wait_for_function("document.getElementById('loop-status').textContent.startsWith('loop ')",
                                    timeout=120_000)
-            page.wait_for_timeout(1500)
-            page.locator('[data-testid="viewer"]').screenshot(path=str(args.shots / "overlay.png"))
+            page.wait_for_timeout(500)
+            for frame in (130, 610):  # paused: the loop in step with the take, early and after 8 cycles
+                page.evaluate(f"window.__studio.player.pause(); window.__studio.player.setFrame({frame})")
+                page.wait_for_timeout(300)
+                page.locator("#review").screenshot(path=str(args.shots / f"overlay-{frame}.png"))
             page.select_option("#layout", "side")
+            # -- the refused take: refused in the library and the review; force shows it marked
+            open_take(page, "limp_500.bvh")
+            page.wait_for_function("document.getElementById('loop-status').dataset.state === 'refused'",
+                                   timeout=120_000)
+            page.wait_for_timeout(300)
+            page.screenshot(path=str(args.shots / "refused.png"))
+            page.locator('[data-testid="force-loop"]').click()
+            page.wait_for_function("document.getElementById('loop-status').dataset.state === 'forced'",
+                                   timeout=120_000)
+            page.evaluate("window.__studio.player.pause(); window.__studio.player.setFrame(200)")
+            page.wait_for_timeout(300)
+            page.locator("#review").screenshot(path=str(args.shots / "forced.png"))
+            page.locator('[data-testid="force"]').uncheck()
             page.locator("#grid-toggle").click()
             page.locator("#library").screenshot(path=str(args.shots / "library-grid.png"))
             page.locator("#grid-toggle").click()
@@ -193,8 +218,15 @@ def main() -> None:
             print(f"{real.name} (100 joints): opened with its plane in {time.perf_counter() - t:.1f} s; first render "
                   f"{page.evaluate('window.__studio.stats.firstRender_ms').pop()['ms']:.0f} ms")
             if args.shots:
+                page.wait_for_function("document.getElementById('loop-status').textContent.startsWith('loop ')",
+                                       timeout=120_000)
                 page.wait_for_timeout(1500)
                 page.screenshot(path=str(args.shots / "iclone.png"))
+                page.select_option("#layout", "overlay")
+                page.evaluate("window.__studio.player.pause(); window.__studio.player.setFrame(100)")
+                page.wait_for_timeout(300)
+                page.locator('[data-testid="viewer"]').screenshot(path=str(args.shots / "overlay-iclone.png"))
+                page.select_option("#layout", "side")
             page.evaluate("window.__studio.stats.hover.length = 0")
             for i in range(40):
                 page.mouse.move(plane["x"] + plane["width"] * (0.2 + 0.6 * i / 39), plane["y"] + plane["height"] * 0.4)

@@ -116,20 +116,21 @@ class Studio:
             raise ValueError(f"force must be true or false; got {force!r}")
         o = tasks.loop.Options(force=force, **opts)  # an OptionError here is the caller's 400
 
+        def named(text: str) -> str:  # messages name the take as the library lists it, not as "take 0"
+            memory = "take 0: "  # how tasks name a motion given in memory
+            return f"{take.name}: {text[len(memory):]}" if text.startswith(memory) else text
+
         def work(job):
             try:
                 report = tasks.loop.run(take.motion(self.amc_fps), o)
-            except LoopRefused as exc:  # the message names the take as the library lists it
-                memory = "take 0: "  # how tasks name a motion given in memory
-                text = str(exc)
-                raise LoopRefused(f"{take.name}: {text[len(memory):]}" if text.startswith(memory) else text,
-                                  exc.failed) from None
+            except LoopRefused as exc:
+                raise LoopRefused(named(str(exc)), exc.failed) from None
             cycle = report.result
             f = report.facts
             phase = np.asarray(cycle.periodic.coords, dtype=np.float64)
             view, view_facts = loop_view(report)
             return {"report": report, "view": view, "take": take, "facts": {
-                "loop": loop_summary(f), "options": o.to_dict(), "warnings": list(report.warnings),
+                "loop": loop_summary(f), "options": o.to_dict(), "warnings": [named(w) for w in report.warnings],
                 "failed_checks": f["failed_checks"], "forced": bool(f["failed_checks"]),
                 "frames_out": f["frames_out"], "phase": phase.round(4).tolist(), "excitation": f["excitation"],
                 "view": view_facts, "seconds": report.seconds}}

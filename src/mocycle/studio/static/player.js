@@ -34,12 +34,14 @@ export class Player {
     this.viewer.setFigure("main", motion.header, kind === "authored" ? COLORS.authored : COLORS.main);
     this.els.scrub.max = motion.header.frames - 1;
     this.t = 0;
-    this.setFrame(0);
+    this.frame = 0;
+    this.setLayout(this.mode);
     this.viewer.track("main");
   }
 
-  setLoop(motion) {
-    this.loop = motion;
+  // motion: the loop as the viewer plays it (one frame per take frame); loopFrames: its cycle frame per frame
+  setLoop(motion, loopFrames = null) {
+    this.loop = motion; this.loopFrames = loopFrames;
     this.viewer.setFigure("loop", motion ? motion.header : null, COLORS.loop);
     this.setLayout(this.mode);
   }
@@ -49,7 +51,7 @@ export class Player {
   setLayout(mode) {
     this.mode = mode;
     const { main, loop } = this.viewer.figures;
-    if (main) main.visible(mode !== "loop");
+    if (main) { main.visible(mode !== "loop"); main.seeThrough(mode === "overlay" && !!loop && this.kind === "take"); }
     if (loop) loop.visible(mode !== "take");
     this.viewer.layout(mode === "side");
     this.setFrame(this.frame);
@@ -84,7 +86,9 @@ export class Player {
     this.viewer.track("main");
     this.viewer.render();
     if (updateScrub) this.els.scrub.value = f;
-    this.els.label.textContent = `${f + 1} / ${this.main.header.frames}`;
+    const lf = this.loopFrames && this.kind === "take" && this.loop ? this.loopFrames[f] : null;
+    this.els.label.textContent = `${f + 1} / ${this.main.header.frames}` +
+      (lf == null ? "" : ` · loop ${Math.floor(lf) + 1} / ${this.loop.header.cycle_frames}`);
     this.drawStrip();
   }
 

@@ -18,7 +18,9 @@ export function startReport(data) {
   S.viewer = viewer; S.player = player;
   player.setMain(fromBase64(data.take), "take");
   if (data.loop) {
-    player.setLoop(fromBase64(data.loop));
+    const loop = fromBase64(data.loop);
+    loop.header.cycle_frames = data.view.cycle_frames;
+    player.setLoop(loop, data.view.loop_frame);
     player.setPhase(data.phase, data.excitation);
   }
   $("layout").addEventListener("change", () => player.setLayout($("layout").value));

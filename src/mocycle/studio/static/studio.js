@@ -125,7 +125,8 @@ async function runLoop() {
     if (j.status !== "done") { loopState("failed", esc(j.error || j.status)); S.player.setLoop(null); return; }
     const loop = await fetchPayload(`/api/jobs/${j.id}/motion`);
     if (S.take !== id) return;
-    S.player.setLoop(loop);
+    loop.header.cycle_frames = j.result.view.cycle_frames;
+    S.player.setLoop(loop, j.result.view.loop_frame);
     S.player.setPhase(j.result.phase, j.result.excitation);
     const l = j.result.loop, failed = j.result.failed_checks;
     const text = `loop ${l.cycle_frames} frames · period ${fmt(l.period_s)} s · ${fmt(j.result.seconds)} s`;

@@ -53,6 +53,12 @@ export class Figure {
 
   visible(v) { this.offset.visible = v; }
 
+  // see-through (overlaid on another figure) or solid
+  seeThrough(on) {
+    const m = this.boneMesh.material;
+    m.transparent = on; m.opacity = on ? 0.45 : 1; m.depthWrite = !on; m.needsUpdate = true;
+  }
+
   dispose(viewer) {
     viewer.scene.remove(this.offset);
     this.boneMesh.geometry.dispose(); this.jointMesh.geometry.dispose(); this.boneMesh.material.dispose();
