@@ -56,7 +56,8 @@ def build_report(title: str, take, loop_report=None, reason: str | None = None) 
         view, view_facts = loop_view(loop_report)  # phase-aligned with the take, repeated with root motion
         data.update(loop=base64.b64encode(motion_payload(view, {"name": "loop"})).decode(), view=view_facts,
                     summary=loop_summary(facts), metrics=facts["metrics"], options={
-                        k: facts.get(k) for k in ("method", "model", "harmonics", "time_axis", "root", "cycles")},
+                        **{k: facts.get(k) for k in ("method", "model", "harmonics", "time_axis", "root")},
+                        "feet": facts["feet"]["mode"]},
                     phase=[round(float(v), 4) for v in loop_report.result.periodic.coords],
                     excitation=facts["excitation"], warnings=list(loop_report.warnings),
                     failed_checks=facts["failed_checks"])
