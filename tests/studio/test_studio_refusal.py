@@ -7,6 +7,7 @@ period found is wrong, as on CMU's basketball take; tests/cycle/test_checks.py):
 
 from __future__ import annotations
 
+import json
 import os
 import warnings
 
@@ -59,8 +60,6 @@ def test_report_refuses_with_exit_3_and_writes_nothing_unless_forced(refused_lib
     assert "--force" in r.output and not out.exists() and not list(tmp_path.iterdir())
     r = CliRunner().invoke(app, ["report", str(refused_library / "limp.bvh"), "-o", str(out), "--force"])
     assert r.exit_code == 0 and "warning:" in r.output and "fit" in r.output and out.exists()
-    import json
-
     text = out.read_text()
     data = json.loads(text.split('<script id="report-data" type="application/json">')[1].split("</script>")[0])
     assert [c["check"] for c in data["failed_checks"]] == ["fit"] and "plain cut" in data["failed_checks"][0]["reason"]
@@ -131,9 +130,11 @@ def test_the_page_shows_a_refused_loop_as_refused(refused_library, tmp_path):
         page.wait_for_function("document.querySelector('[data-testid=take][data-state=refused]')", timeout=10_000)
         assert "refused (fit)" in row.inner_text() and "plain cut" in row.inner_text()
         assert page.locator('[data-testid="take"]', has_text="walk.bvh").get_attribute("data-state") == "ok"
-        row.click()
+        before = page.evaluate("window.__studio.loopJob ? window.__studio.loopJob.id : null")
+        row.click()  # (the page opened it first too: wait for the loop job of this click)
         status = page.locator('[data-testid="loop-status"]')
-        page.wait_for_function("document.getElementById('loop-status').dataset.state === 'refused'", timeout=120_000)
+        page.wait_for_function(f"window.__studio.loopJob && window.__studio.loopJob.id !== {json.dumps(before)} && "
+                               "document.getElementById('loop-status').dataset.state === 'refused'", timeout=120_000)
         assert "refused: limp.bvh: not a loop (fit:" in status.inner_text()
         assert page.locator('[data-testid="loop-bvh"]').get_attribute("href") is None
         assert page.locator('[data-testid="loop-glb"]').get_attribute("href") is None
