@@ -10,7 +10,7 @@ import typer
 from .. import tasks
 from ..errors import NoPeriodicMotion
 from ..io.atomic import atomic_write
-from .common import FORCE_HELP, app, check_output, default, err, flag, friendly, out, print_warnings
+from .common import app, check_output, default, err, flag, friendly, out, print_warnings
 
 L = tasks.loop.Options
 
@@ -25,13 +25,15 @@ def report(
     root: Annotated[str, flag(L, "root")] = "motion",
     feet: Annotated[str, flag(L, "feet")] = default(L, "feet"),
     amc_fps: Annotated[float, flag(L, "amc_fps")] = default(L, "amc_fps"),
-    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    force: Annotated[bool, typer.Option("--force", help=(
+        "Write the report even when the loop fails a loop check (the page names them in a red banner); "
+        "it also lets the output replace an input file."))] = False,
 ):
     """Write one HTML file (viewer, the take beside its loop: in step with the take's phase and repeated with
     root motion over the whole take; phase strip, metrics)
     that opens offline in a browser: to mail or attach to a ticket.
 
-    A loop that fails its checks is refused as by ``mocycle loop``: the reason is printed, exit code 3, no file
+    A loop that fails its checks is refused as by mocycle loop: the reason is printed, exit code 3, no file
     written; --force writes the report anyway, with the failed checks in a banner at the top.  A take without
     periodic motion gets a page with the take and the reason (and a warning).
     """

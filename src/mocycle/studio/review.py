@@ -22,6 +22,9 @@ def cycle_frames(cycle, n_frames: int) -> tuple[np.ndarray, list[tuple[int, int,
     excited region, ``anchor`` its first frame: where the loop is placed at the take."""
     N = cycle.n_frames
     regions = list(cycle.axis.regions)
+    if len(cycle.positions) != sum(e - s for s, e in regions) or regions[-1][1] > n_frames:
+        raise ValueError(f"the cycle's positions ({len(cycle.positions)}) do not cover its excited regions "
+                         f"{regions} of a {n_frames}-frame take")
     u = np.full(n_frames, np.nan)
     at = 0
     for s, e in regions:
