@@ -29,9 +29,9 @@ def report(
         "Write the report even when the loop fails a loop check (the page names them in a red banner); "
         "it also lets the output replace an input file."))] = False,
 ):
-    """Write one HTML file (viewer, the take beside its loop: in step with the take's phase and repeated with
-    root motion over the whole take; phase strip, metrics)
-    that opens offline in a browser: to mail or attach to a ticket.
+    """Write one HTML file (viewer, the take beside its loop repeated with root motion, phase strip, metrics)
+    that opens offline in a browser: to mail or attach to a ticket.  The loop plays in step with the take's
+    phase over the whole take.
 
     A loop that fails its checks is refused as by mocycle loop: the reason is printed, exit code 3, no file
     written; --force writes the report anyway, with the failed checks in a banner at the top.  A take without
