@@ -59,6 +59,7 @@ async function pollLibrary() {
 async function openTake(id) {
   const t0 = performance.now();
   S.take = id;
+  $("loop-options").elements.force.checked = false;  // force is asked for one take's loop, not kept for the next
   document.querySelectorAll(".take").forEach((r) => r.classList.toggle("current", r.dataset.id === id));
   status("loading the take…");
   const motion = await fetchPayload(`/api/takes/${id}/motion`);
