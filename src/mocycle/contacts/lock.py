@@ -54,6 +54,11 @@ DISTANCE_WEIGHT = 1.0  # a hold this much farther from the mean weighs like the 
 EXTEND_SECONDS = 0.2   # a hold reaches at most this far beyond its contact while the joint stays low
 EXTEND_HEIGHT = 0.025  # of the body height above the held height: "low" (the contact detector's height)
 EXTEND_DISTANCE = 0.03  # of the body height: "near" the held point horizontally (farther: no early plant)
+CLEARANCE = 0.015      # of the body height: a swinging foot clears this (the skate measure's H: below it a
+                       # foot counts as on the floor)
+SLOW_SPEED = 0.25      # body heights/s: a free foot this slow is not lifted (it may be a stance the detector missed)
+SWING_SPEED = 0.5      # body heights/s: a free foot this fast is lifted fully
+LIFT_SECONDS = 0.05    # the lift changes by at most CLEARANCE in this time
 BRIDGE_SECONDS = 0.6   # a gap between holds this short (a swing) is bridged; longer ones fade over the blend
 #: how firmly a contact joint is held on a frame: its own contact, its foot's other joint's contact (carried
 #: rigidly), its own low frames around a contact (held horizontally), the other joint's low frames
@@ -247,18 +252,50 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
     corr_a, level_a = _own_holds(a, ma, held_a, up, low, near, n_extend)
     corr_t = None
     if foot.toe is not None:
-        corr_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low,
+        corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low,
                             near, n_extend)
     soft = (level_a > 0) & (level_a < FOLLOW)
     corr_a[soft] = _into_reach(a[soft], corr_a[soft], hips[soft], R[soft])
     corr_a = _bridge(corr_a, n_bridge, n_fade)
     free = level_a == 0
     corr_a[free] = _into_reach(a[free], corr_a[free], hips[free], R[free])
+    clear = CLEARANCE * body
+    corr_a += np.outer(_lift(a + corr_a, level_a, up, clear, body, contacts.frame_time), up)
+    corr_a[free] = _into_reach(a[free], corr_a[free], hips[free], R[free])
     changed = np.any(corr_a != 0, axis=1)
     if corr_t is None:
         return a + corr_a, None, level_a >= FOLLOW, changed
     corr_t = _bridge(corr_t, n_bridge, n_fade)
+    corr_t += np.outer(_lift(t + corr_t, level_t, up, clear, body, contacts.frame_time), up)
     return a + corr_a, t + corr_t, level_a >= FOLLOW, changed | np.any(corr_t != 0, axis=1)
+
+
+def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, body: float,
+          frame_time: float) -> np.ndarray:
+    """How far ``(T,)`` to raise a contact joint's goal ``path`` ``(T, 3)`` where it swings (``level`` 0
+    between two of its holds) and moves on: a foot moving faster than ``SWING_SPEED`` body heights per
+    second is swinging, and a swinging foot clears ``clear`` above its lowest level (it does not glide
+    along the floor, as a heel coming in at full speed or a toe dragged forward does).  The lift fades in
+    from ``SLOW_SPEED``; it changes by at most ``clear`` per ``LIFT_SECONDS`` (a heel lands, it does not
+    drop)."""
+    T = path.shape[0]
+    if T < 2:
+        return np.zeros(T)
+    h = path @ up
+    h = h - h.min()
+    v = np.gradient(path, frame_time, axis=0)
+    v = np.linalg.norm(v - np.outer(v @ up, up), axis=1) / body
+    ramp = np.clip((v - SLOW_SPEED) / (SWING_SPEED - SLOW_SPEED), 0.0, 1.0)
+    swing = np.zeros(T, bool)
+    for p, q in ranges(level == 0):
+        swing[p:q] = p > 0 and q < T    # between two holds: a foot without contacts (or a missed stance) stays
+    lift = np.where(swing, np.maximum(clear - h, 0.0) * ramp, 0.0)
+    rate = clear * frame_time / LIFT_SECONDS
+    for t in range(1, T):
+        lift[t] = min(lift[t], lift[t - 1] + rate)
+    for t in range(T - 2, -1, -1):
+        lift[t] = min(lift[t], lift[t + 1] + rate)
+    return lift
 
 
 def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend):
@@ -283,7 +320,7 @@ def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R,
         goal_t = t[on_toe] + corr_t[on_toe]
         lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
         corr_a[on_toe] = lifted - a[on_toe]
-    return corr_t
+    return corr_t, level_t
 
 
 def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray, r2: np.ndarray) -> np.ndarray:
@@ -368,6 +405,47 @@ def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | N
     return shift - shift.mean(axis=0)
 
 
+def _chain(motion: Motion, joints) -> list[int]:
+    """``joints``, the travel joint and all their ancestors, in skeleton order (parents first)."""
+    parents = motion.skeleton.parents
+    out: set[int] = set()
+    for j in list(joints) + [motion.travel_joint]:
+        j = int(j)
+        while j >= 0 and j not in out:
+            out.add(j)
+            j = int(parents[j])
+    return sorted(out)
+
+
+def _chain_transforms(motion: Motion, chain: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """World rotations ``(T, J, 3, 3)`` and positions ``(T, J, 3)`` of the joints of ``chain`` (NaN for the
+    others): forward kinematics of the legs only, not of a 100-joint rig's fingers and face."""
+    T, J = motion.n_frames, motion.n_joints
+    parents = motion.skeleton.parents
+    local = Rotation.from_quat(motion.rotations[:, chain].reshape(-1, 4)).as_matrix().reshape(T, len(chain), 3, 3)
+    Rw = np.full((T, J, 3, 3), np.nan)
+    W = np.full((T, J, 3), np.nan)
+    for i, j in enumerate(chain):
+        p = int(parents[j])
+        if p < 0:
+            Rw[:, j] = local[:, i]
+            W[:, j] = motion.translations[:, j]
+        else:
+            Rw[:, j] = Rw[:, p] @ local[:, i]
+            W[:, j] = W[:, p] + (Rw[:, p] @ motion.translations[:, j, :, None])[..., 0]
+    return Rw, W
+
+
+def _descendants(motion: Motion, joint: int) -> np.ndarray:
+    """``(J,)`` True for ``joint`` and every joint below it."""
+    parents = motion.skeleton.parents
+    below = np.zeros(motion.n_joints, bool)
+    below[joint] = True
+    for j in range(joint + 1, motion.n_joints):
+        below[j] = parents[j] >= 0 and below[parents[j]]
+    return below
+
+
 def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
     """``motion`` with its travel joint moved by ``world`` ``(T, 3)`` (world frame)."""
     travel = motion.travel_joint
@@ -392,12 +470,15 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
     n_blend = max(1, int(round(blend / motion.frame_time)))
     skel = motion.skeleton
-    Rw, W = motion.world_transforms()
+    legs = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle) + f.contact_joints})
+    chain = _chain(motion, legs)
+    below = _descendants(motion, motion.travel_joint)
+    Rw, W = _chain_transforms(motion, chain)
     if follow:
         shift = _root_shift(W, contacts, n_blend, period)
         if np.abs(shift).max() > 0:
             motion = _move_travel(motion, Rw, shift)
-            Rw, W = motion.world_transforms()
+            W[:, below] += shift[:, None]    # the travel joint and all below it move with it; no rotation changes
     n_extend = int(round(EXTEND_SECONDS / motion.frame_time))
     n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
     goals, toe_goals, held, changed = [], [], [], []
@@ -410,9 +491,13 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     delta = _lowering(W, contacts, goals, held, reach, n_blend)
     lowered = delta > 0
     if lowered.any():  # every foot keeps its goal in the world: a swing foot does not dip with the root
-        motion = _move_travel(motion, Rw, -np.outer(delta, contacts.up))
-        Rw, W = motion.world_transforms()
-    local = motion.rotation_matrices().copy()
+        down = -np.outer(delta, contacts.up)
+        motion = _move_travel(motion, Rw, down)
+        W[:, below] += down[:, None]
+    legs3 = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle)})
+    col = {j: i for i, j in enumerate(legs3)}
+    local = Rotation.from_quat(motion.rotations[:, legs3].reshape(-1, 4)).as_matrix().reshape(
+        motion.n_frames, len(legs3), 3, 3)
     for foot, g, gt, ch in zip(contacts.feet, goals, toe_goals, changed, strict=True):
         t = np.flatnonzero(ch | lowered)
         if t.size == 0:
@@ -430,19 +515,22 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
         hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
         Rp_hip = Rw[t, hp] if hp >= 0 else np.broadcast_to(np.eye(3), (t.size, 3, 3))
-        local[t, foot.hip] = np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rw[t, foot.hip]
-        local[t, foot.knee] = np.swapaxes(Rw[t, kp], 1, 2) @ R1 @ Rw[t, foot.knee]
+        local[t, col[foot.hip]] = np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rw[t, foot.hip]
+        local[t, col[foot.knee]] = np.swapaxes(Rw[t, kp], 1, 2) @ R1 @ Rw[t, foot.knee]
         aim = np.broadcast_to(np.eye(3), (t.size, 3, 3))
         if gt is not None:
             aim = _swing(W[t, foot.toe] - A, gt[t] - G)
         new_parent = R2 @ R1 @ Rw[t, ap]
-        local[t, foot.ankle] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
-    T, J = motion.n_frames, motion.n_joints
-    quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, J, 4)
+        local[t, col[foot.ankle]] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
+    T = motion.n_frames
+    quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, len(legs3), 4)
     # frames and joints not touched keep their exact quaternions
-    touched = np.zeros((T, J), bool)
+    touched = np.zeros((T, len(legs3)), bool)
     for foot, ch in zip(contacts.feet, changed, strict=True):
-        touched[np.ix_(ch | lowered, [foot.hip, foot.knee, foot.ankle])] = True
-    quats = np.where(touched[..., None], quats, motion.rotations)
-    sign = np.where(np.sum(quats * motion.rotations, axis=-1, keepdims=True) < 0, -1.0, 1.0)
-    return motion.replace(rotations=quats * sign)
+        touched[np.ix_(ch | lowered, [col[foot.hip], col[foot.knee], col[foot.ankle]])] = True
+    old = motion.rotations[:, legs3]
+    quats = np.where(touched[..., None], quats, old)
+    sign = np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    rotations = motion.rotations.copy()
+    rotations[:, legs3] = quats * sign
+    return motion.replace(rotations=rotations)
