@@ -54,11 +54,13 @@ DISTANCE_WEIGHT = 1.0  # a hold this much farther from the mean weighs like the 
 EXTEND_SECONDS = 0.2   # a hold reaches at most this far beyond its contact while the joint stays low
 EXTEND_HEIGHT = 0.025  # of the body height above the held height: "low" (the contact detector's height)
 EXTEND_DISTANCE = 0.03  # of the body height: "near" the held point horizontally (farther: no early plant)
+STRAIGHT_KNEE = 0.1   # sine of the knee angle below which the bend axis eases to the leg's usual one
+SOFT_ZONE = 0.03      # of the leg's length: a free goal this close to the reach eases in (soft IK)
 CLEARANCE = 0.015      # of the body height: a swinging foot clears this (the skate measure's H: below it a
                        # foot counts as on the floor)
 SLOW_SPEED = 0.25      # body heights/s: a free foot this slow is not lifted (it may be a stance the detector missed)
 SWING_SPEED = 0.5      # body heights/s: a free foot this fast is lifted fully
-LIFT_SECONDS = 0.05    # the lift changes by at most CLEARANCE in this time
+LIFT_SECONDS = 0.1     # the lift changes by at most CLEARANCE in this time
 BRIDGE_SECONDS = 0.6   # a gap between holds this short (a swing) is bridged; longer ones fade over the blend
 #: how firmly a contact joint is held on a frame: its own contact, its foot's other joint's contact (carried
 #: rigidly), its own low frames around a contact (held horizontally), the other joint's low frames
@@ -109,12 +111,16 @@ def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return Rotation.from_rotvec(rotvec).as_matrix()
 
 
+def _leg_length(W: np.ndarray, foot) -> np.ndarray:
+    """Hip-knee plus knee-ankle ``(T,)``."""
+    H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
+    return np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
+
+
 def _reach(W: np.ndarray, foot, reach: float) -> np.ndarray:
     """How far ``(T,)`` a held ankle may be from its hip: ``reach`` of the leg's length (a held knee never
     goes fully straight, where a millimetre of length takes a large knee angle)."""
-    H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
-    legs = np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
-    return np.maximum(reach * legs, np.linalg.norm(A - H, axis=1))
+    return np.maximum(reach * _leg_length(W, foot), np.linalg.norm(W[:, foot.ankle] - W[:, foot.hip], axis=1))
 
 
 def _need(goals: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -175,6 +181,17 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
     return corr, level
 
 
+def _frames_from(mask: np.ndarray) -> np.ndarray:
+    """``(T,)`` frames from each frame to the nearest True of ``mask`` (``inf`` without any)."""
+    T = mask.shape[0]
+    hits = np.flatnonzero(mask)
+    if hits.size == 0:
+        return np.full(T, np.inf)
+    k = np.clip(np.searchsorted(hits, np.arange(T)), 1, hits.size) - 1
+    nxt = hits[np.minimum(k + 1, hits.size - 1)]
+    return np.minimum(np.abs(np.arange(T) - hits[k]), np.abs(nxt - np.arange(T))).astype(float)
+
+
 def _follow(corr: np.ndarray, level: np.ndarray, other: np.ndarray, other_level: np.ndarray) -> None:
     """Where the other contact joint of the same foot holds and this one does not (as strongly), this one
     moves with it: the foot is carried rigidly (in place, levels ``FOLLOW`` and ``FOLLOW_LOW``)."""
@@ -205,17 +222,23 @@ def _bridge(corr: np.ndarray, n_bridge: int, n_fade: int) -> np.ndarray:
     return out
 
 
-def _into_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndarray) -> np.ndarray:
-    """``corr`` ``(T, 3)`` shortened (toward ``base``, which is within reach) so that ``base + corr`` is
-    within ``R`` ``(T,)`` of ``hips``."""
-    d = base - hips
-    aa = np.sum(corr * corr, axis=1)
-    bb = 2 * np.sum(d * corr, axis=1)
-    cc = np.sum(d * d, axis=1) - R ** 2
-    far = np.sum((d + corr) ** 2, axis=1) > R ** 2
-    disc = np.maximum(bb ** 2 - 4 * aa * cc, 0.0)
-    s = np.where(far & (aa > 0), (-bb + np.sqrt(disc)) / (2 * np.maximum(aa, 1e-300)), 1.0)
-    return corr * np.clip(s, 0.0, 1.0)[:, None]
+def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndarray,
+                zone: np.ndarray) -> np.ndarray:
+    """``corr`` ``(T, 3)`` changed so that ``base + corr`` stays within ``R`` ``(T,)`` of ``hips``, softly
+    (soft IK): a goal within ``zone`` ``(T,)`` of ``R`` (or beyond ``base``'s own distance, if that is
+    farther in) is pulled toward the hip by an exponential ease, so a leg straightens gradually as its goal
+    runs away and never snaps straight.  ``corr`` is unchanged where the goal is nearer than that."""
+    v = base + corr - hips
+    d = np.linalg.norm(v, axis=1)
+    raw = np.linalg.norm(base - hips, axis=1)
+    start = np.minimum(np.maximum(R - zone, raw), R)
+    room = R - start
+    out = corr.copy()
+    far = d > start
+    x = (d[far] - start[far]) / np.maximum(room[far], 1e-12 * d[far])
+    D = start[far] + room[far] * -np.expm1(-x)
+    out[far] = hips[far] + v[far] * (D / d[far])[:, None] - base[far]
+    return out
 
 
 def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
@@ -255,13 +278,14 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
         corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low,
                             near, n_extend)
     soft = (level_a > 0) & (level_a < FOLLOW)
-    corr_a[soft] = _into_reach(a[soft], corr_a[soft], hips[soft], R[soft])
+    zone = SOFT_ZONE * _leg_length(W, foot)
+    corr_a[soft] = _soft_reach(a[soft], corr_a[soft], hips[soft], R[soft], zone[soft])
     corr_a = _bridge(corr_a, n_bridge, n_fade)
     free = level_a == 0
-    corr_a[free] = _into_reach(a[free], corr_a[free], hips[free], R[free])
+    corr_a[free] = _soft_reach(a[free], corr_a[free], hips[free], R[free], zone[free])
     clear = CLEARANCE * body
     corr_a += np.outer(_lift(a + corr_a, level_a, up, clear, body, contacts.frame_time), up)
-    corr_a[free] = _into_reach(a[free], corr_a[free], hips[free], R[free])
+    corr_a[free] = _soft_reach(a[free], corr_a[free], hips[free], R[free], zone[free])
     changed = np.any(corr_a != 0, axis=1)
     if corr_t is None:
         return a + corr_a, None, level_a >= FOLLOW, changed
@@ -310,6 +334,17 @@ def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R,
             fr = np.arange(s, e)
             held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
     corr_t, level_t = _own_holds(t, mt, held_t, up, low, near, n_extend)
+    # both low around a contact: the joint nearer its own contact leads and the other is carried with it
+    # (the heel leads a landing, the toe a push-off), so the foot keeps its own roll and is not stretched
+    # between two holds and then let go
+    both = (level_a == LOW) & (level_t == LOW)
+    if both.any():
+        da, dt = _frames_from(level_a == HELD), _frames_from(level_t == HELD)
+        for lead, (c_own, l_own, c_other) in (((dt < da), (corr_a, level_a, corr_t)),
+                                                ((da <= dt), (corr_t, level_t, corr_a))):
+            m = both & lead
+            c_own[m] = c_other[m]
+            l_own[m] = FOLLOW_LOW
     _follow(corr_a, level_a, corr_t, level_t)
     _follow(corr_t, level_t, corr_a, level_a)
     # a held toe with the ankle out of the leg's reach: the heel lifts (the foot turns about the toe) until
@@ -359,22 +394,29 @@ def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weight
 
 
 def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
-    """Unit normals ``(T, 3)`` of the hip-knee-ankle plane; a straight leg takes the mean normal in its
-    thigh's frame over the frames where the knee is bent."""
-    n = np.cross(u1, u2)
-    s = np.linalg.norm(n, axis=1)
-    ok = s > 1e-4
-    n = np.where(ok[:, None], n / np.maximum(s, 1e-300)[:, None], 0.0)
-    if not ok.all():
-        if ok.any():
-            local = np.einsum("tji,tj->ti", Rw_hip[ok], n[ok]).mean(axis=0)
-        else:  # never bent: any axis across the leg
-            local = np.cross(np.einsum("tji,tj->ti", Rw_hip, u1).mean(axis=0), [0.0, 0.0, 1.0])
-            if np.linalg.norm(local) < 1e-9:
-                local = np.array([1.0, 0.0, 0.0])
-        local = local / np.linalg.norm(local)
-        n[~ok] = np.einsum("tij,j->ti", Rw_hip[~ok], local)
-    return n
+    """Unit normals ``(T, 3)`` of the hip-knee-ankle plane, eased toward the leg's usual bend axis as the
+    knee straightens: ``thigh x shin`` (its length is the sine of the knee angle) plus ``STRAIGHT_KNEE`` times
+    the mean bend axis in the thigh's frame (weighted by the bend).  A nearly straight knee, whose own plane
+    is undefined or turns fast, so bends about its usual axis, and the normal never jumps."""
+    c = np.cross(u1, u2)
+    local = np.einsum("tji,tj->ti", Rw_hip, c).sum(axis=0)
+    if np.linalg.norm(local) < 1e-9:  # never bent: any axis across the leg
+        local = np.cross(np.einsum("tji,tj->ti", Rw_hip, u1).mean(axis=0), [0.0, 0.0, 1.0])
+        if np.linalg.norm(local) < 1e-9:
+            local = np.array([1.0, 0.0, 0.0])
+    local = local / np.linalg.norm(local)
+    return _normalize(c + STRAIGHT_KNEE * np.einsum("tij,j->ti", Rw_hip, local))
+
+
+def _knee_turn(u1: np.ndarray, u2: np.ndarray, n: np.ndarray, cos1: np.ndarray) -> np.ndarray:
+    """The angle ``(T,)`` to turn the shin ``u2`` about the unit axis ``n`` so that ``u1 . u2`` becomes
+    ``cos1`` (exactly, for an axis off the leg's plane too: ``p + A cos x + B sin x = cos1``); the root
+    that bends the knee about ``n`` the usual way (for the plane's normal: new bend minus old bend)."""
+    p = np.sum(u1 * n, axis=1) * np.sum(u2 * n, axis=1)
+    A = np.sum(u1 * u2, axis=1) - p
+    B = np.sum(u1 * np.cross(n, u2), axis=1)
+    r = np.hypot(A, B)
+    return np.arctan2(B, A) + np.arccos(np.clip((cos1 - p) / np.maximum(r, 1e-300), -1.0, 1.0))
 
 
 def _weights(contacts: Contacts, n_blend: int) -> np.ndarray:
@@ -507,10 +549,9 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         l2 = np.linalg.norm(A - K, axis=1)
         u1, u2 = (K - H) / l1[:, None], (A - K) / l2[:, None]
         n = _bend_normals(Rw[t, foot.hip], u1, u2)
-        beta0 = np.arctan2(np.sum(np.cross(u1, u2) * n, axis=1), np.sum(u1 * u2, axis=1))
         d = np.clip(np.linalg.norm(G - H, axis=1), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
-        beta1 = np.pi - np.arccos(np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0))
-        R1 = Rotation.from_rotvec(n * (beta1 - beta0)[:, None]).as_matrix()     # knee bend, world frame
+        cos1 = -np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0)  # thigh . shin wanted
+        R1 = Rotation.from_rotvec(n * _knee_turn(u1, u2, n, cos1)[:, None]).as_matrix()  # knee bend, world
         A1 = K + np.einsum("tij,tj->ti", R1, A - K)
         R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
         hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
