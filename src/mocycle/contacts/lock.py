@@ -275,8 +275,8 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
     corr_a, level_a = _own_holds(a, ma, held_a, up, low, near, n_extend)
     corr_t = None
     if foot.toe is not None:
-        corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low,
-                            near, n_extend)
+        corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body,
+                                     low, near, n_extend, n_fade)
     soft = (level_a > 0) & (level_a < FOLLOW)
     zone = SOFT_ZONE * _leg_length(W, foot)
     corr_a[soft] = _soft_reach(a[soft], corr_a[soft], hips[soft], R[soft], zone[soft])
@@ -322,7 +322,8 @@ def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, bod
     return lift
 
 
-def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend):
+def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend,
+               n_ease):
     """The toe's corrections (NaN where not held); the ankle's (``corr_a``, ``level_a``) updated in place
     where it follows the held toe (heel lifted where the leg cannot reach)."""
     held_t = []
@@ -355,7 +356,27 @@ def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R,
         goal_t = t[on_toe] + corr_t[on_toe]
         lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
         corr_a[on_toe] = lifted - a[on_toe]
+    _ease_carried(corr_a, level_a, n_ease)
+    if on_toe.any():  # still one foot length from the held toe (the toe is aimed at, so it stays put)
+        goal_t = t[on_toe] + corr_t[on_toe]
+        length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
+        corr_a[on_toe] = goal_t + length[:, None] * _normalize(a[on_toe] + corr_a[on_toe] - goal_t) - a[on_toe]
     return corr_t, level_t
+
+
+def _ease_carried(corr: np.ndarray, level: np.ndarray, n: int) -> None:
+    """Where the ankle goes from its own hold to being carried with the held toe (or back), the jump
+    between the two corrections is eased out over ``n`` frames of the carried run, so a heel let go while
+    the toe still holds rises over a few frames instead of popping up (in place).  (The toe is not eased:
+    carried with a held ankle it stays still.)"""
+    T = corr.shape[0]
+    for p, q in ranges((level == FOLLOW) | (level == FOLLOW_LOW)):
+        t = np.arange(p, min(q, p + n))
+        if p > 0 and level[p - 1] == HELD:
+            corr[t] += np.outer(1.0 - _smoothstep((t - p + 1) / (n + 1)), corr[p - 1] - corr[p])
+        t = np.arange(max(p, q - n), q)
+        if q < T and level[q] == HELD:
+            corr[t] += np.outer(_smoothstep((t - (q - n - 1)) / (n + 1)), corr[q] - corr[q - 1])
 
 
 def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray, r2: np.ndarray) -> np.ndarray:
