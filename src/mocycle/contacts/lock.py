@@ -259,7 +259,7 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
     for i, (s, e) in enumerate(rt):
         overlaps = [min(e, y) - max(s, x) for x, y in ra]
         k = int(np.argmax(overlaps)) if overlaps else -1
-        if k >= 0 and overlaps[k] > 0:
+        if k >= 0 and overlaps[k] >= 0:  # overlapping or back to back: one rigid-foot hold
             partner[i] = (k, (max(s, ra[k][0]) + min(e, ra[k][1]) - 1) // 2)
     held_a = []
     for k, (s, e) in enumerate(ra):
