@@ -34,7 +34,7 @@ def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend:
     N = cycle.n_frames
     ext = cycle.repeat(4, root="motion")
     contacts = detect_contacts(ext, feet, **detect_options)
-    locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N)[N:2 * N]
+    locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N, frames=slice(N, 2 * N))
     P, L = cycle.space.encode(locked)
     turn, move = cycle.drift[3], cycle.drift[:3]
     R = axis_rotations(cycle.space.up, np.array([turn]))[0]

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion
-from .feet import Foot, body_height, find_feet, up_axis
+from .feet import Foot, body_height, chain_joints, chain_transforms, find_feet, up_axis
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
 CONTACT_SPEED = 0.15    # body heights per second, horizontal
@@ -189,7 +189,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
     body = body_height(motion, up)
     joints = tuple(j for f in feet for j in f.contact_joints)
     foot_of = tuple(i for i, f in enumerate(feet) for _ in f.contact_joints)
-    W = motion.world_positions()
+    W = chain_transforms(motion, chain_joints(motion, joints))[1]   # the feet and the travel joint only
     h, v, vu = heights_and_speeds(motion, joints, up, positions=W)
     h, v, vu = h / body, v / body, vu / body
     # a foot under a running body is planted when it is slow for the body: a fitted or resampled stance

@@ -45,8 +45,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
-from ..threads import limit_threads
 from .detect import Contacts, ranges
+from .feet import chain_joints, chain_transforms
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
 REACH = 0.995        # of hip-knee plus knee-ankle: farther goals lower the root
@@ -101,10 +101,17 @@ def _normalize(v: np.ndarray) -> np.ndarray:
     return v / np.maximum(n, 1e-300)
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of ``(T, 3)`` arrays (``np.cross`` without its axis handling: it is called
+    on short arrays many times)."""
+    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+
+
 def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The smallest rotations ``(T, 3, 3)`` turning the directions of ``a`` into those of ``b`` ``(T, 3)``."""
     a, b = _normalize(a), _normalize(b)
-    axis = np.cross(a, b)
+    axis = _cross(a, b)
     s = np.linalg.norm(axis, axis=-1)
     angle = np.arctan2(s, np.sum(a * b, axis=-1))
     rotvec = _normalize(axis) * angle[:, None]
@@ -171,13 +178,13 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
         top = target @ up + low
         for frames, edge in ((range(a - 1, max(0, a - n_before) - 1, -1), a),
                              (range(b, min(T, b + n_after)), b - 1)):
-            lift = corr[edge] @ up
-            for t in frames:
-                c = target - path[t]
-                if height[t] >= top or np.linalg.norm(c - (c @ up) * up) > near:
-                    break
-                corr[t] = c + (lift - c @ up) * up
-                level[t] = LOW
+            f = np.asarray(frames, dtype=int)
+            c = target - path[f]
+            cu = c @ up
+            ok = (height[f] < top) & (np.linalg.norm(c - np.outer(cu, up), axis=1) <= near)
+            f, c, cu = (x[:int(np.argmin(ok)) if not ok.all() else ok.size] for x in (f, c, cu))  # up to the first miss
+            corr[f] = c + np.outer(corr[edge] @ up - cu, up)
+            level[f] = LOW
     return corr, level
 
 
@@ -419,7 +426,7 @@ def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndar
     knee straightens: ``thigh x shin`` (its length is the sine of the knee angle) plus ``STRAIGHT_KNEE`` times
     the mean bend axis in the thigh's frame (weighted by the bend).  A nearly straight knee, whose own plane
     is undefined or turns fast, so bends about its usual axis, and the normal never jumps."""
-    c = np.cross(u1, u2)
+    c = _cross(u1, u2)
     local = np.einsum("tji,tj->ti", Rw_hip, c).sum(axis=0)
     if np.linalg.norm(local) < 1e-9:  # never bent: any axis across the leg
         local = np.cross(np.einsum("tji,tj->ti", Rw_hip, u1).mean(axis=0), [0.0, 0.0, 1.0])
@@ -435,7 +442,7 @@ def _knee_turn(u1: np.ndarray, u2: np.ndarray, n: np.ndarray, cos1: np.ndarray) 
     that bends the knee about ``n`` the usual way (for the plane's normal: new bend minus old bend)."""
     p = np.sum(u1 * n, axis=1) * np.sum(u2 * n, axis=1)
     A = np.sum(u1 * u2, axis=1) - p
-    B = np.sum(u1 * np.cross(n, u2), axis=1)
+    B = np.sum(u1 * _cross(n, u2), axis=1)
     r = np.hypot(A, B)
     return np.arctan2(B, A) + np.arccos(np.clip((cos1 - p) / np.maximum(r, 1e-300), -1.0, 1.0))
 
@@ -468,37 +475,6 @@ def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | N
     return shift - shift.mean(axis=0)
 
 
-def _chain(motion: Motion, joints) -> list[int]:
-    """``joints``, the travel joint and all their ancestors, in skeleton order (parents first)."""
-    parents = motion.skeleton.parents
-    out: set[int] = set()
-    for j in list(joints) + [motion.travel_joint]:
-        j = int(j)
-        while j >= 0 and j not in out:
-            out.add(j)
-            j = int(parents[j])
-    return sorted(out)
-
-
-def _chain_transforms(motion: Motion, chain: list[int]) -> tuple[np.ndarray, np.ndarray]:
-    """World rotations ``(T, J, 3, 3)`` and positions ``(T, J, 3)`` of the joints of ``chain`` (NaN for the
-    others): forward kinematics of the legs only, not of a 100-joint rig's fingers and face."""
-    T, J = motion.n_frames, motion.n_joints
-    parents = motion.skeleton.parents
-    local = Rotation.from_quat(motion.rotations[:, chain].reshape(-1, 4)).as_matrix().reshape(T, len(chain), 3, 3)
-    Rw = np.full((T, J, 3, 3), np.nan)
-    W = np.full((T, J, 3), np.nan)
-    for i, j in enumerate(chain):
-        p = int(parents[j])
-        if p < 0:
-            Rw[:, j] = local[:, i]
-            W[:, j] = motion.translations[:, j]
-        else:
-            Rw[:, j] = Rw[:, p] @ local[:, i]
-            W[:, j] = W[:, p] + (Rw[:, p] @ motion.translations[:, j, :, None])[..., 0]
-    return Rw, W
-
-
 def _descendants(motion: Motion, joint: int) -> np.ndarray:
     """``(J,)`` True for ``joint`` and every joint below it."""
     parents = motion.skeleton.parents
@@ -519,24 +495,25 @@ def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
     return motion.replace(translations=trans)
 
 
-@limit_threads
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
-              follow: bool = True, period: int | None = None) -> Motion:
+              follow: bool = True, period: int | None = None, frames: slice | None = None) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
 
     ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
     beyond which the root is lowered; ``follow``: first move the root horizontally with the planted feet;
     ``period``: the motion is a loop repeated every ``period`` frames (at least three times), so the root
-    correction keeps the travel of each period.  Returns a new Motion with the same skeleton and frame time.
+    correction keeps the travel of each period; ``frames``: solve and return only these frames (the rest
+    is context: the frames of a loop's repeat that are read back).  Returns a new Motion with the same
+    skeleton and frame time.
     """
     if contacts.n_frames != motion.n_frames:
         raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
     n_blend = max(1, int(round(blend / motion.frame_time)))
     skel = motion.skeleton
     legs = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle) + f.contact_joints})
-    chain = _chain(motion, legs)
+    chain = chain_joints(motion, legs)
     below = _descendants(motion, motion.travel_joint)
-    Rw, W = _chain_transforms(motion, chain)
+    Rw, W = chain_transforms(motion, chain)
     if follow:
         shift = _root_shift(W, contacts, n_blend, period)
         if np.abs(shift).max() > 0:
@@ -557,12 +534,14 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         down = -np.outer(delta, contacts.up)
         motion = _move_travel(motion, Rw, down)
         W[:, below] += down[:, None]
+    window = np.zeros(motion.n_frames, bool)
+    window[frames if frames is not None else slice(None)] = True
     legs3 = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle)})
     col = {j: i for i, j in enumerate(legs3)}
     local = Rotation.from_quat(motion.rotations[:, legs3].reshape(-1, 4)).as_matrix().reshape(
         motion.n_frames, len(legs3), 3, 3)
     for foot, g, gt, ch in zip(contacts.feet, goals, toe_goals, changed, strict=True):
-        t = np.flatnonzero(ch | lowered)
+        t = np.flatnonzero((ch | lowered) & window)
         if t.size == 0:
             continue
         H, K, A, G = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle], g[t]
@@ -584,6 +563,9 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
             aim = _swing(W[t, foot.toe] - A, gt[t] - G)
         new_parent = R2 @ R1 @ Rw[t, ap]
         local[t, col[foot.ankle]] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
+    if frames is not None:
+        motion, local, lowered = motion[frames], local[frames], lowered[frames]
+        changed = [ch[frames] for ch in changed]
     T = motion.n_frames
     quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, len(legs3), 4)
     # frames and joints not touched keep their exact quaternions
