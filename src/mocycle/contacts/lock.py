@@ -284,15 +284,9 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
     if foot.toe is not None:
         corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body,
                                      low, near, n_extend, n_fade)
-    soft = (level_a > 0) & (level_a < FOLLOW)
-    zone = SOFT_ZONE * _leg_length(W, foot)
-    corr_a[soft] = _soft_reach(a[soft], corr_a[soft], hips[soft], R[soft], zone[soft])
     corr_a = _bridge(corr_a, n_bridge, n_fade)
-    free = level_a == 0
-    corr_a[free] = _soft_reach(a[free], corr_a[free], hips[free], R[free], zone[free])
     clear = CLEARANCE * body
     corr_a += np.outer(_lift(a + corr_a, level_a, up, clear, body, contacts.frame_time), up)
-    corr_a[free] = _soft_reach(a[free], corr_a[free], hips[free], R[free], zone[free])
     changed = np.any(corr_a != 0, axis=1)
     if corr_t is None:
         return a + corr_a, None, level_a >= FOLLOW, changed
@@ -364,6 +358,7 @@ def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R,
         lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
         corr_a[on_toe] = lifted - a[on_toe]
     _ease_carried(corr_a, level_a, n_ease)
+    _ease_carried(corr_t, level_t, n_ease)
     if on_toe.any():  # still one foot length from the held toe (the toe is aimed at, so it stays put)
         goal_t = t[on_toe] + corr_t[on_toe]
         length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
@@ -372,10 +367,10 @@ def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R,
 
 
 def _ease_carried(corr: np.ndarray, level: np.ndarray, n: int) -> None:
-    """Where the ankle goes from its own hold to being carried with the held toe (or back), the jump
-    between the two corrections is eased out over ``n`` frames of the carried run, so a heel let go while
-    the toe still holds rises over a few frames instead of popping up (in place).  (The toe is not eased:
-    carried with a held ankle it stays still.)"""
+    """Where a contact joint goes from its own hold to being carried with the other joint of its foot (or
+    back), the jump between the two corrections is eased out over ``n`` frames of the carried run, so a
+    heel let go while the toe still holds rises over a few frames instead of popping up, and a toe coming
+    down about a held heel lands on its hold without a snap (in place)."""
     T = corr.shape[0]
     for p, q in ranges((level == FOLLOW) | (level == FOLLOW_LOW)):
         t = np.arange(p, min(q, p + n))
@@ -534,6 +529,11 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         down = -np.outer(delta, contacts.up)
         motion = _move_travel(motion, Rw, down)
         W[:, below] += down[:, None]
+    for foot, g, h in zip(contacts.feet, goals, held, strict=True):  # goals not held: within reach, softly
+        free = ~h
+        base, hips = W[free, foot.ankle], W[free, foot.hip]
+        R, zone = _reach(W, foot, reach)[free], SOFT_ZONE * _leg_length(W, foot)[free]
+        g[free] = base + _soft_reach(base, g[free] - base, hips, R, zone)
     window = np.zeros(motion.n_frames, bool)
     window[frames if frames is not None else slice(None)] = True
     legs3 = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle)})
