@@ -230,11 +230,13 @@ def _bridge(corr: np.ndarray, n_bridge: int, n_fade: int) -> np.ndarray:
 
 
 def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndarray,
-                zone: np.ndarray) -> np.ndarray:
+                zone: np.ndarray, up: np.ndarray | None = None) -> np.ndarray:
     """``corr`` ``(T, 3)`` changed so that ``base + corr`` stays within ``R`` ``(T,)`` of ``hips``, softly
     (soft IK): a goal within ``zone`` ``(T,)`` of ``R`` (or beyond ``base``'s own distance, if that is
     farther in) is pulled toward the hip by an exponential ease, so a leg straightens gradually as its goal
-    runs away and never snaps straight.  ``corr`` is unchanged where the goal is nearer than that."""
+    runs away and never snaps straight.  With ``up`` the goal is raised along it (its horizontal place
+    kept) where that is enough, else pulled toward the hip.  ``corr`` is unchanged where the goal is nearer
+    than that."""
     v = base + corr - hips
     d = np.linalg.norm(v, axis=1)
     raw = np.linalg.norm(base - hips, axis=1)
@@ -244,7 +246,14 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
     far = d > start
     x = (d[far] - start[far]) / np.maximum(room[far], 1e-12 * d[far])
     D = start[far] + room[far] * -np.expm1(-x)
-    out[far] = hips[far] + v[far] * (D / d[far])[:, None] - base[far]
+    vf = v[far]
+    radial = vf * (D / d[far])[:, None]
+    if up is not None:  # raised straight up where that reaches: a foot held horizontally keeps its place
+        vu = vf @ up
+        disc = vu ** 2 - d[far] ** 2 + D ** 2
+        s = -vu - np.sqrt(np.maximum(disc, 0.0))
+        radial = np.where((disc >= 0)[:, None], vf + np.outer(s, up), radial)
+    out[far] = hips[far] + radial - base[far]
     return out
 
 
@@ -533,7 +542,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         free = ~h
         base, hips = W[free, foot.ankle], W[free, foot.hip]
         R, zone = _reach(W, foot, reach)[free], SOFT_ZONE * _leg_length(W, foot)[free]
-        g[free] = base + _soft_reach(base, g[free] - base, hips, R, zone)
+        g[free] = base + _soft_reach(base, g[free] - base, hips, R, zone, contacts.up)
     window = np.zeros(motion.n_frames, bool)
     window[frames if frames is not None else slice(None)] = True
     legs3 = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle)})
