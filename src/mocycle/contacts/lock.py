@@ -19,20 +19,27 @@
    ``EXTEND_DISTANCE`` of the held point (at most ``EXTEND_SECONDS``), it is
    held horizontally and keeps its own vertical path: a heel coming down or a
    toe lifting away moves straight down or up instead of gliding on the floor.
+   Where both joints of a foot are low, the one nearer its own contact leads
+   and the other is carried with it; a joint handed over between its own hold
+   and being carried is eased over ``blend`` seconds.
 4. **Swings.** Between two holds of a joint (a gap of at most
    ``BRIDGE_SECONDS``) the correction goes from the one hold's to the next's
    by a smoothstep, so a swing foot keeps the shape of its world path, only
    shifted; longer gaps and the ends of a take fade the correction out over
-   ``blend`` seconds.  Goals off the holds are kept within the leg's reach.
+   ``blend`` seconds.  A joint between two holds that moves faster than
+   ``SWING_SPEED`` clears ``CLEARANCE`` of the body height above its lowest
+   level (a swinging foot does not skim the floor; the lift is rate-limited).
 5. **Root lowering.** Where a held ankle goal is still farther from its hip
    than ``reach`` of the leg's length, the root goes down along the vertical
    (smoothed over the blend window so it never jumps and is never less than
    needed); every foot keeps its goal in the world, so a swing foot does not
-   dip with the root.
+   dip with the root.  Goals not held are then brought within reach softly
+   (soft IK: raised, or pulled toward the hip, with an exponential ease).
 6. **Two-bone IK.** The knee bends about the normal of the hip-knee-ankle
    plane until the hip-ankle distance is right, then the thigh swings by the
    smallest rotation that puts the ankle on its goal (the knee stays in the
-   leg's plane, only turned with it); the foot keeps its world orientation,
+   leg's plane, only turned with it; a nearly straight knee bends about the
+   leg's usual axis); the foot keeps its world orientation,
    turned by the smallest rotation that points it at the toe goal.
 
 Only local rotations of hips, knees and ankles change, and the travel
