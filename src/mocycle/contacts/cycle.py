@@ -1,8 +1,8 @@
 """Foot locking for loops: contacts that cross the seam are one contact, and the cleaned cycle still loops.
 
-A cycle of ``N`` frames is repeated four times with its root motion (each
+A cycle of ``N`` frames is repeated three times with its root motion (each
 repeat moved on by the travel and turned by the turn per cycle), contacts are
-found and locked on those ``4N`` frames, and the second repeat's ``N`` frames
+found and locked on those ``3N`` frames, and the second (middle) repeat's ``N`` frames
 are read back into the cycle's own space, moved back by one cycle.  Everything
 the clean-up does depends only on the frames around it (contacts, their means,
 the low frames, the swing bridges and the root lowering reach less than a
@@ -32,9 +32,9 @@ def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend:
     """The cycle with its feet locked, and its contacts over its ``N`` frames (a contact running over the
     last frame continues at frame 0)."""
     N = cycle.n_frames
-    ext = cycle.repeat(4, root="motion")
+    ext = cycle.repeat(3, root="motion")
     contacts = detect_contacts(ext, feet, **detect_options)
-    locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N)[N:2 * N]
+    locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N, frames=slice(N, 2 * N))
     P, L = cycle.space.encode(locked)
     turn, move = cycle.drift[3], cycle.drift[:3]
     R = axis_rotations(cycle.space.up, np.array([turn]))[0]

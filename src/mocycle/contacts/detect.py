@@ -27,14 +27,16 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion
-from .feet import Foot, body_height, find_feet, up_axis
+from .feet import Foot, body_height, chain_joints, chain_transforms, find_feet, up_axis
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
 CONTACT_SPEED = 0.15    # body heights per second, horizontal
 CONTACT_RISE = 0.05     # body heights per second, vertical: a heel that lifts faster is not planted
+TRAVEL_SHARE = 0.15     # or this share of the body's own horizontal speed (over TRAVEL_SECONDS), if faster
+TRAVEL_SECONDS = 0.5    # std of the Gaussian the body's speed is averaged with
 RELEASE = 1.5           # a contact ends above RELEASE × the thresholds
 SMOOTH_SECONDS = 1 / 60  # std of the Gaussian the positions are smoothed with before differencing
-MIN_CONTACT = 0.06      # seconds
+MIN_CONTACT = 0.03      # seconds
 MIN_GAP = 0.06          # seconds
 
 
@@ -153,17 +155,31 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
     return h, np.linalg.norm(v - vu[..., None] * up, axis=-1), np.abs(vu)
 
 
+def _travel_speed(motion: Motion, W: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """``(T,)`` horizontal speed of the travel joint (units/s), averaged by a Gaussian of ``TRAVEL_SECONDS``."""
+    if motion.n_frames < 2:
+        return np.zeros(motion.n_frames)
+    from scipy.ndimage import gaussian_filter1d  # only when feet are locked
+
+    p = W[:, motion.travel_joint]
+    v = np.gradient(p, motion.frame_time, axis=0)
+    v = np.linalg.norm(v - np.outer(v @ up, up), axis=1)
+    return gaussian_filter1d(v, TRAVEL_SECONDS / motion.frame_time, mode="nearest")
+
+
 def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = CONTACT_HEIGHT,
                     speed: float = CONTACT_SPEED, rise: float = CONTACT_RISE, release: float = RELEASE,
                     min_contact: float = MIN_CONTACT,
-                    min_gap: float = MIN_GAP, up: np.ndarray | None = None) -> Contacts:
+                    min_gap: float = MIN_GAP, travel: float = TRAVEL_SHARE, up: np.ndarray | None = None) -> Contacts:
     """Contacts of every contact joint of ``feet`` (default: :func:`find_feet`; a string names them).
 
     ``height``: fraction of the body height above the joint's lowest level; ``speed``: body heights per
-    second (horizontal), ``rise``: body heights per second (vertical); ``release``: hysteresis factor (> 1);
+    second (horizontal), or ``travel`` times the body's own horizontal speed where that is more (averaged
+    over ``TRAVEL_SECONDS``), ``rise``: body heights per second (vertical); ``release``: hysteresis factor (> 1);
     ``min_contact``, ``min_gap``: seconds.
     """
-    if not (height > 0 and speed > 0 and rise > 0 and release >= 1 and min_contact >= 0 and min_gap >= 0):
+    if not (height > 0 and speed > 0 and rise > 0 and release >= 1 and min_contact >= 0 and min_gap >= 0
+            and travel >= 0):
         raise MocycleError(f"contact thresholds must be positive (height {height}, speed {speed}, release "
                            f"{release} >= 1, durations {min_contact}, {min_gap} >= 0)")
     if feet is None or isinstance(feet, str):
@@ -173,8 +189,12 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
     body = body_height(motion, up)
     joints = tuple(j for f in feet for j in f.contact_joints)
     foot_of = tuple(i for i, f in enumerate(feet) for _ in f.contact_joints)
-    h, v, vu = heights_and_speeds(motion, joints, up)
+    W = chain_transforms(motion, chain_joints(motion, joints))[1]   # the feet and the travel joint only
+    h, v, vu = heights_and_speeds(motion, joints, up, positions=W)
     h, v, vu = h / body, v / body, vu / body
+    # a foot under a running body is planted when it is slow for the body: a fitted or resampled stance
+    # glides at a share of the travel speed
+    speed = np.maximum(speed, travel * _travel_speed(motion, W, up) / body)
     fps = motion.fps
     n_contact = max(1, int(round(min_contact * fps)))
     n_gap = max(1, int(round(min_gap * fps)))

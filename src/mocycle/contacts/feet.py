@@ -22,6 +22,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from ..axes import vertical_axis
 from ..errors import MocycleError
@@ -212,3 +213,34 @@ def body_height(motion: Motion, up: np.ndarray | None = None) -> float:
     W = motion[::max(1, motion.n_frames // 50)].world_positions(end_sites=True)
     pose = (W[:, keep] - W[:, travel:travel + 1]).mean(axis=0)
     return float(np.ptp(pose @ up)) or 1.0
+
+
+def chain_joints(motion: Motion, joints) -> list[int]:
+    """``joints``, the travel joint and all their ancestors, in skeleton order (parents first)."""
+    parents = motion.skeleton.parents
+    out: set[int] = set()
+    for j in list(joints) + [motion.travel_joint]:
+        j = int(j)
+        while j >= 0 and j not in out:
+            out.add(j)
+            j = int(parents[j])
+    return sorted(out)
+
+
+def chain_transforms(motion: Motion, chain: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """World rotations ``(T, J, 3, 3)`` and positions ``(T, J, 3)`` of the joints of ``chain`` (NaN for the
+    others): forward kinematics of the legs only, not of a 100-joint rig's fingers and face."""
+    T, J = motion.n_frames, motion.n_joints
+    parents = motion.skeleton.parents
+    local = Rotation.from_quat(motion.rotations[:, chain].reshape(-1, 4)).as_matrix().reshape(T, len(chain), 3, 3)
+    Rw = np.full((T, J, 3, 3), np.nan)
+    W = np.full((T, J, 3), np.nan)
+    for i, j in enumerate(chain):
+        p = int(parents[j])
+        if p < 0:
+            Rw[:, j] = local[:, i]
+            W[:, j] = motion.translations[:, j]
+        else:
+            Rw[:, j] = Rw[:, p] @ local[:, i]
+            W[:, j] = W[:, p] + (Rw[:, p] @ motion.translations[:, j, :, None])[..., 0]
+    return Rw, W

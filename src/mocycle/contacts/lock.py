@@ -19,20 +19,27 @@
    ``EXTEND_DISTANCE`` of the held point (at most ``EXTEND_SECONDS``), it is
    held horizontally and keeps its own vertical path: a heel coming down or a
    toe lifting away moves straight down or up instead of gliding on the floor.
+   Where both joints of a foot are low, the one nearer its own contact leads
+   and the other is carried with it; a joint handed over between its own hold
+   and being carried is eased over ``blend`` seconds.
 4. **Swings.** Between two holds of a joint (a gap of at most
    ``BRIDGE_SECONDS``) the correction goes from the one hold's to the next's
    by a smoothstep, so a swing foot keeps the shape of its world path, only
    shifted; longer gaps and the ends of a take fade the correction out over
-   ``blend`` seconds.  Goals off the holds are kept within the leg's reach.
+   ``blend`` seconds.  A joint between two holds that moves faster than
+   ``SWING_SPEED`` clears ``CLEARANCE`` of the body height above its lowest
+   level (a swinging foot does not skim the floor; the lift is rate-limited).
 5. **Root lowering.** Where a held ankle goal is still farther from its hip
    than ``reach`` of the leg's length, the root goes down along the vertical
    (smoothed over the blend window so it never jumps and is never less than
    needed); every foot keeps its goal in the world, so a swing foot does not
-   dip with the root.
+   dip with the root.  Goals not held are then brought within reach softly
+   (soft IK: raised, or pulled toward the hip, with an exponential ease).
 6. **Two-bone IK.** The knee bends about the normal of the hip-knee-ankle
    plane until the hip-ankle distance is right, then the thigh swings by the
    smallest rotation that puts the ankle on its goal (the knee stays in the
-   leg's plane, only turned with it); the foot keeps its world orientation,
+   leg's plane, only turned with it; a nearly straight knee bends about the
+   leg's usual axis); the foot keeps its world orientation,
    turned by the smallest rotation that points it at the toe goal.
 
 Only local rotations of hips, knees and ankles change, and the travel
@@ -45,8 +52,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
-from ..threads import limit_threads
 from .detect import Contacts, ranges
+from .feet import chain_joints, chain_transforms
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
 REACH = 0.995        # of hip-knee plus knee-ankle: farther goals lower the root
@@ -54,6 +61,13 @@ DISTANCE_WEIGHT = 1.0  # a hold this much farther from the mean weighs like the 
 EXTEND_SECONDS = 0.2   # a hold reaches at most this far beyond its contact while the joint stays low
 EXTEND_HEIGHT = 0.025  # of the body height above the held height: "low" (the contact detector's height)
 EXTEND_DISTANCE = 0.03  # of the body height: "near" the held point horizontally (farther: no early plant)
+STRAIGHT_KNEE = 0.1   # sine of the knee angle below which the bend axis eases to the leg's usual one
+SOFT_ZONE = 0.03      # of the leg's length: a free goal this close to the reach eases in (soft IK)
+CLEARANCE = 0.015      # of the body height: a swinging foot clears this (the skate measure's H: below it a
+                       # foot counts as on the floor)
+SLOW_SPEED = 0.25      # body heights/s: a free foot this slow is not lifted (it may be a stance the detector missed)
+SWING_SPEED = 0.5      # body heights/s: a free foot this fast is lifted fully
+LIFT_SECONDS = 0.1     # the lift changes by at most CLEARANCE in this time
 BRIDGE_SECONDS = 0.6   # a gap between holds this short (a swing) is bridged; longer ones fade over the blend
 #: how firmly a contact joint is held on a frame: its own contact, its foot's other joint's contact (carried
 #: rigidly), its own low frames around a contact (held horizontally), the other joint's low frames
@@ -94,22 +108,33 @@ def _normalize(v: np.ndarray) -> np.ndarray:
     return v / np.maximum(n, 1e-300)
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of ``(T, 3)`` arrays (``np.cross`` without its axis handling: it is called
+    on short arrays many times)."""
+    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+
+
 def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The smallest rotations ``(T, 3, 3)`` turning the directions of ``a`` into those of ``b`` ``(T, 3)``."""
     a, b = _normalize(a), _normalize(b)
-    axis = np.cross(a, b)
+    axis = _cross(a, b)
     s = np.linalg.norm(axis, axis=-1)
     angle = np.arctan2(s, np.sum(a * b, axis=-1))
     rotvec = _normalize(axis) * angle[:, None]
     return Rotation.from_rotvec(rotvec).as_matrix()
 
 
+def _leg_length(W: np.ndarray, foot) -> np.ndarray:
+    """Hip-knee plus knee-ankle ``(T,)``."""
+    H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
+    return np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
+
+
 def _reach(W: np.ndarray, foot, reach: float) -> np.ndarray:
     """How far ``(T,)`` a held ankle may be from its hip: ``reach`` of the leg's length (a held knee never
     goes fully straight, where a millimetre of length takes a large knee angle)."""
-    H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
-    legs = np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
-    return np.maximum(reach * legs, np.linalg.norm(A - H, axis=1))
+    return np.maximum(reach * _leg_length(W, foot), np.linalg.norm(W[:, foot.ankle] - W[:, foot.hip], axis=1))
 
 
 def _need(goals: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -160,14 +185,25 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
         top = target @ up + low
         for frames, edge in ((range(a - 1, max(0, a - n_before) - 1, -1), a),
                              (range(b, min(T, b + n_after)), b - 1)):
-            lift = corr[edge] @ up
-            for t in frames:
-                c = target - path[t]
-                if height[t] >= top or np.linalg.norm(c - (c @ up) * up) > near:
-                    break
-                corr[t] = c + (lift - c @ up) * up
-                level[t] = LOW
+            f = np.asarray(frames, dtype=int)
+            c = target - path[f]
+            cu = c @ up
+            ok = (height[f] < top) & (np.linalg.norm(c - np.outer(cu, up), axis=1) <= near)
+            f, c, cu = (x[:int(np.argmin(ok)) if not ok.all() else ok.size] for x in (f, c, cu))  # up to the first miss
+            corr[f] = c + np.outer(corr[edge] @ up - cu, up)
+            level[f] = LOW
     return corr, level
+
+
+def _frames_from(mask: np.ndarray) -> np.ndarray:
+    """``(T,)`` frames from each frame to the nearest True of ``mask`` (``inf`` without any)."""
+    T = mask.shape[0]
+    hits = np.flatnonzero(mask)
+    if hits.size == 0:
+        return np.full(T, np.inf)
+    k = np.clip(np.searchsorted(hits, np.arange(T)), 1, hits.size) - 1
+    nxt = hits[np.minimum(k + 1, hits.size - 1)]
+    return np.minimum(np.abs(np.arange(T) - hits[k]), np.abs(nxt - np.arange(T))).astype(float)
 
 
 def _follow(corr: np.ndarray, level: np.ndarray, other: np.ndarray, other_level: np.ndarray) -> None:
@@ -200,17 +236,32 @@ def _bridge(corr: np.ndarray, n_bridge: int, n_fade: int) -> np.ndarray:
     return out
 
 
-def _into_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndarray) -> np.ndarray:
-    """``corr`` ``(T, 3)`` shortened (toward ``base``, which is within reach) so that ``base + corr`` is
-    within ``R`` ``(T,)`` of ``hips``."""
-    d = base - hips
-    aa = np.sum(corr * corr, axis=1)
-    bb = 2 * np.sum(d * corr, axis=1)
-    cc = np.sum(d * d, axis=1) - R ** 2
-    far = np.sum((d + corr) ** 2, axis=1) > R ** 2
-    disc = np.maximum(bb ** 2 - 4 * aa * cc, 0.0)
-    s = np.where(far & (aa > 0), (-bb + np.sqrt(disc)) / (2 * np.maximum(aa, 1e-300)), 1.0)
-    return corr * np.clip(s, 0.0, 1.0)[:, None]
+def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndarray,
+                zone: np.ndarray, up: np.ndarray | None = None) -> np.ndarray:
+    """``corr`` ``(T, 3)`` changed so that ``base + corr`` stays within ``R`` ``(T,)`` of ``hips``, softly
+    (soft IK): a goal within ``zone`` ``(T,)`` of ``R`` (or beyond ``base``'s own distance, if that is
+    farther in) is pulled toward the hip by an exponential ease, so a leg straightens gradually as its goal
+    runs away and never snaps straight.  With ``up`` the goal is raised along it (its horizontal place
+    kept) where that is enough, else pulled toward the hip.  ``corr`` is unchanged where the goal is nearer
+    than that."""
+    v = base + corr - hips
+    d = np.linalg.norm(v, axis=1)
+    raw = np.linalg.norm(base - hips, axis=1)
+    start = np.minimum(np.maximum(R - zone, raw), R)
+    room = R - start
+    out = corr.copy()
+    far = d > start
+    x = (d[far] - start[far]) / np.maximum(room[far], 1e-12 * d[far])
+    D = start[far] + room[far] * -np.expm1(-x)
+    vf = v[far]
+    radial = vf * (D / d[far])[:, None]
+    if up is not None:  # raised straight up where that reaches: a foot held horizontally keeps its place
+        vu = vf @ up
+        disc = vu ** 2 - d[far] ** 2 + D ** 2
+        s = -vu - np.sqrt(np.maximum(disc, 0.0))
+        radial = np.where((disc >= 0)[:, None], vf + np.outer(s, up), radial)
+    out[far] = hips[far] + radial - base[far]
+    return out
 
 
 def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
@@ -231,7 +282,7 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
     for i, (s, e) in enumerate(rt):
         overlaps = [min(e, y) - max(s, x) for x, y in ra]
         k = int(np.argmax(overlaps)) if overlaps else -1
-        if k >= 0 and overlaps[k] > 0:
+        if k >= 0 and overlaps[k] >= 0:  # overlapping or back to back: one rigid-foot hold
             partner[i] = (k, (max(s, ra[k][0]) + min(e, ra[k][1]) - 1) // 2)
     held_a = []
     for k, (s, e) in enumerate(ra):
@@ -247,21 +298,49 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
     corr_a, level_a = _own_holds(a, ma, held_a, up, low, near, n_extend)
     corr_t = None
     if foot.toe is not None:
-        corr_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low,
-                            near, n_extend)
-    soft = (level_a > 0) & (level_a < FOLLOW)
-    corr_a[soft] = _into_reach(a[soft], corr_a[soft], hips[soft], R[soft])
+        corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body,
+                                     low, near, n_extend, n_fade)
     corr_a = _bridge(corr_a, n_bridge, n_fade)
-    free = level_a == 0
-    corr_a[free] = _into_reach(a[free], corr_a[free], hips[free], R[free])
+    clear = CLEARANCE * body
+    corr_a += np.outer(_lift(a + corr_a, level_a, up, clear, body, contacts.frame_time), up)
     changed = np.any(corr_a != 0, axis=1)
     if corr_t is None:
         return a + corr_a, None, level_a >= FOLLOW, changed
     corr_t = _bridge(corr_t, n_bridge, n_fade)
+    corr_t += np.outer(_lift(t + corr_t, level_t, up, clear, body, contacts.frame_time), up)
     return a + corr_a, t + corr_t, level_a >= FOLLOW, changed | np.any(corr_t != 0, axis=1)
 
 
-def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend):
+def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, body: float,
+          frame_time: float) -> np.ndarray:
+    """How far ``(T,)`` to raise a contact joint's goal ``path`` ``(T, 3)`` where it swings (``level`` 0
+    between two of its holds) and moves on: a foot moving faster than ``SWING_SPEED`` body heights per
+    second is swinging, and a swinging foot clears ``clear`` above its lowest level (it does not glide
+    along the floor, as a heel coming in at full speed or a toe dragged forward does).  The lift fades in
+    from ``SLOW_SPEED``; it changes by at most ``clear`` per ``LIFT_SECONDS`` (a heel lands, it does not
+    drop)."""
+    T = path.shape[0]
+    if T < 2:
+        return np.zeros(T)
+    h = path @ up
+    h = h - h.min()
+    v = np.gradient(path, frame_time, axis=0)
+    v = np.linalg.norm(v - np.outer(v @ up, up), axis=1) / body
+    ramp = np.clip((v - SLOW_SPEED) / (SWING_SPEED - SLOW_SPEED), 0.0, 1.0)
+    swing = np.zeros(T, bool)
+    for p, q in ranges(level == 0):
+        swing[p:q] = p > 0 and q < T    # between two holds: a foot without contacts (or a missed stance) stays
+    lift = np.where(swing, np.maximum(clear - h, 0.0) * ramp, 0.0)
+    rate = clear * frame_time / LIFT_SECONDS
+    for t in range(1, T):
+        lift[t] = min(lift[t], lift[t - 1] + rate)
+    for t in range(T - 2, -1, -1):
+        lift[t] = min(lift[t], lift[t + 1] + rate)
+    return lift
+
+
+def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend,
+               n_ease):
     """The toe's corrections (NaN where not held); the ankle's (``corr_a``, ``level_a``) updated in place
     where it follows the held toe (heel lifted where the leg cannot reach)."""
     held_t = []
@@ -273,6 +352,17 @@ def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R,
             fr = np.arange(s, e)
             held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
     corr_t, level_t = _own_holds(t, mt, held_t, up, low, near, n_extend)
+    # both low around a contact: the joint nearer its own contact leads and the other is carried with it
+    # (the heel leads a landing, the toe a push-off), so the foot keeps its own roll and is not stretched
+    # between two holds and then let go
+    both = (level_a == LOW) & (level_t == LOW)
+    if both.any():
+        da, dt = _frames_from(level_a == HELD), _frames_from(level_t == HELD)
+        for lead, (c_own, l_own, c_other) in (((dt < da), (corr_a, level_a, corr_t)),
+                                                ((da <= dt), (corr_t, level_t, corr_a))):
+            m = both & lead
+            c_own[m] = c_other[m]
+            l_own[m] = FOLLOW_LOW
     _follow(corr_a, level_a, corr_t, level_t)
     _follow(corr_t, level_t, corr_a, level_a)
     # a held toe with the ankle out of the leg's reach: the heel lifts (the foot turns about the toe) until
@@ -283,7 +373,28 @@ def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R,
         goal_t = t[on_toe] + corr_t[on_toe]
         lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
         corr_a[on_toe] = lifted - a[on_toe]
-    return corr_t
+    _ease_carried(corr_a, level_a, n_ease)
+    _ease_carried(corr_t, level_t, n_ease)
+    if on_toe.any():  # still one foot length from the held toe (the toe is aimed at, so it stays put)
+        goal_t = t[on_toe] + corr_t[on_toe]
+        length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
+        corr_a[on_toe] = goal_t + length[:, None] * _normalize(a[on_toe] + corr_a[on_toe] - goal_t) - a[on_toe]
+    return corr_t, level_t
+
+
+def _ease_carried(corr: np.ndarray, level: np.ndarray, n: int) -> None:
+    """Where a contact joint goes from its own hold to being carried with the other joint of its foot (or
+    back), the jump between the two corrections is eased out over ``n`` frames of the carried run, so a
+    heel let go while the toe still holds rises over a few frames instead of popping up, and a toe coming
+    down about a held heel lands on its hold without a snap (in place)."""
+    T = corr.shape[0]
+    for p, q in ranges((level == FOLLOW) | (level == FOLLOW_LOW)):
+        t = np.arange(p, min(q, p + n))
+        if p > 0 and level[p - 1] == HELD:
+            corr[t] += np.outer(1.0 - _smoothstep((t - p + 1) / (n + 1)), corr[p - 1] - corr[p])
+        t = np.arange(max(p, q - n), q)
+        if q < T and level[q] == HELD:
+            corr[t] += np.outer(_smoothstep((t - (q - n - 1)) / (n + 1)), corr[q] - corr[q - 1])
 
 
 def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray, r2: np.ndarray) -> np.ndarray:
@@ -322,22 +433,29 @@ def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weight
 
 
 def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
-    """Unit normals ``(T, 3)`` of the hip-knee-ankle plane; a straight leg takes the mean normal in its
-    thigh's frame over the frames where the knee is bent."""
-    n = np.cross(u1, u2)
-    s = np.linalg.norm(n, axis=1)
-    ok = s > 1e-4
-    n = np.where(ok[:, None], n / np.maximum(s, 1e-300)[:, None], 0.0)
-    if not ok.all():
-        if ok.any():
-            local = np.einsum("tji,tj->ti", Rw_hip[ok], n[ok]).mean(axis=0)
-        else:  # never bent: any axis across the leg
-            local = np.cross(np.einsum("tji,tj->ti", Rw_hip, u1).mean(axis=0), [0.0, 0.0, 1.0])
-            if np.linalg.norm(local) < 1e-9:
-                local = np.array([1.0, 0.0, 0.0])
-        local = local / np.linalg.norm(local)
-        n[~ok] = np.einsum("tij,j->ti", Rw_hip[~ok], local)
-    return n
+    """Unit normals ``(T, 3)`` of the hip-knee-ankle plane, eased toward the leg's usual bend axis as the
+    knee straightens: ``thigh x shin`` (its length is the sine of the knee angle) plus ``STRAIGHT_KNEE`` times
+    the mean bend axis in the thigh's frame (weighted by the bend).  A nearly straight knee, whose own plane
+    is undefined or turns fast, so bends about its usual axis, and the normal never jumps."""
+    c = _cross(u1, u2)
+    local = np.einsum("tji,tj->ti", Rw_hip, c).sum(axis=0)
+    if np.linalg.norm(local) < 1e-9:  # never bent: any axis across the leg
+        local = np.cross(np.einsum("tji,tj->ti", Rw_hip, u1).mean(axis=0), [0.0, 0.0, 1.0])
+        if np.linalg.norm(local) < 1e-9:
+            local = np.array([1.0, 0.0, 0.0])
+    local = local / np.linalg.norm(local)
+    return _normalize(c + STRAIGHT_KNEE * np.einsum("tij,j->ti", Rw_hip, local))
+
+
+def _knee_turn(u1: np.ndarray, u2: np.ndarray, n: np.ndarray, cos1: np.ndarray) -> np.ndarray:
+    """The angle ``(T,)`` to turn the shin ``u2`` about the unit axis ``n`` so that ``u1 . u2`` becomes
+    ``cos1`` (exactly, for an axis off the leg's plane too: ``p + A cos x + B sin x = cos1``); the root
+    that bends the knee about ``n`` the usual way (for the plane's normal: new bend minus old bend)."""
+    p = np.sum(u1 * n, axis=1) * np.sum(u2 * n, axis=1)
+    A = np.sum(u1 * u2, axis=1) - p
+    B = np.sum(u1 * _cross(n, u2), axis=1)
+    r = np.hypot(A, B)
+    return np.arctan2(B, A) + np.arccos(np.clip((cos1 - p) / np.maximum(r, 1e-300), -1.0, 1.0))
 
 
 def _weights(contacts: Contacts, n_blend: int) -> np.ndarray:
@@ -368,6 +486,16 @@ def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | N
     return shift - shift.mean(axis=0)
 
 
+def _descendants(motion: Motion, joint: int) -> np.ndarray:
+    """``(J,)`` True for ``joint`` and every joint below it."""
+    parents = motion.skeleton.parents
+    below = np.zeros(motion.n_joints, bool)
+    below[joint] = True
+    for j in range(joint + 1, motion.n_joints):
+        below[j] = parents[j] >= 0 and below[parents[j]]
+    return below
+
+
 def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
     """``motion`` with its travel joint moved by ``world`` ``(T, 3)`` (world frame)."""
     travel = motion.travel_joint
@@ -378,26 +506,30 @@ def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
     return motion.replace(translations=trans)
 
 
-@limit_threads
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
-              follow: bool = True, period: int | None = None) -> Motion:
+              follow: bool = True, period: int | None = None, frames: slice | None = None) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
 
     ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
     beyond which the root is lowered; ``follow``: first move the root horizontally with the planted feet;
     ``period``: the motion is a loop repeated every ``period`` frames (at least three times), so the root
-    correction keeps the travel of each period.  Returns a new Motion with the same skeleton and frame time.
+    correction keeps the travel of each period; ``frames``: solve and return only these frames (the rest
+    is context: the frames of a loop's repeat that are read back).  Returns a new Motion with the same
+    skeleton and frame time.
     """
     if contacts.n_frames != motion.n_frames:
         raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
     n_blend = max(1, int(round(blend / motion.frame_time)))
     skel = motion.skeleton
-    Rw, W = motion.world_transforms()
+    legs = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle) + f.contact_joints})
+    chain = chain_joints(motion, legs)
+    below = _descendants(motion, motion.travel_joint)
+    Rw, W = chain_transforms(motion, chain)
     if follow:
         shift = _root_shift(W, contacts, n_blend, period)
         if np.abs(shift).max() > 0:
             motion = _move_travel(motion, Rw, shift)
-            Rw, W = motion.world_transforms()
+            W[:, below] += shift[:, None]    # the travel joint and all below it move with it; no rotation changes
     n_extend = int(round(EXTEND_SECONDS / motion.frame_time))
     n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
     goals, toe_goals, held, changed = [], [], [], []
@@ -410,11 +542,22 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     delta = _lowering(W, contacts, goals, held, reach, n_blend)
     lowered = delta > 0
     if lowered.any():  # every foot keeps its goal in the world: a swing foot does not dip with the root
-        motion = _move_travel(motion, Rw, -np.outer(delta, contacts.up))
-        Rw, W = motion.world_transforms()
-    local = motion.rotation_matrices().copy()
+        down = -np.outer(delta, contacts.up)
+        motion = _move_travel(motion, Rw, down)
+        W[:, below] += down[:, None]
+    for foot, g, h in zip(contacts.feet, goals, held, strict=True):  # goals not held: within reach, softly
+        free = ~h
+        base, hips = W[free, foot.ankle], W[free, foot.hip]
+        R, zone = _reach(W, foot, reach)[free], SOFT_ZONE * _leg_length(W, foot)[free]
+        g[free] = base + _soft_reach(base, g[free] - base, hips, R, zone, contacts.up)
+    window = np.zeros(motion.n_frames, bool)
+    window[frames if frames is not None else slice(None)] = True
+    legs3 = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle)})
+    col = {j: i for i, j in enumerate(legs3)}
+    local = Rotation.from_quat(motion.rotations[:, legs3].reshape(-1, 4)).as_matrix().reshape(
+        motion.n_frames, len(legs3), 3, 3)
     for foot, g, gt, ch in zip(contacts.feet, goals, toe_goals, changed, strict=True):
-        t = np.flatnonzero(ch | lowered)
+        t = np.flatnonzero((ch | lowered) & window)
         if t.size == 0:
             continue
         H, K, A, G = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle], g[t]
@@ -422,27 +565,32 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         l2 = np.linalg.norm(A - K, axis=1)
         u1, u2 = (K - H) / l1[:, None], (A - K) / l2[:, None]
         n = _bend_normals(Rw[t, foot.hip], u1, u2)
-        beta0 = np.arctan2(np.sum(np.cross(u1, u2) * n, axis=1), np.sum(u1 * u2, axis=1))
         d = np.clip(np.linalg.norm(G - H, axis=1), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
-        beta1 = np.pi - np.arccos(np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0))
-        R1 = Rotation.from_rotvec(n * (beta1 - beta0)[:, None]).as_matrix()     # knee bend, world frame
+        cos1 = -np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0)  # thigh . shin wanted
+        R1 = Rotation.from_rotvec(n * _knee_turn(u1, u2, n, cos1)[:, None]).as_matrix()  # knee bend, world
         A1 = K + np.einsum("tij,tj->ti", R1, A - K)
         R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
         hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
         Rp_hip = Rw[t, hp] if hp >= 0 else np.broadcast_to(np.eye(3), (t.size, 3, 3))
-        local[t, foot.hip] = np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rw[t, foot.hip]
-        local[t, foot.knee] = np.swapaxes(Rw[t, kp], 1, 2) @ R1 @ Rw[t, foot.knee]
+        local[t, col[foot.hip]] = np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rw[t, foot.hip]
+        local[t, col[foot.knee]] = np.swapaxes(Rw[t, kp], 1, 2) @ R1 @ Rw[t, foot.knee]
         aim = np.broadcast_to(np.eye(3), (t.size, 3, 3))
         if gt is not None:
             aim = _swing(W[t, foot.toe] - A, gt[t] - G)
         new_parent = R2 @ R1 @ Rw[t, ap]
-        local[t, foot.ankle] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
-    T, J = motion.n_frames, motion.n_joints
-    quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, J, 4)
+        local[t, col[foot.ankle]] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
+    if frames is not None:
+        motion, local, lowered = motion[frames], local[frames], lowered[frames]
+        changed = [ch[frames] for ch in changed]
+    T = motion.n_frames
+    quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, len(legs3), 4)
     # frames and joints not touched keep their exact quaternions
-    touched = np.zeros((T, J), bool)
+    touched = np.zeros((T, len(legs3)), bool)
     for foot, ch in zip(contacts.feet, changed, strict=True):
-        touched[np.ix_(ch | lowered, [foot.hip, foot.knee, foot.ankle])] = True
-    quats = np.where(touched[..., None], quats, motion.rotations)
-    sign = np.where(np.sum(quats * motion.rotations, axis=-1, keepdims=True) < 0, -1.0, 1.0)
-    return motion.replace(rotations=quats * sign)
+        touched[np.ix_(ch | lowered, [col[foot.hip], col[foot.knee], col[foot.ankle]])] = True
+    old = motion.rotations[:, legs3]
+    quats = np.where(touched[..., None], quats, old)
+    sign = np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    rotations = motion.rotations.copy()
+    rotations[:, legs3] = quats * sign
+    return motion.replace(rotations=rotations)
