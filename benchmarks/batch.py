@@ -116,6 +116,8 @@ def main() -> None:
     parser.add_argument("--takes", type=int, default=None, help="only the first N takes")
     parser.add_argument("--workers", type=int, default=None, help="batch workers (default: one per core)")
     parser.add_argument("--repeat", type=int, default=1, help="batch and in-process: K copies of every take")
+    parser.add_argument("--no-shell", action="store_true", help="leave out the shell loop (minutes of one "
+                                                                  "process per take)")
     args = parser.parse_args()
     files = sorted(args.data.glob("*.bvh"))[: args.takes]
     if not files:
@@ -145,15 +147,17 @@ def main() -> None:
               f"workers; ok {s['ok']}, "
               f"no periodic motion {s['no-periodic-motion']}, refused {s['refused']}, error {s['error']}; "
               f"{s['task_seconds']:.2f} s in the tasks")
-        print(f"shell loop  ({load()})", flush=True)
-        c0 = children_cpu()
-        wall_shell, written = shell_loop(files, tmp / "shell")
-        cpu_shell = children_cpu() - c0
-        print(f"  {wall_shell:.2f} s, {wall_shell / n_shell:.3f} s per take (CPU {cpu_shell / n_shell:.3f} s); "
-              f"{written} loops written")
+        if not args.no_shell:
+            print(f"shell loop  ({load()})", flush=True)
+            c0 = children_cpu()
+            wall_shell, written = shell_loop(files, tmp / "shell")
+            cpu_shell = children_cpu() - c0
+            print(f"  {wall_shell:.2f} s, {wall_shell / n_shell:.3f} s per take (CPU {cpu_shell / n_shell:.3f} s); "
+                  f"{written} loops written")
     print(f"after       ({load()})")
-    print(f"batch / shell loop: {wall_batch / n / (wall_shell / n_shell):.2f}x wall per take (goal <= 0.5x), "
-          f"{cpu_batch / n / (cpu_shell / n_shell):.2f}x CPU")
+    if not args.no_shell:
+        print(f"batch / shell loop: {wall_batch / n / (wall_shell / n_shell):.2f}x wall per take (goal <= 0.5x), "
+              f"{cpu_batch / n / (cpu_shell / n_shell):.2f}x CPU")
     print(f"batch / in-process: {wall_batch / compute:.2f}x wall per take (goal <= 1.3x), "
           f"{cpu_batch / cpu_in:.2f}x CPU")
 
