@@ -50,7 +50,7 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
             if row is not None:
                 rows[take.source] = {**row, "resumed": True}
     todo = [t for t in takes if t.source not in rows]
-    run = {"engine": None, "scheduler": None, "workers": 0}
+    run = {"engine": None, "scheduler": None, "workers": 0, "worker_start": None}
     shown = progress(len(takes), len(rows)) if progress is not None else None
     if todo:
         with ExitStack() as stack:

@@ -94,7 +94,8 @@ def run_takes(job: Job, takes: Iterable[Take], on_row: Callable[[dict], None], *
     scheduler : the address of a running scheduler (``tcp://host:8786``); ``None``: a LocalCluster here.
     workers : LocalCluster: its number of workers (default: one per core, at most one per take); with a
         scheduler: wait until that many workers are connected (default 1).
-    Returns how the batch ran: ``{"engine", "scheduler", "workers"}``.
+    Returns how the batch ran: ``{"engine", "scheduler", "workers", "worker_start"}`` (how the LocalCluster's
+    workers were started: ``forkserver`` or ``spawn``; ``None`` on an existing scheduler).
     """
     try:
         return _run(job, list(takes), on_row, scheduler, workers)
@@ -107,14 +108,17 @@ def _run(job: Job, takes: list[Take], on_row, scheduler: str | None, workers: in
     with ExitStack() as stack:
         stack.enter_context(dask.config.set(QUIET))
         if scheduler is None:
+            start = "spawn"  # dask's default
             if stack.enter_context(forkserver.warm_workers(COMMANDS[job.command].imports)):  # run_batch's, or ours
-                stack.enter_context(dask.config.set({"distributed.worker.multiprocessing-method": forkserver.METHOD}))
+                start = forkserver.METHOD
+                stack.enter_context(dask.config.set({"distributed.worker.multiprocessing-method": start}))
             n = workers or max(1, min(default_workers(), len(takes)))
             cluster = stack.enter_context(LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                 silence_logs=logging.ERROR, env=ONE_THREAD_ENV))
             client = stack.enter_context(Client(cluster))
         else:
+            start = None  # the cluster's own business
             client = stack.enter_context(Client(scheduler))
             client.wait_for_workers(workers or 1, timeout=WORKERS_TIMEOUT_S)
         client.register_plugin(OneBlasThread())
@@ -129,7 +133,8 @@ def _run(job: Job, takes: list[Take], on_row, scheduler: str | None, workers: in
             except KilledWorker as exc:  # the take itself kills workers
                 row = lost_row(job, take, f"the take killed its workers ({message_of(exc)})")
             on_row(row)
-        return {"engine": "dask.distributed", "scheduler": client.scheduler.address, "workers": n_workers}
+        return {"engine": "dask.distributed", "scheduler": client.scheduler.address, "workers": n_workers,
+                "worker_start": start}
 
 
 def lost_row(job: Job, take: Take, message: str) -> dict:
