@@ -34,8 +34,6 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
     Raises MocycleError (nothing is run) for bad inputs, a bad suffix or an output folder that cannot be made;
     a failure of the engine itself (no scheduler, all workers gone) propagates.
     """
-    from .results import summary, write_results
-
     t0 = time.perf_counter()
     outdir = Path(outdir).resolve()
     suffix = check_suffix(COMMANDS[command], suffix)
@@ -51,11 +49,13 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
                 rows[take.source] = {**row, "resumed": True}
     todo = [t for t in takes if t.source not in rows]
     run = {"engine": None, "scheduler": None, "workers": 0, "worker_start": None}
-    shown = progress(len(takes), len(rows)) if progress is not None else None
-    if todo:
-        with ExitStack() as stack:
-            if scheduler is None:  # the workers' imports begin now, while this process imports dask
-                stack.enter_context(forkserver.warm_workers(COMMANDS[command].imports))
+    with ExitStack() as stack:
+        if todo and scheduler is None:  # the workers' imports begin now, while this process imports dask
+            stack.enter_context(forkserver.warm_workers(COMMANDS[command].imports))
+        from .results import summary, write_results  # (numpy, scipy: mocycle.io)
+
+        shown = progress(len(takes), len(rows)) if progress is not None else None
+        if todo:
             from .engine import run_takes
 
             if shown is not None:
