@@ -115,6 +115,8 @@ def _run(job: Job, takes: list[Take], on_row, scheduler: str | None, workers: in
             n = workers or max(1, min(default_workers(), len(takes)))
             cluster = stack.enter_context(LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its HTTP routes (it has them even without
+                # a dashboard) on a free port of this host, not 8787, which another dask may hold (a warning)
                 silence_logs=logging.ERROR, env=ONE_THREAD_ENV))
             client = stack.enter_context(Client(cluster))
         else:
