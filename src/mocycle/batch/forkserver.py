@@ -10,9 +10,9 @@ parent, and a worker is a ``fork`` of a single-threaded process: cheap, and safe
 dask starts its workers with ``multiprocessing.get_context(method)`` for its setting
 ``distributed.worker.multiprocessing-method`` (:data:`METHOD`); :func:`start` starts that forkserver first,
 with our modules to preload (dask's own preload list would come too late: a forkserver preloads only when it
-starts). dask's caveat for ``fork``/``forkserver``: the variables a process reads when it starts (the thread counts BLAS
-reads when it loads) must be in the forkserver's environment, not in the nanny's: :func:`start` gives it
-:data:`ONE_THREAD_ENV`. dask's other such variable, ``MALLOC_TRIM_THRESHOLD_=65536``, is left out on purpose
+starts). dask's caveat for ``fork``/``forkserver``: the variables a process reads when it starts (the thread
+counts BLAS reads when it loads) must be in the forkserver's environment, not in the nanny's: :func:`start`
+gives it :data:`ONE_THREAD_ENV`. dask's other such variable, ``MALLOC_TRIM_THRESHOLD_=65536``, is left out on purpose
 (:data:`.engine.QUIET`). Importing this module imports no dask.
 """
 
@@ -53,7 +53,11 @@ def _environment(values: Mapping[str, str]):
 
 
 def _server():
-    """multiprocessing's forkserver of this process (its module keeps one; ``None`` if that ever changes)."""
+    """multiprocessing's forkserver of this process (its module keeps one; ``None`` if that ever changes).
+
+    Whether it runs and how to stop it are private attributes (``_forkserver_pid``, ``_stop``: CPython 3.8 to
+    3.14); without them :func:`start` still starts one (``ensure_running`` is public) and it ends with this
+    process instead of with the batch."""
     from multiprocessing import forkserver
 
     return getattr(forkserver, "_forkserver", None)
@@ -97,7 +101,7 @@ def warm_workers(modules: Iterable[str]):
     it. Yields whether a forkserver is running (False where the platform has none: dask then spawns)."""
     started = start(modules)
     try:
-        yield running()
+        yield started or running()
     finally:
         if started:
             stop()
