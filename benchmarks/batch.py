@@ -1,6 +1,6 @@
 """Throughput of ``mocycle batch loop`` (issue 16) against one process per take and against the bare compute.
 
-    python benchmarks/batch.py [--data DIR] [--takes N] [--workers N] [--repeat K]
+    python benchmarks/batch.py [--data DIR] [--takes N] [--workers N] [--repeat K] [--rounds R] [--no-shell]
 
 Over the Bandai Namco takes of ../shared/data/bandai (all of them, or the first N), three ways, in one run:
 
@@ -14,6 +14,9 @@ Over the Bandai Namco takes of ../shared/data/bandai (all of them, or the first 
 ``--repeat K`` makes the library of batch and in-process K copies of the takes (a library of 3000 takes
 is what the issue has in mind: the start-up of the cluster is shared by more takes); the shell loop runs
 each take once (one process per take costs the same whatever the library's size).
+
+``--rounds R`` runs in-process and batch R times in turn (which one goes first alternates) and prints each
+round's ratio and the medians: on a shared machine the load moves between the parts of one round.
 
 Goals: batch <= 0.5x the shell loop, and within 1.3x of the in-process time. The machine's load average is
 printed before each part (other jobs share the cores; the ratios are measured in the same run). Because wall
@@ -30,6 +33,7 @@ import json
 import os
 import resource
 import shlex
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -116,6 +120,10 @@ def main() -> None:
     parser.add_argument("--takes", type=int, default=None, help="only the first N takes")
     parser.add_argument("--workers", type=int, default=None, help="batch workers (default: one per core)")
     parser.add_argument("--repeat", type=int, default=1, help="batch and in-process: K copies of every take")
+    parser.add_argument("--rounds", type=int, default=1, help="in-process and batch this many times in turn "
+                                                                 "(the ratios of each round, and their median)")
+    parser.add_argument("--no-shell", action="store_true", help="leave out the shell loop (minutes of one "
+                                                                  "process per take)")
     args = parser.parse_args()
     files = sorted(args.data.glob("*.bvh"))[: args.takes]
     if not files:
@@ -133,29 +141,48 @@ def main() -> None:
                 library[-1].symlink_to(f.resolve())
         print(f"{n_shell} takes from {args.data}" + (f", {args.repeat} copies of each for batch and in-process"
                                                      if args.repeat > 1 else "") + "; mocycle loop, default options")
-        print(f"in-process  ({load()})", flush=True)
-        compute, cpu_in, statuses = in_process(library)
-        print(f"  {compute:.2f} s, {compute / n:.3f} s per take (CPU {cpu_in / n:.3f} s); statuses {statuses}")
-        print(f"batch       ({load()})", flush=True)
-        c0 = children_cpu()
-        wall_batch, summary = batch(folder, tmp / "batch", args.workers)
-        cpu_batch = children_cpu() - c0
-        s = json.loads(summary)
-        print(f"  {wall_batch:.2f} s, {wall_batch / n:.3f} s per take (CPU {cpu_batch / n:.3f} s); {s['workers']} "
-              f"workers; ok {s['ok']}, "
-              f"no periodic motion {s['no-periodic-motion']}, refused {s['refused']}, error {s['error']}; "
-              f"{s['task_seconds']:.2f} s in the tasks")
-        print(f"shell loop  ({load()})", flush=True)
-        c0 = children_cpu()
-        wall_shell, written = shell_loop(files, tmp / "shell")
-        cpu_shell = children_cpu() - c0
-        print(f"  {wall_shell:.2f} s, {wall_shell / n_shell:.3f} s per take (CPU {cpu_shell / n_shell:.3f} s); "
-              f"{written} loops written")
+        rounds = []
+        for r in range(args.rounds):  # in-process and batch in turn, the first of the two alternating
+            parts = {}
+            for part in (("in-process", "batch") if r % 2 == 0 else ("batch", "in-process")):
+                print(f"{part:<11} ({load()})" + (f" round {r + 1}" if args.rounds > 1 else ""), flush=True)
+                if part == "in-process":
+                    compute, cpu_in, statuses = in_process(library)
+                    parts[part] = compute, cpu_in
+                    print(f"  {compute:.2f} s, {compute / n:.3f} s per take (CPU {cpu_in / n:.3f} s); "
+                          f"statuses {statuses}")
+                else:
+                    c0 = children_cpu()
+                    wall_batch, summary = batch(folder, tmp / f"batch{r}", args.workers)
+                    cpu_batch = children_cpu() - c0
+                    parts[part] = wall_batch, cpu_batch
+                    s = json.loads(summary)
+                    print(f"  {wall_batch:.2f} s, {wall_batch / n:.3f} s per take (CPU {cpu_batch / n:.3f} s); "
+                          f"{s['workers']} workers ({s['worker_start']}); ok {s['ok']}, no periodic motion "
+                          f"{s['no-periodic-motion']}, refused {s['refused']}, error {s['error']}; "
+                          f"{s['task_seconds']:.2f} s in the tasks")
+            rounds.append((*parts["in-process"], *parts["batch"]))
+        if not args.no_shell:
+            print(f"shell loop  ({load()})", flush=True)
+            c0 = children_cpu()
+            wall_shell, written = shell_loop(files, tmp / "shell")
+            cpu_shell = children_cpu() - c0
+            print(f"  {wall_shell:.2f} s, {wall_shell / n_shell:.3f} s per take (CPU {cpu_shell / n_shell:.3f} s); "
+                  f"{written} loops written")
     print(f"after       ({load()})")
-    print(f"batch / shell loop: {wall_batch / n / (wall_shell / n_shell):.2f}x wall per take (goal <= 0.5x), "
-          f"{cpu_batch / n / (cpu_shell / n_shell):.2f}x CPU")
-    print(f"batch / in-process: {wall_batch / compute:.2f}x wall per take (goal <= 1.3x), "
-          f"{cpu_batch / cpu_in:.2f}x CPU")
+    wall_ratios = [wall_batch / compute for compute, _, wall_batch, _ in rounds]
+    cpu_ratios = [cpu_batch / cpu_in for _, cpu_in, _, cpu_batch in rounds]
+    wall_batch = statistics.median(w for _, _, w, _ in rounds)
+    cpu_batch = statistics.median(c for _, _, _, c in rounds)
+    if not args.no_shell:
+        print(f"batch / shell loop: {wall_batch / n / (wall_shell / n_shell):.2f}x wall per take (goal <= 0.5x), "
+              f"{cpu_batch / n / (cpu_shell / n_shell):.2f}x CPU")
+    if len(rounds) > 1:
+        print("batch / in-process by round: " + ", ".join(f"{w:.2f}x" for w in wall_ratios) + " wall; "
+              + ", ".join(f"{c:.2f}x" for c in cpu_ratios) + " CPU")
+    print(f"batch / in-process: {statistics.median(wall_ratios):.2f}x wall per take (goal <= 1.3x), "
+          f"{statistics.median(cpu_ratios):.2f}x CPU" + (f" (medians of {len(rounds)} rounds)" if len(rounds) > 1
+                                                          else ""))
 
 
 if __name__ == "__main__":

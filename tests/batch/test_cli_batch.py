@@ -97,6 +97,8 @@ def test_no_scheduler_is_a_failed_run(take, tmp_path):
     import socket
 
     import dask
+    import distributed  # noqa: F401  (its defaults first: a dask.config.set of a key dask does not know yet
+    # would remove the whole "distributed" section on exit, and the later tests' clients would find no config)
 
     with socket.socket() as s:  # a free port nobody listens on
         s.bind(("127.0.0.1", 0))

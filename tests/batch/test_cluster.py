@@ -126,6 +126,9 @@ def test_a_local_batch_processes_every_take(library, local_run):
     head = (out / "results.csv").read_text().splitlines()[0]
     assert head.startswith("file,status,message,period_frames,periods,cycle_frames,seam_pose")
     assert len((out / "results.csv").read_text().splitlines()) == 8
+    run = json.loads((out / "results.json").read_text())["run"]
+    assert run["workers"] == 2  # forked from the warm forkserver where there is one (Linux has it)
+    assert run["worker_start"] in (("forkserver",) if sys.platform == "linux" else ("forkserver", "spawn"))
 
 
 def test_resume_starts_no_cluster_when_every_take_is_fresh(library, local_run, tmp_path):

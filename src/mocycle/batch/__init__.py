@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from contextlib import ExitStack
 from pathlib import Path
 
 from ..tasks.options import Options
+from . import forkserver
 from .commands import COMMANDS, check_suffix
 from .discover import Take, find_takes
 from .take import Job, fresh_record
@@ -32,9 +34,6 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
     Raises MocycleError (nothing is run) for bad inputs, a bad suffix or an output folder that cannot be made;
     a failure of the engine itself (no scheduler, all workers gone) propagates.
     """
-    from .engine import run_takes
-    from .results import summary, write_results
-
     t0 = time.perf_counter()
     outdir = Path(outdir).resolve()
     suffix = check_suffix(COMMANDS[command], suffix)
@@ -49,10 +48,19 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
             if row is not None:
                 rows[take.source] = {**row, "resumed": True}
     todo = [t for t in takes if t.source not in rows]
-    run = {"engine": None, "scheduler": None, "workers": 0}
-    shown = progress(len(takes), len(rows)) if progress is not None else None
-    if todo:
-        with shown if shown is not None else _Quiet():
+    run = {"engine": None, "scheduler": None, "workers": 0, "worker_start": None}
+    with ExitStack() as stack:
+        if todo and scheduler is None:  # the workers' imports begin now, while this process imports dask
+            stack.enter_context(forkserver.warm_workers(COMMANDS[command].imports))
+        from .results import summary, write_results  # (numpy, scipy: mocycle.io)
+
+        shown = progress(len(takes), len(rows)) if progress is not None else None
+        if todo:
+            from .engine import run_takes
+
+            if shown is not None:
+                stack.enter_context(shown)
+
             def on_row(row):
                 rows[Path(row["file"])] = {**row, "resumed": False}
                 if shown is not None:
@@ -63,14 +71,6 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
     run = {**run, "wall_seconds": time.perf_counter() - t0, "options_hash": job.options_hash, "suffix": suffix}
     write_results(outdir, command, options.to_dict(), ordered, run)
     return ordered, {**run, **summary(ordered)}
-
-
-class _Quiet:
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
 
 
 def _refuse_overwriting_inputs(job: Job, takes: list[Take]) -> None:

@@ -24,12 +24,17 @@ class Command:
         (the ``.mck`` take), ``"swings"`` (the segmentation) or ``None`` (the per-take JSON record only).
     suffix : the default output suffix.
     figures : results column -> how to read it from the report's facts.
+    imports : the modules the task imports when it runs (its algorithm package, the scipy parts it loads in
+        its functions): a LocalCluster's workers get them preloaded (:mod:`.forkserver`), so they are imported
+        once per batch, not once per worker at its first take. Only a matter of speed: a module missing here
+        is imported by the first take (``tests/batch/test_commands.py`` checks that none is).
     """
 
     name: str
     writes: str | None
     suffix: str | None
     figures: Mapping[str, Callable[[Mapping], object]]
+    imports: tuple[str, ...] = ()
 
     def suffixes(self) -> tuple[str, ...]:
         """The output suffixes this command can write (asked of ``mocycle.io`` at run time, so a new motion
@@ -80,30 +85,39 @@ def _skate(facts: Mapping):
 COMMANDS: dict[str, Command] = {c.name: c for c in (
     Command("info", None, None, {
         "frames": lambda f: f["frames"], "fps": lambda f: f["fps"], "duration_s": lambda f: f["duration_s"],
-        "joints": lambda f: f["joints"], "root_displacement": lambda f: f["root_displacement"]}),
+        "joints": lambda f: f["joints"], "root_displacement": lambda f: f["root_displacement"]},
+        imports=("mocycle.tasks.info", "mocycle.io.bvh")),
     Command("phase", None, None, {
         "frames": lambda f: f["frames"], "fps": lambda f: f["fps"], "classes": lambda f: len(f["classes"]),
         "period_frames": lambda f: _first_class(f, "period_frames"),
         "periods": lambda f: _first_class(f, "n_periods"),
-        "autocorrelation_period_frames": lambda f: f["autocorrelation_period_frames"]}),
+        "autocorrelation_period_frames": lambda f: f["autocorrelation_period_frames"]},
+        imports=("mocycle.tasks.phase", "mocycle.phase", "pyRipser")),
     Command("loop", "motion", ".bvh", {
         "period_frames": lambda f: _loop(f)["period_frames"], "periods": lambda f: _loop(f)["n_periods"],
         "cycle_frames": lambda f: _loop(f)["cycle_frames"],
         "seam_pose": lambda f: _loop(f)["metrics"]["seam_pose"],
         "seam_velocity": lambda f: _loop(f)["metrics"]["seam_velocity"],
-        "foot_skate": _skate}),
+        "foot_skate": _skate},
+        imports=("mocycle.tasks.loop", "mocycle.phase", "pyRipser", "mocycle.cycle", "mocycle.cycle.checks",
+                 "mocycle.tasks.feet", "mocycle.contacts")),
     Command("swings", "swings", ".mosw", {
         "frames": lambda f: f["frames"], "swings": lambda f: f["n_swings"],
         "per_angle_error_deg": lambda f: f["per_angle_error_deg"], "compressed_bytes": lambda f: f["compressed_bytes"],
-        "ratio_bvh": lambda f: f["ratio_bvh"]}),
+        "ratio_bvh": lambda f: f["ratio_bvh"]},
+        imports=("mocycle.tasks.swings", "mocycle.swings", "mocycle.io.mosw", "scipy.optimize", "scipy.ndimage")),
     Command("compress", "compressed", ".mck", {
         "frames": lambda f: f["frames"], "keyframes": lambda f: f["keyframes"],
         "keys_per_period": lambda f: f["keys_per_period"],
         "error_per_frame_per_joint": lambda f: f["error_per_frame_per_joint"],
-        "compressed_bytes": lambda f: f["compressed_bytes"], "real_ratio": lambda f: f["real_ratio"]}),
+        "compressed_bytes": lambda f: f["compressed_bytes"], "real_ratio": lambda f: f["real_ratio"]},
+        imports=("mocycle.tasks.compress", "mocycle.keyframes", "mocycle.phase", "pyRipser", "mocycle.io.mck",
+                 "scipy.optimize")),
     Command("stretch", "motion", ".bvh", {
         "factor": lambda f: f["factor"], "frames_in": lambda f: f["frames_in"], "frames_out": lambda f: f["frames_out"],
-        "periodic_regions": lambda f: len(f["periodic_regions"])}),
+        "periodic_regions": lambda f: len(f["periodic_regions"])},
+        imports=("mocycle.tasks.stretch", "mocycle.warp", "mocycle.phase", "pyRipser", "mocycle.cycle",
+                 "mocycle.tasks.feet", "mocycle.contacts", "scipy.ndimage")),
 )}
 
 
