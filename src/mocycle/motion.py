@@ -255,6 +255,28 @@ class Motion:
         self.translations = trans
         self.frame_time = frame_time
 
+    @classmethod
+    def _adopt(cls, skeleton: Skeleton, rotations: np.ndarray, translations: np.ndarray,
+               frame_time: float) -> Motion:
+        """A motion that takes the arrays as they are: for readers that made them and checked them as
+        ``__init__`` does (float64 unit, sign-continuous quaternions ``(T, J, 4)``, finite translations
+        ``(T, J, 3)`` within ±MAX_MAGNITUDE, a checked frame time).  Only the shapes are checked again; the
+        arrays are frozen, not copied."""
+        J = skeleton.n_joints
+        T = rotations.shape[0]
+        if T < 1 or rotations.shape != (T, J, 4) or translations.shape != (T, J, 3) \
+                or rotations.dtype != np.float64 or translations.dtype != np.float64:
+            raise MocycleError(f"rotations (T, {J}, 4) and translations (T, {J}, 3) of T >= 1 frames expected; "
+                               f"got {rotations.shape} and {translations.shape}")
+        self = object.__new__(cls)
+        rotations.setflags(write=False)
+        translations.setflags(write=False)
+        self.skeleton = skeleton
+        self.rotations = rotations
+        self.translations = translations
+        self.frame_time = float(frame_time)
+        return self
+
     # -- basic facts -----------------------------------------------------
     @property
     def n_frames(self) -> int:

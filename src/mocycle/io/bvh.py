@@ -404,10 +404,13 @@ def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float,
 
 
 def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Local quaternions ``(T, J, 4)`` and translations ``(T, J, 3)`` from the channel values ``(T, C)``.
+    """Local unit, sign-continuous quaternions ``(T, J, 4)`` and translations ``(T, J, 3)`` from the checked
+    channel values ``(T, C)`` (finite, within ``MAX_MAGNITUDE``).
 
-    Euler angles go to quaternions :data:`BLOCK_FRAMES` frames at a time, so no temporary is larger than a
-    block (and each stays in cache).
+    One pass over the frames, :data:`BLOCK_FRAMES` at a time, so every temporary is a block (and stays in
+    cache): Euler angles to quaternions (:func:`_euler_block`), normalised (the norm summed in
+    ``np.linalg.norm``'s order) and made sign-continuous with the previous block's last frame, as
+    :class:`Motion` would, so the motion can take the arrays as they are (:func:`_motion`).
     """
     T, J = values.shape[0], skel.n_joints
     quats = np.empty((T, J, 4))
@@ -423,6 +426,7 @@ def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarra
         if pos_cols:
             trans[:, j, pos_axes] = values[:, pos_cols]
     quats[:, still] = (0.0, 0.0, 0.0, 1.0)
+    groups = []
     for order, items in by_order.items():
         joints = [j for j, _ in items]
         cols = [c for _, cs in items for c in cs]
@@ -430,18 +434,95 @@ def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarra
             joints = slice(joints[0], joints[-1] + 1)
         if cols == list(range(cols[0], cols[-1] + 1)):
             cols = slice(cols[0], cols[-1] + 1)
-        n = len(items)
-        for f0 in range(0, T, BLOCK_FRAMES):
-            f1 = min(T, f0 + BLOCK_FRAMES)
-            angles = values[f0:f1, cols].reshape(f1 - f0, n, len(order))
-            quats[f0:f1, joints] = euler_to_quats(angles, order, degrees=True)
+        groups.append((order, joints, cols, len(items)))
+    last = parity = None  # the previous block's last frame (before its flips) and its flip parity
+    for f0 in range(0, T, BLOCK_FRAMES):
+        f1 = min(T, f0 + BLOCK_FRAMES)
+        block = quats[f0:f1]
+        for order, joints, cols, n in groups:
+            q = _euler_block(values[f0:f1, cols], order, f1 - f0, n)
+            if isinstance(joints, slice):
+                block[:, joints] = q
+            else:
+                block[:, joints] = q.reshape(f1 - f0, n, 4)
+        last, parity = _continuous_block(block, last, parity)
     return quats, trans
 
 
+def _euler_block(angles: np.ndarray, order: str, frames: int, n: int) -> np.ndarray:
+    """Unit quaternions ``(frames, n, 4)`` of a block of Euler angles in degrees ``(frames, n * len(order))``.
+
+    :func:`~mocycle.rotations.euler_to_quats`' products, then divided by the norm, which is summed as
+    ``np.linalg.norm`` sums it, so the result is what normalising its quaternions gives, bit for bit.
+    """
+    k = len(order)
+    comp = _euler_components(angles.reshape(frames * n, k), order)
+    sq = [np.multiply(c, c) for c in comp]
+    norm = np.sqrt(((sq[0] + sq[1]) + sq[2]) + sq[3])
+    out = np.empty((frames, n, 4))
+    flat = out.reshape(frames * n, 4)
+    for m in range(4):
+        np.divide(comp[m], norm, out=flat[:, m])
+    return out
+
+
+def _euler_components(angles: np.ndarray, order: str) -> list[np.ndarray]:
+    """The x, y, z, w arrays ``(n,)`` of :func:`~mocycle.rotations.euler_to_quats` (degrees), zeros included."""
+    from ..rotations import _AXIS_PRODUCT
+
+    k = angles.shape[1]
+    half = np.multiply(angles.T, np.pi / 360.0, order="C")
+    s, c = np.sin(half), np.cos(half)
+    comp: list[np.ndarray | None] = [None, None, None, c[0]]
+    comp["XYZ".index(order[0])] = s[0]
+    for i, axis in enumerate(order[1:k], start=1):
+        perm, sign = _AXIS_PRODUCT[axis]
+        new = []
+        for m in range(4):
+            a, b = comp[m], comp[perm[m]]
+            cos_a = None if a is None else c[i] * a
+            sin_b = None if b is None else s[i] * b
+            if sin_b is None:
+                new.append(cos_a)
+            elif cos_a is None:
+                new.append(sin_b if sign[m] > 0 else np.negative(sin_b, out=sin_b))
+            else:
+                new.append(np.add(cos_a, sin_b, out=cos_a) if sign[m] > 0 else np.subtract(cos_a, sin_b, out=cos_a))
+        comp = new
+    zero = None
+    for m in range(4):
+        if comp[m] is None:
+            zero = np.zeros(angles.shape[0]) if zero is None else zero
+            comp[m] = zero
+    return comp
+
+
+def _continuous_block(block: np.ndarray, last, parity):
+    """Flip quaternion signs in ``block`` ``(B, J, 4)`` as :func:`~mocycle.rotations.continuous_quats` does
+    over the whole take; ``last``/``parity``: the previous block's last frame before flipping and its flip
+    parity (``None`` for the first block).  Returns them for this block."""
+    if last is None:
+        rows = block
+        flips = np.zeros(block.shape[1:2], dtype=np.intp)
+    else:
+        rows = np.concatenate([last[None], block])
+        flips = parity
+    new_last = block[-1].copy()
+    if rows.shape[0] > 1:
+        dots = np.einsum("t...k,t...k->t...", rows[1:], rows[:-1])
+        cum = (np.cumsum(dots < 0, axis=0) + flips) % 2
+        if cum.any():
+            target = block[1:] if last is None else block
+            target *= (1.0 - 2.0 * cum)[..., None]
+        flips = cum[-1]
+    return new_last, flips
+
+
 def _motion(skel: Skeleton, quats: np.ndarray, trans: np.ndarray, frame_time: float, path) -> Motion:
-    """The motion, owning ``quats`` and ``trans`` (normalised and frozen in place, not copied)."""
+    """The motion, owning ``quats`` and ``trans`` as :func:`_arrays_from_channels` made them (frozen, not
+    copied or checked again: the values were checked when read)."""
     try:
-        return Motion(skel, quats, trans, frame_time, copy=False)
+        return Motion._adopt(skel, quats, trans, frame_time)
     except MocycleError as exc:
         raise MotionFileError(f"cannot build a motion from this file: {exc}", path) from None
 
