@@ -9,7 +9,7 @@ Quaternions are ``(x, y, z, w)`` arrays (scipy's order), matrices ``(..., 3, 3)`
   previous frame, so curves written to BVH or fed to regressions are smooth.
 * **Vectorised quaternion algebra** on ``(..., 4)`` arrays: :func:`quat_multiply`
   (about 10× faster than ``Rotation.__mul__`` on 100 000 products), :func:`quat_conj`,
-  :func:`quat_log` / :func:`quat_exp`, :func:`euler_to_quats`, :func:`axis_angle_quats`,
+  :func:`quat_log` / :func:`quat_exp`, :func:`euler_to_quats` (:func:`euler_quat_components`), :func:`axis_angle_quats`,
   :func:`twist_angles`, :func:`quat_angles` (geodesic), :func:`slerp`; single rotations:
   :func:`rotvec_quat`, :func:`quat_rotvec`.
 * **Matrices**: :func:`axis_rotations` (about one axis), :func:`nearest_rotations` (Newton polar
@@ -138,11 +138,21 @@ def euler_to_quats(angles: np.ndarray, order: str, degrees: bool = False) -> np.
         return q
     # (k, n) half angles, each axis contiguous in memory
     half = np.multiply(angles.reshape(-1, k).T, np.pi / 360.0 if degrees else 0.5, order="C")
+    comp = euler_quat_components(half, order)
+    out = np.empty((half.shape[1], 4))
+    for m in range(4):
+        out[:, m] = 0.0 if comp[m] is None else comp[m]
+    return out.reshape(shape + (4,))
+
+
+def euler_quat_components(half: np.ndarray, order: str) -> list[np.ndarray | None]:
+    """The x, y, z, w arrays of :func:`euler_to_quats` from half angles ``(k, ...)`` in radians, axis by axis
+    along the first dimension; ``None`` for a component that is exactly zero (one-axis orders)."""
     s, c = np.sin(half), np.cos(half)
     order = order.upper()
     comp: list[np.ndarray | None] = [None, None, None, c[0]]  # x, y, z, w; None: exactly zero
     comp["XYZ".index(order[0])] = s[0]
-    for i, axis in enumerate(order[1:], start=1):
+    for i, axis in enumerate(order[1:half.shape[0]], start=1):
         # q ⊗ (sin·e_axis + cos) = cos·q + sin·(q ⊗ e_axis); q ⊗ e_axis permutes q's entries (zeros skipped).
         perm, sign = _AXIS_PRODUCT[axis]
         new = []
@@ -157,10 +167,7 @@ def euler_to_quats(angles: np.ndarray, order: str, degrees: bool = False) -> np.
             else:
                 new.append(np.add(cos_a, sin_b, out=cos_a) if sign[m] > 0 else np.subtract(cos_a, sin_b, out=cos_a))
         comp = new
-    out = np.empty((half.shape[1], 4))
-    for m in range(4):
-        out[:, m] = 0.0 if comp[m] is None else comp[m]
-    return out.reshape(shape + (4,))
+    return comp
 
 
 # q ⊗ e for the pure unit quaternions e = x, y, z: entry permutation and signs.
