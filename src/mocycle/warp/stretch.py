@@ -346,18 +346,19 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
                 Y[:, plain] = warp_curves(X[:, plain], factor, windows[g])
             if tr.size:
                 Y[:, tr] = _warp_detrended(X[:, tr], factor, windows[g])
-    new = decoder.decode(Y)
+    quats, _ = decoder.decode_arrays(Y, translations=False)
 
     # Translations: the travelling joint as mean velocity + warped residual; other moving joints warped.
     trans = np.broadcast_to(motion.translations[0], (n_out,) + motion.translations.shape[1:]).copy()
     travel = motion.travel_joint if travel is None else travel
-    for j in range(skel.n_joints):
-        p = motion.translations[:, j]
+    P = motion.translations
+    moving = np.ptp(P, axis=0).max(axis=1) > 1e-9 * (1.0 + np.abs(P).max(axis=(0, 2)))  # (J,)
+    for j in sorted(set(np.flatnonzero(moving).tolist()) | {travel}):
         if j == travel:
-            trans[:, j] = _warp_detrended(p, factor, windows[group_of[j]])
-        elif np.ptp(p, axis=0).max() > 1e-9 * (1.0 + np.abs(p).max()):
-            trans[:, j] = warp_curves(p, factor, windows[group_of[j]])
-    new = new.replace(translations=trans)
+            trans[:, j] = _warp_detrended(P[:, j], factor, windows[group_of[j]])
+        else:
+            trans[:, j] = warp_curves(P[:, j], factor, windows[group_of[j]])
+    new = Motion(skel, quats, trans, motion.frame_time)
 
     report = StretchReport(
         factor=factor,
