@@ -377,14 +377,18 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
         resid_ptp = np.ptp(X - (a + v * np.arange(T)[:, None]), axis=0)
         trend = rise > TREND_DOMINATED * np.maximum(resid_ptp, 1e-12)
         trend_cols = [int(i) for i in np.flatnonzero(trend)]
+        by_window: dict[int, list[np.ndarray]] = {}  # groups with the same window warp in one transform
         for g, c in cols.items():
             if not c.size:
                 continue
             plain, tr = c[~trend[c]], c[trend[c]]
             if plain.size:
-                Y[:, plain] = warp_curves(X[:, plain], factor, windows[g])
+                by_window.setdefault(windows[g], []).append(plain)
             if tr.size:
                 Y[:, tr] = _warp_detrended(X[:, tr], factor, windows[g])
+        for N, parts in by_window.items():
+            plain = np.concatenate(parts)
+            Y[:, plain] = warp_curves(X[:, plain], factor, N)
     quats, _ = decoder.decode_arrays(Y, translations=False)
 
     # Translations: the travelling joint as mean velocity + warped residual; other moving joints warped.
