@@ -123,3 +123,18 @@ def test_matrix_quats_and_mean_rotations_match_scipy():
     ours = mean_rotations(near)
     theirs = np.stack([Rotation.from_quat(near[:, j]).mean().as_quat() for j in range(15)])
     assert np.abs(ours - theirs).max() < 1e-12
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 4, 6, 9])
+def test_vector_norms_are_numpys_norms_bit_for_bit(k):
+    from mocycle.rotations import vector_norms
+
+    rng = np.random.default_rng(k)
+    a = rng.normal(size=(300, 7, k)) * rng.choice([1e-8, 1.0, 1e8], size=(300, 7, k))
+    for v in (a, a[..., ::-1], a[::3, 2:], a.transpose(1, 0, 2)):
+        assert np.array_equal(vector_norms(v), np.linalg.norm(v, axis=-1))
+        assert np.array_equal(vector_norms(v, keepdims=True), np.linalg.norm(v, axis=-1, keepdims=True))
+    assert np.isnan(vector_norms(np.array([[np.nan, 1.0, 0.0]]))[0])
+    assert np.isinf(vector_norms(np.array([[np.inf, 1.0, 0.0]]))[0])
+    one = np.array([3.0, 4.0, 12.0])
+    assert vector_norms(one) == np.linalg.norm(one) == 13.0 and vector_norms(one, keepdims=True).shape == (1,)

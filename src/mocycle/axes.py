@@ -10,6 +10,7 @@ the vertical) of any direction, unwrapped in time.
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from .errors import OptionError
 from .motion import Motion
@@ -87,12 +88,26 @@ def up_in_parent_frame(motion: Motion, joint: int, world_up: np.ndarray) -> np.n
     over the take (the world up itself for a root).  Unit vector."""
     parent = int(motion.skeleton.parents[joint])
     if parent >= 0:
-        world_rot, _ = motion[:: max(1, motion.n_frames // 50)].world_transforms()
-        mean_parent = nearest_rotations(world_rot[:, parent].mean(axis=0))
+        mean_parent = nearest_rotations(_world_rotation(motion[:: max(1, motion.n_frames // 50)], parent).mean(axis=0))
         up = mean_parent.T @ world_up
     else:
         up = np.asarray(world_up, dtype=np.float64)
     return up / np.linalg.norm(up)
+
+
+def _world_rotation(motion: Motion, joint: int) -> np.ndarray:
+    """World rotation matrices ``(T, 3, 3)`` of one joint: the products of :meth:`Motion.world_transforms`
+    along its chain from the root only (not every joint of a 100-joint rig)."""
+    chain = [joint]
+    while motion.skeleton.parents[chain[-1]] >= 0:
+        chain.append(int(motion.skeleton.parents[chain[-1]]))
+    chain.reverse()
+    T = motion.n_frames
+    local = Rotation.from_quat(motion.rotations[:, chain].reshape(-1, 4)).as_matrix().reshape(T, len(chain), 3, 3)
+    world = local[:, 0]
+    for k in range(1, len(chain)):
+        world = world @ local[:, k]
+    return world
 
 
 def horizontal_basis(up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -107,6 +107,13 @@ class PoseDecoder:
         Non-feature parts come from the template frame by frame when T matches,
         otherwise from its mean pose (rotations) and first frame (root).
         """
+        quats, trans = self.decode_arrays(X)
+        tpl = self.template
+        return Motion(tpl.skeleton, quats, trans, tpl.frame_time if frame_time is None else frame_time)
+
+    def decode_arrays(self, X: np.ndarray, translations: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """What :meth:`decode` makes a motion of: quaternions ``(T, J, 4)`` (not yet normalised) and
+        translations ``(T, J, 3)`` (``None`` with ``translations=False``, for a caller that has its own)."""
         X = np.asarray(X, dtype=np.float64)
         if X.ndim != 2 or X.shape[1] != self.n_features:
             raise MocycleError(f"X must have shape (T, {self.n_features}); got {X.shape}")
@@ -116,14 +123,19 @@ class PoseDecoder:
         tpl = self.template
         T, J = X.shape[0], tpl.n_joints
         same_length = T == tpl.n_frames
+        kept = np.setdiff1d(np.arange(J), self.joints)  # joints whose rotations are not columns
         if same_length:
             quats = tpl.rotations.copy()
-            trans = tpl.translations.copy()
+            trans = tpl.translations.copy() if translations else None
         else:
-            mean_q = mean_rotations(tpl.rotations)
-            quats = np.broadcast_to(mean_q, (T, J, 4)).copy()
-            trans = np.broadcast_to(tpl.translations.mean(axis=0), (T, J, 3)).copy()
-            trans[:, self.travel] = tpl.translations[0, self.travel]
+            quats = np.empty((T, J, 4))
+            if kept.size:
+                quats[:, kept] = mean_rotations(tpl.rotations[:, kept])
+            if translations:
+                trans = np.broadcast_to(tpl.translations.mean(axis=0), (T, J, 3)).copy()
+                trans[:, self.travel] = tpl.translations[0, self.travel]
+            else:
+                trans = None
         col = 0
         skel = tpl.skeleton
         if self.root == "heading":  # the travel joint's columns hold its tilt: start from the template's
@@ -148,9 +160,9 @@ class PoseDecoder:
                 quats[:, js] = quat_multiply(ref, quat_exp(2.0 * block))
             else:
                 quats[:, js] = matrix_quats(nearest_rotations(block.reshape(T, n, 3, 3)))
-        if self.root == "keep":
+        if self.root == "keep" and trans is not None:
             trans[:, self.travel] = raw[:, col: col + 3]
-        elif self.root == "velocity":
+        elif self.root == "velocity" and trans is not None:
             v = raw[:, col: col + 3]
             start = tpl.translations[0, self.travel]
             trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
@@ -158,10 +170,11 @@ class PoseDecoder:
             _, psi = self.frame.tilt(tpl[:1])
             psi = psi[0] + np.concatenate([[0.0], np.cumsum(raw[1:, col + 3])])
             quats[:, self.travel] = self.frame.turn(quats[:, self.travel], psi)
-            v = self.frame.to_world(raw[1:, col: col + 3], 0.5 * (psi[1:] + psi[:-1]))
-            start = tpl.translations[0, self.travel]
-            trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v, axis=0)])
-        return Motion(skel, quats, trans, tpl.frame_time if frame_time is None else frame_time)
+            if trans is not None:
+                v = self.frame.to_world(raw[1:, col: col + 3], 0.5 * (psi[1:] + psi[:-1]))
+                start = tpl.translations[0, self.travel]
+                trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v, axis=0)])
+        return quats, trans
 
 
 @dataclass(frozen=True, eq=False)

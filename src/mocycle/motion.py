@@ -27,7 +27,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from . import _validate
 from .errors import MocycleError
 from .limits import MAX_MAGNITUDE, check_frames, frame_time_problem
-from .rotations import continuous_quats
+from .rotations import continuous_quats, vector_norms
 
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
 POSITION_CHANNELS = ("Xposition", "Yposition", "Zposition")
@@ -220,7 +220,7 @@ class Motion:
         # a NaN or infinite component makes the norm NaN or infinite: one (T, J) check instead of (T, J, 4)
         norms = np.empty(rot.shape[:-1] + (1,))
         for f0 in range(0, T, 4096):  # in blocks of frames: numpy's norm makes a temporary as large as its input
-            norms[f0:f0 + 4096] = np.linalg.norm(rot[f0:f0 + 4096], axis=-1, keepdims=True)
+            norms[f0:f0 + 4096] = vector_norms(rot[f0:f0 + 4096], keepdims=True)
         if not np.all(np.isfinite(norms)) or np.any(norms < 1e-12):
             raise MocycleError("rotations contain NaN, infinite or zero quaternions")
         if copy or rot is not rotations or not rot.flags.writeable:
@@ -254,6 +254,28 @@ class Motion:
         self.rotations = rot
         self.translations = trans
         self.frame_time = frame_time
+
+    @classmethod
+    def _adopt(cls, skeleton: Skeleton, rotations: np.ndarray, translations: np.ndarray,
+               frame_time: float) -> Motion:
+        """A motion that takes the arrays as they are: for readers that made them and checked them as
+        ``__init__`` does (float64 unit, sign-continuous quaternions ``(T, J, 4)``, finite translations
+        ``(T, J, 3)`` within ±MAX_MAGNITUDE, a checked frame time).  Only the shapes are checked again; the
+        arrays are frozen, not copied."""
+        J = skeleton.n_joints
+        T = rotations.shape[0]
+        if T < 1 or rotations.shape != (T, J, 4) or translations.shape != (T, J, 3) \
+                or rotations.dtype != np.float64 or translations.dtype != np.float64:
+            raise MocycleError(f"rotations (T, {J}, 4) and translations (T, {J}, 3) of T >= 1 frames expected; "
+                               f"got {rotations.shape} and {translations.shape}")
+        self = object.__new__(cls)
+        rotations.setflags(write=False)
+        translations.setflags(write=False)
+        self.skeleton = skeleton
+        self.rotations = rotations
+        self.translations = translations
+        self.frame_time = float(frame_time)
+        return self
 
     # -- basic facts -----------------------------------------------------
     @property

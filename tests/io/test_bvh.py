@@ -119,6 +119,44 @@ def test_round_trip_shared_files(path, tmp_path):
             assert ours_step < 180 and ours_step <= file_step + 1e-6, m.skeleton.names[j]
 
 
+@pytest.mark.parametrize("block", [1, 7, 1024])
+def test_read_in_blocks_is_the_motion_of_its_channels(tmp_path, monkeypatch, block):
+    """read_bvh normalises and sign-flips block by block (and skips Motion's own pass): bit for bit what
+    Motion makes of euler_to_quats' quaternions, with sign flips inside and across blocks."""
+    from mocycle.io import bvh
+    from mocycle.motion import Motion
+    from mocycle.rotations import euler_to_quats
+
+    m = random_motion(200, spin=True)
+    values = motion_channels(m)
+    rng = np.random.default_rng(1)
+    rot_cols = [k for k, c in enumerate(c for chans in m.skeleton.channels for c in chans) if "rotation" in c]
+    for frame in rng.choice(200, 40, replace=False):  # a whole turn more: the quaternion's sign flips
+        values[frame, rng.choice(rot_cols)] += 360.0
+    text = format_bvh(m).split("Frame Time:")[0] + f"Frame Time: {m.frame_time!r}\n"
+    path = tmp_path / "flips.bvh"
+    path.write_text(text + "\n".join(" ".join(repr(float(v)) for v in row) for row in values) + "\n")
+    monkeypatch.setattr(bvh, "BLOCK_FRAMES", block)
+    read = read_bvh(path)
+
+    quats = np.empty_like(m.rotations)
+    trans = np.broadcast_to(m.skeleton.offsets, m.translations.shape).copy()
+    col = 0
+    for j, chans in enumerate(m.skeleton.channels):
+        rot = [col + k for k, c in enumerate(chans) if "rotation" in c]
+        for k, c in enumerate(chans):
+            if "position" in c:
+                trans[:, j, "XYZ".index(c[0])] = values[:, col + k]
+        quats[:, j] = euler_to_quats(values[:, rot], m.skeleton.euler_order(j), degrees=True)
+        col += len(chans)
+    raw_flips = np.einsum("tjk,tjk->tj", quats[1:], quats[:-1]) < 0
+    assert raw_flips.sum() >= 40  # the test flips signs
+    expected = Motion(m.skeleton, quats, trans, m.frame_time)
+    assert np.array_equal(read.rotations, expected.rotations)
+    assert np.array_equal(read.translations, expected.translations)
+    assert not read.rotations.flags.writeable and not read.translations.flags.writeable
+
+
 def test_cmu_bvh_facts():
     m = read_bvh(shared_path("cmu", "01_01.bvh"))
     assert m.n_frames == 2752 and m.n_joints == 31

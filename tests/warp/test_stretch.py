@@ -118,6 +118,22 @@ def test_fundamental_cycle_of_every_curve():
     assert abs(cycles[0] - 20) < 0.3 and abs(cycles[1] - 50) < 0.5 and np.isnan(cycles[2])
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_fundamental_cycles_in_one_fft_are_autocorrelation_period_of_each_column(seed):
+    """One FFT for all columns, the maximum chosen column by column: the same numbers as eq. 1 on each."""
+    from mocycle.phase.period import autocorrelation_period
+
+    walk = synthetic_walk(n_frames=[171, 300, 457][seed], fps=60, noise_deg=1.0, seed=seed).motion
+    X, _ = pose_matrix(walk, rep="quatlog", root="drop")
+    X = np.concatenate([X, np.random.default_rng(seed).normal(size=(X.shape[0], 3)), np.ones((X.shape[0], 1))], 1)
+    X[:, -2] = np.nan  # a column with a NaN has no cycle
+    expected = [autocorrelation_period(X[:, d], min_strength=0.3) if np.ptp(X[:, d]) > 0 else np.nan
+                for d in range(X.shape[1])]
+    got = fundamental_cycles(X)
+    assert np.array_equal(got, expected, equal_nan=True)
+    assert np.isfinite(got).sum() >= 10 and np.isnan(got[-2:]).all()
+
+
 def test_group_cycle_is_the_largest_cycle_of_the_curves_that_move():
     t = np.arange(400.0)
     rng = np.random.default_rng(4)

@@ -14,7 +14,7 @@ target file in one step (never a half-written file).
 
 :func:`read_bvh` reads the hierarchy line by line, then hands the file to numpy's C ``loadtxt`` (the
 floor for text numbers) and turns the channels into quaternions a block of frames at a time, so a read
-takes little more than ``loadtxt`` of the same numbers and peaks at about 3.5 times the float64 channel
+takes about 1.2 times ``loadtxt`` of the same numbers and peaks at about 3.3 times the float64 channel
 array (``docs/performance.md``).  When anything is off (a warning, an error, a line ``loadtxt`` cannot
 take), the whole file is parsed again the careful way (:func:`parse_bvh`), which says what is wrong where.
 """
@@ -22,6 +22,7 @@ take), the whole file is parsed again the careful way (:func:`parse_bvh`), which
 from __future__ import annotations
 
 import io
+import math
 import os
 import warnings
 from pathlib import Path
@@ -31,14 +32,15 @@ import numpy as np
 from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..limits import MAX_MAGNITUDE, check_frames, frame_time_problem
 from ..motion import POSITION_CHANNELS, ROTATION_CHANNELS, EndSite, Motion, Skeleton
-from ..rotations import continuous_euler, euler_to_quats
+from ..rotations import continuous_euler, euler_quat_components
 from .atomic import atomic_write
 
 _CHANNEL_NAMES = {c.lower(): c for c in ROTATION_CHANNELS + POSITION_CHANNELS}
 
 
-#: frames converted to quaternions at a time (keeps the temporaries small and in cache)
-BLOCK_FRAMES = 1024
+#: frames converted to quaternions at a time (keeps the temporaries small and in cache: 128 frames were
+#: fastest on the CMU and 100-joint iClone takes; 1024 is 1.5x slower)
+BLOCK_FRAMES = 128
 
 
 def read_bvh(path: str | os.PathLike) -> Motion:
@@ -141,7 +143,7 @@ class _Header:
             vals = tuple(float(w) for w in words)
         except ValueError:
             raise self.error(lineno, f"expected {n} numbers after {what}, found {' '.join(words)!r}") from None
-        if not all(np.isfinite(vals)) or max(map(abs, vals)) > MAX_MAGNITUDE:
+        if not all(map(math.isfinite, vals)) or max(map(abs, vals)) > MAX_MAGNITUDE:
             raise self.error(lineno, f"{what} values must be finite numbers within ±{MAX_MAGNITUDE:g}, "
                                      f"found {' '.join(words)!r}")
         return vals
@@ -404,10 +406,14 @@ def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float,
 
 
 def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Local quaternions ``(T, J, 4)`` and translations ``(T, J, 3)`` from the channel values ``(T, C)``.
+    """Local unit, sign-continuous quaternions ``(T, J, 4)`` and translations ``(T, J, 3)`` from the checked
+    channel values ``(T, C)`` (finite, within ``MAX_MAGNITUDE``).
 
-    Euler angles go to quaternions :data:`BLOCK_FRAMES` frames at a time, so no temporary is larger than a
-    block (and each stays in cache).
+    One pass over the frames, :data:`BLOCK_FRAMES` at a time, so every temporary is a block (and stays in
+    cache): Euler angles to quaternion components (:func:`~mocycle.rotations.euler_quat_components`),
+    normalised (:func:`_norms`) and made sign-continuous with the previous block's last frame
+    (:func:`_flip_signs`) as :class:`Motion` would, so the motion takes the arrays as they are
+    (:func:`_motion`): bit for bit the motion of the previous reader.
     """
     T, J = values.shape[0], skel.n_joints
     quats = np.empty((T, J, 4))
@@ -415,14 +421,18 @@ def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarra
     trans[...] = skel.offsets
     by_order: dict[str, list[tuple[int, list[int]]]] = {}
     still = []
+    columns, targets = [], []  # position channels and their places in trans.reshape(T, 3 * J)
     for j, (rot_cols, order, pos_cols, pos_axes) in enumerate(_channel_layout(skel)):
         if rot_cols:
             by_order.setdefault(order, []).append((j, rot_cols))
         else:
             still.append(j)
-        if pos_cols:
-            trans[:, j, pos_axes] = values[:, pos_cols]
+        columns += pos_cols
+        targets += [3 * j + a for a in pos_axes]
+    if columns:
+        trans.reshape(T, 3 * J)[:, targets] = values[:, columns]
     quats[:, still] = (0.0, 0.0, 0.0, 1.0)
+    groups = []
     for order, items in by_order.items():
         joints = [j for j, _ in items]
         cols = [c for _, cs in items for c in cs]
@@ -430,18 +440,71 @@ def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarra
             joints = slice(joints[0], joints[-1] + 1)
         if cols == list(range(cols[0], cols[-1] + 1)):
             cols = slice(cols[0], cols[-1] + 1)
-        n = len(items)
+        groups.append((order, joints, cols, len(items)))
+    for order, joints, cols, n in groups:
+        carry = None  # the previous block's last frame and its flip parity
         for f0 in range(0, T, BLOCK_FRAMES):
             f1 = min(T, f0 + BLOCK_FRAMES)
-            angles = values[f0:f1, cols].reshape(f1 - f0, n, len(order))
-            quats[f0:f1, joints] = euler_to_quats(angles, order, degrees=True)
+            # half angles (k, B, n) in one pass over the block's channels (a view of them when cols is a slice)
+            angles = values[f0:f1, cols].reshape(f1 - f0, n, len(order)).transpose(2, 0, 1)
+            comp = euler_quat_components(np.multiply(angles, np.pi / 360.0, order="C"), order)
+            comp = [np.zeros((f1 - f0, n)) if c is None else c for c in comp]
+            norm = _norms(comp)
+            sign, carry = _flip_signs(comp, carry)
+            if sign is not None:
+                norm *= sign  # x / -n is exactly -(x / n): the flip costs no pass of its own
+            out = quats[f0:f1, joints] if isinstance(joints, slice) else np.empty((f1 - f0, n, 4))
+            for m in range(4):
+                np.divide(comp[m], norm, out=out[..., m])
+            if not isinstance(joints, slice):  # joints of this order interleaved with others'
+                quats[f0:f1, joints] = out
     return quats, trans
 
 
+def _norms(comp: list[np.ndarray]) -> np.ndarray:
+    """The quaternions' norms from their four component arrays, summed in ``np.linalg.norm``'s order (so
+    the quotients are what :class:`Motion` makes of :func:`~mocycle.rotations.euler_to_quats`' quaternions,
+    bit for bit)."""
+    x, y, z, w = comp
+    norm = np.multiply(x, x)
+    sq = np.multiply(y, y)
+    norm += sq
+    np.multiply(z, z, out=sq)
+    norm += sq
+    np.multiply(w, w, out=sq)
+    norm += sq
+    return np.sqrt(norm, out=norm)
+
+
+def _flip_signs(comp: list[np.ndarray], carry):
+    """Signs ``(B, n)`` (or ``None``: none flips) that make a block of quaternions (components ``(B, n)``)
+    sign-continuous, as :func:`~mocycle.rotations.continuous_quats` does over the whole take: a frame flips
+    when its dot product with the frame before is negative, and so do all frames after it.  ``carry``: the
+    previous block's last frame (its components, unflipped) and its flip parity, or ``None``.  Returns the
+    signs and this block's carry."""
+    dots = np.empty(comp[0].shape)
+    np.multiply(comp[0][1:], comp[0][:-1], out=dots[1:])
+    for c in comp[1:]:
+        dots[1:] += c[1:] * c[:-1]
+    if carry is None:
+        dots[0] = 1.0  # the first frame keeps its sign
+    else:
+        last, parity = carry
+        dots[0] = comp[0][0] * last[0] + comp[1][0] * last[1] + comp[2][0] * last[2] + comp[3][0] * last[3]
+    flips = np.logical_xor.accumulate(dots < 0, axis=0)  # an odd number of sign changes so far
+    if carry is not None:
+        flips ^= parity
+    carry = ([c[-1].copy() for c in comp], flips[-1].copy())
+    if not flips.any():
+        return None, carry
+    return 1.0 - 2.0 * flips, carry
+
+
 def _motion(skel: Skeleton, quats: np.ndarray, trans: np.ndarray, frame_time: float, path) -> Motion:
-    """The motion, owning ``quats`` and ``trans`` (normalised and frozen in place, not copied)."""
+    """The motion, owning ``quats`` and ``trans`` as :func:`_arrays_from_channels` made them (frozen, not
+    copied or checked again: the values were checked when read)."""
     try:
-        return Motion(skel, quats, trans, frame_time, copy=False)
+        return Motion._adopt(skel, quats, trans, frame_time)
     except MocycleError as exc:
         raise MotionFileError(f"cannot build a motion from this file: {exc}", path) from None
 

@@ -39,7 +39,7 @@ from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
 from ..limits import check_frames
 from ..motion import JOINT_GROUPS, Motion, Skeleton, concatenate
-from ..phase.period import autocorrelation_period
+from ..phase.period import PEAK_TIE, autocorrelation_period, local_maxima, periodic_hann
 from ..rotations import axis_angle_quats, quat_conj, quat_exp, quat_log, quat_multiply
 from ..threads import limit_threads
 from .lct import block_edges, ilct, lct
@@ -139,23 +139,62 @@ def warp_curves(X, factor: float, window: int, overlap: int | None = None) -> np
 def fundamental_cycles(X, min_strength: float = CURVE_MIN_STRENGTH) -> np.ndarray:
     """The fundamental cycle (frames) of every curve of ``X`` (``(T, D)``): ``(D,)``, NaN where none is found.
 
-    Paper 004 eq. 1, curve by curve: :func:`mocycle.phase.period.autocorrelation_period` (Hann-windowed
-    circular autocorrelation, highest maximum in ``[2, T // 2]``) on each column, with a maximum needed of
-    ``min_strength * r(0)`` (0.3: drifting, weakly periodic curves such as a head slowly turning give no
-    cycle rather than a spurious long one).  Constant curves give NaN.
+    Paper 004 eq. 1, curve by curve: what :func:`mocycle.phase.period.autocorrelation_period` gives on each
+    column (Hann-windowed circular autocorrelation, highest maximum in ``[2, T // 2]``), with a maximum needed
+    of ``min_strength * r(0)`` (0.3: drifting, weakly periodic curves such as a head slowly turning give no
+    cycle rather than a spurious long one).  Constant curves give NaN.  The autocorrelations of all columns
+    come from one FFT; only the choice of each column's maximum is done column by column.
     """
     A = np.asarray(X, dtype=np.float64)
     if A.ndim == 1:
         A = A[:, None]
     if A.ndim != 2:
         raise MocycleError(f"X must be a (T,) or (T, D) array; got shape {A.shape}")
-    if A.shape[0] < 4:
-        raise MocycleError(f"the fundamental cycle needs at least 4 frames; got {A.shape[0]}")
+    T = A.shape[0]
+    if T < 4:
+        raise MocycleError(f"the fundamental cycle needs at least 4 frames; got {T}")
+    min_strength = _validate.real("min_strength", min_strength, 0.0, 1.0, high_open=True)
     out = np.full(A.shape[1], np.nan)
-    for d in range(A.shape[1]):
-        if np.ptp(A[:, d]) > 0:
-            out[d] = autocorrelation_period(A[:, d], min_strength=min_strength)
+    use = np.flatnonzero((np.ptp(A, axis=0) > 0) & np.all(np.isfinite(A), axis=0))
+    if use.size == 0:
+        return out
+    B = A[:, use]
+    B = B - np.mean(B, axis=0)
+    window = periodic_hann(T)
+    r = np.fft.irfft(np.abs(np.fft.rfft(B * window[:, None], axis=0)) ** 2, n=T, axis=0)  # (T, n) per column
+    env = np.fft.irfft(np.abs(np.fft.rfft(window)) ** 2, n=T)
+    for k, d in enumerate(use.tolist()):
+        if r[0, k] > 0.0:
+            out[d] = _cycle_from_autocorrelation(r[:, k] / r[0, k], env, 2, T // 2, min_strength)
     return out
+
+
+def _cycle_from_autocorrelation(r: np.ndarray, env: np.ndarray, min_lag: int, max_lag: int,
+                                min_strength: float) -> float:
+    """The cycle (frames) at the highest maximum of a normalised autocorrelation ``r`` ``(T,)``, as
+    :func:`~mocycle.phase.period.autocorrelation_period` chooses and refines it (``env``: the window's own
+    circular autocorrelation); NaN when no maximum reaches ``min_strength``."""
+    T = r.size
+    seg = r[: max_lag + 2]
+    peaks = local_maxima(seg)
+    peaks = peaks[(peaks >= min_lag) & (peaks <= max_lag)]
+    peaks = peaks[seg[peaks] > min_strength]
+    if peaks.size == 0:
+        return float("nan")
+    p = int(peaks[np.argmax(seg[peaks])])
+    level = peaks[(seg[peaks] >= seg[p] - PEAK_TIE) & (peaks < p)]
+    times = p / np.maximum(level, 1)
+    whole = (np.round(times) >= 2) & (np.abs(times / np.maximum(np.round(times), 1) - 1) <= 0.1)
+    if whole.any():
+        p = int(level[whole][0])
+    q = np.arange(p - 2, p + 3) % T
+    u = r[q] / env[q]
+    c = 1 + int(np.argmax(u[1:4]))
+    p += c - 2
+    left, mid, right = u[c - 1], u[c], u[c + 1]
+    curvature = left - 2.0 * mid + right
+    shift = 0.5 * (left - right) / curvature if curvature < 0 else 0.0
+    return float(p + np.clip(shift, -0.5, 0.5))
 
 
 def group_cycle(X, min_strength: float = CURVE_MIN_STRENGTH, weak: float = WEAK_CURVE) -> float:
@@ -338,26 +377,31 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
         resid_ptp = np.ptp(X - (a + v * np.arange(T)[:, None]), axis=0)
         trend = rise > TREND_DOMINATED * np.maximum(resid_ptp, 1e-12)
         trend_cols = [int(i) for i in np.flatnonzero(trend)]
+        by_window: dict[int, list[np.ndarray]] = {}  # groups with the same window warp in one transform
         for g, c in cols.items():
             if not c.size:
                 continue
             plain, tr = c[~trend[c]], c[trend[c]]
             if plain.size:
-                Y[:, plain] = warp_curves(X[:, plain], factor, windows[g])
+                by_window.setdefault(windows[g], []).append(plain)
             if tr.size:
                 Y[:, tr] = _warp_detrended(X[:, tr], factor, windows[g])
-    new = decoder.decode(Y)
+        for N, parts in by_window.items():
+            plain = np.concatenate(parts)
+            Y[:, plain] = warp_curves(X[:, plain], factor, N)
+    quats, _ = decoder.decode_arrays(Y, translations=False)
 
     # Translations: the travelling joint as mean velocity + warped residual; other moving joints warped.
     trans = np.broadcast_to(motion.translations[0], (n_out,) + motion.translations.shape[1:]).copy()
     travel = motion.travel_joint if travel is None else travel
-    for j in range(skel.n_joints):
-        p = motion.translations[:, j]
+    P = motion.translations
+    moving = np.ptp(P, axis=0).max(axis=1) > 1e-9 * (1.0 + np.abs(P).max(axis=(0, 2)))  # (J,)
+    for j in sorted(set(np.flatnonzero(moving).tolist()) | {travel}):
         if j == travel:
-            trans[:, j] = _warp_detrended(p, factor, windows[group_of[j]])
-        elif np.ptp(p, axis=0).max() > 1e-9 * (1.0 + np.abs(p).max()):
-            trans[:, j] = warp_curves(p, factor, windows[group_of[j]])
-    new = new.replace(translations=trans)
+            trans[:, j] = _warp_detrended(P[:, j], factor, windows[group_of[j]])
+        else:
+            trans[:, j] = warp_curves(P[:, j], factor, windows[group_of[j]])
+    new = Motion(skel, quats, trans, motion.frame_time)
 
     report = StretchReport(
         factor=factor,
