@@ -101,16 +101,27 @@ def phase_features(motion: Motion, *, joints: str | Iterable[str] | None = None,
 def principal_components(X: np.ndarray, n: int) -> np.ndarray:
     """The scores ``(T, n)`` of ``X`` ``(T, D)`` on its first ``n`` principal components.
 
-    What scikit-learn's ``PCA(n_components=n, svd_solver="full").fit_transform(X)`` returns, computed the same
-    way (centre, ``scipy.linalg.svd``, sign of each component set by its largest coefficient, ``U * S``)
-    without importing scikit-learn, which takes longer than a whole ``find_phase``.
+    What scikit-learn's ``PCA(n_components=n, svd_solver="full").fit_transform(X)`` returns (centred, the sign
+    of each component set by its largest coefficient), without importing scikit-learn, which takes longer than
+    a whole ``find_phase``.  With more frames than columns the components are the eigenvectors of the
+    ``(D, D)`` scatter matrix ``Xcᵀ Xc`` (``numpy.linalg.eigh``): the same scores within rounding, 5-8× faster
+    than the SVD of the ``(T, D)`` matrix, which short takes on wide rigs (T < D) still use.
     """
-    from scipy.linalg import svd
-
     Xc = X - X.mean(axis=0)
-    U, S, Vt = svd(Xc, full_matrices=False)
-    signs = np.sign(Vt[np.arange(Vt.shape[0]), np.argmax(np.abs(Vt), axis=1)])
-    return U[:, :n] * signs[:n] * S[:n]
+    if Xc.shape[0] < Xc.shape[1]:
+        from scipy.linalg import svd
+
+        U, S, Vt = svd(Xc, full_matrices=False)
+        signs = _component_signs(Vt[:n])
+        return U[:, :n] * signs * S[:n]
+    _, V = np.linalg.eigh(Xc.T @ Xc)
+    Vt = V[:, ::-1][:, :n].T  # largest first
+    return Xc @ (Vt * _component_signs(Vt)[:, None]).T
+
+
+def _component_signs(Vt: np.ndarray) -> np.ndarray:
+    """``(n,)``: the sign of each component's (row's) largest coefficient (scikit-learn's ``svd_flip``)."""
+    return np.sign(Vt[np.arange(Vt.shape[0]), np.argmax(np.abs(Vt), axis=1)])
 
 
 @dataclass(kw_only=True)

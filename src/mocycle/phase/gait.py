@@ -26,6 +26,7 @@ import numpy as np
 from ..errors import MocycleError
 from ..features import HeadingFrame
 from ..motion import Motion
+from ..rotations import quat_conj, quat_multiply
 from .period import autocorrelation_period
 
 
@@ -44,11 +45,11 @@ def leg_curves(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
     frame = HeadingFrame.fit(motion)
     travel = frame.travel
     legs = legs[legs != travel]
-    R, P = motion.world_transforms()
-    rel = P[:, legs] - P[:, travel][:, None]                       # (T, n, 3) world
     parent = int(skel.parents[travel])
+    Q, P = _world_chain(motion, [*legs.tolist(), travel, parent])
+    rel = np.stack([P[j] - P[travel] for j in legs.tolist()], axis=1)  # (T, n, 3) world
     if parent >= 0:                                                 # into the travel joint's parent frame
-        rel = np.einsum("tji,tnj->tni", R[:, parent], rel)
+        rel = _rotate(quat_conj(Q[parent])[:, None], rel)
     _, psi = frame.tilt(motion)
     T, n = rel.shape[:2]
     local = frame.to_local(rel.reshape(-1, 3), np.repeat(psi, n)).reshape(T, n, 3)
@@ -65,6 +66,34 @@ def leg_curves(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
             fwd = np.array([side[1], -side[0]])
             xyz = np.stack([xyz[..., [0, 2]] @ fwd, xyz[..., 1], xyz[..., [0, 2]] @ side], axis=-1)
     return legs, xyz
+
+
+def _world_chain(motion: Motion, joints: list[int]) -> tuple[dict[int, np.ndarray], dict[int, np.ndarray]]:
+    """World rotations (quaternions ``(T, 4)``) and positions ``(T, 3)`` of ``joints`` and their ancestors only
+    (a leg chain, not the whole rig: forward kinematics by quaternion products), keyed by joint index."""
+    parents = motion.skeleton.parents
+    needed: set[int] = set()
+    for j in joints:
+        while j >= 0 and j not in needed:
+            needed.add(j)
+            j = int(parents[j])
+    Q: dict[int, np.ndarray] = {}
+    P: dict[int, np.ndarray] = {}
+    for j in sorted(needed):  # parents come before their children
+        p = int(parents[j])
+        if p < 0:
+            Q[j], P[j] = motion.rotations[:, j], motion.translations[:, j]
+        else:
+            Q[j] = quat_multiply(Q[p], motion.rotations[:, j])
+            P[j] = P[p] + _rotate(Q[p], motion.translations[:, j])
+    return Q, P
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Vectors ``(..., 3)`` rotated by unit quaternions ``(..., 4)`` (broadcast): ``v + 2w(u×v) + 2u×(u×v)``."""
+    u, w = q[..., :3], q[..., 3:]
+    uv = np.cross(u, v)
+    return v + 2.0 * (w * uv + np.cross(u, uv))
 
 
 def leg_sides(curves: np.ndarray, legs: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
