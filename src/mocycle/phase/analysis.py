@@ -361,18 +361,21 @@ def _full_cycle(pm: PeriodicMotion, curves: np.ndarray, legs: float) -> Periodic
                    n_periods=0.5 * pm.n_periods, half_cycle=True, period_reason=reason)
 
 
-def _choose_period(pm: PeriodicMotion, X: np.ndarray, min_lag: int, legs: float) -> PeriodicMotion:
+def _choose_period(pm: PeriodicMotion, X: np.ndarray, min_lag: int, legs: float,
+                   whole: float | None = None) -> PeriodicMotion:
     """The period of ``pm``: the cohomology's, unless a cross-check disagrees and fits the take better.
 
     Candidates are the windowed autocorrelation period of the features on the longest excited region and
     the legs' own period, each kept when within 25 % of the cohomology's.  When one differs by more than
     :data:`PERIOD_AGREEMENT`, the candidate with the lowest :func:`self_similarity` of the region wins.
+    ``whole``: the autocorrelation period of all of ``X``, if known (used when the region is all of X).
     """
     s, e = _longest(pm, X.shape[0])
     P = pm.period_frames
     cands = {"cohomology": P}
     if (e - s) // 2 >= max(min_lag, 2) + 1:
-        acf = autocorrelation_period(X[s:e], min_lag=min_lag)
+        acf = whole if whole is not None and (s, e) == (0, X.shape[0]) else \
+            autocorrelation_period(X[s:e], min_lag=min_lag)
         if pm.half_cycle and np.isfinite(acf) and abs(2 * acf / P - 1) < abs(acf / P - 1):
             acf *= 2  # the features repeat every step; their autocorrelation says so
         cands["autocorrelation"] = acf
@@ -465,6 +468,7 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
                                         min_cycles=float(min_periods)).fit(X)
         found = _separate(_distinct([_periodic_motion(estimator.coords_[:, k], c, motion.frame_time,
                                                       motion.n_frames) for k, c in enumerate(estimator.classes_)]), X)
+        acf = autocorrelation_period(X, min_lag=min_lag)
         checked = []
         for pm in found:
             own = legs
@@ -474,8 +478,7 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
             pm = replace(pm, joints_used=label, legs_period_frames=own)
             if legs_ids.size:
                 pm = _full_cycle(pm, curves, own)
-            checked.append(_choose_period(pm, X, min_lag, own))
-        acf = autocorrelation_period(X, min_lag=min_lag)
+            checked.append(_choose_period(pm, X, min_lag, own, whole=acf))
         doubt = _doubt(checked, acf, legs, X)
         tries.append((label, estimator.reason_ + doubt))
         if kept is None or (checked and not kept[0]):
