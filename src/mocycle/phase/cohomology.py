@@ -289,23 +289,24 @@ def landmark_pool(N: int, size: int = LANDMARK_POOL) -> np.ndarray:
     return np.r_[0, np.sort(rest)]
 
 
-def _landmark_blocks(X: np.ndarray, landmarks: np.ndarray):
-    """``(start, d)`` per block of :data:`BLOCK` rows of ``X`` ``(N, D)``: ``d`` ``(n, L)`` the distances of the
-    block's rows to the ``landmarks`` ``(L, D)``, by one matrix product (``|x|² + |l|² - 2 x·l``)."""
-    sq_l = np.einsum("ld,ld->l", landmarks, landmarks)
+def _landmark_blocks(X: np.ndarray, landmarks: np.ndarray, dtype=np.float64):
+    """``(start, d2)`` per block of :data:`BLOCK` rows of ``X`` ``(N, D)``: ``d2`` ``(n, L)`` the squared distances
+    of the block's rows to the ``landmarks`` ``(L, D)``, ``|x|² - 2 x·l + |l|²`` as one matrix product of the
+    rows and the landmarks each with two columns appended (``[x, 1, |x|²] @ [-2 l, |l|², 1]ᵀ``), in ``dtype``."""
+    L = landmarks.shape[0]
+    right = np.concatenate([-2.0 * landmarks, np.einsum("ld,ld->l", landmarks, landmarks)[:, None],
+                            np.ones((L, 1))], axis=1).T.astype(dtype)
     for start in range(0, X.shape[0], BLOCK):
         x = X[start: start + BLOCK]
-        d = x @ landmarks.T
-        d *= -2.0
-        d += np.einsum("nd,nd->n", x, x)[:, None]
-        d += sq_l
-        np.maximum(d, 0.0, out=d)
-        yield start, np.sqrt(d, out=d)
+        left = np.concatenate([x, np.ones((x.shape[0], 1)), np.einsum("nd,nd->n", x, x)[:, None]], axis=1)
+        d2 = left.astype(dtype, copy=False) @ right
+        yield start, np.maximum(d2, 0.0, out=d2)
 
 
 def cover_radius(X: np.ndarray, landmarks: np.ndarray) -> float:
-    """The largest distance from a row of ``X`` ``(N, D)`` to its nearest landmark (``(L, D)``)."""
-    return max(float(d.min(axis=1).max()) for _, d in _landmark_blocks(X, landmarks))
+    """The largest distance from a row of ``X`` ``(N, D)`` to its nearest landmark (``(L, D)``), to about 1e-6
+    (single precision: it only sets how far the scale is raised, :class:`CohomologyFit`)."""
+    return float(np.sqrt(max(float(d2.min(axis=1).max()) for _, d2 in _landmark_blocks(X, landmarks, np.float32))))
 
 
 def _extend(X: np.ndarray, landmarks: np.ndarray, classes: list[CircleClass]) -> np.ndarray:
@@ -318,6 +319,7 @@ def _extend(X: np.ndarray, landmarks: np.ndarray, classes: list[CircleClass]) ->
     """
     out = np.empty((X.shape[0], len(classes)))
     for start, d in _landmark_blocks(X, landmarks):
+        np.sqrt(d, out=d)
         nearest = np.argmin(d, axis=1)
         for k, c in enumerate(classes):
             phi = np.maximum(c.scale / 2 - d, 0.0)
