@@ -249,7 +249,13 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
         for order, group in _joints_by_order(motion.skeleton, js).items():
             parts.append(continuous_euler(rotations(group), order).reshape(T, -1))
     elif rep == "expmap":
-        parts.append(continuous_rotvec(rotations(js)).reshape(T, -1))
+        if js == list(range(motion.n_joints)):  # every joint: no (T, J, 4) copy; each joint's curve is its own
+            v = continuous_rotvec(motion.rotations)
+            if tilt is not None:
+                v[:, travel] = continuous_rotvec(tilt[:, None])[:, 0]
+        else:
+            v = continuous_rotvec(rotations(js))
+        parts.append(v.reshape(T, -1))
     elif rep == "quatlog":
         ref = reference[js] / np.linalg.norm(reference[js], axis=-1, keepdims=True)
         rel = quat_multiply(quat_conj(ref), rotations(js))

@@ -348,7 +348,7 @@ def _longest(pm: PeriodicMotion, n_rows: int) -> tuple[int, int]:
 def _full_cycle(pm: PeriodicMotion, curves: np.ndarray, legs: float) -> PeriodicMotion:
     """``pm`` with its phase halved when its period is one step of a two-step gait (module notes, 4)."""
     s, e = _longest(pm, curves.shape[0])
-    swap = sides_swap(curves, pm.period_frames, np.arange(s, e))
+    swap = sides_swap(curves, pm.period_frames, slice(s, e))
     ratio = legs / pm.period_frames if np.isfinite(legs) else float("nan")
     if not swap.swaps or (np.isfinite(ratio) and not HALF_RATIO[0] <= ratio <= HALF_RATIO[1]):
         return pm

