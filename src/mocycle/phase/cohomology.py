@@ -194,25 +194,17 @@ def greedy_permutation(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     Returns the landmark row indices ``(n,)`` and the landmark-to-row
     distances ``(n, N)``.  ripser's ``n_perm`` does the same but calls
     scikit-learn's ``pairwise_distances`` (with its input checks) once per
-    landmark, which was 85 % of the time of a whole fit.  Each landmark's distances are one matrix-vector
-    product (``|x|² - 2 x·l + |l|²``, exactly 0 from a landmark to itself): 3-4× faster than the differences.
+    landmark, which was 85 % of the time of a whole fit.
     """
-    X = np.ascontiguousarray(X, dtype=np.float64)
     N = X.shape[0]
-    sq = np.einsum("nd,nd->n", X, X)
     idx = np.zeros(n, dtype=np.int64)
     dist = np.empty((n, N))
     nearest = np.full(N, np.inf)
+    diff = np.empty_like(X)
     for i in range(n):
-        row = dist[i]
-        np.matmul(X, X[idx[i]], out=row)
-        row *= -2.0
-        row += sq
-        row += sq[idx[i]]
-        np.maximum(row, 0.0, out=row)
-        np.sqrt(row, out=row)
-        row[idx[i]] = 0.0
-        np.minimum(nearest, row, out=nearest)
+        np.subtract(X, X[idx[i]], out=diff)
+        np.sqrt(np.einsum("nd,nd->n", diff, diff), out=dist[i])
+        np.minimum(nearest, dist[i], out=nearest)
         if i + 1 < n:
             idx[i + 1] = int(np.argmax(nearest))
     return idx, dist
