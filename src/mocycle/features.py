@@ -207,8 +207,13 @@ class HeadingFrame:
         forward, _ = horizontal_basis(local_up / np.linalg.norm(local_up))
         return cls(travel, up, e1, e2, forward)
 
-    def _about_up(self, angles: np.ndarray) -> Rotation:
-        return Rotation.from_rotvec(np.outer(angles, self.up))
+    def _about_up(self, v: np.ndarray, angles: np.ndarray) -> np.ndarray:
+        """Vectors ``(N, 3)`` turned by ``angles`` ``(N,)`` rad about ``up`` (Rodrigues' formula)."""
+        v = np.asarray(v, dtype=np.float64)
+        u = self.up
+        c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+        cross = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])  # u × v = cross @ v
+        return v * c + (v @ cross.T) * s + (v @ u)[:, None] * u * (1.0 - c)
 
     def tilt(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
         """The travel joint's rotation without its heading ``(T, 4)`` and the unwrapped heading ``(T,)`` rad."""
@@ -223,11 +228,11 @@ class HeadingFrame:
 
     def to_local(self, v: np.ndarray, angles: np.ndarray) -> np.ndarray:
         """Vectors ``(T, 3)`` of the parent frame in the heading frames at ``angles`` ``(T,)``."""
-        return self._about_up(-angles).apply(v)
+        return self._about_up(v, -np.asarray(angles, dtype=np.float64))
 
     def to_world(self, v: np.ndarray, angles: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`to_local`."""
-        return self._about_up(angles).apply(v)
+        return self._about_up(v, np.asarray(angles, dtype=np.float64))
 
 
 def _joints_by_order(skel, joints: Iterable[int]) -> dict[str, list[int]]:
@@ -242,22 +247,34 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
     T = motion.n_frames
     js = list(joints)
     parts = []
+    tilt = None
     if root == "heading":
         tilt, psi = frame.tilt(motion)
-        rotations = motion.rotations.copy()
-        rotations[:, travel] = tilt
-        motion = Motion(motion.skeleton, rotations, motion.translations, motion.frame_time)
+
+    def rotations(group: list[int]) -> np.ndarray:
+        """``(T, len(group), 4)``: the joints' rotations, the travel joint's tilt in place of its own."""
+        q = motion.rotations[:, group]
+        if tilt is not None and travel in group:
+            q[:, group.index(travel)] = tilt
+        return q
+
     if rep == "euler":
         for order, group in _joints_by_order(motion.skeleton, js).items():
-            parts.append(continuous_euler(motion.rotations[:, group], order).reshape(T, -1))
+            parts.append(continuous_euler(rotations(group), order).reshape(T, -1))
     elif rep == "expmap":
-        parts.append(continuous_rotvec(motion.rotations[:, js]).reshape(T, -1))
+        if js == list(range(motion.n_joints)):  # every joint: no (T, J, 4) copy; each joint's curve is its own
+            v = continuous_rotvec(motion.rotations)
+            if tilt is not None:
+                v[:, travel] = continuous_rotvec(tilt[:, None])[:, 0]
+        else:
+            v = continuous_rotvec(rotations(js))
+        parts.append(v.reshape(T, -1))
     elif rep == "quatlog":
         ref = reference[js] / np.linalg.norm(reference[js], axis=-1, keepdims=True)
-        rel = quat_multiply(quat_conj(ref), motion.rotations[:, js])
+        rel = quat_multiply(quat_conj(ref), rotations(js))
         parts.append(0.5 * continuous_rotvec(rel).reshape(T, -1))
     else:
-        parts.append(Rotation.from_quat(motion.rotations[:, js].reshape(-1, 4)).as_matrix().reshape(T, -1))
+        parts.append(Rotation.from_quat(rotations(js).reshape(-1, 4)).as_matrix().reshape(T, -1))
     if root == "keep":
         parts.append(motion.translations[:, travel])
     elif root == "velocity":

@@ -195,7 +195,7 @@ class Motion:
         normalises and freezes them in place instead of copying them (what the readers do: half the memory).
     """
 
-    __slots__ = ("skeleton", "rotations", "translations", "frame_time")
+    __slots__ = ("skeleton", "rotations", "translations", "frame_time", "_travel")
 
     def __init__(
         self,
@@ -311,8 +311,11 @@ class Motion:
         Usually the root; in files such as the Bandai Namco set the root is a
         static ``joint_Root`` and ``Hips`` carries the motion in its position channels.
         """
-        moving = np.ptp(self.translations, axis=0).max(axis=1) > 1e-9  # (J,)
-        return int(np.argmax(moving)) if moving.any() else 0
+        known = getattr(self, "_travel", None)  # the arrays are read-only: found once per motion
+        if known is None:
+            moving = np.ptp(self.translations, axis=0).max(axis=1) > 1e-9  # (J,)
+            known = self._travel = int(np.argmax(moving)) if moving.any() else 0
+        return known
 
     def __repr__(self) -> str:
         return (

@@ -30,6 +30,7 @@ from scipy.spatial.transform import Rotation
 from .errors import MocycleError
 
 TWO_PI = 2.0 * np.pi
+_BLOCK = 4096  # frames per block of continuous_rotvec: its (frames, joints) temporaries stay in the cache
 
 
 def vector_norms(v: np.ndarray, keepdims: bool = False) -> np.ndarray:
@@ -216,15 +217,38 @@ def continuous_rotvec(quats: np.ndarray) -> np.ndarray:
     ``u·(θ + 2πk)``, the one closest to the frame before; frame 0 is canonical
     (angle ≤ π).  Returns ``(T, N, 3)`` radians.
     """
-    q = continuous_quats(quats)
-    q = q * np.where(q[:1, :, 3:4] < 0, -1.0, 1.0)  # frame 0 canonical
-    v = quat_log(q)  # continuous while the angle stays in [0, 2π]
-    if v.shape[0] < 2:
+    q = np.asarray(quats, dtype=np.float64)
+    T, N = q.shape[:2]
+    v = np.empty((T, N, 3))
+    turned = np.zeros(N, dtype=bool)  # joints whose angle passes π/2 somewhere
+    sign = np.where(q[0, :, 3] < 0, -1.0, 1.0)  # frame 0 canonical
+    # quat_log of the sign-continuous quaternions (continuous_quats) without making them: one sign and one
+    # scale per (frame, joint), by blocks of frames that stay in the cache
+    for a in range(0, T, _BLOCK):
+        b = min(a + _BLOCK, T)
+        block = q[a:b]
+        lo = max(a - 1, 0)
+        flip = np.einsum("tnk,tnk->tn", q[lo + 1:b], q[lo:b - 1]) < 0  # frame t against t - 1, t in (lo, b)
+        if a == 0:
+            flip = np.concatenate([np.zeros((1, N), dtype=bool), flip])
+        signs = sign * (1.0 - 2.0 * (np.cumsum(flip, axis=0) % 2)) if flip.any() else np.broadcast_to(sign, (b - a, N))
+        sign = signs[-1].copy()
+        s = np.sqrt(np.einsum("tnk,tnk->tn", block[..., :3], block[..., :3]))
+        w = signs * block[..., 3]
+        angle = 2.0 * np.arctan2(s, w)  # continuous while it stays in [0, 2π]
+        turned |= (angle > 0.5 * np.pi).any(axis=0)
+        scale = np.where(s > 1e-12, angle / np.maximum(s, 1e-300), 2.0 * np.sign(w + 1e-300))  # as quat_log
+        np.multiply(block[..., :3], (signs * scale)[..., None], out=v[a:b])
+    if T < 2:
         return v
-    jumps = vector_norms(np.diff(v, axis=0)) > np.pi  # (T-1, N)
-    cols = np.flatnonzero(jumps.any(axis=0))
+    # a jump (> π between frames) needs an angle above π/2 at one of its two frames: only those joints are checked
+    cols = np.flatnonzero(turned)
     if cols.size:
-        start = int(np.argmax(jumps[:, cols].any(axis=1)))
+        jumps = vector_norms(np.diff(v[:, cols], axis=0)) > np.pi  # (T-1, n)
+        hit = jumps.any(axis=0)
+        cols, jumps = cols[hit], jumps[:, hit]
+    if cols.size:
+        start = int(np.argmax(jumps.any(axis=1)))
         prev = v[start, cols]
         for t in range(start + 1, v.shape[0]):
             cur = v[t, cols]

@@ -165,3 +165,20 @@ def test_scikit_learn_estimator_contract(estimator, check):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         check(estimator)
+
+
+def test_landmarks_of_a_long_take_come_from_a_bounded_pool_and_cover_every_row():
+    from mocycle.phase.cohomology import LANDMARK_POOL, cover_radius, landmark_pool
+
+    assert landmark_pool(50).tolist() == list(range(50))
+    pool = landmark_pool(3 * LANDMARK_POOL)
+    assert pool.size == LANDMARK_POOL and pool[0] == 0 and np.all(np.diff(pool) > 0)
+    assert np.array_equal(pool, landmark_pool(3 * LANDMARK_POOL))  # seeded: the same take, the same landmarks
+    take = synthetic_walk(n_frames=LANDMARK_POOL + 2000, noise_deg=1.0, seed=4)
+    X = phase_features(take.motion)
+    cc = CircularCoordinates().fit(X)
+    assert np.isin(cc.landmarks_, landmark_pool(X.shape[0])).all()
+    # the cover radius is measured on every row, not only the pool's
+    full = np.sqrt(((X[:, None, :] - cc.landmark_points_[None]) ** 2).sum(-1)).min(axis=1).max()
+    assert np.isclose(cc.cover_radius_, full) and np.isclose(cover_radius(X, cc.landmark_points_), full)
+    assert circular_rank_correlation(cc.coords_[:, 0], take.phase) > 0.99

@@ -314,3 +314,14 @@ def test_autocorrelation_period_of_a_long_take_is_the_cycle_not_a_multiple():
         X = np.c_[np.sin(2 * np.pi * ph), np.cos(2 * np.pi * ph) + 0.3 * np.sin(4 * np.pi * ph),
                   np.sin(6 * np.pi * ph)] + 0.3 * rng.normal(size=(T, 3))
         assert autocorrelation_period(X, min_lag=8) == pytest.approx(60.0, abs=0.1)
+
+
+def test_circular_autocorrelation_is_the_same_at_fast_and_slow_fft_lengths():
+    from mocycle.phase.period import _smooth_length, circular_autocorrelation
+
+    assert [_smooth_length(n) for n in (1, 7, 11, 97, 99998, 199995)] == [1, 8, 12, 100, 100000, 200000]
+    rng = np.random.default_rng(0)
+    for T in (30, 97, 998):  # smooth, prime, 2 x 499: direct and zero-padded paths
+        Y = rng.normal(size=(T, 3))
+        direct = [sum(float(Y[:, d] @ np.roll(Y[:, d], -k)) for d in range(3)) for k in range(T)]
+        assert np.allclose(circular_autocorrelation(Y), direct, rtol=0, atol=1e-9)

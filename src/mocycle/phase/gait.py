@@ -26,6 +26,7 @@ import numpy as np
 from ..errors import MocycleError
 from ..features import HeadingFrame
 from ..motion import Motion
+from ..rotations import quat_conj, quat_multiply
 from .period import autocorrelation_period
 
 
@@ -44,15 +45,17 @@ def leg_curves(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
     frame = HeadingFrame.fit(motion)
     travel = frame.travel
     legs = legs[legs != travel]
-    R, P = motion.world_transforms()
-    rel = P[:, legs] - P[:, travel][:, None]                       # (T, n, 3) world
     parent = int(skel.parents[travel])
+    Q, P = _world_chain(motion, [*legs.tolist(), travel, parent])
+    rel = np.stack([P[j] - P[travel] for j in legs.tolist()], axis=1)  # (T, n, 3) world
     if parent >= 0:                                                 # into the travel joint's parent frame
-        rel = np.einsum("tji,tnj->tni", R[:, parent], rel)
+        rel = _rotate(quat_conj(Q[parent])[:, None], rel)
     _, psi = frame.tilt(motion)
-    T, n = rel.shape[:2]
-    local = frame.to_local(rel.reshape(-1, 3), np.repeat(psi, n)).reshape(T, n, 3)
-    xyz = local @ np.stack([frame.e1, frame.up, frame.e2]).T           # (e1, up, e2) components
+    # (e1, up, e2) components in the heading frame (frame.to_local, then onto the basis): turning by -psi about
+    # up turns the horizontal components (a, b) along (e1, e2) to (a cos psi + b sin psi, b cos psi - a sin psi)
+    a, h, b = np.moveaxis(rel @ np.stack([frame.e1, frame.up, frame.e2]).T, -1, 0)
+    c, s = np.cos(psi)[:, None], np.sin(psi)[:, None]
+    xyz = np.stack([a * c + b * s, h, b * c - a * s], axis=-1)
     # The lateral direction: from one top leg joint (its parent is no leg joint: the hips) to the other.
     tops = [k for k, j in enumerate(legs) if int(skel.parents[j]) not in set(legs.tolist())]
     mean = xyz.mean(axis=0)[:, [0, 2]]
@@ -65,6 +68,36 @@ def leg_curves(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
             fwd = np.array([side[1], -side[0]])
             xyz = np.stack([xyz[..., [0, 2]] @ fwd, xyz[..., 1], xyz[..., [0, 2]] @ side], axis=-1)
     return legs, xyz
+
+
+def _world_chain(motion: Motion, joints: list[int]) -> tuple[dict[int, np.ndarray], dict[int, np.ndarray]]:
+    """World rotations (quaternions ``(T, 4)``) and positions ``(T, 3)`` of ``joints`` and their ancestors only
+    (a leg chain, not the whole rig: forward kinematics by quaternion products), keyed by joint index."""
+    parents = motion.skeleton.parents
+    needed: set[int] = set()
+    for j in joints:
+        while j >= 0 and j not in needed:
+            needed.add(j)
+            j = int(parents[j])
+    Q: dict[int, np.ndarray] = {}
+    P: dict[int, np.ndarray] = {}
+    for j in sorted(needed):  # parents come before their children
+        p = int(parents[j])
+        if p < 0:
+            Q[j], P[j] = motion.rotations[:, j], motion.translations[:, j]
+        else:
+            Q[j] = quat_multiply(Q[p], motion.rotations[:, j])
+            P[j] = P[p] + _rotate(Q[p], motion.translations[:, j])
+    return Q, P
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Vectors ``(..., 3)`` rotated by unit quaternions ``(..., 4)`` (broadcast), through their rotation matrices."""
+    x, y, z, w = np.moveaxis(q, -1, 0)
+    R = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
+                  2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+                  2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1)
+    return np.einsum("...ij,...j->...i", R.reshape(R.shape[:-1] + (3, 3)), v)
 
 
 def leg_sides(curves: np.ndarray, legs: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -139,11 +172,11 @@ class SideSwap:
         return self.pairs > 0 and self.swapped < 0.5 * self.same
 
 
-def sides_swap(curves: np.ndarray, period: float, frames: np.ndarray | None = None) -> SideSwap:
+def sides_swap(curves: np.ndarray, period: float, frames: np.ndarray | slice | None = None) -> SideSwap:
     """Whether left and right leg curves ``(T, n, 3)`` trade places across ``period`` frames.
 
     Uses the forward and up components (lateral ones mirror between sides), each joint's mean removed,
-    on ``frames`` (a contiguous run of frame indices; default all).
+    on ``frames`` (a contiguous run of frame indices, or a slice; default all).
     """
     a, b = leg_sides(curves)
     if a.size == 0 or not np.isfinite(period) or period <= 0:

@@ -147,8 +147,11 @@ def fit_period(unwrapped, frame_time: float | None = None, frames=None) -> Perio
         raise MocycleError(f"fitting a period needs at least two distinct frames; got {np.unique(idx).size}")
     y = y_all[idx]
     x = idx.astype(np.float64)
-    slope, intercept = np.polyfit(x, y, 1)
-    slope, intercept = float(slope), float(intercept)
+    # the least-squares line (what np.polyfit(x, y, 1) gives, in closed form about the means: 10x faster)
+    xm, ym = float(x.mean()), float(y.mean())
+    dx = x - xm
+    slope = float(dx @ (y - ym) / (dx @ dx))
+    intercept = ym - slope * xm
     span = float(x.max() - x.min())
     if abs(slope) * span < _FLAT_CYCLES:
         period = float("inf")
@@ -205,6 +208,41 @@ def moving_average(x: np.ndarray, size: int) -> np.ndarray:
     return (sums[size:] - sums[:-size]) / size + level
 
 
+def _smooth_length(n: int) -> int:
+    """The smallest ``2^a 3^b 5^c >= n``: a length pocketfft transforms fast (a length with a large prime
+    factor takes it 10-20 times as long: 99 998 = 2 x 49 999)."""
+    best = 1 << max(0, int(n - 1).bit_length())
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            m = p35 << max(0, int(-(-n // p35) - 1).bit_length())  # p35 x the power of two reaching n
+            best = min(best, m)
+            p35 *= 3
+        p5 *= 5
+    return best
+
+
+def circular_autocorrelation(Y: np.ndarray) -> np.ndarray:
+    """``r(k) = Σ_d Σ_n y_d(n) y_d((n + k) mod T)`` of ``Y`` ``(T,)`` or ``(T, D)``: ``(T,)``, by FFT.
+
+    When T is a fast FFT length (no prime factor above 5) directly; otherwise from the linear autocorrelation
+    ``c`` zero-padded to the next fast length of at least ``2T - 1`` (``r(k) = c(k) + c(T - k)``): the same
+    numbers within rounding, without pocketfft's slow path for lengths with large prime factors.
+    """
+    Y = np.asarray(Y, dtype=np.float64)
+    if Y.ndim == 1:
+        Y = Y[:, None]
+    T = Y.shape[0]
+    if _smooth_length(T) == T:
+        return np.fft.irfft(np.sum(np.abs(np.fft.rfft(Y, axis=0)) ** 2, axis=1), n=T)
+    n = _smooth_length(2 * T - 1)
+    c = np.fft.irfft(np.sum(np.abs(np.fft.rfft(Y, n=n, axis=0)) ** 2, axis=1), n=n)[:T]
+    r = c.copy()
+    r[1:] += c[:0:-1]
+    return r
+
+
 #: Autocorrelation maxima (fractions of ``r(0)``) this close to the highest count as level with it.
 PEAK_TIE = 0.02
 
@@ -252,9 +290,7 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
     A = A - A.mean(axis=0)
     A[:, np.ptp(A, axis=0) == 0.0] = 0.0  # exactly constant columns: remove the rounding left by centring
     window = periodic_hann(T)
-    Y = A * window[:, None]
-    spectrum = np.fft.rfft(Y, axis=0)
-    r = np.fft.irfft(np.sum(np.abs(spectrum) ** 2, axis=1), n=T)
+    r = circular_autocorrelation(A * window[:, None])
     if not r[0] > 0.0:
         return float("nan")
     r = r / r[0]
@@ -275,7 +311,7 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
         p = int(level[whole][0])
     # Refine on r / (the window's own circular autocorrelation): the window's decay would pull the vertex
     # towards smaller lags by up to ~1 % of the period; the division undoes that bias for a stationary signal.
-    env = np.fft.irfft(np.abs(np.fft.rfft(window)) ** 2, n=T)
+    env = circular_autocorrelation(window)
     q = np.arange(p - 2, p + 3) % T  # r is circular
     u = r[q] / env[q]
     c = 1 + int(np.argmax(u[1:4]))  # the largest of lags p-1, p, p+1
