@@ -51,7 +51,7 @@ def signature(seg: Segmentation, rate_hz: float = 30.0) -> Signature:
         t0, t1 = s.start * seg.frame_time, s.end * seg.frame_time
         rate = (s.end_angle - s.start_angle) / max(t1 - t0, 1e-12)
         track = tracks.setdefault(s.name, np.zeros((L, 3)))
-        inside = (t >= t0) & (t < t1)
+        inside = slice(*np.searchsorted(t, (t0, t1)))  # the samples t0 <= t < t1 (t increases)
         track[inside] = np.asarray(s.axis) * rate
     return Signature(tracks, float(rate_hz), L)
 
