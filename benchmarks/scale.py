@@ -2,15 +2,16 @@
 
     python benchmarks/scale.py                        # 10k and 100k frames (a few minutes)
     python benchmarks/scale.py --frames 10000,100000,1000000 --mem-gb 14 --timeout 900
-    python benchmarks/scale.py --frames 1000000 --only swings,loop --markdown
+    python benchmarks/scale.py --frames 1000000 --only swings,loop --keep /tmp/scale --markdown
 
 The take is the synthetic walk (22 joints, 69 channels, 120 fps, 0.3 deg noise) generated in chunks of
 100 cycles that follow on (phase, root travel and a fresh noise seed per chunk), so a take of any length
-is written without holding it whole.  Every command then runs in a fresh ``python -m mocycle`` process
-under a memory limit (``RLIMIT_AS``) and a wall-clock timeout; the parent reads that process's own
-peak resident memory from ``os.wait4``.  Printed per command and size: exit code, seconds, peak MB,
+is written without holding it whole (``--keep DIR`` keeps it for the next run).  Every command then runs
+in a fresh ``python -m mocycle`` process under a memory limit (``RLIMIT_AS``) and a wall-clock timeout;
+the parent reads that process's own rusage from ``os.wait4``.  Printed per command and size: exit code,
+wall seconds, CPU seconds (user + system: the figure to compare on a loaded machine), peak resident MB,
 peak / channel array (``frames × channels × 8`` bytes, the float64 array the BVH holds) and, between
-consecutive sizes, the growth exponents of time and of peak memory (1 = linear).
+consecutive sizes, the growth exponents of CPU time and of peak memory (1 = linear).
 """
 
 from __future__ import annotations
@@ -88,8 +89,8 @@ def commands(folder: Path) -> list[tuple[str, list[str]]]:
     ]
 
 
-def run(argv: list[str], mem_bytes: int, timeout: float) -> tuple[int, float, float, str]:
-    """Run ``mocycle argv`` in a fresh process: exit code, seconds, peak RSS (MB), last stderr line."""
+def run(argv: list[str], mem_bytes: int, timeout: float) -> tuple[int, float, float, float, str]:
+    """Run ``mocycle argv`` in a fresh process: exit code, seconds, CPU seconds, peak RSS (MB), last stderr line."""
     env = dict(os.environ, PYTHONPATH=f"{SRC}{os.pathsep}{os.environ.get('PYTHONPATH', '')}")
 
     def limit() -> None:
@@ -115,7 +116,7 @@ def run(argv: list[str], mem_bytes: int, timeout: float) -> tuple[int, float, fl
         lines = [x for x in err.read().decode(errors="replace").splitlines() if x.strip()]
     code = os.waitstatus_to_exitcode(status) if status != -9 << 8 else -9
     last = "timeout" if code == -9 and secs > timeout else (lines[-1][:110] if lines else "")
-    return code, secs, usage.ru_maxrss / 1024, last
+    return code, secs, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024, last
 
 
 def main() -> int:
@@ -138,27 +139,33 @@ def main() -> int:
             (folder / "out").mkdir(parents=True, exist_ok=True)
             (folder / "library").mkdir(exist_ok=True)
             t0 = time.perf_counter()
-            channels = write_take(folder / "take.bvh", n)
+            marker = folder / f"take.{n}.channels"
+            if a.keep is not None and marker.exists() and (folder / "take.bvh").exists():
+                channels = int(marker.read_text())  # the kept take of this length
+            else:
+                channels = write_take(folder / "take.bvh", n)
+                marker.write_text(str(channels))
             (folder / "library" / "take.bvh").unlink(missing_ok=True)
             os.symlink(folder / "take.bvh", folder / "library" / "take.bvh")
             array_mb = n * channels * 8 / 2**20
             file_mb = (folder / "take.bvh").stat().st_size / 2**20
             print(f"\n## {n:,} frames × {channels} channels: file {file_mb:,.0f} MB, channel array {array_mb:,.0f} MB"
                   f" (written in {time.perf_counter() - t0:.0f} s, load {os.getloadavg()[0]:.1f})", flush=True)
-            print(f"{'command':14s} {'exit':>4s} {'s':>8s} {'peak MB':>8s} {'/array':>7s}  note", flush=True)
+            print(f"{'command':14s} {'exit':>4s} {'s':>8s} {'cpu s':>8s} {'peak MB':>8s} {'/array':>7s}  note",
+                  flush=True)
             for name, argv in commands(folder):
                 if only and name not in only:
                     continue
-                code, secs, peak, last = run(argv, int(a.mem_gb * 2**30), a.timeout)
+                code, secs, cpu, peak, last = run(argv, int(a.mem_gb * 2**30), a.timeout)
                 ratio = peak / array_mb
-                results.setdefault(name, []).append((n, code, secs, peak, ratio, last))
+                results.setdefault(name, []).append((n, code, cpu, peak, ratio, secs))
                 note = last if code else ""
-                print(f"{name:14s} {code:4d} {secs:8.1f} {peak:8.0f} {ratio:7.2f}  {note}", flush=True)
+                print(f"{name:14s} {code:4d} {secs:8.1f} {cpu:8.1f} {peak:8.0f} {ratio:7.2f}  {note}", flush=True)
         finally:
             if a.keep is None:
                 shutil.rmtree(folder, ignore_errors=True)
     if len(sizes) > 1:
-        print("\n## growth exponents between consecutive sizes (time, peak memory; 1 = linear)")
+        print("\n## growth exponents between consecutive sizes (CPU time, peak memory; 1 = linear)")
         for name, rows in results.items():
             parts = []
             for (n0, _, s0, p0, *_), (n1, _, s1, p1, *_) in zip(rows, rows[1:], strict=False):
@@ -166,10 +173,11 @@ def main() -> int:
                 parts.append(f"{n0:,}→{n1:,}: {math.log(s1 / s0) / e:.2f}, {math.log(p1 / p0) / e:.2f}")
             print(f"{name:14s} " + "; ".join(parts))
     if a.markdown:
-        print("\n| command | frames | exit | seconds | peak MB | peak / channel array |\n|---|---|---|---|---|---|")
+        print("\n| command | frames | exit | wall s | CPU s | peak MB | peak / channel array |\n"
+              "|---|---|---|---|---|---|---|")
         for name, rows in results.items():
-            for n, code, secs, peak, ratio, _last in rows:
-                print(f"| `{name}` | {n:,} | {code} | {secs:.1f} | {peak:,.0f} | {ratio:.2f} |")
+            for n, code, cpu, peak, ratio, secs in rows:
+                print(f"| `{name}` | {n:,} | {code} | {secs:.0f} | {cpu:.0f} | {peak:,.0f} | {ratio:.2f} |")
     return 0
 
 

@@ -131,14 +131,17 @@ def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> li
         tmpl = metrics["template_error"]
         seam = max(metrics["seam_pose_local"], metrics["seam_velocity_local"])
     else:
-        tmpl = template_error(metric_features(motion[slice(*max(cycle.axis.regions, key=lambda r: r[1] - r[0]))],
-                                              ref), C)[0]
+        tmpl = template_error(metric_features(motion, ref, slice(*max(cycle.axis.regions, key=lambda r: r[1] - r[0]))),
+                              C)[0]
         ratios = [seam_ratios(C), seam_ratios(root)]
         seam = max(max(r["pose_local"], r["velocity_local"]) for r in ratios)
     cut, cut_period = best_cut_error(motion, cycle, ref)
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    Y = metric_features(motion[s:e], ref)
-    spread = float(np.sqrt(((Y - Y.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    Y = metric_features(motion, ref, slice(s, e))
+    mean = Y.mean(axis=0)
+    spread = float(np.sqrt(sum(float(((Y[r:r + 8192] - mean) ** 2).sum()) for r in range(0, Y.shape[0], 8192))
+                           / Y.shape[0]))
+    del Y
     if np.isfinite(cut) and not tmpl <= max(MAX_FIT_RATIO * cut, FIT_FLOOR * spread):
         why = (f"the period found ({cycle.period_frames:.1f} frames) is probably wrong"
                if abs(cut_period / cycle.period_frames - 1) > PERIOD_AGREES else

@@ -266,6 +266,8 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
                                                   motion.frame_time, rate)
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
     tmpl, offset = template_error(Y[s:e], C)
+    jerk = jerk_ratio([Y[a:b] for a, b in cycle.axis.regions], C, motion.frame_time)
+    del Y  # (T, 9J): not held while the feet are measured
     seams = [seam_ratios(C), seam_ratios(root)]
     travelling = cycle.repeat(2, root="motion")
     captured = motion[frames[0]:frames[-1] + 1]
@@ -275,7 +277,7 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
         "rmse_ddh": rmse_ddh,
         "template_error": tmpl,
         "template_offset": offset,
-        "jerk_ratio": jerk_ratio([Y[a:b] for a, b in cycle.axis.regions], C, motion.frame_time),
+        "jerk_ratio": jerk,
         "seam_pose": max(r["pose"] for r in seams),
         "seam_velocity": max(r["velocity"] for r in seams),
         "seam_pose_local": max(r["pose_local"] for r in seams),
