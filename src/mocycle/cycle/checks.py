@@ -80,7 +80,10 @@ def _plain_cut_error(Y: np.ndarray, period: float) -> tuple[float, int]:
     h = max(1, int(round(0.1 * period)))
     best = (np.inf, 0, 0)
     for lag in lags:
-        d = ((Y[:-lag] - Y[lag:]) ** 2).sum(axis=1)
+        d = np.empty(M - lag)
+        for r in range(0, M - lag, 8192):  # in blocks of rows: no temporaries as large as Y
+            r1 = min(r + 8192, M - lag)
+            d[r:r1] = ((Y[r:r1] - Y[r + lag:r1 + lag]) ** 2).sum(axis=1)
         if d.size < 2 * h + 1:
             continue
         c = np.concatenate([[0.0], np.cumsum(d)])
@@ -101,7 +104,7 @@ def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = 
     (paper 004 eq. 1 on the pose features; independent of the phase)."""
     ref = mean_rotations(motion.rotations) if reference is None else reference
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    Y = metric_features(motion[s:e], ref)
+    Y = metric_features(motion, ref, slice(s, e))
     candidates = [cycle.period_frames]
     if Y.shape[0] >= 8:
         min_lag = max(2, int(round(MIN_PERIOD_S / motion.frame_time)))
