@@ -179,6 +179,26 @@ JOINT_GROUPS: dict[str, list[str]] = {
 }
 
 
+#: Frames per block of :meth:`Motion.world_positions` (its matrices take 168 bytes per joint and frame).
+_FK_BLOCK = 4096
+
+
+def _forward_kinematics(quats: np.ndarray, translations: np.ndarray, parents) -> tuple[np.ndarray, np.ndarray]:
+    """World rotations ``(T, J, 3, 3)`` and positions ``(T, J, 3)`` of local ``quats`` (T, J, 4) and
+    ``translations`` (T, J, 3) (parents before children)."""
+    T, J = quats.shape[:2]
+    local = Rotation.from_quat(quats.reshape(-1, 4)).as_matrix().reshape(T, J, 3, 3)
+    world_r = np.empty_like(local)
+    world_p = np.empty((T, J, 3))
+    world_r[:, 0] = local[:, 0]
+    world_p[:, 0] = translations[:, 0]
+    for j in range(1, J):
+        p = parents[j]
+        world_r[:, j] = world_r[:, p] @ local[:, j]
+        world_p[:, j] = world_p[:, p] + (world_r[:, p] @ translations[:, j, :, None])[..., 0]
+    return world_r, world_p
+
+
 class Motion:
     """A take: skeleton, local rotations, local translations and the exact frame time.
 
@@ -337,20 +357,12 @@ class Motion:
     # -- forward kinematics ---------------------------------------------
     def world_transforms(self) -> tuple[np.ndarray, np.ndarray]:
         """World rotations ``(T, J, 3, 3)`` and world joint positions ``(T, J, 3)``."""
-        local = self.rotation_matrices()
-        parents = self.skeleton.parents
-        world_r = np.empty_like(local)
-        world_p = np.empty((self.n_frames, self.n_joints, 3))
-        world_r[:, 0] = local[:, 0]
-        world_p[:, 0] = self.translations[:, 0]
-        for j in range(1, self.n_joints):
-            p = parents[j]
-            world_r[:, j] = world_r[:, p] @ local[:, j]
-            world_p[:, j] = world_p[:, p] + (world_r[:, p] @ self.translations[:, j, :, None])[..., 0]
-        return world_r, world_p
+        return _forward_kinematics(self.rotations, self.translations, self.skeleton.parents)
 
     def world_positions(self, end_sites: bool = False) -> np.ndarray:
         """Forward kinematics: world joint positions ``(T, J, 3)`` in file units.
+
+        Computed in blocks of frames, so that the ``(T, J, 3, 3)`` rotation matrices are never held whole.
 
         Parameters
         ----------
@@ -367,14 +379,17 @@ class Motion:
         >>> walk.world_positions().shape, walk.world_positions(end_sites=True).shape
         ((300, 22, 3), (300, 27, 3))
         """
-        world_r, world_p = self.world_transforms()
-        if not end_sites or not self.skeleton.end_sites:
-            return world_p
-        extra = [
-            world_p[:, s.parent] + world_r[:, s.parent] @ np.asarray(s.offset)
-            for s in self.skeleton.end_sites
-        ]
-        return np.concatenate([world_p, np.stack(extra, axis=1)], axis=1)
+        ends = self.skeleton.end_sites if end_sites else []
+        T, J = self.n_frames, self.n_joints
+        out = np.empty((T, J + len(ends), 3))
+        for f0 in range(0, T, _FK_BLOCK):
+            block = slice(f0, f0 + _FK_BLOCK)
+            world_r, world_p = _forward_kinematics(self.rotations[block], self.translations[block],
+                                                   self.skeleton.parents)
+            out[block, :J] = world_p
+            for k, s in enumerate(ends):
+                out[block, J + k] = world_p[:, s.parent] + world_r[:, s.parent] @ np.asarray(s.offset)
+        return out
 
     # -- new motions -----------------------------------------------------
     def replace(self, **changes) -> Motion:

@@ -96,26 +96,33 @@ def continuous_euler(quats: np.ndarray, order: str) -> np.ndarray:
     if k == 0:
         return np.zeros((T, N, 0))
     full = _full_order(order)
+    a = np.empty((T, N, 3))
     with warnings.catch_warnings():
         # At gimbal lock scipy warns and sets the third angle to 0; the
         # continuity pass below then picks the split closest to the neighbours.
         warnings.simplefilter("ignore", UserWarning)
-        a = Rotation.from_quat(quats.reshape(-1, 4)).as_euler(full).reshape(T, N, 3)
+        for f0 in range(0, T, _BLOCK):  # in blocks of frames: scipy's temporaries stay small
+            block = quats[f0:f0 + _BLOCK]
+            a[f0:f0 + _BLOCK] = Rotation.from_quat(block.reshape(-1, 4)).as_euler(full).reshape(-1, N, 3)
     if k < 3:
         # Only the primary solution keeps the dropped angles at zero.
-        return np.unwrap(a[..., :k], axis=0)
-    # The other solution of the same rotation.
-    b = a.copy()
-    b[..., 0] += np.pi
-    b[..., 2] += np.pi
-    b[..., 1] = -a[..., 1] if full[0] == full[2] else np.pi - a[..., 1]
-    out = np.unwrap(a, axis=0)
+        return _unwrap_frames(np.ascontiguousarray(a[..., :k]))
+    out = _unwrap_frames(a)
     # Where the unwrapped primary solution still jumps, choose frame by frame.
-    jumps = np.abs(np.diff(out, axis=0)).max(axis=2) > np.pi / 2  # (T-1, N)
+    jumps = np.empty((max(T - 1, 0), N), dtype=bool)
+    for f0 in range(0, T - 1, _BLOCK):
+        jumps[f0:f0 + _BLOCK] = np.abs(np.diff(out[f0:f0 + _BLOCK + 1], axis=0)).max(axis=2) > np.pi / 2
     cols = np.flatnonzero(jumps.any(axis=0))
     if cols.size:
         start = int(np.argmax(jumps[:, cols].any(axis=1)))
-        aa, bb = a[:, cols], b[:, cols]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            aa = Rotation.from_quat(quats[:, cols].reshape(-1, 4)).as_euler(full).reshape(T, cols.size, 3)
+        # The other solution of the same rotation.
+        bb = aa.copy()
+        bb[..., 0] += np.pi
+        bb[..., 2] += np.pi
+        bb[..., 1] = -aa[..., 1] if full[0] == full[2] else np.pi - aa[..., 1]
         prev = out[start, cols]
         for t in range(start + 1, T):
             ca = _wrap_near(aa[t], prev)
@@ -124,6 +131,30 @@ def continuous_euler(quats: np.ndarray, order: str) -> np.ndarray:
             prev = np.where(use_b[:, None], cb, ca)
             out[t, cols] = prev
     return out
+
+
+#: Frames per block of the long per-frame passes (their temporaries stay a few MB).
+_BLOCK = 8192
+
+
+def _unwrap_frames(p: np.ndarray) -> np.ndarray:
+    """``np.unwrap(p, axis=0)`` computed in place, block by block of frames (the same numbers)."""
+    carry = np.zeros(p.shape[1:])
+    last = p[0].copy()
+    for f0 in range(1, p.shape[0], _BLOCK):
+        block = p[f0:f0 + _BLOCK]
+        raw_last = block[-1].copy()
+        dd = np.diff(np.concatenate([last[None], block]), axis=0)
+        ddmod = np.mod(dd + np.pi, TWO_PI) - np.pi
+        ddmod[(ddmod == -np.pi) & (dd > 0)] = np.pi
+        correct = ddmod - dd
+        correct[np.abs(dd) < np.pi] = 0.0
+        correct[0] += carry  # the running sum goes on from the block before, in the same order
+        np.cumsum(correct, axis=0, out=correct)
+        carry = correct[-1].copy()
+        block += correct
+        last = raw_last
+    return p
 
 
 def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:

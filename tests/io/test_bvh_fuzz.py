@@ -505,10 +505,11 @@ def test_write_bvh_interrupted_by_other_exception_leaves_nothing(tmp_path, monke
 def test_write_bvh_formatter_failure_leaves_nothing(tmp_path, monkeypatch):
     import mocycle.io.bvh as bvh
 
-    def boom(motion):
+    def boom(motion):  # fails after the first piece was written
+        yield "HIERARCHY\n"
         raise RuntimeError("formatter failed")
 
-    monkeypatch.setattr(bvh, "format_bvh", boom)
+    monkeypatch.setattr(bvh, "bvh_chunks", boom)
     with pytest.raises(RuntimeError):
         bvh.write_bvh(parse_bvh(VALID), tmp_path / "out.bvh")
     assert list(tmp_path.iterdir()) == []

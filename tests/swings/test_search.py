@@ -72,3 +72,17 @@ def test_real_bandai_precision_at_5_beats_chance():
     p = precision_at_k(idx, k=5)
     assert p["n_queries"] == 45
     assert p["precision"] > 0.6  # chance is about 14/44 = 0.32
+
+
+def test_a_long_query_is_measured_on_evenly_spread_windows_and_still_finds_itself(monkeypatch):
+    from mocycle.swings import search
+
+    walk = synthetic_walk(n_frames=60 * 300, fps=60, noise_deg=0.5, seed=2).motion
+    sig = signature(segment(walk))
+    assert (sig.n_samples - 30) // 15 + 1 > search.MAX_QUERY_WINDOWS  # half-overlapping 1 s windows
+    passes = []
+    real = search.fftconvolve
+    monkeypatch.setattr(search, "fftconvolve", lambda *a, **k: passes.append(1) or real(*a, **k))
+    score, offset = compare(sig, sig)
+    assert score == pytest.approx(1.0) and offset == 0.0
+    assert len(passes) == search.MAX_QUERY_WINDOWS  # one pass over the candidate per window

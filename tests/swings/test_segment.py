@@ -139,3 +139,60 @@ def test_real_bandai_walk_segments_major_bones():
     # about two thigh swings (forward, back) per stride of about 1.1 s over 6.5 s
     assert 8 <= len(legs) <= 30
     assert all(s.error <= 0.4 + 1e-9 for s in seg.swings)
+
+
+def _fit_one_by_one(q, axes, speed, first, last, frame_time):
+    """The per-swing fit written plainly (what fit_swings does for all swings at once)."""
+    from mocycle.rotations import axis_angle_quats, mean_quat, quat_conj, quat_multiply, quat_rotvec, twist_angles
+
+    w = speed[first:last + 1]
+    axis = (axes[first:last + 1] * w[:, None]).sum(axis=0)
+    axis = axis / np.linalg.norm(axis)
+    qs = q[first:last + 2]
+    theta = twist_angles(qs, axis)
+    base = mean_quat(quat_multiply(axis_angle_quats(axis, -theta), qs))
+    theta = twist_angles(quat_multiply(qs, quat_conj(base)[None, :]), axis)
+    n = theta.size
+    u = np.linspace(0.0, 1.0, n)
+    dur = (n - 1) * frame_time
+    a0, a1 = theta[0], theta[-1]
+    h = np.stack([u**3 - 2 * u**2 + u, u**3 - u**2], axis=1) * dur
+    rest = theta - (2 * u**3 - 3 * u**2 + 1) * a0 - (-2 * u**3 + 3 * u**2) * a1
+    (v0, v1), *_ = np.linalg.lstsq(h, rest, rcond=None) if n >= 3 else [((a1 - a0) / dur,) * 2]
+    shift = 2 * np.pi * np.round(a0 / (2 * np.pi))
+    return np.r_[axis, a0 - shift, a1 - shift, v0, v1, quat_rotvec(base)]
+
+
+@pytest.mark.parametrize("fps", [30, 120])
+def test_swings_fitted_all_at_once_match_the_fit_of_each_swing(fps):
+    from mocycle.swings.segment import fit_swings, smooth_velocity
+
+    walk = synthetic_walk(n_frames=8 * fps, fps=fps, noise_deg=0.5, seed=3).motion
+    j = walk.skeleton.index("LeftUpLeg")
+    n = window_frames(PAPER_WINDOW_S, fps)
+    omega = smooth_velocity(angular_velocity(walk.rotations[:, j], walk.frame_time), n)
+    axes, speed = unit_axes(omega)
+    eligible = speed >= np.radians(20.0)
+    spans = grow_swings(axes, np.where(eligible, swing_error(axes, n), np.inf), eligible, 0.4, 2)
+    spans = [sp for sp in spans if sp[1] < axes.shape[0] - 12]
+    assert len(spans) > 10
+    # and short ones: 2 frames (no inside to fit) and 3 frames (one inside frame for two end speeds)
+    end = spans[-1][1]
+    spans += [(end + 2, end + 2, 0.1), (end + 4, end + 5, 0.2), (end + 7, end + 8, 0.3)]
+    fitted = fit_swings(walk.rotations[:, j], axes, speed, spans, j, "LeftUpLeg", walk.frame_time)
+    for (a, b, err), s in zip(spans, fitted, strict=True):
+        got = np.r_[s.axis, s.start_angle, s.end_angle, s.start_speed, s.end_speed, s.base]
+        want = _fit_one_by_one(walk.rotations[:, j], axes, speed, a, b, walk.frame_time)
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9)
+        assert (s.start, s.end, s.error) == (a, b + 1, err)
+
+
+def test_translation_track_of_a_long_periodic_path_keeps_a_key_every_span_and_the_tolerance():
+    from mocycle.swings.segment import TRACK_SPAN, translation_track
+
+    t = np.arange(3 * TRACK_SPAN + 100)
+    path = np.stack([np.sin(2 * np.pi * t / 120.0), np.zeros(t.size), 0.5 * t], axis=1)
+    frames, values = translation_track(path, 0.01)
+    assert set(range(0, t.size - 1, TRACK_SPAN)) | {t.size - 1} <= set(frames.tolist())
+    back = np.stack([np.interp(t, frames, values[:, a]) for a in range(3)], axis=1)
+    assert np.linalg.norm(back - path, axis=1).max() <= 0.01

@@ -80,7 +80,10 @@ def _plain_cut_error(Y: np.ndarray, period: float) -> tuple[float, int]:
     h = max(1, int(round(0.1 * period)))
     best = (np.inf, 0, 0)
     for lag in lags:
-        d = ((Y[:-lag] - Y[lag:]) ** 2).sum(axis=1)
+        d = np.empty(M - lag)
+        for r in range(0, M - lag, 8192):  # in blocks of rows: no temporaries as large as Y
+            r1 = min(r + 8192, M - lag)
+            d[r:r1] = ((Y[r:r1] - Y[r + lag:r1 + lag]) ** 2).sum(axis=1)
         if d.size < 2 * h + 1:
             continue
         c = np.concatenate([[0.0], np.cumsum(d)])
@@ -101,7 +104,7 @@ def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = 
     (paper 004 eq. 1 on the pose features; independent of the phase)."""
     ref = mean_rotations(motion.rotations) if reference is None else reference
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    Y = metric_features(motion[s:e], ref)
+    Y = metric_features(motion, ref, slice(s, e))
     candidates = [cycle.period_frames]
     if Y.shape[0] >= 8:
         min_lag = max(2, int(round(MIN_PERIOD_S / motion.frame_time)))
@@ -131,14 +134,17 @@ def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> li
         tmpl = metrics["template_error"]
         seam = max(metrics["seam_pose_local"], metrics["seam_velocity_local"])
     else:
-        tmpl = template_error(metric_features(motion[slice(*max(cycle.axis.regions, key=lambda r: r[1] - r[0]))],
-                                              ref), C)[0]
+        tmpl = template_error(metric_features(motion, ref, slice(*max(cycle.axis.regions, key=lambda r: r[1] - r[0]))),
+                              C)[0]
         ratios = [seam_ratios(C), seam_ratios(root)]
         seam = max(max(r["pose_local"], r["velocity_local"]) for r in ratios)
     cut, cut_period = best_cut_error(motion, cycle, ref)
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    Y = metric_features(motion[s:e], ref)
-    spread = float(np.sqrt(((Y - Y.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    Y = metric_features(motion, ref, slice(s, e))
+    mean = Y.mean(axis=0)
+    spread = float(np.sqrt(sum(float(((Y[r:r + 8192] - mean) ** 2).sum()) for r in range(0, Y.shape[0], 8192))
+                           / Y.shape[0]))
+    del Y
     if np.isfinite(cut) and not tmpl <= max(MAX_FIT_RATIO * cut, FIT_FLOOR * spread):
         why = (f"the period found ({cycle.period_frames:.1f} frames) is probably wrong"
                if abs(cut_period / cycle.period_frames - 1) > PERIOD_AGREES else

@@ -22,6 +22,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from .. import _validate
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
@@ -354,7 +355,7 @@ def cut_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, p
 
 
 # ------------------------------------------------------------------ pipeline
-def metric_features(motion: Motion, reference: np.ndarray | None = None) -> np.ndarray:
+def metric_features(motion: Motion, reference: np.ndarray | None = None, rows: slice = slice(None)) -> np.ndarray:
     """``(T, 9J)`` the space the loop metrics are measured in: every joint's rotation matrix (its 9 entries,
     :func:`~mocycle.features.pose_matrix` ``rotmat``) divided by √2.
 
@@ -364,8 +365,21 @@ def metric_features(motion: Motion, reference: np.ndarray | None = None) -> np.n
     the same wrap-free space the cycle is regressed in (:class:`~mocycle.cycle.representation.CycleSpace`).
     ``reference`` (``(J, 4)``, the input's mean rotation per joint, as the callers pass it) changes no
     distance in this space and is accepted for the callers' sake only; values are not relative to it.
+    ``rows``: only these frames (a slice), without copying the motion.  Computed block by block of frames:
+    the same numbers as ``pose_matrix(motion, rep="rotmat", root="drop")[0] / √2``.
     """
-    return pose_matrix(motion, rep="rotmat", root="drop")[0] / np.sqrt(2.0)
+    skel = motion.skeleton
+    joints = [j for j in skel.select(None) if skel.euler_order(j)]
+    if not joints:
+        return pose_matrix(motion, rep="rotmat", root="drop")[0]  # raises: no features
+    quats = motion.rotations[rows]
+    T = quats.shape[0]
+    out = np.empty((T, 9 * len(joints)))
+    for f0 in range(0, T, 8192):
+        block = quats[f0:f0 + 8192][:, joints]
+        out[f0:f0 + 8192] = Rotation.from_quat(block.reshape(-1, 4)).as_matrix().reshape(block.shape[0], -1)
+    out /= np.sqrt(2.0)
+    return out
 
 
 def loop_blocks(cycle: Cycle, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -67,6 +67,15 @@ def max_harmonics(n_rows: int, cycle_frames: int | None = None) -> int:
     return max(k, 0)
 
 
+def _column_sq_sums(B: np.ndarray, coef: np.ndarray, Y: np.ndarray, rows: int = 8192) -> np.ndarray:
+    """``((B @ coef - Y) ** 2).sum(axis=0)`` ``(D,)``, block by block of rows (no residual array as large as Y)."""
+    out = np.zeros(Y.shape[1])
+    for r in range(0, Y.shape[0], rows):
+        e = B[r:r + rows] @ coef - Y[r:r + rows]
+        out += np.einsum("ij,ij->j", e, e)
+    return out
+
+
 class HarmonicRegression:
     """Harmonic regression of ``D`` curves on a shared time axis (scikit-learn style).
 
@@ -144,7 +153,7 @@ class HarmonicRegression:
         def resid_var(B, T, dof):
             cols = np.flatnonzero(np.abs(B).max(axis=0) > 0)  # derivative designs lose the constant column
             beta = np.linalg.lstsq(B[:, cols], T, rcond=None)[0]
-            return ((B[:, cols] @ beta - T) ** 2).sum(axis=0) / max(dof, 1)
+            return _column_sq_sums(B[:, cols], beta, T) / max(dof, 1)
 
         s2p = resid_var(P, Y, M - 2 * K - 1 - int(self.linear))
         s2v = resid_var(V, dY, Md - 2 * K)
@@ -161,14 +170,14 @@ class HarmonicRegression:
         self.coef_ = np.linalg.solve(G, b[..., None])[..., 0].T
 
     def _rmse(self, P, Y, xd, dY, ddY) -> np.ndarray:
-        rp = np.sqrt(((P @ self.coef_ - Y) ** 2).sum(axis=1).mean())
+        rp = np.sqrt(_column_sq_sums(P, self.coef_, Y).sum() / Y.shape[0])
         if xd is None or dY is None:
             return np.array([rp, np.nan, np.nan])
         K, lin = self.n_harmonics, self.linear
         a = np.sqrt(self.alpha_ if self.model != "M2" else np.ones_like(self.alpha_))
         g = np.sqrt(self.gamma_ if self.model != "M2" else np.ones_like(self.gamma_))
-        rv = np.sqrt(((a * (harmonic_basis(xd, K, 1, lin) @ self.coef_ - dY)) ** 2).sum(axis=1).mean())
-        ra = np.sqrt(((g * (harmonic_basis(xd, K, 2, lin) @ self.coef_ - ddY)) ** 2).sum(axis=1).mean())
+        rv = np.sqrt((a**2 * _column_sq_sums(harmonic_basis(xd, K, 1, lin), self.coef_, dY)).sum() / dY.shape[0])
+        ra = np.sqrt((g**2 * _column_sq_sums(harmonic_basis(xd, K, 2, lin), self.coef_, ddY)).sum() / ddY.shape[0])
         return np.array([rp, rv, ra])
 
     def predict(self, x, derivative: int = 0, drift: bool = True) -> np.ndarray:

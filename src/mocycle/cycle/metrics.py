@@ -44,7 +44,7 @@ from ..axes import vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion
 from ..rotations import mean_rotations
-from .differences import HALF, central_acceleration, central_velocity, forward_jerk
+from .differences import FORWARD_3, HALF, central_acceleration, central_velocity, forward_jerk
 from .extract import Cycle, loop_blocks, metric_features
 from .seam import seam_ratios
 
@@ -97,45 +97,81 @@ def _rms(E: np.ndarray) -> float:
     return float(np.sqrt((E ** 2).sum(axis=1).mean())) if E.size else float("nan")
 
 
+#: Rows per block of the long metric passes (their (rows, D) temporaries stay a few MB).
+_ROWS = 8192
+
+
 def regression_errors(Y: np.ndarray, C: np.ndarray, positions: np.ndarray, regions, frames: np.ndarray,
                       frame_time: float, rate: float) -> tuple[float, float, float]:
     """Eq. 4.1-4.3 (unweighted): the cycle ``C (N, D)`` read at ``positions`` (cycle frames) against ``Y``.
 
-    ``rate``: cycle frames per input frame (the cycle's length over the input's period).
+    ``rate``: cycle frames per input frame (the cycle's length over the input's period).  Summed block by
+    block of frames, so no error array as large as ``Y`` is held.
     """
     spline = _spline(C)
-    h = spline(positions)
-    pos_of = dict(zip(frames.tolist(), positions, strict=True))
-    e_p = h - Y[frames]
-    e_v, e_a = [], []
+    frames = np.asarray(frames)
+    positions = np.asarray(positions, dtype=np.float64)
+    pos_of = np.full(Y.shape[0], np.nan)
+    pos_of[frames] = positions
+    sums, counts = [0.0, 0.0, 0.0], [0, 0, 0]
+    for b in range(0, frames.size, _ROWS):
+        e = spline(positions[b:b + _ROWS]) - Y[frames[b:b + _ROWS]]
+        sums[0] += float(np.einsum("ij,ij->", e, e))
+        counts[0] += e.shape[0]
     for s, e in regions:
         if e - s < 2 * HALF + 1:
             continue
-        p = np.array([pos_of[i] for i in range(s + HALF, e - HALF)])
-        e_v.append(spline(p, 1) * rate / frame_time - central_velocity(Y[s:e], frame_time))
-        e_a.append(spline(p, 2) * (rate / frame_time) ** 2 - central_acceleration(Y[s:e], frame_time))
-    e_v = np.concatenate(e_v) if e_v else np.zeros((0, Y.shape[1]))
-    e_a = np.concatenate(e_a) if e_a else np.zeros((0, Y.shape[1]))
-    return _rms(e_p), _rms(e_v), _rms(e_a)
+        for r0 in range(s + HALF, e - HALF, _ROWS):  # output rows r0 .. r1-1 need Y[r0 - HALF : r1 + HALF]
+            r1 = min(r0 + _ROWS, e - HALF)
+            p = pos_of[r0:r1]
+            window = Y[r0 - HALF:r1 + HALF]
+            ev = spline(p, 1) * rate / frame_time - central_velocity(window, frame_time)
+            ea = spline(p, 2) * (rate / frame_time) ** 2 - central_acceleration(window, frame_time)
+            sums[1] += float(np.einsum("ij,ij->", ev, ev))
+            sums[2] += float(np.einsum("ij,ij->", ea, ea))
+            counts[1] += ev.shape[0]
+            counts[2] += ea.shape[0]
+    rms = [float(np.sqrt(t / n)) if n else float("nan") for t, n in zip(sums, counts, strict=True)]
+    return rms[0], rms[1], rms[2]
 
 
 def template_error(Y: np.ndarray, C: np.ndarray) -> tuple[float, int]:
-    """Eq. 4.4-4.5: slide the repeated cycle ``C (N, D)`` along ``Y (M, D)``; (RMS error, best offset n)."""
+    """Eq. 4.4-4.5: slide the repeated cycle ``C (N, D)`` along ``Y (M, D)``; (RMS error, best offset n).
+
+    The ``(M, N)`` distances are computed block by block of rows (twice: to choose ``n``, then its error)."""
     M, N = Y.shape[0], C.shape[0]
-    d2 = (Y ** 2).sum(1)[:, None] + (C ** 2).sum(1)[None, :] - 2 * Y @ C.T  # (M, N) squared distances
-    d = np.sqrt(np.maximum(d2, 0.0))
-    idx = (np.arange(M)[:, None] + np.arange(N)[None, :]) % N               # [i, n] -> cycle frame i + n
-    rows = np.arange(M)[:, None]
-    n = int(np.argmin(d[rows, idx].sum(axis=0)))                            # eq. 4.4
-    return float(np.sqrt(np.maximum(d2[np.arange(M), idx[:, n]], 0).mean())), n   # eq. 4.5
+    c2 = (C ** 2).sum(1)[None, :]
+
+    def d2_block(r0: int) -> tuple[np.ndarray, np.ndarray]:
+        Yb = Y[r0:r0 + _ROWS]
+        rows = np.arange(r0, r0 + Yb.shape[0])
+        return (Yb ** 2).sum(1)[:, None] + c2 - 2 * Yb @ C.T, rows  # squared distances
+
+    total = np.zeros(N)
+    for r0 in range(0, M, _ROWS):
+        d2, rows = d2_block(r0)
+        idx = (rows[:, None] + np.arange(N)[None, :]) % N                   # [i, n] -> cycle frame i + n
+        total += np.sqrt(np.maximum(np.take_along_axis(d2, idx, axis=1), 0.0)).sum(axis=0)
+    n = int(np.argmin(total))                                               # eq. 4.4
+    sq = 0.0
+    for r0 in range(0, M, _ROWS):
+        d2, rows = d2_block(r0)
+        sq += float(np.maximum(d2[np.arange(rows.size), (rows + n) % N], 0).sum())
+    return float(np.sqrt(sq / M)), n                                         # eq. 4.5
 
 
 def jerk_ratio(Y_regions: list[np.ndarray], C: np.ndarray, frame_time: float) -> float:
     """RMS jerk of the looped cycle over the RMS jerk of the input regions (paper 001 §6.3)."""
-    j_in = [forward_jerk(Y, frame_time) for Y in Y_regions if Y.shape[0] >= 7]
-    if not j_in:
+    width = FORWARD_3.size - 1  # rows lost at the end of each region
+    total, rows = 0.0, 0
+    for Y in Y_regions:
+        for r0 in range(0, Y.shape[0] - width, _ROWS):  # in blocks: no jerk array as large as the input
+            j = forward_jerk(Y[r0:r0 + _ROWS + width], frame_time)
+            total += float(np.einsum("ij,ij->", j, j))
+            rows += j.shape[0]
+    if not rows:
         return float("nan")
-    return _rms(forward_jerk(C, frame_time, periodic=True)) / _rms(np.concatenate(j_in))
+    return _rms(forward_jerk(C, frame_time, periodic=True)) / float(np.sqrt(total / rows))
 
 
 def foot_points(motion: Motion, up: np.ndarray | None = None) -> list[int]:
@@ -230,6 +266,8 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
                                                   motion.frame_time, rate)
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
     tmpl, offset = template_error(Y[s:e], C)
+    jerk = jerk_ratio([Y[a:b] for a, b in cycle.axis.regions], C, motion.frame_time)
+    del Y  # (T, 9J): not held while the feet are measured
     seams = [seam_ratios(C), seam_ratios(root)]
     travelling = cycle.repeat(2, root="motion")
     captured = motion[frames[0]:frames[-1] + 1]
@@ -239,7 +277,7 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
         "rmse_ddh": rmse_ddh,
         "template_error": tmpl,
         "template_offset": offset,
-        "jerk_ratio": jerk_ratio([Y[a:b] for a, b in cycle.axis.regions], C, motion.frame_time),
+        "jerk_ratio": jerk,
         "seam_pose": max(r["pose"] for r in seams),
         "seam_velocity": max(r["velocity"] for r in seams),
         "seam_pose_local": max(r["pose_local"] for r in seams),

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import tempfile
 import time
+from collections.abc import Iterable
 from pathlib import Path
 
 #: A leftover temporary file without a process id in its name counts as stale after this many seconds.
@@ -28,8 +29,10 @@ def _file_mode(path: Path) -> int:
         return 0o666 & ~mask
 
 
-def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
+def atomic_write(path: str | os.PathLike, data: str | bytes | Iterable[str]) -> Path:
     """Write ``data`` to ``path`` so that ``path`` is either the old file or the whole new one.
+
+    ``data`` may also be an iterable of text pieces (a long file written without holding it whole).
 
     A failure part-way (disk full, an exception while writing) leaves no
     half-written file and no temporary file behind.
@@ -40,7 +43,11 @@ def atomic_write(path: str | os.PathLike, data: str | bytes) -> Path:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent or ".")
     try:
         with os.fdopen(fd, mode, **({} if mode == "wb" else {"encoding": "utf-8", "newline": ""})) as fh:
-            fh.write(data)
+            if isinstance(data, str | bytes):
+                fh.write(data)
+            else:
+                for piece in data:
+                    fh.write(piece)
         os.chmod(tmp, _file_mode(path))  # mkstemp makes 0o600 files; others could not read the output
         os.replace(tmp, path)
     except BaseException:

@@ -25,6 +25,7 @@ import io
 import math
 import os
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -534,6 +535,21 @@ def _fmt(x: float) -> str:
 
 def format_bvh(motion: Motion) -> str:
     """The BVH text of ``motion`` (written without recursion: any depth of hierarchy)."""
+    return "".join(bvh_chunks(motion))
+
+
+def bvh_size(motion: Motion) -> int:
+    """Bytes of the BVH file of ``motion`` (counted piece by piece, without holding the text)."""
+    return sum(len(piece.encode("utf-8")) for piece in bvh_chunks(motion))
+
+
+#: Frames per piece of text :func:`bvh_chunks` yields.
+_ROWS_PER_CHUNK = 8192
+
+
+def bvh_chunks(motion: Motion) -> Iterator[str]:
+    """The BVH text of ``motion`` in pieces (the header, then blocks of frames), so that a long take is
+    written without holding its whole text."""
     skel = motion.skeleton
     out = io.StringIO()
     out.write("HIERARCHY\n")
@@ -564,20 +580,23 @@ def format_bvh(motion: Motion) -> str:
             stack += [("close", c, depth + 1), ("open", c, depth + 1)]
 
     out.write(f"MOTION\nFrames: {motion.n_frames}\nFrame Time: {motion.frame_time!r}\n")
+    yield out.getvalue()
     values = motion_channels(motion)
-    if values.shape[1]:
+    if not values.shape[1]:
+        yield "\n" * motion.n_frames
+        return
+    for f0 in range(0, motion.n_frames, _ROWS_PER_CHUNK):
+        block = values[f0:f0 + _ROWS_PER_CHUNK]
         # Write tiny values as 0 so files stay readable; keep 9 significant digits.
-        values = np.where(np.abs(values) < 1e-9, 0.0, values)
-        np.savetxt(out, values, fmt="%.9g", delimiter=" ")
-    else:
-        out.write("\n" * motion.n_frames)
-    return out.getvalue()
+        block = np.where(np.abs(block) < 1e-9, 0.0, block)
+        out = io.StringIO()
+        np.savetxt(out, block, fmt="%.9g", delimiter=" ")
+        yield out.getvalue()
 
 
 def write_bvh(motion: Motion, path: str | os.PathLike) -> Path:
     """Write ``motion`` as a BVH file at ``path`` (atomically).  Returns the path."""
-    text = format_bvh(motion)
     try:
-        return atomic_write(path, text)
+        return atomic_write(path, bvh_chunks(motion))
     except OSError as exc:
         raise MotionFileError(f"cannot write file ({exc.strerror or exc})", path) from None

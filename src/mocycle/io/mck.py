@@ -36,7 +36,7 @@ from scipy.spatial.transform import Rotation
 from .. import _validate
 from ..errors import MocycleWarning, MotionFileError
 from ..io.atomic import atomic_write
-from ..io.bvh import format_bvh, parse_bvh
+from ..io.bvh import bvh_size, format_bvh, parse_bvh
 from ..io.inflate import Inflater
 from ..keyframes.density import SPATIAL_MIN_KEYS, keyframe_density
 from ..keyframes.distance import joint_weights
@@ -217,7 +217,7 @@ class Compressed:
         c = f * (r * (3 * dof + 1) + (5 if self.scheme == "spatial" else 3))
         real = len(self.to_bytes())
         if bvh_bytes is None:
-            bvh_bytes = len(format_bvh(self.decompress()).encode("utf-8"))
+            bvh_bytes = bvh_size(self.decompress())
         return {"frames": f, "joints": dof, "keyframes": self.n_keyframes, "keyframe_ratio": r,
                 "formula_uncompressed_numbers": m, "formula_compressed_numbers": c, "formula_ratio": c / m,
                 "compressed_bytes": real, "bvh_bytes": int(bvh_bytes), "real_ratio": real / bvh_bytes}

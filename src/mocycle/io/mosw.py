@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..io.atomic import atomic_write
-from ..io.bvh import format_bvh, parse_bvh
+from ..io.bvh import bvh_size, format_bvh, parse_bvh
 from ..io.inflate import Inflater
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion, Skeleton
@@ -274,7 +274,7 @@ def size_report(seg: Segmentation, motion: Motion | None = None) -> dict:
     data = encode(seg)
     skel_bytes = len(MAGIC) + len(zlib.compress(skeleton_text(seg.skeleton).encode("utf-8"), 9))
     raw = seg.n_frames * seg.skeleton.n_channels * 4
-    bvh = len(format_bvh(motion).encode("utf-8")) if motion is not None else None
+    bvh = bvh_size(motion) if motion is not None else None
     return dict(
         compressed_bytes=len(data),
         payload_bytes=max(len(data) - skel_bytes, 0),

@@ -247,6 +247,10 @@ def circular_autocorrelation(Y: np.ndarray) -> np.ndarray:
 PEAK_TIE = 0.02
 
 
+#: Columns per block of :func:`autocorrelation_period`.
+_COLUMNS = 16
+
+
 def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_strength: float = 0.1) -> float:
     """The fundamental cycle (frames) of ``X`` (``(T,)`` or ``(T, D)``) by windowed circular autocorrelation.
 
@@ -284,13 +288,16 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
         raise MocycleError(f"max_lag ({max_lag}) must not be smaller than min_lag ({min_lag})")
     min_strength = _validate.real("min_strength", min_strength, 0.0, 1.0, high_open=True)
 
-    A = A[:, np.all(np.isfinite(A), axis=0)]
-    if A.shape[1] == 0:
+    finite = np.flatnonzero(np.all(np.isfinite(A), axis=0))
+    if finite.size == 0:
         return float("nan")
-    A = A - A.mean(axis=0)
-    A[:, np.ptp(A, axis=0) == 0.0] = 0.0  # exactly constant columns: remove the rounding left by centring
     window = periodic_hann(T)
-    r = circular_autocorrelation(A * window[:, None])
+    r = np.zeros(T)
+    for c0 in range(0, finite.size, _COLUMNS):  # a few columns at a time: no temporaries as large as A
+        B = A[:, finite[c0:c0 + _COLUMNS]]
+        B = B - B.mean(axis=0)
+        B[:, np.ptp(B, axis=0) == 0.0] = 0.0  # exactly constant columns: remove the rounding left by centring
+        r += circular_autocorrelation(B * window[:, None])  # sums over columns: blocks add up
     if not r[0] > 0.0:
         return float("nan")
     r = r / r[0]

@@ -17,7 +17,7 @@ from .. import _validate
 from ..errors import MocycleError
 from ..io.bvh import _channel_layout, motion_channels
 from ..motion import Motion
-from ..rotations import quat_angles, quat_exp, quat_multiply, rotvec_quat, slerp
+from ..rotations import quat_angles, quat_exp, quat_multiply, slerp
 from .segment import Segmentation, swing_angles
 
 PROFILES = ("hermite", "linear")
@@ -45,27 +45,28 @@ def _swing_table(swings: list, frame_time: float, profile: str) -> tuple[np.ndar
     return owner, frames, quat_multiply(turn, base)
 
 
-def _play_joint(seg: Segmentation, j: int, swings: list, table) -> np.ndarray:
-    """Joint ``j``'s rotations ``(T, 4)`` from its ``swings`` (in time order) and their :func:`_swing_table`."""
+def _play_joint(seg: Segmentation, j: int, swings: list, table, holds: list | None = None) -> np.ndarray:
+    """Joint ``j``'s rotations ``(T, 4)`` from its ``swings`` (in time order) and their :func:`_swing_table`;
+    ``holds``: its holds (default ``seg.holds_of(j)``)."""
     T = seg.n_frames
     owner, frames, q = table
+    holds = seg.holds_of(j) if holds is None else holds
     index = np.arange(len(swings))
     first = np.searchsorted(owner, index)
     last = np.searchsorted(owner, index, side="right") - 1
-    keys: dict[float, np.ndarray] = {}
-    for k, s in enumerate(swings):
-        keys.setdefault(float(s.start), q[first[k]])
-        keys.setdefault(float(s.end), q[last[k]])
-    for h in seg.holds_of(j):
-        keys.setdefault(0.5 * (h.start + h.end), rotvec_quat(np.asarray(h.mean)))
-    if not keys:
+    # keys in the order start, end of each swing, then the holds' middles; at equal times the first one counts
+    times = np.concatenate([np.array([(s.start, s.end) for s in swings], dtype=np.float64).reshape(-1),
+                            np.array([0.5 * (h.start + h.end) for h in holds], dtype=np.float64)])
+    hq = quat_exp(np.array([h.mean for h in holds], dtype=np.float64).reshape(-1, 3))
+    values = np.concatenate([np.stack([q[first], q[last]], axis=1).reshape(-1, 4), hq])
+    times, pick = np.unique(times, return_index=True)  # sorted, first occurrence of each time
+    kq = values[pick]
+    if times.size == 0:
         out = np.zeros((T, 4))
         out[:, 3] = 1.0
-    elif len(keys) == 1:
-        out = np.repeat(next(iter(keys.values()))[None, :], T, axis=0)
+    elif times.size == 1:
+        out = np.repeat(kq[:1], T, axis=0)
     else:
-        times = np.array(sorted(keys))
-        kq = np.stack([keys[t] for t in times])
         kq /= np.linalg.norm(kq, axis=1, keepdims=True)
         at = np.clip(np.arange(T, dtype=float), times[0], times[-1])
         seg_of = np.clip(np.searchsorted(times, at, side="right") - 1, 0, len(times) - 2)
@@ -102,11 +103,14 @@ def playback(seg: Segmentation, profile: str = "hermite") -> Motion:
     owner, frames, q = _swing_table(swings, seg.frame_time, profile)
     joint_of = np.array([s.joint for s in swings], dtype=int)
     bounds = np.searchsorted(joint_of, np.arange(J + 1))
+    holds = sorted(seg.holds, key=lambda h: (h.joint, h.start))  # as holds_of, all joints at once
+    hold_bounds = np.searchsorted(np.array([h.joint for h in holds], dtype=int), np.arange(J + 1))
     quats = np.empty((T, J, 4))
     for j in range(J):
         a, b = bounds[j], bounds[j + 1]
         rows = slice(np.searchsorted(owner, a), np.searchsorted(owner, b))
-        quats[:, j] = _play_joint(seg, j, swings[a:b], (owner[rows] - a, frames[rows], q[rows]))
+        quats[:, j] = _play_joint(seg, j, swings[a:b], (owner[rows] - a, frames[rows], q[rows]),
+                                  holds[hold_bounds[j]:hold_bounds[j + 1]])
     trans = np.empty((T, J, 3))
     frames = np.arange(T)
     for j in range(J):

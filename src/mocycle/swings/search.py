@@ -7,6 +7,9 @@ compared **by sliding windows**: each window of the query (``window_s`` long,
 half-overlapping) slides over the candidate and keeps its best match, which
 absorbs differences in timing; the score is the mean of the windows' best
 similarities, ``1 - ‖Q - C‖ / (‖Q‖ + ‖C‖)`` (1 = identical, 0 = unrelated).
+A query of more than :data:`MAX_QUERY_WINDOWS` windows (a minute or more at the default 1 s windows) is
+measured on that many windows spread evenly over it: each window costs a pass over the whole candidate, so
+the search stays linear in the takes' length.
 """
 
 from __future__ import annotations
@@ -36,6 +39,8 @@ class Signature:
     n_samples: int
 
 
+#: The most windows of a query that slide over each candidate (evenly spread over a longer query).
+MAX_QUERY_WINDOWS = 128
 #: The longest sliding window of a search (seconds): an hour, longer than any take.
 MAX_WINDOW_S = 3600.0
 
@@ -51,7 +56,7 @@ def signature(seg: Segmentation, rate_hz: float = 30.0) -> Signature:
         t0, t1 = s.start * seg.frame_time, s.end * seg.frame_time
         rate = (s.end_angle - s.start_angle) / max(t1 - t0, 1e-12)
         track = tracks.setdefault(s.name, np.zeros((L, 3)))
-        inside = (t >= t0) & (t < t1)
+        inside = slice(*np.searchsorted(t, (t0, t1)))  # the samples t0 <= t < t1 (t increases)
         track[inside] = np.asarray(s.axis) * rate
     return Signature(tracks, float(rate_hz), L)
 
@@ -77,7 +82,10 @@ def compare(query: Signature, cand: Signature, window_s: float = 1.0) -> tuple[f
     c2 = np.concatenate([[0.0], np.cumsum(np.sum(C**2, axis=1))])
     win_c2 = c2[w:] - c2[:-w]  # ‖C[o:o+w]‖² for every offset o
     scores, offsets = [], []
-    for s in range(0, Q.shape[0] - w + 1, hop):
+    starts = np.arange(0, Q.shape[0] - w + 1, hop)
+    if starts.size > MAX_QUERY_WINDOWS:  # a long query: windows spread evenly over it
+        starts = np.unique(np.linspace(0, Q.shape[0] - w, MAX_QUERY_WINDOWS).round().astype(int))
+    for s in starts.tolist():
         Qw = Q[s:s + w]
         q2 = float(np.sum(Qw**2))
         corr = fftconvolve(C, Qw[::-1], mode="valid", axes=0).sum(axis=1)  # Σ C[o+k]·Q[k]

@@ -36,13 +36,10 @@ from ..errors import MocycleError
 from ..motion import Motion, Skeleton
 from ..rotations import (
     axis_angle_quats,
-    mean_quat,
     quat_conj,
     quat_log,
     quat_multiply,
-    quat_rotvec,
     rotvec_quat,
-    twist_angles,
 )
 from ..threads import limit_threads
 
@@ -340,32 +337,105 @@ def choose_joints(motion: Motion, joints: str | Iterable[str] | None = None, min
 
 
 # ---------------------------------------------------------------- fitting
+def _ranges(first: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All indices of the ranges ``first[i] .. first[i] + count[i] - 1`` and the range each belongs to."""
+    owner = np.repeat(np.arange(first.size), count)
+    offsets = np.cumsum(count) - count
+    return first[owner] + np.arange(owner.size) - offsets[owner], owner
+
+
+def _range_sums(values: np.ndarray, first: np.ndarray, last: np.ndarray) -> np.ndarray:
+    """Sums of ``values[first[i]:last[i] + 1]`` along axis 0 for disjoint, increasing ranges (added in order)."""
+    padded = np.concatenate([values, np.zeros((1,) + values.shape[1:])])  # reduceat's indices must be < len
+    edges = np.stack([first, last + 1], axis=1).ravel()
+    return np.add.reduceat(padded, edges, axis=0)[::2]
+
+
+def _range_unwrap(p: np.ndarray, owner: np.ndarray) -> np.ndarray:
+    """``np.unwrap`` of each range of ``p`` (ranges are consecutive runs of ``owner``)."""
+    dd = np.diff(p)
+    ddmod = np.mod(dd + np.pi, 2 * np.pi) - np.pi
+    ddmod[(ddmod == -np.pi) & (dd > 0)] = np.pi
+    correct = ddmod - dd
+    correct[np.abs(dd) < np.pi] = 0.0
+    correct[owner[1:] != owner[:-1]] = 0.0  # no correction carried across ranges
+    if not correct.any():
+        return p
+    total = np.concatenate([[0.0], np.cumsum(correct)])
+    starts = np.flatnonzero(np.concatenate([[True], owner[1:] != owner[:-1]]))
+    return p + total - total[starts][np.searchsorted(starts, np.arange(p.size), side="right") - 1]
+
+
+def _twists(q: np.ndarray, axis: np.ndarray, owner: np.ndarray) -> np.ndarray:
+    """:func:`~mocycle.rotations.twist_angles` of each range: ``q`` (m, 4), ``axis`` (m, 3) per row."""
+    return _range_unwrap(2.0 * np.arctan2(np.einsum("ij,ij->i", q[:, :3], axis), q[:, 3]), owner)
+
+
+def fit_swings(q: np.ndarray, axes: np.ndarray, speed: np.ndarray, spans: list[tuple[int, int, float]],
+               joint: int, name: str, frame_time: float) -> list[Swing]:
+    """Swing records of one joint for the ``spans`` ``(first, last, error)`` of :func:`grow_swings` (velocity
+    samples ``first..last``, frames ``first..last+1``), all at once: :func:`fit_swing` for each.
+
+    ``q`` (T, 4) the joint's quaternions, ``axes`` (T-1, 3) and ``speed`` (T-1,) its smoothed velocity axes and
+    speeds (rad/s)."""
+    if not spans:
+        return []
+    first = np.array([f for f, _, _ in spans])
+    last = np.array([la for _, la, _ in spans])
+    axis = _range_sums(axes * speed[:, None], first, last)
+    norm = np.linalg.norm(axis, axis=1)
+    axis = np.where(norm[:, None] < 1e-12, axes[first], axis / np.maximum(norm, 1e-300)[:, None])
+    count = last - first + 2  # frames
+    rows, owner = _ranges(first, count)
+    qs = q[rows]
+    ax = axis[owner]
+    theta = _twists(qs, ax, owner)
+    half = -0.5 * theta
+    rest = quat_multiply(np.concatenate([np.sin(half)[:, None] * ax, np.cos(half)[:, None]], axis=1), qs)
+    starts = np.cumsum(count) - count
+    ends = starts + count - 1
+    rest *= np.where(np.einsum("ij,ij->i", rest, rest[starts][owner]) < 0, -1.0, 1.0)[:, None]
+    base = _range_sums(rest, starts, ends)  # mean_quat of each range: the sign-aligned normalised sum
+    base /= np.linalg.norm(base, axis=1, keepdims=True)
+    theta = _twists(quat_multiply(qs, quat_conj(base)[owner]), ax, owner)
+    a0, a1 = theta[starts], theta[ends]
+    n = count.astype(np.float64)
+    u = (rows - first[owner]) / (n - 1)[owner]
+    dur = (n - 1) * frame_time
+    h0 = (u**3 - 2 * u**2 + u) * dur[owner]
+    h1 = (u**3 - u**2) * dur[owner]
+    r = theta - (2 * u**3 - 3 * u**2 + 1) * a0[owner] - (-2 * u**3 + 3 * u**2) * a1[owner]
+    # least squares of [h0 h1] (v0, v1) = r per swing (the ends are kept exactly; the end speeds fit the inside)
+    ata = np.stack([_range_sums(h0 * h0, starts, ends), _range_sums(h0 * h1, starts, ends),
+                    _range_sums(h1 * h1, starts, ends)], axis=1)
+    atb = np.stack([_range_sums(h0 * r, starts, ends), _range_sums(h1 * r, starts, ends)], axis=1)
+    det = ata[:, 0] * ata[:, 2] - ata[:, 1] ** 2
+    v0 = (ata[:, 2] * atb[:, 0] - ata[:, 1] * atb[:, 1]) / np.where(det != 0, det, 1.0)
+    v1 = (ata[:, 0] * atb[:, 1] - ata[:, 1] * atb[:, 0]) / np.where(det != 0, det, 1.0)
+    short = count < 3
+    v0[short] = v1[short] = ((a1 - a0) / dur)[short]
+    # ill-conditioned normal equations (3 frames: one inner frame, two unknowns): lstsq's minimum-norm answer
+    for i in np.flatnonzero(~short & ~(np.abs(det) > 1e-10 * (ata[:, 0] + ata[:, 2]) ** 2)):
+        s, e = starts[i], ends[i] + 1
+        (v0[i], v1[i]), *_ = np.linalg.lstsq(np.stack([h0[s:e], h1[s:e]], axis=1), r[s:e], rcond=None)
+    shift = 2 * np.pi * np.round(a0 / (2 * np.pi))  # Rot(a, θ) has period 2π: keep the start in [-π, π]
+    base = np.where(base[:, 3:4] < 0, -base, base)
+    rotvec = quat_log(base)
+    return [Swing(joint=joint, name=name, start=f, end=la + 1, axis=tuple(a), start_angle=s0, end_angle=s1,
+                  start_speed=w0, end_speed=w1, base=tuple(b), error=float(err))
+            for (f, la, err), a, s0, s1, w0, w1, b in zip(
+                spans, axis.tolist(), (a0 - shift).tolist(), (a1 - shift).tolist(), v0.tolist(), v1.tolist(),
+                rotvec.tolist(), strict=True)]
+
+
 def fit_swing(q: np.ndarray, axes: np.ndarray, speed: np.ndarray, first: int, last: int, joint: int, name: str,
               frame_time: float, err: float) -> Swing:
-    """Swing record for velocity samples ``first..last`` (frames ``first..last+1``) of one joint's quats ``q``."""
-    w = speed[first:last + 1]
-    axis = (axes[first:last + 1] * w[:, None]).sum(axis=0)
-    norm = np.linalg.norm(axis)
-    axis = axes[first] if norm < 1e-12 else axis / norm
-    qs = q[first:last + 2]
-    theta = twist_angles(qs, axis)
-    rest = quat_multiply(axis_angle_quats(axis, -theta), qs)  # Rot(a, -θ) ⊗ q: the part off the axis
-    base = mean_quat(rest)
-    theta = twist_angles(quat_multiply(qs, quat_conj(base)[None, :]), axis)
-    n = theta.size
-    u = np.linspace(0.0, 1.0, n)
-    dur = (n - 1) * frame_time
-    a0, a1 = float(theta[0]), float(theta[-1])  # the ends are kept exactly; the end speeds fit the inside
-    if n >= 3:
-        h = np.stack([u**3 - 2 * u**2 + u, u**3 - u**2], axis=1) * dur
-        rest_theta = theta - (2 * u**3 - 3 * u**2 + 1) * a0 - (-2 * u**3 + 3 * u**2) * a1
-        (v0, v1), *_ = np.linalg.lstsq(h, rest_theta, rcond=None)
-    else:
-        v0 = v1 = (a1 - a0) / dur
-    shift = 2 * np.pi * np.round(a0 / (2 * np.pi))  # Rot(a, θ) has period 2π: keep the start in [-π, π]
-    return Swing(joint=joint, name=name, start=first, end=last + 1, axis=tuple(float(x) for x in axis),
-                 start_angle=float(a0 - shift), end_angle=float(a1 - shift), start_speed=float(v0),
-                 end_speed=float(v1), base=tuple(float(x) for x in quat_rotvec(base)), error=float(err))
+    """Swing record for velocity samples ``first..last`` (frames ``first..last+1``) of one joint's quats ``q``.
+
+    The swing's axis is the speed-weighted mean of its frames' axes; ``base`` the mean of what is left off
+    that axis; the angles about the axis at its ends are kept exactly and the end speeds are the least-squares
+    fit of the cubic Hermite to the inside.  (:func:`fit_swings` does many at once.)"""
+    return fit_swings(q, axes, speed, [(first, last, err)], joint, name, frame_time)[0]
 
 
 def _holds(q: np.ndarray, spans: list[tuple[int, int]], n_frames: int, joint: int, name: str,
@@ -378,26 +448,47 @@ def _holds(q: np.ndarray, spans: list[tuple[int, int]], n_frames: int, joint: in
     if free.size == 0:
         return []
     breaks = np.flatnonzero(np.diff(free) > 1) + 1
-    holds = []
-    for run in np.split(free, breaks):
-        a, b = int(run[0]), int(run[-1])
-        pieces = 1 if not max_hold else max(1, int(np.ceil((b - a + 1) / max_hold)))
-        edges = np.linspace(a, b + 1, pieces + 1).round().astype(int)
-        for s, e in zip(edges[:-1], edges[1:] - 1, strict=True):
-            holds.append(Hold(joint=joint, name=name, start=int(s), end=int(e),
-                              mean=tuple(float(x) for x in quat_rotvec(mean_quat(q[s:e + 1])))))
-    return holds
+    run_first = free[np.concatenate([[0], breaks])]
+    run_last = free[np.concatenate([breaks - 1, [free.size - 1]])]
+    length = run_last - run_first + 1
+    pieces = np.ones_like(length) if not max_hold else np.maximum(1, np.ceil(length / max_hold).astype(int))
+    first, last = [], []
+    for a, b, k in zip(run_first.tolist(), (run_last + 1).tolist(), pieces.tolist(), strict=True):
+        if k == 1:
+            first.append(a)
+            last.append(b - 1)
+        else:
+            edges = np.linspace(a, b, k + 1).round().astype(int)
+            first += edges[:-1].tolist()
+            last += (edges[1:] - 1).tolist()
+    first_a, last_a = np.array(first), np.array(last)
+    rows, owner = _ranges(first_a, last_a - first_a + 1)
+    qs = q[rows]
+    starts = np.searchsorted(owner, np.arange(first_a.size))
+    qs = qs * np.where(np.einsum("ij,ij->i", qs, qs[starts][owner]) < 0, -1.0, 1.0)[:, None]
+    mean = _range_sums(qs, starts, starts + last_a - first_a)  # mean_quat of each hold
+    mean /= np.linalg.norm(mean, axis=1, keepdims=True)
+    mean = quat_log(np.where(mean[:, 3:4] < 0, -mean, mean))
+    return [Hold(joint=joint, name=name, start=s, end=e, mean=tuple(m))
+            for s, e, m in zip(first, last, mean.tolist(), strict=True)]
+
+
+#: Translation tracks are simplified in spans of this many frames (a key at every multiple): the
+#: Ramer-Douglas-Peucker splits cost the span's length each, so long periodic paths stay linear in time.
+TRACK_SPAN = 8192
 
 
 def translation_track(values: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """Piecewise-linear keys ``(frames, values)`` within ``tol`` of ``values`` (T, 3) (Ramer-Douglas-Peucker)."""
+    """Piecewise-linear keys ``(frames, values)`` within ``tol`` of ``values`` (T, 3) (Ramer-Douglas-Peucker,
+    with a key every :data:`TRACK_SPAN` frames)."""
     values = np.asarray(values, dtype=np.float64)
     T = values.shape[0]
     if T == 1 or np.ptp(values, axis=0).max() <= 1e-9:
         return np.array([0]), values[:1].copy()
     keep = np.zeros(T, dtype=bool)
-    keep[[0, T - 1]] = True
-    stack = [(0, T - 1)]
+    fixed = list(range(0, T - 1, TRACK_SPAN)) + [T - 1]
+    keep[fixed] = True
+    stack = list(zip(fixed[:-1], fixed[1:], strict=True))
     while stack:
         a, b = stack.pop()
         if b - a < 2:
@@ -472,9 +563,8 @@ def segment(motion: Motion, threshold: float = DEFAULT_THRESHOLD, joints: str | 
         error = swing_error(axes, n_win)
         eligible = speed >= np.radians(still_deg_s)
         error = np.where(eligible, error, np.inf)
-        q = motion.rotations[:, j]
-        for first, last, err in grow_swings(axes, error, eligible, threshold, min_len):
-            swings.append(fit_swing(q, axes, speed, first, last, j, skel.names[j], dt, err))
+        spans_j = grow_swings(axes, error, eligible, threshold, min_len)
+        swings += fit_swings(motion.rotations[:, j], axes, speed, spans_j, j, skel.names[j], dt)
     spans: dict[int, list[tuple[int, int]]] = {}
     for s in swings:
         spans.setdefault(s.joint, []).append((s.start, s.end))
