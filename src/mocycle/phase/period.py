@@ -223,8 +223,9 @@ def _smooth_length(n: int) -> int:
     return best
 
 
-def circular_autocorrelation(Y: np.ndarray) -> np.ndarray:
-    """``r(k) = Σ_d Σ_n y_d(n) y_d((n + k) mod T)`` of ``Y`` ``(T,)`` or ``(T, D)``: ``(T,)``, by FFT.
+def circular_autocorrelation(Y: np.ndarray, per_column: bool = False) -> np.ndarray:
+    """``r(k) = Σ_d Σ_n y_d(n) y_d((n + k) mod T)`` of ``Y`` ``(T,)`` or ``(T, D)``: ``(T,)``, by FFT;
+    ``per_column=True`` keeps the columns apart: ``(T, D)``.
 
     When T is a fast FFT length (no prime factor above 5) directly; otherwise from the linear autocorrelation
     ``c`` zero-padded to the next fast length of at least ``2T - 1`` (``r(k) = c(k) + c(T - k)``): the same
@@ -234,10 +235,14 @@ def circular_autocorrelation(Y: np.ndarray) -> np.ndarray:
     if Y.ndim == 1:
         Y = Y[:, None]
     T = Y.shape[0]
-    if _smooth_length(T) == T:
-        return np.fft.irfft(np.sum(np.abs(np.fft.rfft(Y, axis=0)) ** 2, axis=1), n=T)
-    n = _smooth_length(2 * T - 1)
-    c = np.fft.irfft(np.sum(np.abs(np.fft.rfft(Y, n=n, axis=0)) ** 2, axis=1), n=n)[:T]
+    n = T if _smooth_length(T) == T else _smooth_length(2 * T - 1)
+    power = np.abs(np.fft.rfft(Y, n=n, axis=0)) ** 2
+    if not per_column:
+        power = np.sum(power, axis=1)
+    c = np.fft.irfft(power, n=n, axis=0)
+    if n == T:
+        return c
+    c = c[:T]
     r = c.copy()
     r[1:] += c[:0:-1]
     return r

@@ -39,7 +39,7 @@ from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
 from ..limits import check_frames
 from ..motion import JOINT_GROUPS, Motion, Skeleton, concatenate
-from ..phase.period import PEAK_TIE, autocorrelation_period, local_maxima, periodic_hann
+from ..phase.period import PEAK_TIE, autocorrelation_period, circular_autocorrelation, local_maxima, periodic_hann
 from ..rotations import axis_angle_quats, quat_conj, quat_exp, quat_log, quat_multiply
 from ..threads import limit_threads
 from .lct import block_edges, ilct, lct
@@ -161,8 +161,8 @@ def fundamental_cycles(X, min_strength: float = CURVE_MIN_STRENGTH) -> np.ndarra
     B = A[:, use]
     B = B - np.mean(B, axis=0)
     window = periodic_hann(T)
-    r = np.fft.irfft(np.abs(np.fft.rfft(B * window[:, None], axis=0)) ** 2, n=T, axis=0)  # (T, n) per column
-    env = np.fft.irfft(np.abs(np.fft.rfft(window)) ** 2, n=T)
+    r = circular_autocorrelation(B * window[:, None], per_column=True)  # (T, n)
+    env = circular_autocorrelation(window)
     for k, d in enumerate(use.tolist()):
         if r[0, k] > 0.0:
             out[d] = _cycle_from_autocorrelation(r[:, k] / r[0, k], env, 2, T // 2, min_strength)
