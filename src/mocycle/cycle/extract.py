@@ -46,6 +46,7 @@ FEW_PERIODS = 1.5        # fewer periods than this: warn
 CENTROID_SAMPLES = 500   # paper 001 §6: 500 sampled coordinate values
 CENTROID_NEIGHBOURS = 10  # paper 001 §6: 10 nearest neighbours
 SUBFRAMES = 10           # the harmonic cycle's start is chosen to a tenth of a frame
+BLOCK_ROWS = 8192        # rows of the harmonic fit read at a time
 
 
 @dataclass(kw_only=True)
@@ -197,23 +198,36 @@ def _check_choice(value, choices, name):
 
 
 # ------------------------------------------------------------------ harmonic
-def _derivative_rows(Y: np.ndarray, axis: TimeAxis):
-    """Velocities and accelerations per period (eq. 3.23-3.25) on the interior frames of every region."""
-    xs, dYs, ddYs = [], [], []
-    for s, e in axis.regions:
-        if e - s < 2 * HALF + 1:
-            continue
-        x = axis.x[s:e]
-        if axis.method in ("smooth", "line"):  # the local tempo, frames per period, follows the axis
-            rate = central_velocity(x, 1.0)[:, 0]
-        else:                                  # the thesis: t = 1/N everywhere (eq. 3.25)
-            rate = np.full(e - s - 2 * HALF, 1.0 / axis.period_frames)
-        xs.append(x[HALF:e - s - HALF])
-        dYs.append(central_velocity(Y[s:e], 1.0) / rate[:, None])
-        ddYs.append(central_acceleration(Y[s:e], 1.0) / rate[:, None] ** 2)
-    if not xs:
-        return None, None, None
-    return np.concatenate(xs), np.concatenate(dYs), np.concatenate(ddYs)
+def _derivative_blocks(Y: np.ndarray, axis: TimeAxis, rows: int = BLOCK_ROWS):
+    """Velocities and accelerations per period (eq. 3.23-3.25) on the interior frames of every region, as a
+    function that returns a new iterator of ``(x, dY, ddY)`` blocks of at most ``rows`` rows (each block reads
+    its rows of ``Y`` and the stencil's ``2 * HALF`` beyond)."""
+    def blocks():
+        for s, e in axis.regions:
+            if e - s < 2 * HALF + 1:
+                continue
+            n = e - s - 2 * HALF  # rows of this region: frames s + HALF .. e - HALF - 1
+            for r0 in range(0, n, rows):
+                r1 = min(n, r0 + rows)
+                a, b = s + r0, s + r1 + 2 * HALF  # the input frames the block's stencils read
+                if axis.method in ("smooth", "line"):  # the local tempo, frames per period, follows the axis
+                    rate = central_velocity(axis.x[a:b], 1.0)[:, 0]
+                else:                                  # the thesis: t = 1/N everywhere (eq. 3.25)
+                    rate = np.full(r1 - r0, 1.0 / axis.period_frames)
+                yield (axis.x[a + HALF:b - HALF], central_velocity(Y[a:b], 1.0) / rate[:, None],
+                       central_acceleration(Y[a:b], 1.0) / rate[:, None] ** 2)
+    return blocks
+
+
+def _position_blocks(Y: np.ndarray, axis: TimeAxis, rows: int = BLOCK_ROWS):
+    """A function that returns a new iterator of ``(x, Y)`` blocks over the axis' frames (``Y`` read a block
+    at a time, never copied whole)."""
+    def blocks():
+        for s, e in axis.regions:
+            for r0 in range(s, e, rows):
+                r1 = min(e, r0 + rows)
+                yield axis.x[r0:r1], Y[r0:r1]
+    return blocks
 
 
 def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
@@ -241,13 +255,17 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     N = int(round(axis.period_frames))
     K = _harmonics(n_harmonics, frames.size, N)
     x = axis.x[frames]
-    xd, dP, ddP = _derivative_rows(P, axis) if model != "M2" else (None, None, None)
-    _, dL, ddL = _derivative_rows(L, axis) if model != "M2" else (None, None, None)
-    if model != "M2" and (xd is None or xd.size < 2 * K):
-        raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the excited "
-                           f"regions are too short: use --model M2 or fewer harmonics")
-    fit_p = HarmonicRegression(K, model).fit(x, P[frames], xd, dP, ddP)
-    fit_l = HarmonicRegression(K, model, linear=True).fit(x, L[frames], xd, dL, ddL)
+    if model != "M2":
+        n_derivative = sum(max(0, e - s - 2 * HALF) for s, e in axis.regions)
+        if n_derivative < max(2 * K, 1):
+            raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the "
+                               f"excited regions are too short: use --model M2 or fewer harmonics")
+    # the rows are read block by block from P and L: no copy of P's frames or of its derivatives is held
+    fits = []
+    for Y, linear in ((P, False), (L, True)):
+        derivatives = _derivative_blocks(Y, axis) if model != "M2" else None
+        fits.append(HarmonicRegression(K, model, linear=linear).fit_blocks(_position_blocks(Y, axis), derivatives))
+    fit_p, fit_l = fits
     x0 = float(np.floor(x[0]))
     if reference is not None:  # start where the wrap is the calmest step, choosing between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)

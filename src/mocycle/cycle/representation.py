@@ -28,12 +28,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from ..axes import heading_angles, horizontal_basis, up_in_parent_frame, vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion, Skeleton
 from ..phase.period import moving_average
 from ..rotations import axis_rotations, continuous_quats, matrix_quats, nearest_rotations
+
+#: frames encoded at a time (the rotation matrices of a block, not of the take, are temporaries)
+BLOCK_FRAMES = 8192
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -99,16 +103,20 @@ class CycleSpace:
         """``P (T, n_periodic)`` and ``L (T, 4)`` of a motion with the space's skeleton."""
         if not motion.skeleton.same_as(self.skeleton):
             raise MocycleError("this motion's skeleton differs from the one the cycle space was made for")
-        R = motion.rotation_matrices()  # (T, J, 3, 3)
-        psi = self.heading(R[:, self.travel])
-        R = R.copy()
-        R[:, self.travel] = np.swapaxes(axis_rotations(self.up, psi), 1, 2) @ R[:, self.travel]
-        T = motion.n_frames
-        parts = [R.reshape(T, -1)]
+        T, J, travel = motion.n_frames, self.n_joints, self.travel
+        psi = self.heading(Rotation.from_quat(motion.rotations[:, travel]).as_matrix())
+        turn = np.swapaxes(axis_rotations(self.up, psi), 1, 2)  # (T, 3, 3): the heading taken out
+        # written block by block of frames straight into P: no (T, J, 3, 3) array or copy of it is held
+        P = np.empty((T, self.n_periodic))
+        rot = P[:, :9 * J].reshape(T, J, 3, 3)
+        for f0 in range(0, T, BLOCK_FRAMES):
+            f1 = min(T, f0 + BLOCK_FRAMES)
+            rot[f0:f1] = Rotation.from_quat(motion.rotations[f0:f1].reshape(-1, 4)).as_matrix().reshape(
+                f1 - f0, J, 3, 3)
+            rot[f0:f1, travel] = turn[f0:f1] @ rot[f0:f1, travel]
         if self.moving:
-            parts.append(motion.translations[:, list(self.moving)].reshape(T, -1))
-        P = np.concatenate(parts, axis=1)
-        L = np.concatenate([motion.translations[:, self.travel], psi[:, None]], axis=1)
+            P[:, 9 * J:] = motion.translations[:, list(self.moving)].reshape(T, -1)
+        L = np.concatenate([motion.translations[:, travel], psi[:, None]], axis=1)
         return P, L
 
     # -- straight and curved paths ---------------------------------------
