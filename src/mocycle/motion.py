@@ -404,13 +404,17 @@ class Motion:
         return Motion(**args)
 
     def __getitem__(self, index) -> Motion:
-        """Frames by slice (``motion[10:200]``, ``motion[::2]``) or index array."""
+        """Frames by slice (``motion[10:200]``, ``motion[::2]``) or index array.
+
+        A slice of consecutive frames shares this motion's (read-only) arrays: it is a view, not a copy."""
         if isinstance(index, (int, np.integer)):
             index = slice(int(index), int(index) + 1 if index != -1 else None)
         step = index.step if isinstance(index, slice) and index.step else 1
         rot = self.rotations[index]
         if rot.shape[0] == 0:
             raise MocycleError(f"frame selection {index!r} is empty (motion has {self.n_frames} frames)")
+        if isinstance(index, slice) and step == 1:  # unit, continuous and checked already
+            return Motion._adopt(self.skeleton, rot, self.translations[index], self.frame_time)
         return Motion(self.skeleton, rot, self.translations[index], self.frame_time * step)
 
     def slice(self, start: int = 0, stop: int | None = None) -> Motion:
