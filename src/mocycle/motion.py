@@ -199,6 +199,18 @@ def _forward_kinematics(quats: np.ndarray, translations: np.ndarray, parents) ->
     return world_r, world_p
 
 
+def _check_translations(trans: np.ndarray) -> None:
+    """Refuse translations with NaN or infinite values or beyond ±MAX_MAGNITUDE (two reductions: NaN propagates)."""
+    if not trans.size:
+        return
+    high, low = trans.max(), trans.min()
+    if not (np.isfinite(high) and np.isfinite(low)):
+        raise MocycleError("translations contain NaN or infinite values")
+    reach = max(high, -low)
+    if reach > MAX_MAGNITUDE:
+        raise MocycleError(f"translations reach {reach:.3g}, beyond ±{MAX_MAGNITUDE:g}")
+
+
 class Motion:
     """A take: skeleton, local rotations, local translations and the exact frame time.
 
@@ -260,11 +272,7 @@ class Motion:
             if rp.shape != (T, 3):
                 raise MocycleError(f"root_positions must have shape ({T}, 3); got {rp.shape}")
             trans[:, 0] = rp
-        if not np.all(np.isfinite(trans)):
-            raise MocycleError("translations contain NaN or infinite values")
-        reach = max(trans.max(), -trans.min()) if trans.size else 0.0
-        if reach > MAX_MAGNITUDE:
-            raise MocycleError(f"translations reach {reach:.3g}, beyond ±{MAX_MAGNITUDE:g}")
+        _check_translations(trans)
         frame_time = _validate.positive("frame_time", frame_time)
         if frame_time_problem(frame_time):
             raise MocycleError(frame_time_problem(frame_time))
@@ -392,8 +400,22 @@ class Motion:
         return out
 
     # -- new motions -----------------------------------------------------
-    def replace(self, **changes) -> Motion:
-        """A copy with some of ``skeleton``, ``rotations``, ``translations``, ``frame_time`` changed."""
+    def replace(self, *, copy: bool = True, **changes) -> Motion:
+        """A copy with some of ``skeleton``, ``rotations``, ``translations``, ``frame_time`` changed.
+
+        Arrays not changed are shared (they are read-only), not copied.  ``copy=False``: the caller hands
+        the new arrays over (they are normalised in place and frozen, as ``Motion(..., copy=False)`` does)."""
+        if "skeleton" not in changes and "rotations" not in changes:  # the checked rotations are kept as they are
+            frame_time = _validate.positive("frame_time", changes.get("frame_time", self.frame_time))
+            if frame_time_problem(frame_time):
+                raise MocycleError(frame_time_problem(frame_time))
+            trans = changes.get("translations", self.translations)
+            if trans is not self.translations:
+                trans = np.array(trans, dtype=np.float64, copy=True) if copy else np.asarray(trans, dtype=np.float64)
+                if trans.shape != self.translations.shape:
+                    raise MocycleError(f"translations must have shape {self.translations.shape}; got {trans.shape}")
+                _check_translations(trans)
+            return Motion._adopt(self.skeleton, self.rotations, trans, frame_time)
         args = dict(
             skeleton=self.skeleton,
             rotations=self.rotations,
@@ -401,7 +423,7 @@ class Motion:
             frame_time=self.frame_time,
         )
         args.update(changes)
-        return Motion(**args)
+        return Motion(**args, copy=copy)
 
     def __getitem__(self, index) -> Motion:
         """Frames by slice (``motion[10:200]``, ``motion[::2]``) or index array.

@@ -227,20 +227,38 @@ def chain_joints(motion: Motion, joints) -> list[int]:
     return sorted(out)
 
 
-def chain_transforms(motion: Motion, chain: list[int]) -> tuple[np.ndarray, np.ndarray]:
-    """World rotations ``(T, J, 3, 3)`` and positions ``(T, J, 3)`` of the joints of ``chain`` (NaN for the
-    others): forward kinematics of the legs only, not of a 100-joint rig's fingers and face."""
+class ChainRotations:
+    """World rotation matrices of the joints of a chain, read as a ``(T, J, 3, 3)`` array would be,
+    ``rotations[frames, joint]`` (NaN for a joint outside the chain), but holding the chain's joints only."""
+
+    def __init__(self, n_frames: int, chain: list[int]):
+        self.column = {int(j): i for i, j in enumerate(chain)}
+        self.data = np.empty((n_frames, len(chain), 3, 3))
+
+    def __getitem__(self, key) -> np.ndarray:
+        rows, joint = key
+        i = self.column.get(int(joint))
+        if i is None:
+            return np.full(self.data[rows, 0].shape, np.nan)
+        return self.data[rows, i]
+
+
+def chain_transforms(motion: Motion, chain: list[int]) -> tuple[ChainRotations, np.ndarray]:
+    """World rotations (:class:`ChainRotations`, ``[frames, joint]`` -> ``(..., 3, 3)``) and positions
+    ``(T, J, 3)`` of the joints of ``chain`` (NaN for the others): forward kinematics of the legs only, not of
+    a 100-joint rig's fingers and face."""
     T, J = motion.n_frames, motion.n_joints
     parents = motion.skeleton.parents
-    local = Rotation.from_quat(motion.rotations[:, chain].reshape(-1, 4)).as_matrix().reshape(T, len(chain), 3, 3)
-    Rw = np.full((T, J, 3, 3), np.nan)
+    Rw = ChainRotations(T, chain)
     W = np.full((T, J, 3), np.nan)
     for i, j in enumerate(chain):
         p = int(parents[j])
+        local = Rotation.from_quat(motion.rotations[:, j]).as_matrix()
         if p < 0:
-            Rw[:, j] = local[:, i]
+            Rw.data[:, i] = local
             W[:, j] = motion.translations[:, j]
         else:
-            Rw[:, j] = Rw[:, p] @ local[:, i]
-            W[:, j] = W[:, p] + (Rw[:, p] @ motion.translations[:, j, :, None])[..., 0]
+            Rp = Rw[:, p]
+            Rw.data[:, i] = Rp @ local
+            W[:, j] = W[:, p] + (Rp @ motion.translations[:, j, :, None])[..., 0]
     return Rw, W

@@ -503,7 +503,7 @@ def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
     step = np.einsum("tji,tj->ti", Rw[:, parent], world) if parent >= 0 else world
     trans = motion.translations.copy()
     trans[:, travel] += step
-    return motion.replace(translations=trans)
+    return motion.replace(translations=trans, copy=False)
 
 
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
@@ -593,4 +593,4 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     sign = np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)
     rotations = motion.rotations.copy()
     rotations[:, legs3] = quats * sign
-    return motion.replace(rotations=rotations)
+    return motion.replace(rotations=rotations, copy=False)
