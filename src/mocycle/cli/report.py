@@ -38,7 +38,7 @@ def report(
     periodic motion gets a page with the take and the reason (and a warning).
     """
     check_output(output, [path], force, (".html", ".htm"), "--output")
-    from ..studio.report import build_report
+    from ..studio.report import report_pieces
 
     options = L(method=method, model=model, root=root, feet=feet, amc_fps=amc_fps, force=force)
     loop_report, reason = None, None
@@ -50,5 +50,5 @@ def report(
         take = tasks.info.run(path, tasks.info.Options(amc_fps=amc_fps)).motions["motion"]
         reason = str(exc)
         err.print(f"[yellow]warning:[/] no loop in the report: {reason}", markup=True, soft_wrap=True)
-    atomic_write(output, build_report(path.name, take, loop_report, reason))
+    atomic_write(output, report_pieces(path.name, take, loop_report, reason))
     out.print(f"wrote {output}", soft_wrap=True)

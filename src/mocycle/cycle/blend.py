@@ -235,8 +235,8 @@ def _prepare(cycle: Cycle, space: CycleSpace, reference: _Loop | None) -> _Loop:
     skel = space.skeleton
     inplace = _on(skel, cycle.motion("inplace"))
     n = cycle.n_frames
-    _, L = space.encode(inplace)
-    _, L2 = space.encode(_on(skel, cycle.repeat(2, root="motion")))
+    L = space.path(inplace)
+    L2 = space.path(_on(skel, cycle.repeat(2, root="motion")))
     drift = L2[n] - L2[0]
     heading = float(L[:, 3].mean())
     pos = L[:, :3] - np.outer(L[:, :3] @ space.up, space.up)

@@ -119,6 +119,13 @@ class CycleSpace:
         L = np.concatenate([motion.translations[:, travel], psi[:, None]], axis=1)
         return P, L
 
+    def path(self, motion: Motion) -> np.ndarray:
+        """``L (T, 4)`` of :meth:`encode` alone (the travel joint's translation and heading), without ``P``."""
+        if not motion.skeleton.same_as(self.skeleton):
+            raise MocycleError("this motion's skeleton differs from the one the cycle space was made for")
+        psi = self.heading(Rotation.from_quat(motion.rotations[:, self.travel]).as_matrix())
+        return np.concatenate([motion.translations[:, self.travel], psi[:, None]], axis=1)
+
     # -- straight and curved paths ---------------------------------------
     def _turned(self, V: np.ndarray, angles: np.ndarray) -> np.ndarray:
         """The vectors ``V (T, 3)`` each turned by ``angles (T,)`` about the vertical."""
@@ -179,11 +186,21 @@ class CycleSpace:
         N, J = P.shape[0], self.n_joints
         if P.shape != (N, self.n_periodic) or L.shape != (N, self.n_drifting):
             raise MocycleError(f"expected P ({N}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
-        R = nearest_rotations(P[:, : 9 * J].reshape(N, J, 3, 3))
+        quats = np.empty((N, J, 4))
+        trans = np.empty((N, J, 3))
+        for f0 in range(0, N, BLOCK_FRAMES):  # no (N, J, 3, 3) array of the whole take is held
+            quats[f0:f0 + BLOCK_FRAMES], trans[f0:f0 + BLOCK_FRAMES] = self.decode_rows(
+                P[f0:f0 + BLOCK_FRAMES], L[f0:f0 + BLOCK_FRAMES])
+        return Motion(self.skeleton, continuous_quats(quats, inplace=True), trans, self.frame_time, copy=False)
+
+    def decode_rows(self, P: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The local quaternions ``(B, J, 4)`` (not yet made sign-continuous) and translations ``(B, J, 3)``
+        of rows ``P (B, n_periodic)``, ``L (B, 4)``: :meth:`decode` a block of frames at a time."""
+        B, J = P.shape[0], self.n_joints
+        R = nearest_rotations(P[:, : 9 * J].reshape(B, J, 3, 3))
         R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
-        quats = continuous_quats(matrix_quats(R))
-        trans = np.broadcast_to(self.static_translations, (N, J, 3)).copy()
+        trans = np.broadcast_to(self.static_translations, (B, J, 3)).copy()
         if self.moving:
-            trans[:, list(self.moving)] = P[:, 9 * J:].reshape(N, len(self.moving), 3)
+            trans[:, list(self.moving)] = P[:, 9 * J:].reshape(B, len(self.moving), 3)
         trans[:, self.travel] = L[:, :3]
-        return Motion(self.skeleton, quats, trans, self.frame_time)
+        return matrix_quats(R), trans

@@ -17,15 +17,19 @@ MAGIC = b"MOCY"
 
 def pack(header: dict, arrays: dict[str, np.ndarray]) -> bytes:
     """One buffer: ``header`` (JSON-ready) and the ``arrays`` as float32 blocks."""
-    blocks, chunks, offset = {}, [], 0
-    for name, a in arrays.items():
-        a = np.ascontiguousarray(a, dtype="<f4")
-        blocks[name] = {"offset": offset, "shape": list(a.shape)}
-        chunks.append(a.tobytes())
-        offset += a.nbytes
+    chunks = [np.ascontiguousarray(a, dtype="<f4").tobytes() for a in arrays.values()]
+    return _head(header, {name: np.shape(a) for name, a in arrays.items()}) + b"".join(chunks)
+
+
+def _head(header: dict, shapes: dict[str, tuple]) -> bytes:
+    """The buffer up to its float32 blocks, which follow in the order of ``shapes`` (name -> shape)."""
+    blocks, offset = {}, 0
+    for name, shape in shapes.items():
+        blocks[name] = {"offset": offset, "shape": [int(n) for n in shape]}
+        offset += 4 * int(np.prod(shape, dtype=np.int64))
     text = json.dumps({**header, "blocks": blocks}, allow_nan=False).encode()
     text += b" " * (-len(text) % 4)
-    return MAGIC + struct.pack("<I", len(text)) + text + b"".join(chunks)
+    return MAGIC + struct.pack("<I", len(text)) + text
 
 
 def unpack(data: bytes) -> tuple[dict, dict[str, np.ndarray]]:
@@ -57,8 +61,17 @@ def skeleton_header(motion) -> dict:
 
 def motion_payload(motion, extra: dict | None = None) -> bytes:
     """World positions of every joint and End Site per frame ``(T, J + E, 3)`` with the skeleton header."""
+    return b"".join(motion_payload_pieces(motion, extra))
+
+
+def motion_payload_pieces(motion, extra: dict | None = None, frames: int = 8192):
+    """:func:`motion_payload` as an iterator of byte pieces, the positions ``frames`` frames at a time (a
+    long take's payload is written without holding its positions or the buffer whole)."""
     header = {**skeleton_header(motion), **(extra or {})}
-    return pack(header, {"positions": motion.world_positions(end_sites=True)})
+    T, points = motion.n_frames, motion.n_joints + len(motion.skeleton.end_sites)
+    yield _head(header, {"positions": (T, points, 3)})
+    for f0 in range(0, T, frames):
+        yield np.ascontiguousarray(motion[f0:f0 + frames].world_positions(end_sites=True), dtype="<f4").tobytes()
 
 
 def plane_payload(motion, plane: dict, facts: dict) -> bytes:

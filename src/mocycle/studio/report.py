@@ -9,9 +9,10 @@ from __future__ import annotations
 import base64
 import html
 import json
+from collections.abc import Iterator
 from pathlib import Path
 
-from .payload import motion_payload
+from .payload import motion_payload_pieces
 
 STATIC = Path(__file__).parent / "static"
 #: modules the report page loads: import-map name -> file under static/
@@ -25,6 +26,8 @@ MODULES = {
     "mocycle/player.js": "player.js",
     "mocycle/report.js": "report.js",
 }
+#: placeholders in the page text where the payload and the motions' base64 texts are streamed in
+MARK = {"payload": "\x00payload\x00", "take": "\x00take\x00", "loop": "\x00loop\x00"}
 CORE_IMPORT = '"./three.core.min.js"'  # three.module.min.js imports the core by a relative path
 
 
@@ -45,16 +48,36 @@ def _data_url(text: str) -> str:
 def build_report(title: str, take, loop_report=None, reason: str | None = None) -> str:
     """The HTML text: ``take`` (a Motion) and, when there is one, the ``tasks.loop`` report of its loop (a loop
     with failed checks, made with ``force``, is shown under a banner naming them)."""
+    return "".join(report_pieces(title, take, loop_report, reason))
+
+
+def _base64(pieces) -> Iterator[str]:
+    """The base64 text of the bytes ``pieces`` joined, piece by piece (each cut at a multiple of 3 bytes)."""
+    rest = b""
+    for piece in pieces:
+        data = rest + piece
+        cut = len(data) - len(data) % 3
+        if cut:
+            yield base64.b64encode(data[:cut]).decode("ascii")
+        rest = data[cut:]
+    if rest:
+        yield base64.b64encode(rest).decode("ascii")
+
+
+def report_pieces(title: str, take, loop_report=None, reason: str | None = None) -> Iterator[str]:
+    """:func:`build_report` as an iterator of text pieces (for :func:`~mocycle.io.atomic.atomic_write`): the
+    motions' base64 payloads are made a block of frames at a time, never held whole."""
     from .library import loop_summary
 
-    data: dict = {"title": title, "take": base64.b64encode(motion_payload(take, {"name": title})).decode(),
-                  "reason": reason}
+    motions = {"take": (take, {"name": title})}
+    data: dict = {"title": title, "take": MARK["take"], "reason": reason}
     if loop_report is not None:
         from .review import loop_view
 
         facts = loop_report.facts
         view, view_facts = loop_view(loop_report)  # phase-aligned with the take, repeated with root motion
-        data.update(loop=base64.b64encode(motion_payload(view, {"name": "loop"})).decode(), view=view_facts,
+        motions["loop"] = (view, {"name": "loop"})
+        data.update(loop=MARK["loop"], view=view_facts,
                     summary=loop_summary(facts), metrics=facts["metrics"], options={
                         **{k: facts.get(k) for k in ("method", "model", "harmonics", "time_axis", "root")},
                         "feet": facts["feet"]["mode"]},
@@ -64,7 +87,7 @@ def build_report(title: str, take, loop_report=None, reason: str | None = None) 
     imports = {name: _data_url(_module_text(name)) for name in MODULES}
     payload = json.dumps(data, allow_nan=False).replace("</", "<\\/")
     css = (STATIC / "studio.css").read_text(encoding="utf-8")
-    return f"""<!doctype html>
+    page = f"""<!doctype html>
 <html lang="en">
 <head>
 <meta charset="utf-8">
@@ -94,7 +117,7 @@ main {{ grid-template-columns: minmax(420px, 1fr) 360px; }}
   <section><div id="banner" class="banner" data-testid="banner" hidden></div>
     <div id="metrics" data-testid="metrics"></div></section>
 </main>
-<script id="report-data" type="application/json">{payload}</script>
+<script id="report-data" type="application/json">{MARK["payload"]}</script>
 <script type="module">
 import {{ startReport }} from "mocycle/report.js";
 startReport(JSON.parse(document.getElementById("report-data").textContent));
@@ -102,3 +125,13 @@ startReport(JSON.parse(document.getElementById("report-data").textContent));
 </body>
 </html>
 """
+    head, tail = page.split(MARK["payload"])
+    yield head
+    # the payload's JSON with each motion's base64 text streamed where its mark stands
+    for name, (motion, extra) in motions.items():
+        before, payload = payload.split(json.dumps(MARK[name]), 1)
+        yield before + '"'
+        yield from _base64(motion_payload_pieces(motion, extra))
+        yield '"'
+    yield payload
+    yield tail

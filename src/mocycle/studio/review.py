@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..rotations import axis_rotations
+from ..cycle.representation import BLOCK_FRAMES
+from ..motion import Motion
+from ..rotations import axis_rotations, continuous_quats
 
 
 def cycle_frames(cycle, n_frames: int) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
@@ -57,12 +59,12 @@ def loop_view(report):
     for start, stop, _ in segments:  # each region's passes counted from the first repeat
         index[start:stop] = u[start:stop] - N * np.floor(u[start:stop].min() / N)
     view = cycle.repeat(int(np.floor(index.max() / N)) + 2, root=root)
-    Pv, Lv = space.encode(view)
+    Lv = space.path(view)
+    Pv = space.encode(view[: N + 1])[0]  # P repeats every cycle (the repeats differ in L only): one cycle read
     i0 = np.floor(index).astype(int)
     a = (index - i0)[:, None]
-    P = (1 - a) * Pv[i0] + a * Pv[i0 + 1]
     L = (1 - a) * Lv[i0] + a * Lv[i0 + 1]
-    _, Lt = space.encode(take)
+    Lt = space.path(take)
     up = space.up
     for start, stop, anchor in segments:
         turn = Lt[anchor, 3] - L[anchor, 3]
@@ -77,4 +79,10 @@ def loop_view(report):
         L[:, :3] += gap - np.outer(gap @ up, up)
     facts = {"loop_frame": np.round(np.mod(u, N), 3).tolist(), "segments": [list(s) for s in segments],
              "cycle_frames": N, "root": root}
-    return space.decode(P, L), facts
+    # the rows of P are interpolated and decoded a block of frames at a time: no (T, 9J) array is held
+    quats, trans = np.empty((T, space.n_joints, 4)), np.empty((T, space.n_joints, 3))
+    for f0 in range(0, T, BLOCK_FRAMES):
+        f1 = min(T, f0 + BLOCK_FRAMES)
+        i, w = i0[f0:f1] % N, a[f0:f1]
+        quats[f0:f1], trans[f0:f1] = space.decode_rows((1 - w) * Pv[i] + w * Pv[i + 1], L[f0:f1])
+    return Motion(space.skeleton, continuous_quats(quats, inplace=True), trans, space.frame_time, copy=False), facts
