@@ -109,7 +109,7 @@ class Compressed:
         """
         trans = np.broadcast_to(self.static, (self.n_frames,) + self.static.shape).copy()
         trans[:, self.track_joints] = self.track
-        return Motion(self.skeleton, self.rotations(), trans, self.frame_time)
+        return Motion(self.skeleton, self.rotations(), trans, self.frame_time, copy=False)  # arrays made here
 
     # ------------------------------------------------------------ bytes
     def to_bytes(self) -> bytes:

@@ -29,6 +29,9 @@ from ..rotations import continuous_euler, euler_to_quats, matrix_quats, nearest_
 SCHEMES = ("linear", "hermite", "slerp", "rbf")
 
 
+#: frames interpolated at a time
+BLOCK_FRAMES = 8192
+
 def check_keys(key_idx, n_frames: int) -> np.ndarray:
     """Validated keyframe indices: increasing, within ``[0, n_frames)``, first and last frame included."""
     idx = np.asarray(key_idx)
@@ -61,7 +64,10 @@ def interpolate_rotations(skeleton: Skeleton, key_idx, key_quats: np.ndarray, n_
     t = np.arange(n_frames, dtype=np.float64)
     if scheme == "slerp":
         seg, u = segments(idx, n_frames)
-        out = slerp(kq[seg], kq[seg + 1], np.broadcast_to(u[:, None], (n_frames, J)))
+        out = np.empty((n_frames, J, 4))
+        for f0 in range(0, n_frames, BLOCK_FRAMES):  # frame by frame the same; no (T, J, 4) temporaries
+            s, v = seg[f0:f0 + BLOCK_FRAMES], u[f0:f0 + BLOCK_FRAMES]
+            out[f0:f0 + BLOCK_FRAMES] = slerp(kq[s], kq[s + 1], np.broadcast_to(v[:, None], (v.size, J)))
     elif scheme == "rbf":
         R = Rotation.from_quat(kq.reshape(-1, 4)).as_matrix().reshape(len(idx), J * 9)
         f = RBFInterpolator(idx[:, None].astype(np.float64), R, kernel="linear", degree=1)
