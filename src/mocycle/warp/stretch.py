@@ -401,7 +401,7 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
             trans[:, j] = _warp_detrended(P[:, j], factor, windows[group_of[j]])
         else:
             trans[:, j] = warp_curves(P[:, j], factor, windows[group_of[j]])
-    new = Motion(skel, quats, trans, motion.frame_time)
+    new = Motion(skel, quats, trans, motion.frame_time, copy=False)  # the arrays were made here
 
     report = StretchReport(
         factor=factor,
