@@ -76,14 +76,29 @@ def lct(X, edges, overlap: int | None = None) -> np.ndarray:
     ``edges``: increasing block edges from 0 to T (e.g. :func:`block_edges`).  ``overlap``: samples folded
     on each side of an interior edge (default: as large as allowed, ``min(block length) // 2``).
     """
-    A, edges, overlap = _check(X, edges, overlap)
-    return _dct4_blocks(_fold(A, edges, overlap, inverse=False), edges)
+    A, edges, overlap = _check(X, edges, overlap, copy=False)
+    return _by_columns(A, lambda B: _dct4_blocks(_fold(B, edges, overlap, inverse=False), edges))
 
 
 def ilct(C, edges, overlap: int | None = None) -> np.ndarray:
     """Inverse of :func:`lct`: DCT-IV of every block, then the unfold.  Same shape as ``C``."""
-    A, edges, overlap = _check(C, edges, overlap)
-    return _fold(_dct4_blocks(A, edges), edges, overlap, inverse=True)
+    A, edges, overlap = _check(C, edges, overlap, copy=False)
+    return _by_columns(A, lambda B: _fold(_dct4_blocks(B, edges), edges, overlap, inverse=True))
+
+
+#: columns transformed at a time (the transform works on each column alone: the fold's and the DCT's
+#: temporaries are a few times a block of columns, not of the whole array)
+COLUMNS = 8
+
+
+def _by_columns(A: np.ndarray, transform) -> np.ndarray:
+    """``transform`` (which may change its argument) applied to copies of ``COLUMNS`` columns of ``A`` at a time."""
+    if A.ndim == 1:
+        return transform(A.copy())
+    out = np.empty_like(A)
+    for c0 in range(0, A.shape[1], COLUMNS):
+        out[:, c0:c0 + COLUMNS] = transform(A[:, c0:c0 + COLUMNS].copy())
+    return out
 
 
 # -- internals ---------------------------------------------------------------------------------------------------
@@ -105,7 +120,7 @@ def max_overlap(edges: np.ndarray) -> int:
     return limit
 
 
-def _check(X, edges, overlap):
+def _check(X, edges, overlap, copy: bool = True):
     try:
         A = np.asarray(X, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -132,7 +147,7 @@ def _check(X, edges, overlap):
     if overlap > limit:
         raise MocycleError(f"overlap must be at most {limit} samples for these blocks (half the shortest inner "
                            f"block); got {overlap}")
-    return A.copy(), e, overlap
+    return (A.copy() if copy else A), e, overlap
 
 
 def _fold(A: np.ndarray, edges: np.ndarray, overlap: int, inverse: bool) -> np.ndarray:
