@@ -147,13 +147,12 @@ class Cycle:
         count = _validate.integer("count", count, 1)
         check_frames(count * self.n_frames, self.space.skeleton.n_joints,
                      f"{count} cycles of {self.n_frames} frames")
-        P = np.tile(self.P, (count, 1))
         if root == "inplace":
-            return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)))
+            return self.space.decode(self.P, np.tile(self._inplace_L(), (count, 1)), repeats=count)
         Ls = [self.L]
         for _ in range(count - 1):  # each repeat is the last one moved rigidly: a turning walk walks a circle
             Ls.append(self._next_repeat(Ls[-1]))
-        return self.space.decode(P, np.concatenate(Ls))
+        return self.space.decode(self.P, np.concatenate(Ls), repeats=count)  # rotations projected once
 
     def to_dict(self) -> dict:
         return {

@@ -165,13 +165,19 @@ class CycleSpace:
         return L, np.append(path[-1] - path[0], drift[3])
 
     # -- (P, L) -> motion -----------------------------------------------
-    def decode(self, P: np.ndarray, L: np.ndarray) -> Motion:
-        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``."""
+    def decode(self, P: np.ndarray, L: np.ndarray, repeats: int = 1) -> Motion:
+        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``.
+
+        ``repeats``: ``P`` holds ``N / repeats`` rows that repeat ``repeats`` times (a loop's cycle): they are
+        projected onto rotations once."""
         P, L = np.asarray(P, dtype=np.float64), np.asarray(L, dtype=np.float64)
-        N, J = P.shape[0], self.n_joints
-        if P.shape != (N, self.n_periodic) or L.shape != (N, self.n_drifting):
-            raise MocycleError(f"expected P ({N}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
-        R = nearest_rotations(P[:, : 9 * J].reshape(N, J, 3, 3))
+        n, J = P.shape[0], self.n_joints
+        N = n * repeats
+        if P.shape != (n, self.n_periodic) or L.shape != (N, self.n_drifting):
+            raise MocycleError(f"expected P ({n}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
+        R = nearest_rotations(P[:, : 9 * J].reshape(n, J, 3, 3))
+        if repeats > 1:
+            R, P = np.tile(R, (repeats, 1, 1, 1)), np.tile(P, (repeats, 1))
         R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
         quats = continuous_quats(matrix_quats(R))
         trans = np.broadcast_to(self.static_translations, (N, J, 3)).copy()
