@@ -33,6 +33,7 @@ def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend:
     last frame continues at frame 0)."""
     N = cycle.n_frames
     ext = cycle.repeat(3, root="motion")
+    detect_options.setdefault("up", cycle.space.world_up)   # the take's vertical (found once, by the fit)
     contacts = detect_contacts(ext, feet, **detect_options)
     locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N, frames=slice(N, 2 * N))
     P, L = cycle.space.encode(locked)

@@ -38,6 +38,7 @@ import numpy as np
 from ..errors import MocycleError
 from ..motion import Motion
 from .feet import Foot, body_height, chain_joints, chain_transforms, find_feet, up_axis
+from .smooth import gaussian
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
 CONTACT_SPEED = 0.15    # body heights per second, horizontal
@@ -156,9 +157,7 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
     h = P @ up
     h = h - h.min(axis=0)
     sigma = smooth / motion.frame_time
-    from scipy.ndimage import gaussian_filter1d  # only when feet are locked
-
-    Ps = gaussian_filter1d(P, sigma, axis=0, mode="nearest") if sigma >= 0.3 else P
+    Ps = gaussian(P, sigma) if sigma >= 0.3 else P
     if motion.n_frames < 2:
         return h, np.zeros_like(h), np.zeros_like(h)
     v = np.gradient(Ps, motion.frame_time, axis=0)
@@ -170,12 +169,10 @@ def _travel_speed(motion: Motion, W: np.ndarray, up: np.ndarray) -> np.ndarray:
     """``(T,)`` horizontal speed of the travel joint (units/s), averaged by a Gaussian of ``TRAVEL_SECONDS``."""
     if motion.n_frames < 2:
         return np.zeros(motion.n_frames)
-    from scipy.ndimage import gaussian_filter1d  # only when feet are locked
-
     p = W[:, motion.travel_joint]
     v = np.gradient(p, motion.frame_time, axis=0)
     v = np.linalg.norm(v - np.outer(v @ up, up), axis=1)
-    return gaussian_filter1d(v, TRAVEL_SECONDS / motion.frame_time, mode="nearest")
+    return gaussian(v, TRAVEL_SECONDS / motion.frame_time)
 
 
 def _find(h, v, vu, height, speed, rise, release, n_contact, n_gap) -> np.ndarray:

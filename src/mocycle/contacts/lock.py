@@ -54,6 +54,7 @@ from scipy.spatial.transform import Rotation
 from ..motion import Motion
 from .detect import Contacts, ranges
 from .feet import chain_joints, chain_transforms
+from .smooth import maximum, uniform
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
 REACH = 0.995        # of hip-knee plus knee-ankle: farther goals lower the root
@@ -426,9 +427,7 @@ def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weight
     if not need.any():
         return need
     width = 2 * max(1, n_blend) + 1
-    from scipy.ndimage import maximum_filter1d, uniform_filter1d  # only when feet are locked
-
-    delta = uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
+    delta = uniform(maximum(need, width), width)
     return np.where(delta > 1e-9 * contacts.body, delta, 0.0)  # no round-off tails: untouched frames stay exact
 
 
