@@ -80,28 +80,36 @@ def _smoothstep(x: np.ndarray) -> np.ndarray:
     return x * x * (3.0 - 2.0 * x)
 
 
-def _holds(mask: np.ndarray, targets: list[np.ndarray], n_blend: int) -> tuple[np.ndarray, np.ndarray]:
-    """Weights ``(T,)`` and held points ``(T, 3)`` of one contact joint: 1 inside each contact, smoothstep
-    ramps of ``n_blend`` frames (at most half the gap to the neighbour contact) outside."""
+def _windows(first: np.ndarray, count: np.ndarray, step: int) -> tuple[np.ndarray, np.ndarray]:
+    """The frames ``(M,)`` of windows that start at ``first`` ``(k,)`` and run ``count`` ``(k,)`` frames on in the
+    direction ``step`` (+1 or -1), window after window, and the window ``(M,)`` each belongs to."""
+    count = np.maximum(count, 0)
+    owner = np.repeat(np.arange(first.size), count)
+    pos = np.arange(owner.size) - np.repeat(np.cumsum(count) - count, count)
+    return first[owner] + step * pos, owner
+
+
+def _contact_ends(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and stops ``(k,)`` (exclusive) of the contacts of one joint."""
+    rs = np.array(ranges(mask), dtype=int).reshape(-1, 2)
+    return rs[:, 0], rs[:, 1]
+
+
+def _hold_weights(mask: np.ndarray, n_blend: int) -> np.ndarray:
+    """Weights ``(T,)`` of one contact joint: 1 inside each contact, smoothstep ramps of ``n_blend`` frames
+    (at most half the gap to the neighbour contact) outside."""
     T = mask.shape[0]
-    rs = ranges(mask)
-    w = np.zeros(T)
-    hold = np.zeros((T, 3))
-    for k, ((a, b), target) in enumerate(zip(rs, targets, strict=True)):
-        before = a - (rs[k - 1][1] if k else -n_blend * 2)
-        after = (rs[k + 1][0] if k + 1 < len(rs) else T + n_blend * 2) - b
-        r_in, r_out = min(n_blend, before // 2), min(n_blend, after // 2)
-        w[a:b] = 1.0
-        hold[a:b] = target
-        if r_in > 0:
-            t = np.arange(max(0, a - r_in), a)
-            w[t] = _smoothstep((t - (a - r_in - 1)) / (r_in + 1))
-            hold[t] = target
-        if r_out > 0:
-            t = np.arange(b, min(T, b + r_out))
-            w[t] = _smoothstep((b + r_out - t) / (r_out + 1))
-            hold[t] = target
-    return w, hold
+    w = mask.astype(np.float64)
+    a, b = _contact_ends(mask)
+    if a.size == 0:
+        return w
+    r_in = np.minimum(n_blend, (a - np.concatenate([[-2 * n_blend], b[:-1]])) // 2)
+    r_out = np.minimum(n_blend, (np.concatenate([a[1:], [T + 2 * n_blend]]) - b) // 2)
+    t, k = _windows(a - 1, np.minimum(r_in, a), -1)
+    w[t] = _smoothstep((t - (a[k] - r_in[k] - 1)) / (r_in[k] + 1))
+    t, k = _windows(b, np.minimum(r_out, T - b), 1)
+    w[t] = _smoothstep((b[k] + r_out[k] - t) / (r_out[k] + 1))
+    return w
 
 
 def _normalize(v: np.ndarray) -> np.ndarray:
@@ -176,23 +184,30 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
     T = path.shape[0]
     corr = np.full((T, 3), np.nan)
     level = np.zeros(T, dtype=int)
-    rs = ranges(mask)
+    a, b = _contact_ends(mask)
+    if a.size == 0:
+        return corr, level
+    targets = np.asarray(targets, dtype=np.float64).reshape(-1, 3)
+    held = np.flatnonzero(mask)
+    corr[held] = targets[np.repeat(np.arange(a.size), b - a)] - path[held]
+    level[held] = HELD
     height = path @ up
-    for k, ((a, b), target) in enumerate(zip(rs, targets, strict=True)):
-        corr[a:b] = target - path[a:b]
-        level[a:b] = HELD
-        n_before = n_extend if k == 0 else min(n_extend, (a - rs[k - 1][1]) // 3)
-        n_after = n_extend if k + 1 == len(rs) else min(n_extend, (rs[k + 1][0] - b) // 3)
-        top = target @ up + low
-        for frames, edge in ((range(a - 1, max(0, a - n_before) - 1, -1), a),
-                             (range(b, min(T, b + n_after)), b - 1)):
-            f = np.asarray(frames, dtype=int)
-            c = target - path[f]
-            cu = c @ up
-            ok = (height[f] < top) & (np.linalg.norm(c - np.outer(cu, up), axis=1) <= near)
-            f, c, cu = (x[:int(np.argmin(ok)) if not ok.all() else ok.size] for x in (f, c, cu))  # up to the first miss
-            corr[f] = c + np.outer(corr[edge] @ up - cu, up)
-            level[f] = LOW
+    third = (a[1:] - b[:-1]) // 3
+    n_before = np.minimum(np.minimum(n_extend, np.concatenate([[n_extend], third])), a)
+    n_after = np.minimum(np.minimum(n_extend, np.concatenate([third, [n_extend]])), T - b)
+    for first, count, edge, step in ((a - 1, n_before, a, -1), (b, n_after, b - 1, 1)):
+        f, k = _windows(first, count, step)
+        if f.size == 0:
+            continue
+        c = targets[k] - path[f]
+        cu = c @ up
+        ok = (height[f] < targets[k] @ up + low) & (np.linalg.norm(c - cu[:, None] * up, axis=1) <= near)
+        misses = np.cumsum(~ok)                                     # up to the first miss of each window
+        keep = misses == np.concatenate([[0], misses])[np.cumsum(count) - count][k]
+        f, k, c, cu = f[keep], k[keep], c[keep], cu[keep]
+        edge_u = (targets[k] - path[edge[k]]) @ up
+        corr[f] = c + (edge_u - cu)[:, None] * up
+        level[f] = LOW
     return corr, level
 
 
@@ -328,16 +343,16 @@ def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, bod
     v = np.gradient(path, frame_time, axis=0)
     v = np.linalg.norm(v - np.outer(v @ up, up), axis=1) / body
     ramp = np.clip((v - SLOW_SPEED) / (SWING_SPEED - SLOW_SPEED), 0.0, 1.0)
-    swing = np.zeros(T, bool)
-    for p, q in ranges(level == 0):
-        swing[p:q] = p > 0 and q < T    # between two holds: a foot without contacts (or a missed stance) stays
+    holds = np.flatnonzero(level)
+    if holds.size == 0:   # a foot without contacts (or a missed stance) stays
+        return np.zeros(T)
+    frames = np.arange(T)
+    swing = (level == 0) & (frames > holds[0]) & (frames < holds[-1])   # between two holds
     lift = np.where(swing, np.maximum(clear - h, 0.0) * ramp, 0.0)
     rate = clear * frame_time / LIFT_SECONDS
-    for t in range(1, T):
-        lift[t] = min(lift[t], lift[t - 1] + rate)
-    for t in range(T - 2, -1, -1):
-        lift[t] = min(lift[t], lift[t + 1] + rate)
-    return lift
+    # rate-limited: lift[t] = min over s of lift[s] + rate |t - s| (a running minimum each way)
+    lift = np.minimum(lift, rate * frames + np.minimum.accumulate(lift - rate * frames))
+    return np.minimum(lift, np.minimum.accumulate((lift + rate * frames)[::-1])[::-1] - rate * frames)
 
 
 def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend,
@@ -459,12 +474,7 @@ def _knee_turn(u1: np.ndarray, u2: np.ndarray, n: np.ndarray, cos1: np.ndarray) 
 
 def _weights(contacts: Contacts, n_blend: int) -> np.ndarray:
     """Hold weights ``(T, C)`` of every contact joint: 1 in contact, smoothstep ramps around."""
-    T, C = contacts.mask.shape
-    w = np.zeros((T, C))
-    for c in range(C):
-        n = len(ranges(contacts.mask[:, c]))
-        w[:, c] = _holds(contacts.mask[:, c], [np.zeros(3)] * n, n_blend)[0]
-    return w
+    return np.stack([_hold_weights(m, n_blend) for m in contacts.mask.T], axis=1)
 
 
 def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | None) -> np.ndarray:
