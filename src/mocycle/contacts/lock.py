@@ -505,14 +505,12 @@ def _descendants(motion: Motion, joint: int) -> np.ndarray:
     return below
 
 
-def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
-    """``motion`` with its travel joint moved by ``world`` ``(T, 3)`` (world frame)."""
+def _move_travel(motion: Motion, trans: np.ndarray, Rw: np.ndarray, world: np.ndarray) -> None:
+    """Move ``motion``'s travel joint by ``world`` ``(T, 3)`` (world frame) in its translations ``trans``
+    ``(T, J, 3)`` (in place)."""
     travel = motion.travel_joint
     parent = int(motion.skeleton.parents[travel])
-    step = np.einsum("tji,tj->ti", Rw[:, parent], world) if parent >= 0 else world
-    trans = motion.translations.copy()
-    trans[:, travel] += step
-    return motion.replace(translations=trans)
+    trans[:, travel] += np.einsum("tji,tj->ti", Rw[:, parent], world) if parent >= 0 else world
 
 
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
@@ -534,10 +532,11 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     chain = chain_joints(motion, legs)
     below = _descendants(motion, motion.travel_joint)
     Rw, W = chain_transforms(motion, chain)
+    trans = motion.translations.copy()
     if follow:
         shift = _root_shift(W, contacts, n_blend, period)
         if np.abs(shift).max() > 0:
-            motion = _move_travel(motion, Rw, shift)
+            _move_travel(motion, trans, Rw, shift)
             W[:, below] += shift[:, None]    # the travel joint and all below it move with it; no rotation changes
     n_extend = int(round(EXTEND_SECONDS / motion.frame_time))
     n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
@@ -552,7 +551,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     lowered = delta > 0
     if lowered.any():  # every foot keeps its goal in the world: a swing foot does not dip with the root
         down = -np.outer(delta, contacts.up)
-        motion = _move_travel(motion, Rw, down)
+        _move_travel(motion, trans, Rw, down)
         W[:, below] += down[:, None]
     for foot, g, h in zip(contacts.feet, goals, held, strict=True):  # goals not held: within reach, softly
         free = ~h
@@ -588,18 +587,19 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
             aim = _swing(W[t, foot.toe] - A, gt[t] - G)
         new_parent = R2 @ R1 @ Rw[t, ap]
         local[t, col[foot.ankle]] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
+    rotations = motion.rotations
     if frames is not None:
-        motion, local, lowered = motion[frames], local[frames], lowered[frames]
+        rotations, trans, local, lowered = rotations[frames], trans[frames], local[frames], lowered[frames]
         changed = [ch[frames] for ch in changed]
-    T = motion.n_frames
+    T = rotations.shape[0]
     quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, len(legs3), 4)
     # frames and joints not touched keep their exact quaternions
     touched = np.zeros((T, len(legs3)), bool)
     for foot, ch in zip(contacts.feet, changed, strict=True):
         touched[np.ix_(ch | lowered, [col[foot.hip], col[foot.knee], col[foot.ankle]])] = True
-    old = motion.rotations[:, legs3]
+    old = rotations[:, legs3]
     quats = np.where(touched[..., None], quats, old)
     sign = np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)
-    rotations = motion.rotations.copy()
+    rotations = rotations.copy()
     rotations[:, legs3] = quats * sign
-    return motion.replace(rotations=rotations)
+    return Motion(motion.skeleton, rotations, trans, motion.frame_time, copy=False)
