@@ -55,8 +55,8 @@ MIN_GAP = 0.06          # seconds
 def ranges(mask: np.ndarray) -> list[tuple[int, int]]:
     """``[(start, stop), ...]`` (stop exclusive) of the runs of True in a boolean ``(T,)`` array."""
     m = np.concatenate([[False], np.asarray(mask, bool), [False]])
-    edges = np.flatnonzero(m[1:] != m[:-1])
-    return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+    edges = np.flatnonzero(m[1:] != m[:-1]).tolist()
+    return list(zip(edges[::2], edges[1::2], strict=True))
 
 
 @dataclass(frozen=True, eq=False)

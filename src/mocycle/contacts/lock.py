@@ -306,7 +306,8 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
         offsets = [np.zeros((e - s, 3))]
         for i, (k2, mid) in partner.items():
             if k2 == k:  # toe-only frames of the partner contact: the ankle follows the held toe
-                only = np.array([x for x in range(*rt[i]) if not ma[x]], dtype=int)
+                only = np.arange(*rt[i])
+                only = only[~ma[only]]
                 frames.append(only)
                 offsets.append((t[mid] - a[mid]) - (t[only] - a[only]))
         fr, off = np.concatenate(frames), np.concatenate(offsets)
