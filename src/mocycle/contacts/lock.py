@@ -281,7 +281,7 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
 
 
 def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
-                reach: float):
+                reach: float, clearance: float = CLEARANCE):
     """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and ``(T,)`` True where the foot is held."""
     foot = contacts.feet[f]
     up, body = contacts.up, contacts.body
@@ -318,7 +318,7 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
         corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body,
                                      low, near, n_extend, n_fade)
     corr_a = _bridge(corr_a, n_bridge, n_fade)
-    clear = CLEARANCE * body
+    clear = clearance * body
     corr_a += np.outer(_lift(a + corr_a, level_a, up, clear, body, contacts.frame_time), up)
     changed = np.any(corr_a != 0, axis=1)
     if corr_t is None:
@@ -515,15 +515,17 @@ def _move_travel(motion: Motion, trans: np.ndarray, Rw: np.ndarray, world: np.nd
 
 
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
-              follow: bool = True, period: int | None = None, frames: slice | None = None) -> Motion:
+              follow: bool = True, period: int | None = None, frames: slice | None = None,
+              clearance: float = CLEARANCE) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
 
     ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
     beyond which the root is lowered; ``follow``: first move the root horizontally with the planted feet;
     ``period``: the motion is a loop repeated every ``period`` frames (at least three times), so the root
     correction keeps the travel of each period; ``frames``: solve and return only these frames (the rest
-    is context: the frames of a loop's repeat that are read back).  Returns a new Motion with the same
-    skeleton and frame time.
+    is context: the frames of a loop's repeat that are read back); ``clearance``: fraction of the body
+    height a swinging foot clears (0: no swing clearance).  Returns a new Motion with the same skeleton and
+    frame time.
     """
     if contacts.n_frames != motion.n_frames:
         raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
@@ -543,7 +545,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
     goals, toe_goals, held, changed = [], [], [], []
     for f in range(len(contacts.feet)):
-        g, gt, h, ch = _foot_goals(W, contacts, f, n_extend, n_bridge, n_blend, reach)
+        g, gt, h, ch = _foot_goals(W, contacts, f, n_extend, n_bridge, n_blend, reach, clearance)
         goals.append(g)
         toe_goals.append(gt)
         held.append(h)
