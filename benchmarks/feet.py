@@ -42,13 +42,21 @@ from pathlib import Path
 
 import numpy as np
 
-from mocycle.contacts import detect_contacts, largest_leg_step, lock_cycle, lock_feet, ranges, skate
+from mocycle.contacts import detect_contacts, largest_leg_step, lock_cycle, lock_feet, ranges
+from mocycle.contacts import skate as skate_measure
 from mocycle.contacts.skate import leg_joints
 from mocycle.cycle import extract_cycle
 from mocycle.errors import MocycleError
 from mocycle.io import read
 
 LOCK: dict = {}  # options of lock_cycle / lock_feet (--clearance)
+SKATE: dict = {}  # options of the skate measure (--skate-height)
+
+
+def skate(motion, *args, **kw):
+    return skate_measure(motion, *args, **SKATE, **kw)
+
+
 ICLONE = ("02_01", "02_02", "02_03", "05_01") + tuple(f"07_{i:02d}" for i in range(1, 13))
 
 
@@ -185,6 +193,8 @@ def main() -> None:
     ap.add_argument("--part", choices=("all", "loops", "blends", "stretch"), default="all")
     ap.add_argument("--clearance", type=float, default=None,
                     help="swing clearance, fraction of the body height (default: lock's CLEARANCE; 0: off)")
+    ap.add_argument("--skate-height", type=float, default=None,
+                    help="H of the skate measure, fraction of the body height (default 0.015, the issue's)")
     ap.add_argument("--data", type=Path, default=Path(__file__).resolve().parents[1].parent / "shared" / "data")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
@@ -192,6 +202,9 @@ def main() -> None:
         global LOCK
         LOCK = {"clearance": args.clearance}
         print(f"swing clearance: {args.clearance} of the body height")
+    if args.skate_height is not None:
+        SKATE["height"] = args.skate_height
+        print(f"skate measure's H: {args.skate_height} of the body height")
     if args.part in ("all", "loops"):
         loops(args)
     if args.part in ("all", "blends"):
