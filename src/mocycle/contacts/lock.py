@@ -237,18 +237,19 @@ def _bridge(corr: np.ndarray, n_bridge: int, n_fade: int) -> np.ndarray:
     take, fades each side's correction to zero over ``n_fade`` frames."""
     out = corr.copy()
     T = corr.shape[0]
-    for p, q in ranges(np.isnan(corr[:, 0])):
-        t = np.arange(p, q)
-        c0 = corr[p - 1] if p > 0 else None
-        c1 = corr[q] if q < T else None
-        if c0 is not None and c1 is not None and q - p <= n_bridge:
-            out[p:q] = c0 + np.outer(_smoothstep((t - p + 1) / (q - p + 1)), c1 - c0)
-            continue
-        out[p:q] = 0.0
-        if c0 is not None:
-            out[p:q] += np.outer(_smoothstep((p + n_fade - t) / (n_fade + 1)), c0)
-        if c1 is not None:
-            out[p:q] += np.outer(_smoothstep((t - (q - 1 - n_fade)) / (n_fade + 1)), c1)
+    p, q = _contact_ends(np.isnan(corr[:, 0]))      # the gaps [p, q)
+    if p.size == 0:
+        return out
+    t, k = _windows(p, q - p, 1)
+    p, q = p[k], q[k]
+    before, after = p > 0, q < T
+    c0 = np.where(before[:, None], corr[np.maximum(p - 1, 0)], 0.0)
+    c1 = np.where(after[:, None], corr[np.minimum(q, T - 1)], 0.0)
+    bridged = before & after & (q - p <= n_bridge)
+    fade0 = np.where(before, _smoothstep((p + n_fade - t) / (n_fade + 1)), 0.0)
+    fade1 = np.where(after, _smoothstep((t - (q - 1 - n_fade)) / (n_fade + 1)), 0.0)
+    faded = fade0[:, None] * c0 + fade1[:, None] * c1
+    out[t] = np.where(bridged[:, None], c0 + _smoothstep((t - p + 1) / (q - p + 1))[:, None] * (c1 - c0), faded)
     return out
 
 
