@@ -19,6 +19,9 @@
    ``EXTEND_DISTANCE`` of the held point (at most ``EXTEND_SECONDS``), it is
    held horizontally and keeps its own vertical path: a heel coming down or a
    toe lifting away moves straight down or up instead of gliding on the floor.
+   Its path is shifted vertically as at the contact's edge; a downward shift
+   (a contact held lower than the joint came in) eases out away from the
+   contact, so a heel coming in at speed is not pulled down to skim the floor.
    Where both joints of a foot are low, the one nearer its own contact leads
    and the other is carried with it; a joint handed over between its own hold
    and being carried is eased over ``blend`` seconds.
@@ -179,7 +182,8 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
     In each contact the correction takes the joint to its target (level ``HELD``).  Around it, while the
     joint stays within ``low`` of the target's height and within ``near`` of it horizontally (at most
     ``n_extend`` frames and a third of the gap to the neighbour contact), it is held horizontally and
-    keeps its own vertical path, shifted as at the contact's edge (level ``LOW``).
+    keeps its own vertical path, shifted as at the contact's edge (level ``LOW``); a downward shift eases
+    out over ``n_extend`` frames away from the contact.
     """
     T = path.shape[0]
     corr = np.full((T, 3), np.nan)
@@ -206,6 +210,11 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
         keep = misses == np.concatenate([[0], misses])[np.cumsum(count) - count][k]
         f, k, c, cu = f[keep], k[keep], c[keep], cu[keep]
         edge_u = (targets[k] - path[edge[k]]) @ up
+        # a joint held lower than it came in (or left) moves down with the hold only near the contact: the
+        # shift eases out over the low frames, so a heel coming in at speed is not pulled down to skim
+        # the floor from far away
+        ease = 1.0 - _smoothstep((np.abs(f - first[k]) + 1) / (n_extend + 1))
+        edge_u = np.where(edge_u < 0, edge_u * ease, edge_u)
         corr[f] = c + (edge_u - cu)[:, None] * up
         level[f] = LOW
     return corr, level
