@@ -285,3 +285,24 @@ def test_a_foot_held_up_is_not_planted_in_the_air(monkeypatch):
     assert con.foot_mask(1).all()
     monkeypatch.setattr(detect, "RELAX_FLOOR", 1.0)   # without the floor check it would be planted in the air
     assert detect_contacts(held_up, up=up).foot_mask(0).any()
+
+
+def test_a_low_frame_is_shifted_down_with_its_hold_only_near_the_contact():
+    """A heel coming in above the height it is held at during its contact: the low frames before the contact
+    keep its path horizontally held, and the downward shift eases out away from the contact (a heel coming in
+    at speed is not pulled down to skim the floor); a shift up is kept whole."""
+    from mocycle.contacts.lock import LOW, _own_holds
+
+    T, up = 40, np.array([0.0, 1.0, 0.0])
+    path = np.zeros((T, 3))
+    path[:20, 1] = np.linspace(2.0, 1.0, 20)         # coming down
+    path[20:30, 1] = np.linspace(1.0, 0.0, 10)       # the contact settles to 0: held at its lowest, 0
+    mask = np.zeros(T, bool)
+    mask[20:30] = True
+    corr, level = _own_holds(path, mask, [np.zeros(3)], up, low=3.0, near=10.0, n_extend=12)
+    assert np.all(level[8:20] == LOW) and np.all(level[:8] == 0)
+    assert corr[19, 1] < -0.9 and abs(corr[8, 1]) < 0.1      # full shift beside the contact, none 12 frames off
+    assert np.all(np.diff(corr[8:20, 1]) <= 1e-12)            # growing toward the contact
+    assert np.allclose(corr[8:20, [0, 2]], 0.0)               # held horizontally
+    corr, _ = _own_holds(path, mask, [np.array([0.0, 1.5, 0.0])], up, low=3.0, near=10.0, n_extend=12)
+    assert np.allclose(corr[8:20, 1], 0.5)                    # held higher than it came in: shifted up whole
