@@ -74,6 +74,8 @@ class Cycle:
     periodic: PeriodicMotion
     regression: HarmonicRegression | None = field(default=None, repr=False)
     seconds: float = 0.0
+    #: :func:`loop_blocks` of this cycle, once made (not copied by ``dataclasses.replace``)
+    _blocks: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         up = self.space.up
@@ -368,8 +370,7 @@ def metric_features(motion: Motion, reference: np.ndarray | None = None, rows: s
     ``rows``: only these frames (a slice), without copying the motion.  Computed block by block of frames:
     the same numbers as ``pose_matrix(motion, rep="rotmat", root="drop")[0] / √2``.
     """
-    skel = motion.skeleton
-    joints = [j for j in skel.select(None) if skel.euler_order(j)]
+    joints = _rotation_joints(motion.skeleton)
     if not joints:
         return pose_matrix(motion, rep="rotmat", root="drop")[0]  # raises: no features
     quats = motion.rotations[rows]
@@ -382,11 +383,30 @@ def metric_features(motion: Motion, reference: np.ndarray | None = None, rows: s
     return out
 
 
-def loop_blocks(cycle: Cycle, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _rotation_joints(skeleton) -> list[int]:
+    """The joints :func:`metric_features` measures: those with rotation channels."""
+    return [j for j in skeleton.select(None) if skeleton.euler_order(j)]
+
+
+def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """What the seam of a cycle is judged on: its in-place rotations as :func:`metric_features` ``(N, 9J)``
-    and the world path of its travel joint ``(N, 3)``."""
-    inplace = cycle.motion("inplace")
-    return metric_features(inplace, reference), inplace.world_positions()[:, cycle.space.travel]
+    and the world path of its travel joint ``(N, 3)``.
+
+    Made from the decoded rotation matrices directly (the numbers of ``metric_features`` and
+    ``world_positions`` of ``cycle.motion("inplace")`` within rounding, without building the motion or
+    running forward kinematics of every joint), and kept on the cycle: the metrics and the checks ask
+    for the same blocks.  ``reference`` changes nothing (see :func:`metric_features`)."""
+    if cycle._blocks is None:
+        space = cycle.space
+        joints = _rotation_joints(space.skeleton)
+        if not joints:
+            raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
+        L = cycle._inplace_L()
+        R = space.rotations(cycle.P, L)
+        C = R[:, joints].reshape(R.shape[0], -1)
+        C /= np.sqrt(2.0)
+        cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L)))
+    return cycle._blocks
 
 
 def choose_periodic(result: PhaseResult, which: int | None = None) -> PeriodicMotion:

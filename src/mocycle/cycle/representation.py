@@ -165,17 +165,56 @@ class CycleSpace:
         return L, np.append(path[-1] - path[0], drift[3])
 
     # -- (P, L) -> motion -----------------------------------------------
-    def decode(self, P: np.ndarray, L: np.ndarray) -> Motion:
-        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``."""
+    def _check(self, P: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         P, L = np.asarray(P, dtype=np.float64), np.asarray(L, dtype=np.float64)
-        N, J = P.shape[0], self.n_joints
+        N = P.shape[0]
         if P.shape != (N, self.n_periodic) or L.shape != (N, self.n_drifting):
             raise MocycleError(f"expected P ({N}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
-        R = nearest_rotations(P[:, : 9 * J].reshape(N, J, 3, 3))
+        return P, L
+
+    def rotations(self, P: np.ndarray, L: np.ndarray) -> np.ndarray:
+        """The local rotation matrices ``(N, J, 3, 3)`` that :meth:`decode` puts in its motion: each joint's
+        block of ``P (N, n_periodic)`` projected onto the nearest rotation, the travel joint turned to the
+        heading ``L[:, 3]``.  A joint whose block is the same on every row (one that never moves) is
+        projected once."""
+        P, L = self._check(P, L)
+        N, J = P.shape[0], self.n_joints
+        M = P[:, : 9 * J].reshape(N, J, 3, 3)
+        still = np.all(M == M[:1], axis=(0, 2, 3)) if N > 1 else np.zeros(J, dtype=bool)
+        if still.any():
+            R = np.empty_like(M)
+            R[:, still] = nearest_rotations(M[0, still])
+            R[:, ~still] = nearest_rotations(M[:, ~still])
+        else:
+            R = nearest_rotations(M)
         R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
-        quats = continuous_quats(matrix_quats(R))
+        return R
+
+    def translations(self, P: np.ndarray, L: np.ndarray) -> np.ndarray:
+        """The local translations ``(N, J, 3)`` that :meth:`decode` puts in its motion."""
+        P, L = self._check(P, L)
+        N, J = P.shape[0], self.n_joints
         trans = np.broadcast_to(self.static_translations, (N, J, 3)).copy()
         if self.moving:
             trans[:, list(self.moving)] = P[:, 9 * J:].reshape(N, len(self.moving), 3)
         trans[:, self.travel] = L[:, :3]
-        return Motion(self.skeleton, quats, trans, self.frame_time)
+        return trans
+
+    def travel_path(self, rotations: np.ndarray, translations: np.ndarray) -> np.ndarray:
+        """World positions ``(N, 3)`` of the travel joint from local ``rotations (N, J, 3, 3)`` and
+        ``translations (N, J, 3)``: forward kinematics along its chain from the root only (the products of
+        :meth:`Motion.world_positions <mocycle.motion.Motion.world_positions>` for that joint)."""
+        chain = [self.travel]
+        while self.skeleton.parents[chain[-1]] >= 0:
+            chain.append(int(self.skeleton.parents[chain[-1]]))
+        chain.reverse()
+        world_r, world_p = rotations[:, chain[0]], translations[:, chain[0]]
+        for j in chain[1:]:
+            world_p = world_p + (world_r @ translations[:, j, :, None])[..., 0]
+            world_r = world_r @ rotations[:, j]
+        return world_p
+
+    def decode(self, P: np.ndarray, L: np.ndarray) -> Motion:
+        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``."""
+        quats = continuous_quats(matrix_quats(self.rotations(P, L)))
+        return Motion(self.skeleton, quats, self.translations(P, L), self.frame_time)
