@@ -128,6 +128,9 @@ class HarmonicRegression:
         """Fit positions ``Y (M, D)`` at times ``x (M,)`` (periods); velocities ``dY`` and accelerations
         ``ddY`` ``(M', D)`` per period (and per period²) at times ``xd (M',)`` for M1 and M3."""
         x, Y, xd, dY, ddY = self._check(x, Y, xd, dY, ddY)
+        still = np.all(Y == Y[:1], axis=0)
+        if still.any():
+            return self._fit_moving(~still, x, Y, xd, dY, ddY)
         K, lin, D = self.n_harmonics, self.linear, Y.shape[1]
         P = harmonic_basis(x, K, 0, lin)
         if self.model == "M2":
@@ -143,6 +146,29 @@ class HarmonicRegression:
             else:
                 self._fit_fgls(P, V, A, Y, dY, ddY)
         self.rmse_ = self._rmse(P, Y, xd, dY, ddY)
+        return self
+
+    def _fit_moving(self, moving: np.ndarray, x, Y, xd, dY, ddY) -> HarmonicRegression:
+        """Fit the columns where ``moving`` ``(D,)`` is set; every other column of ``Y`` is one value on every
+        row (a joint that never moves): its curve is that constant (``coef_`` ``[c, 0, ..., 0]``, so
+        :meth:`predict` gives ``c`` exactly), with the weights a still curve gets (``alpha_``, ``gamma_``
+        0, or 1 for M3) and no error."""
+        D = Y.shape[1]
+        sub = HarmonicRegression(self.n_harmonics, self.model, self.linear)
+        if moving.any():
+            sub.fit(x, Y[:, moving], xd, None if dY is None else dY[:, moving],
+                    None if ddY is None else ddY[:, moving])
+        p = 2 * self.n_harmonics + 1 + int(self.linear)
+        self.coef_ = np.zeros((p, D))
+        self.coef_[0] = Y[0]
+        still_weight = 1.0 if self.model == "M3" else 0.0
+        self.alpha_, self.gamma_ = np.full(D, still_weight), np.full(D, still_weight)
+        self.sigma2_ = np.zeros((3, D)) if self.model == "M1" else np.full((3, D), np.nan)
+        if moving.any():
+            self.coef_[:, moving] = sub.coef_
+            self.alpha_[moving], self.gamma_[moving] = sub.alpha_, sub.gamma_
+            self.sigma2_[:, moving] = sub.sigma2_
+        self.rmse_ = self._rmse(harmonic_basis(x, self.n_harmonics, 0, self.linear), Y, xd, dY, ddY)
         return self
 
     def _fit_fgls(self, P, V, A, Y, dY, ddY) -> None:
