@@ -215,7 +215,7 @@ class Motion:
         normalises and freezes them in place instead of copying them (what the readers do: half the memory).
     """
 
-    __slots__ = ("skeleton", "rotations", "translations", "frame_time", "_travel")
+    __slots__ = ("skeleton", "rotations", "translations", "frame_time", "_travel", "_up")
 
     def __init__(
         self,
