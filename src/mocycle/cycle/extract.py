@@ -74,8 +74,9 @@ class Cycle:
     periodic: PeriodicMotion
     regression: HarmonicRegression | None = field(default=None, repr=False)
     seconds: float = 0.0
-    #: :func:`loop_blocks` of this cycle, once made (not copied by ``dataclasses.replace``)
+    #: :func:`loop_blocks` of this cycle and ``space.project(P)``, once made (not copied by ``dataclasses.replace``)
     _blocks: tuple | None = field(default=None, init=False, repr=False, compare=False)
+    _projected: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         up = self.space.up
@@ -90,6 +91,14 @@ class Cycle:
     @property
     def n_frames(self) -> int:
         return self.P.shape[0]
+
+    def _rotations(self, count: int = 1) -> np.ndarray:
+        """``space.project(P)`` ``(N, J, 3, 3)``, made once, repeated ``count`` times: every motion of the
+        cycle (in place, moving on, repeated, the seam's blocks) has these rotations, only the travel joint's
+        heading differs."""
+        if self._projected is None:
+            self._projected = self.space.project(self.P)
+        return self._projected if count == 1 else np.tile(self._projected, (count, 1, 1, 1))
 
     @property
     def period_frames(self) -> float:
@@ -141,7 +150,7 @@ class Cycle:
     def motion(self, root: str = "inplace") -> Motion:
         """The cycle as a Motion; ``root="inplace"`` walks on the spot, ``"motion"`` moves on by ``drift``."""
         _check_choice(root, ROOT_MODES, "root")
-        return self.space.decode(self.P, self._inplace_L() if root == "inplace" else self.L)
+        return self.space.decode(self.P, self._inplace_L() if root == "inplace" else self.L, self._rotations())
 
     def repeat(self, count: int, root: str = "inplace") -> Motion:
         """The cycle ``count`` times, seamlessly; with ``root="motion"`` each repeat starts where the last ends."""
@@ -151,11 +160,11 @@ class Cycle:
                      f"{count} cycles of {self.n_frames} frames")
         P = np.tile(self.P, (count, 1))
         if root == "inplace":
-            return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)))
+            return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)), self._rotations(count))
         Ls = [self.L]
         for _ in range(count - 1):  # each repeat is the last one moved rigidly: a turning walk walks a circle
             Ls.append(self._next_repeat(Ls[-1]))
-        return self.space.decode(P, np.concatenate(Ls))
+        return self.space.decode(P, np.concatenate(Ls), self._rotations(count))
 
     def to_dict(self) -> dict:
         return {
@@ -402,7 +411,7 @@ def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.n
         if not joints:
             raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
         L = cycle._inplace_L()
-        R = space.rotations(cycle.P, L)
+        R = space.rotations(cycle.P, L, cycle._rotations())
         C = R[:, joints].reshape(R.shape[0], -1)
         C /= np.sqrt(2.0)
         cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L)))

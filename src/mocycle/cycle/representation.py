@@ -172,21 +172,27 @@ class CycleSpace:
             raise MocycleError(f"expected P ({N}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
         return P, L
 
-    def rotations(self, P: np.ndarray, L: np.ndarray) -> np.ndarray:
-        """The local rotation matrices ``(N, J, 3, 3)`` that :meth:`decode` puts in its motion: each joint's
-        block of ``P (N, n_periodic)`` projected onto the nearest rotation, the travel joint turned to the
-        heading ``L[:, 3]``.  A joint whose block is the same on every row (one that never moves) is
-        projected once."""
-        P, L = self._check(P, L)
+    def project(self, P: np.ndarray) -> np.ndarray:
+        """Each joint's block of ``P (N, n_periodic)`` projected onto the nearest rotation: ``(N, J, 3, 3)``
+        local rotation matrices, the travel joint's without its heading.  A joint whose block is the same
+        on every row (one that never moves) is projected once."""
+        P = np.asarray(P, dtype=np.float64)
         N, J = P.shape[0], self.n_joints
         M = P[:, : 9 * J].reshape(N, J, 3, 3)
         still = np.all(M == M[:1], axis=(0, 2, 3)) if N > 1 else np.zeros(J, dtype=bool)
-        if still.any():
-            R = np.empty_like(M)
-            R[:, still] = nearest_rotations(M[0, still])
-            R[:, ~still] = nearest_rotations(M[:, ~still])
-        else:
-            R = nearest_rotations(M)
+        if not still.any():
+            return nearest_rotations(M)
+        R = np.empty_like(M)
+        R[:, still] = nearest_rotations(M[0, still])
+        R[:, ~still] = nearest_rotations(M[:, ~still])
+        return R
+
+    def rotations(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray | None = None) -> np.ndarray:
+        """The local rotation matrices ``(N, J, 3, 3)`` that :meth:`decode` puts in its motion:
+        :meth:`project` of ``P`` (or ``projected``, when the caller has it), the travel joint turned to the
+        heading ``L[:, 3]``."""
+        P, L = self._check(P, L)
+        R = self.project(P) if projected is None else projected.copy()
         R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
         return R
 
@@ -214,7 +220,8 @@ class CycleSpace:
             world_r = world_r @ rotations[:, j]
         return world_p
 
-    def decode(self, P: np.ndarray, L: np.ndarray) -> Motion:
-        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``."""
-        quats = continuous_quats(matrix_quats(self.rotations(P, L)))
+    def decode(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray | None = None) -> Motion:
+        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``;
+        ``projected``: :meth:`project` of ``P`` when the caller has it."""
+        quats = continuous_quats(matrix_quats(self.rotations(P, L, projected)))
         return Motion(self.skeleton, quats, self.translations(P, L), self.frame_time)
