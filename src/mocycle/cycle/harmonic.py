@@ -26,6 +26,8 @@ from .. import _validate
 from ..errors import MocycleError
 
 MODELS = ("M1", "M2", "M3")
+#: DOFs per batch of M1's normal equations: a 100-joint rig's (D, 41, 41) at once is 10 MB of temporaries
+_SOLVE_BLOCK = 64
 WEIGHT_LIMIT = 1e8  # alpha, gamma are clipped here: a DOF whose derivatives fit perfectly stays solvable
 
 
@@ -189,11 +191,17 @@ class HarmonicRegression:
         self.gamma_ = np.clip(s2p / np.maximum(s2a, tiny), 0.0, WEIGHT_LIMIT)
         self.sigma2_ = np.vstack([s2p, s2v, s2a])
         PtP, VtV, AtA = P.T @ P, V.T @ V, A.T @ A
-        G = PtP + self.alpha_[:, None, None] * VtV + self.gamma_[:, None, None] * AtA  # (D, p, p)
         b = (P.T @ Y).T + self.alpha_[:, None] * (V.T @ dY).T + self.gamma_[:, None] * (A.T @ ddY).T  # (D, p)
         # A tiny ridge keeps DOFs that never move (all-zero rows and columns but the constant) solvable.
-        G = G + 1e-12 * np.trace(PtP) / PtP.shape[0] * np.eye(G.shape[-1])
-        self.coef_ = np.linalg.solve(G, b[..., None])[..., 0].T
+        ridge = 1e-12 * np.trace(PtP) / PtP.shape[0] * np.eye(PtP.shape[0])
+        coef = np.empty(b.shape)
+        for d in range(0, b.shape[0], _SOLVE_BLOCK):  # (block, p, p) normal matrices that stay in the cache
+            block = slice(d, d + _SOLVE_BLOCK)
+            G = PtP + self.alpha_[block, None, None] * VtV
+            G += self.gamma_[block, None, None] * AtA
+            G += ridge
+            coef[block] = np.linalg.solve(G, b[block, :, None])[..., 0]
+        self.coef_ = coef.T
 
     def _rmse(self, P, Y, xd, dY, ddY) -> np.ndarray:
         rp = np.sqrt(_column_sq_sums(P, self.coef_, Y).sum() / Y.shape[0])
