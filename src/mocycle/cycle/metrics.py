@@ -67,18 +67,19 @@ class PeriodicSpline:
         column = np.zeros(N)
         np.add.at(column, [0, 1 % N, -1 % N], [4.0, 1.0, 1.0])
         self.F, self.N = F, N
-        self.m = solve_circulant(column, 6.0 * (np.roll(F, 1, axis=0) - 2.0 * F + np.roll(F, -1, axis=0)))
+        self.m = m = solve_circulant(column, 6.0 * (np.roll(F, 1, axis=0) - 2.0 * F + np.roll(F, -1, axis=0)))
+        m1 = np.roll(m, -1, axis=0)  # each knot's polynomial, once (not once per point it is read at)
+        self.b = (np.roll(F, -1, axis=0) - F) - (2.0 * m + m1) / 6.0
+        self.c = m / 2.0
+        self.d = (m1 - m) / 6.0
 
     def __call__(self, x, nu: int = 0) -> np.ndarray:
         x = np.mod(np.asarray(x, dtype=np.float64), self.N)
         i = np.minimum(np.floor(x).astype(np.intp), self.N - 1)
-        j = (i + 1) % self.N
         t = (x - i)[:, None]
-        y0, y1, m0, m1 = self.F[i], self.F[j], self.m[i], self.m[j]
-        b = (y1 - y0) - (2.0 * m0 + m1) / 6.0
-        c = m0 / 2.0
-        d = (m1 - m0) / 6.0
+        b, c, d = self.b[i], self.c[i], self.d[i]
         if nu == 0:
+            y0 = self.F[i]
             return y0 + t * (b + t * (c + t * d))
         if nu == 1:
             return b + t * (2.0 * c + 3.0 * t * d)
