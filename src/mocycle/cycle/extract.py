@@ -386,7 +386,7 @@ def metric_features(motion: Motion, reference: np.ndarray | None = None, rows: s
     T = quats.shape[0]
     out = np.empty((T, 9 * len(joints)))
     for f0 in range(0, T, 8192):
-        block = quats[f0:f0 + 8192][:, joints]
+        block = np.take(quats[f0:f0 + 8192], joints, axis=1)  # contiguous, unlike [:, joints]
         out[f0:f0 + 8192] = Rotation.from_quat(block.reshape(-1, 4)).as_matrix().reshape(block.shape[0], -1)
     out /= np.sqrt(2.0)
     return out
@@ -412,8 +412,7 @@ def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.n
             raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
         L = cycle._inplace_L()
         R = space.rotations(cycle.P, L, cycle._rotations())
-        C = R[:, joints].reshape(R.shape[0], -1)
-        C /= np.sqrt(2.0)
+        C = (R if len(joints) == space.n_joints else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
         cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L)))
     return cycle._blocks
 

@@ -179,12 +179,14 @@ class CycleSpace:
         P = np.asarray(P, dtype=np.float64)
         N, J = P.shape[0], self.n_joints
         M = P[:, : 9 * J].reshape(N, J, 3, 3)
-        still = np.all(M == M[:1], axis=(0, 2, 3)) if N > 1 else np.zeros(J, dtype=bool)
+        still = np.all(P[:, : 9 * J] == P[:1, : 9 * J], axis=0).reshape(J, 9).all(axis=1) if N > 1 \
+            else np.zeros(J, dtype=bool)
         if not still.any():
             return nearest_rotations(M)
         R = np.empty_like(M)
         R[:, still] = nearest_rotations(M[0, still])
-        R[:, ~still] = nearest_rotations(M[:, ~still])
+        moving = np.flatnonzero(~still)
+        R[:, moving] = nearest_rotations(np.take(M, moving, axis=1))  # take: a contiguous copy, unlike M[:, moving]
         return R
 
     def rotations(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray | None = None) -> np.ndarray:
