@@ -69,6 +69,18 @@ def max_harmonics(n_rows: int, cycle_frames: int | None = None) -> int:
     return max(k, 0)
 
 
+def least_squares(B: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """``numpy.linalg.lstsq(B, Y, rcond=None)[0]`` for a small design ``B (M, p)`` and many columns ``Y (M, D)``:
+    the minimum-norm solution ``(p, D)`` through the pseudo-inverse from ``B``'s SVD (singular values up to
+    ``eps · max(M, p)`` of the largest dropped, as lstsq drops them), applied in two matrix products.  The
+    same coefficients within rounding; 3-4× faster than LAPACK's ``gelsd`` on hundreds of columns, which
+    applies its reflections to the columns one at a time."""
+    U, S, Vt = np.linalg.svd(B, full_matrices=False)
+    kept = S > np.finfo(np.float64).eps * max(B.shape) * (S[0] if S.size else 0.0)
+    inv = np.where(kept, 1.0 / np.where(kept, S, 1.0), 0.0)
+    return Vt.T @ (inv[:, None] * (U.T @ Y))
+
+
 def _column_sq_sums(B: np.ndarray, coef: np.ndarray, Y: np.ndarray, rows: int = 8192) -> np.ndarray:
     """``((B @ coef - Y) ** 2).sum(axis=0)`` ``(D,)``, block by block of rows (no residual array as large as Y)."""
     out = np.zeros(Y.shape[1])
@@ -180,7 +192,7 @@ class HarmonicRegression:
 
         def resid_var(B, T, dof):
             cols = np.flatnonzero(np.abs(B).max(axis=0) > 0)  # derivative designs lose the constant column
-            beta = np.linalg.lstsq(B[:, cols], T, rcond=None)[0]
+            beta = least_squares(B[:, cols], T)
             return _column_sq_sums(B[:, cols], beta, T) / max(dof, 1)
 
         s2p = resid_var(P, Y, M - 2 * K - 1 - int(self.linear))
