@@ -107,16 +107,21 @@ def principal_components(X: np.ndarray, n: int) -> np.ndarray:
     (``numpy.linalg.eigh``): with more frames than columns the eigenvectors ``V`` of the ``(D, D)`` matrix
     ``Xcᵀ Xc``; with fewer (short takes on wide rigs, e.g. 157 frames of a 100-joint rig) the eigenvectors
     ``U`` of the ``(T, T)`` Gram matrix ``Xc Xcᵀ``, whose scores are ``U S`` and components ``Uᵀ Xc / S``.
-    The same scores as the SVD of ``Xc`` within rounding, several times faster.
+    Only the ``n`` largest eigenpairs are computed (LAPACK's ``syevr`` through ``scipy.linalg.eigh``).  The
+    same scores as the SVD of ``Xc`` within rounding, several times faster.
     """
+    from scipy.linalg import eigh
+
     Xc = X - X.mean(axis=0)
     if Xc.shape[0] < Xc.shape[1]:
-        w, U = np.linalg.eigh(Xc @ Xc.T)
-        U, S = U[:, ::-1][:, :n], np.sqrt(np.maximum(w[::-1][:n], 0.0))  # largest first
+        G = Xc @ Xc.T
+        w, U = eigh(G, subset_by_index=[G.shape[0] - n, G.shape[0] - 1], driver="evr")
+        U, S = U[:, ::-1], np.sqrt(np.maximum(w[::-1], 0.0))  # largest first
         Vt = (U.T @ Xc) / np.where(S > 0, S, 1.0)[:, None]
         return U * _component_signs(Vt) * S
-    _, V = np.linalg.eigh(Xc.T @ Xc)
-    Vt = V[:, ::-1][:, :n].T  # largest first
+    G = Xc.T @ Xc
+    _, V = eigh(G, subset_by_index=[G.shape[0] - n, G.shape[0] - 1], driver="evr")
+    Vt = V[:, ::-1].T  # largest first
     return Xc @ (Vt * _component_signs(Vt)[:, None]).T
 
 
