@@ -181,7 +181,7 @@ def foot_points(motion: Motion, up: np.ndarray | None = None, positions: np.ndar
     ``motion.world_positions(end_sites=True)`` when the caller has it."""
     skel = motion.skeleton
     up = vertical_axis(motion, up)
-    parents = list(skel.parents) + [site.parent for site in skel.end_sites]
+    parents = [int(p) for p in skel.parents] + [int(site.parent) for site in skel.end_sites]  # Python ints: fast
     has_child = np.zeros(len(parents), bool)
     for p in parents:
         if p >= 0:
