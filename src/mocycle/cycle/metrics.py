@@ -142,10 +142,17 @@ def template_error(Y: np.ndarray, C: np.ndarray) -> tuple[float, int]:
     M, N = Y.shape[0], C.shape[0]
     c2 = (C ** 2).sum(1)[None, :]
 
+    made: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
     def d2_block(r0: int) -> tuple[np.ndarray, np.ndarray]:
+        if r0 in made:  # a take of one block: its distances are made once for both passes
+            return made.pop(r0)
         Yb = Y[r0:r0 + _ROWS]
         rows = np.arange(r0, r0 + Yb.shape[0])
-        return (Yb ** 2).sum(1)[:, None] + c2 - 2 * Yb @ C.T, rows  # squared distances
+        d2 = (Yb ** 2).sum(1)[:, None] + c2 - 2 * Yb @ C.T, rows  # squared distances
+        if M <= _ROWS:
+            made[r0] = d2
+        return d2
 
     total = np.zeros(N)
     for r0 in range(0, M, _ROWS):
