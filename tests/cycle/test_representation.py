@@ -66,6 +66,6 @@ def test_decode_of_a_repeated_cycle_projects_once_and_gives_the_same_motion():
     P, L = space.encode(motion)
     P = P + np.random.default_rng(0).normal(scale=0.01, size=P.shape)   # not rotations: decode projects them
     L3 = np.vstack([L, L + 1.0, L + 2.0])
-    once = space.decode(P, L3, repeats=3)
+    once = space.decode(np.tile(P, (3, 1)), L3, projected=np.tile(space.project(P), (3, 1, 1, 1)))
     tiled = space.decode(np.tile(P, (3, 1)), L3)
     assert np.array_equal(once.rotations, tiled.rotations) and np.array_equal(once.translations, tiled.translations)

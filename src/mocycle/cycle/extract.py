@@ -74,6 +74,9 @@ class Cycle:
     periodic: PeriodicMotion
     regression: HarmonicRegression | None = field(default=None, repr=False)
     seconds: float = 0.0
+    #: :func:`loop_blocks` of this cycle and ``space.project(P)``, once made (not copied by ``dataclasses.replace``)
+    _blocks: tuple | None = field(default=None, init=False, repr=False, compare=False)
+    _projected: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         up = self.space.up
@@ -88,6 +91,14 @@ class Cycle:
     @property
     def n_frames(self) -> int:
         return self.P.shape[0]
+
+    def _rotations(self, count: int = 1) -> np.ndarray:
+        """``space.project(P)`` ``(N, J, 3, 3)``, made once, repeated ``count`` times: every motion of the
+        cycle (in place, moving on, repeated, the seam's blocks) has these rotations, only the travel joint's
+        heading differs."""
+        if self._projected is None:
+            self._projected = self.space.project(self.P)
+        return self._projected if count == 1 else np.tile(self._projected, (count, 1, 1, 1))
 
     @property
     def period_frames(self) -> float:
@@ -139,7 +150,7 @@ class Cycle:
     def motion(self, root: str = "inplace") -> Motion:
         """The cycle as a Motion; ``root="inplace"`` walks on the spot, ``"motion"`` moves on by ``drift``."""
         _check_choice(root, ROOT_MODES, "root")
-        return self.space.decode(self.P, self._inplace_L() if root == "inplace" else self.L)
+        return self.space.decode(self.P, self._inplace_L() if root == "inplace" else self.L, self._rotations())
 
     def repeat(self, count: int, root: str = "inplace") -> Motion:
         """The cycle ``count`` times, seamlessly; with ``root="motion"`` each repeat starts where the last ends."""
@@ -147,12 +158,13 @@ class Cycle:
         count = _validate.integer("count", count, 1)
         check_frames(count * self.n_frames, self.space.skeleton.n_joints,
                      f"{count} cycles of {self.n_frames} frames")
+        P = np.tile(self.P, (count, 1))
         if root == "inplace":
-            return self.space.decode(self.P, np.tile(self._inplace_L(), (count, 1)), repeats=count)
+            return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)), self._rotations(count))
         Ls = [self.L]
         for _ in range(count - 1):  # each repeat is the last one moved rigidly: a turning walk walks a circle
             Ls.append(self._next_repeat(Ls[-1]))
-        return self.space.decode(self.P, np.concatenate(Ls), repeats=count)  # rotations projected once
+        return self.space.decode(P, np.concatenate(Ls), self._rotations(count))
 
     def to_dict(self) -> dict:
         return {
@@ -367,25 +379,42 @@ def metric_features(motion: Motion, reference: np.ndarray | None = None, rows: s
     ``rows``: only these frames (a slice), without copying the motion.  Computed block by block of frames:
     the same numbers as ``pose_matrix(motion, rep="rotmat", root="drop")[0] / √2``.
     """
-    skel = motion.skeleton
-    joints = [j for j in skel.select(None) if skel.euler_order(j)]
+    joints = _rotation_joints(motion.skeleton)
     if not joints:
         return pose_matrix(motion, rep="rotmat", root="drop")[0]  # raises: no features
     quats = motion.rotations[rows]
     T = quats.shape[0]
     out = np.empty((T, 9 * len(joints)))
     for f0 in range(0, T, 8192):
-        block = quats[f0:f0 + 8192][:, joints]
+        block = np.take(quats[f0:f0 + 8192], joints, axis=1)  # contiguous, unlike [:, joints]
         out[f0:f0 + 8192] = Rotation.from_quat(block.reshape(-1, 4)).as_matrix().reshape(block.shape[0], -1)
     out /= np.sqrt(2.0)
     return out
 
 
-def loop_blocks(cycle: Cycle, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _rotation_joints(skeleton) -> list[int]:
+    """The joints :func:`metric_features` measures: those with rotation channels."""
+    return [j for j in skeleton.select(None) if skeleton.euler_order(j)]
+
+
+def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """What the seam of a cycle is judged on: its in-place rotations as :func:`metric_features` ``(N, 9J)``
-    and the world path of its travel joint ``(N, 3)``."""
-    inplace = cycle.motion("inplace")
-    return metric_features(inplace, reference), inplace.world_positions()[:, cycle.space.travel]
+    and the world path of its travel joint ``(N, 3)``.
+
+    Made from the decoded rotation matrices directly (the numbers of ``metric_features`` and
+    ``world_positions`` of ``cycle.motion("inplace")`` within rounding, without building the motion or
+    running forward kinematics of every joint), and kept on the cycle: the metrics and the checks ask
+    for the same blocks.  ``reference`` changes nothing (see :func:`metric_features`)."""
+    if cycle._blocks is None:
+        space = cycle.space
+        joints = _rotation_joints(space.skeleton)
+        if not joints:
+            raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
+        L = cycle._inplace_L()
+        R = space.rotations(cycle.P, L, cycle._rotations())
+        C = (R if len(joints) == space.n_joints else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
+        cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L)))
+    return cycle._blocks
 
 
 def choose_periodic(result: PhaseResult, which: int | None = None) -> PeriodicMotion:

@@ -165,23 +165,65 @@ class CycleSpace:
         return L, np.append(path[-1] - path[0], drift[3])
 
     # -- (P, L) -> motion -----------------------------------------------
-    def decode(self, P: np.ndarray, L: np.ndarray, repeats: int = 1) -> Motion:
-        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``.
-
-        ``repeats``: ``P`` holds ``N / repeats`` rows that repeat ``repeats`` times (a loop's cycle): they are
-        projected onto rotations once."""
+    def _check(self, P: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         P, L = np.asarray(P, dtype=np.float64), np.asarray(L, dtype=np.float64)
-        n, J = P.shape[0], self.n_joints
-        N = n * repeats
-        if P.shape != (n, self.n_periodic) or L.shape != (N, self.n_drifting):
-            raise MocycleError(f"expected P ({n}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
-        R = nearest_rotations(P[:, : 9 * J].reshape(n, J, 3, 3))
-        if repeats > 1:
-            R, P = np.tile(R, (repeats, 1, 1, 1)), np.tile(P, (repeats, 1))
+        N = P.shape[0]
+        if P.shape != (N, self.n_periodic) or L.shape != (N, self.n_drifting):
+            raise MocycleError(f"expected P ({N}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
+        return P, L
+
+    def project(self, P: np.ndarray) -> np.ndarray:
+        """Each joint's block of ``P (N, n_periodic)`` projected onto the nearest rotation: ``(N, J, 3, 3)``
+        local rotation matrices, the travel joint's without its heading.  A joint whose block is the same
+        on every row (one that never moves) is projected once."""
+        P = np.asarray(P, dtype=np.float64)
+        N, J = P.shape[0], self.n_joints
+        M = P[:, : 9 * J].reshape(N, J, 3, 3)
+        still = np.all(P[:, : 9 * J] == P[:1, : 9 * J], axis=0).reshape(J, 9).all(axis=1) if N > 1 \
+            else np.zeros(J, dtype=bool)
+        if not still.any():
+            return nearest_rotations(M)
+        R = np.empty_like(M)
+        R[:, still] = nearest_rotations(M[0, still])
+        moving = np.flatnonzero(~still)
+        R[:, moving] = nearest_rotations(np.take(M, moving, axis=1))  # take: a contiguous copy, unlike M[:, moving]
+        return R
+
+    def rotations(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray | None = None) -> np.ndarray:
+        """The local rotation matrices ``(N, J, 3, 3)`` that :meth:`decode` puts in its motion:
+        :meth:`project` of ``P`` (or ``projected``, when the caller has it), the travel joint turned to the
+        heading ``L[:, 3]``."""
+        P, L = self._check(P, L)
+        R = self.project(P) if projected is None else projected.copy()
         R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
-        quats = continuous_quats(matrix_quats(R))
+        return R
+
+    def translations(self, P: np.ndarray, L: np.ndarray) -> np.ndarray:
+        """The local translations ``(N, J, 3)`` that :meth:`decode` puts in its motion."""
+        P, L = self._check(P, L)
+        N, J = P.shape[0], self.n_joints
         trans = np.broadcast_to(self.static_translations, (N, J, 3)).copy()
         if self.moving:
             trans[:, list(self.moving)] = P[:, 9 * J:].reshape(N, len(self.moving), 3)
         trans[:, self.travel] = L[:, :3]
-        return Motion(self.skeleton, quats, trans, self.frame_time)
+        return trans
+
+    def travel_path(self, rotations: np.ndarray, translations: np.ndarray) -> np.ndarray:
+        """World positions ``(N, 3)`` of the travel joint from local ``rotations (N, J, 3, 3)`` and
+        ``translations (N, J, 3)``: forward kinematics along its chain from the root only (the products of
+        :meth:`Motion.world_positions <mocycle.motion.Motion.world_positions>` for that joint)."""
+        chain = [self.travel]
+        while self.skeleton.parents[chain[-1]] >= 0:
+            chain.append(int(self.skeleton.parents[chain[-1]]))
+        chain.reverse()
+        world_r, world_p = rotations[:, chain[0]], translations[:, chain[0]]
+        for j in chain[1:]:
+            world_p = world_p + (world_r @ translations[:, j, :, None])[..., 0]
+            world_r = world_r @ rotations[:, j]
+        return world_p
+
+    def decode(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray | None = None) -> Motion:
+        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``;
+        ``projected``: :meth:`project` of ``P`` when the caller has it."""
+        quats = continuous_quats(matrix_quats(self.rotations(P, L, projected)))
+        return Motion(self.skeleton, quats, self.translations(P, L), self.frame_time)
