@@ -42,11 +42,20 @@ from pathlib import Path
 
 import numpy as np
 
-from mocycle.contacts import detect_contacts, largest_leg_step, lock_cycle, lock_feet, ranges, skate
+from mocycle.contacts import detect_contacts, largest_leg_step, lock_cycle, lock_feet, ranges
+from mocycle.contacts import skate as skate_measure
 from mocycle.contacts.skate import leg_joints
 from mocycle.cycle import extract_cycle
 from mocycle.errors import MocycleError
 from mocycle.io import read
+
+LOCK: dict = {}  # options of lock_cycle / lock_feet (--clearance)
+SKATE: dict = {}  # options of the skate measure (--skate-height)
+
+
+def skate(motion, *args, **kw):
+    return skate_measure(motion, *args, **SKATE, **kw)
+
 
 ICLONE = ("02_01", "02_02", "02_03", "05_01") + tuple(f"07_{i:02d}" for i in range(1, 13))
 
@@ -127,7 +136,7 @@ def blends(data: Path, quick: bool) -> list[dict]:
             print(f"{path.name:34s} no blend: {exc}")
             continue
         t0 = time.perf_counter()
-        cleaned, _ = lock_cycle(blend.cycle)
+        cleaned, _ = lock_cycle(blend.cycle, **LOCK)
         t_lock = time.perf_counter() - t0
         s_in = float(np.mean([skate(a), skate(b)]))  # the two captures
         before, after = blend.cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
@@ -138,7 +147,9 @@ def blends(data: Path, quick: bool) -> list[dict]:
         print(f"{path.name:34s} {s_in:8.2f} {row['s_fit']:7.2f} {row['s_out']:7.2f} {row['ratio']:7.2f} "
               f"{row['step_before']:11.3f} {row['step_after']:6.3f} {t_lock:7.3f}")
     if rows:
-        print(f"blends: median locked/input {statistics.median(r['ratio'] for r in rows):.2f} (goal <= 0.5); "
+        worst = max(rows, key=lambda r: r["ratio"])
+        print(f"blends: median locked/input {statistics.median(r['ratio'] for r in rows):.2f} (goal <= 0.5), worst "
+              f"{worst['ratio']:.2f} ({worst['take']}); "
               f"locked above input: {sum(r['s_out'] > r['s_in'] for r in rows)} of {len(rows)}; leg step > 1.5x "
               f"before: {sum(r['step_after'] > 1.5 * r['step_before'] for r in rows)}")
     return rows
@@ -159,7 +170,7 @@ def stretched(data: Path, quick: bool) -> list[dict]:
             print(f"{path.name:34s} no stretch: {exc}")
             continue
         t0 = time.perf_counter()
-        locked = lock_feet(long, detect_contacts(long))
+        locked = lock_feet(long, detect_contacts(long), **LOCK)
         t_lock = time.perf_counter() - t0
         row = dict(take=path.name, s_in=skate(motion), s_fit=skate(long), s_out=skate(locked),
                    step_before=largest_leg_step(long), step_after=largest_leg_step(locked))
@@ -168,7 +179,9 @@ def stretched(data: Path, quick: bool) -> list[dict]:
         print(f"{path.name:34s} {row['s_in']:8.2f} {row['s_fit']:7.2f} {row['s_out']:7.2f} {row['ratio']:7.2f} "
               f"{row['step_before']:11.3f} {row['step_after']:6.3f} {t_lock:7.3f}")
     if rows:
-        print(f"stretched: median locked/input {statistics.median(r['ratio'] for r in rows):.2f} (goal <= 0.5); "
+        worst = max(rows, key=lambda r: r["ratio"])
+        print(f"stretched: median locked/input {statistics.median(r['ratio'] for r in rows):.2f} (goal <= 0.5), worst "
+              f"{worst['ratio']:.2f} ({worst['take']}); "
               f"locked above input: {sum(r['s_out'] > r['s_in'] for r in rows)} of {len(rows)}; leg step > 1.5x "
               f"before: {sum(r['step_after'] > 1.5 * r['step_before'] for r in rows)}")
     return rows
@@ -178,9 +191,20 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--part", choices=("all", "loops", "blends", "stretch"), default="all")
+    ap.add_argument("--clearance", type=float, default=None,
+                    help="swing clearance, fraction of the body height (default: lock's CLEARANCE; 0: off)")
+    ap.add_argument("--skate-height", type=float, default=None,
+                    help="H of the skate measure, fraction of the body height (default 0.015, the issue's)")
     ap.add_argument("--data", type=Path, default=Path(__file__).resolve().parents[1].parent / "shared" / "data")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
+    if args.clearance is not None:
+        global LOCK
+        LOCK = {"clearance": args.clearance}
+        print(f"swing clearance: {args.clearance} of the body height")
+    if args.skate_height is not None:
+        SKATE["height"] = args.skate_height
+        print(f"skate measure's H: {args.skate_height} of the body height")
     if args.part in ("all", "loops"):
         loops(args)
     if args.part in ("all", "blends"):
@@ -202,7 +226,7 @@ def loops(args) -> None:
             print(f"{path.name:34s} no loop: {exc}")
             continue
         t1 = time.perf_counter()
-        cleaned, contacts = lock_cycle(cycle)
+        cleaned, contacts = lock_cycle(cycle, **LOCK)
         t2 = time.perf_counter()
         frames = cycle.axis.frames()
         s_in = skate(motion[frames[0]:frames[-1] + 1])
@@ -210,7 +234,7 @@ def loops(args) -> None:
         s_fit, s_out = skate(before), skate(after)
         ext = cycle.repeat(3, root="motion")
         con = detect_contacts(ext)
-        locked = lock_feet(ext, con)  # bones and held feet checked on the whole repeated take
+        locked = lock_feet(ext, con, **LOCK)  # bones and held feet checked on the whole repeated take
         row = dict(take=path.name, s_in=s_in, s_fit=s_fit, s_out=s_out, ratio=s_out / s_in,
                    fast=fast_share(motion[frames[0]:frames[-1] + 1]),
                    step_before=largest_leg_step(before), step_after=largest_leg_step(after),
@@ -231,7 +255,8 @@ def loops(args) -> None:
     print(f"takes: {len(rows)}")
     print(f"median skate: input {statistics.median(r['s_in'] for r in rows):.2f}, fitted "
           f"{statistics.median(r['s_fit'] for r in rows):.2f}, locked {statistics.median(r['s_out'] for r in rows):.2f}"
-          f" units/s; median locked/input {statistics.median(ratios):.2f} (goal <= 0.5)")
+          f" units/s; median locked/input {statistics.median(ratios):.2f} (goal <= 0.5), worst {max(ratios):.2f} "
+          f"({max(rows, key=lambda r: r['ratio'])['take']})")
     print(f"share of the input's skate from steps faster than 1 body height/s (swing feet passing low, heels "
           f"landing at speed; not a planted foot): median {statistics.median(r['fast'] for r in rows):.0%}")
     print(f"takes whose locked loop skates more than the input: {len(worse)} (goal 0) {' '.join(worse[:12])}")

@@ -1,11 +1,11 @@
 """Long fuzzing run of every reader, to run before releases (the suite's fuzz tests are the short version).
 
-    python benchmarks/fuzz.py [--seconds 3600] [--readers bvh,asf,amc,mck,mosw] [--engine auto|atheris|random]
+    python benchmarks/fuzz.py [--seconds 3600] [--readers bvh,asf,amc,mck,mosw,json] [--engine auto|atheris|random]
                               [--rss-mb 2048] [--timeout 10] [--out DIR] [--data DIR]
 
 Each reader runs in its own process under a memory limit (``RLIMIT_AS`` of ``--rss-mb``) and a time limit
 per input (``--timeout`` seconds).  A reader passes an input when it returns a result that goes on working
-(``.mck`` decompresses, ``.mosw`` plays back, BVH/ASF/AMC write as BVH and read back) or raises one
+(``.mck`` decompresses, ``.mosw`` and swings JSON play back, BVH/ASF/AMC write as BVH and read back) or raises one
 :class:`~mocycle.errors.MotionFileError`; anything else is a crash, a run past the time limit a hang, a
 ``MemoryError`` a blow-up.
 
@@ -36,7 +36,7 @@ from pathlib import Path
 
 from mocycle.datasets.asfamc_text import TINY_AMC, TINY_ASF
 
-READERS = ("bvh", "asf", "amc", "mck", "mosw")
+READERS = ("bvh", "asf", "amc", "mck", "mosw", "json")
 DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
 ASF, AMC = TINY_ASF, TINY_AMC
@@ -57,6 +57,7 @@ def _targets():
     from mocycle.io.bvh import format_bvh, parse_bvh
     from mocycle.io.mck import MAGIC as MCK
     from mocycle.io.mosw import MAGIC as MOSW
+    from mocycle.io.swings_json import parse_swings_json
     from mocycle.keyframes import Compressed, compress
     from mocycle.swings import decode, encode, playback, segment
 
@@ -84,6 +85,9 @@ def _targets():
     def mosw(data):
         finite(playback(decode(data, "fuzz.mosw")))
 
+    def swings_json(data):
+        finite(playback(parse_swings_json(data, "fuzz.json")))
+
     bvh_seeds = [format_bvh(walk).encode(), format_bvh(walk[:3]).encode()]
     mck_seeds = [compress(walk, count=5, scheme=s).to_bytes() for s in ("slerp", "hermite", "rbf")]
     mck_seeds.append(compress(walk, count=5, scheme="spatial", projection="pca").to_bytes())
@@ -91,7 +95,8 @@ def _targets():
     real_bvh = sorted(data.glob("*/*.bvh"), key=lambda p: p.stat().st_size)[:2] if data.is_dir() else []
     bvh_seeds += [p.read_bytes() for p in real_bvh]
     return {"bvh": (bvh, bvh_seeds, None), "asf": (asf, [ASF.encode()], None), "amc": (amc, [AMC.encode()], None),
-            "mck": (mck, mck_seeds, MCK), "mosw": (mosw, [encode(segment(walk))], MOSW)}
+            "mck": (mck, mck_seeds, MCK), "mosw": (mosw, [encode(segment(walk))], MOSW),
+            "json": (swings_json, [json.dumps(segment(walk[:40]).to_dict()).encode()], None)}
 
 
 INTERESTING = [b"\x00", b"\xff", b"\x7f", b"\x80", b"\x00\x00\x00\x00", b"\xff\xff\xff\xff", b"\x00\xca\x9a\x3b",
@@ -221,6 +226,7 @@ def child_atheris(reader: str, seconds: float, rss_mb: int, timeout: float, out:
         import mocycle.io.inflate  # noqa: F401
         import mocycle.io.mck  # noqa: F401
         import mocycle.io.mosw  # noqa: F401
+        import mocycle.io.swings_json  # noqa: F401
         import mocycle.swings.playback  # noqa: F401
         from mocycle.errors import MotionFileError
     run, seeds, magic = _targets()[reader]

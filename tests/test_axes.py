@@ -38,3 +38,16 @@ def test_heading_about_any_up_axis_is_unwrapped():
         turns = np.linspace(0, 5 * np.pi, 200)
         forward = Rotation.from_rotvec(np.outer(turns, up)).apply(e1 + 0.3 * up)   # tilted up: no effect
         assert np.allclose(heading_angles(forward, e1, e2), turns)
+
+
+def test_the_detected_up_axis_is_kept_per_motion_and_handed_out_as_a_copy():
+    from mocycle.axes import _detect_up, vertical_axis
+    from mocycle.datasets import synthetic_walk
+
+    walk = synthetic_walk(n_frames=120, fps=60, seed=1).motion
+    up = vertical_axis(walk)
+    up[:] = 7.0  # a caller scribbling on its copy changes nothing
+    assert vertical_axis(walk).tolist() == _detect_up(walk).tolist() == [0.0, 1.0, 0.0]
+    assert vertical_axis(walk[::2]).tolist() == [0.0, 1.0, 0.0]  # a new motion detects again
+    assert vertical_axis(walk, "-z").tolist() == [0.0, 0.0, -1.0]  # an override is never cached
+    assert vertical_axis(walk).tolist() == [0.0, 1.0, 0.0]

@@ -108,6 +108,11 @@ def test_nearest_rotations_match_the_svd_without_it():
     for noise in (0.0, 1e-3, 0.3, 0.8):
         M = R * rng.uniform(0.3, 1.2, (2000, 1, 1)) + noise * rng.normal(size=(2000, 3, 3))
         assert np.abs(nearest_rotations(M) - svd_nearest_rotations(M)).max() < 1e-12
+    for noise in (1e-9, 1e-4, 1e-2, 0.03):  # near rotations (a harmonic fit): the Newton-Schulz steps
+        M = R + noise * rng.normal(size=(2000, 3, 3))
+        assert np.abs(nearest_rotations(M) - svd_nearest_rotations(M)).max() < 1e-12
+    near_reflections = -R[:50] + 1e-4 * rng.normal(size=(50, 3, 3))  # orthogonal enough, but det -1
+    assert np.allclose(nearest_rotations(near_reflections), svd_nearest_rotations(near_reflections), atol=1e-12)
     flipped = -R[:5]  # det -1: no polar iteration reaches a rotation, the SVD answers
     assert np.allclose(nearest_rotations(flipped), svd_nearest_rotations(flipped), atol=1e-12)
     assert np.linalg.det(nearest_rotations(flipped)) == pytest.approx(np.ones(5))

@@ -58,6 +58,14 @@ def vertical_axis(motion: Motion, up=None) -> np.ndarray:
     """
     if up is not None:
         return parse_up(up)
+    known = getattr(motion, "_up", None)  # the arrays are read-only: detected once per motion
+    if known is None:
+        known = motion._up = _detect_up(motion)
+    return known.copy()
+
+
+def _detect_up(motion: Motion) -> np.ndarray:
+    """:func:`vertical_axis` detected from the mean pose (its docstring says how)."""
     step = max(1, motion.n_frames // 50)
     travel = motion.travel_joint
     parents = list(motion.skeleton.parents) + [site.parent for site in motion.skeleton.end_sites]

@@ -126,9 +126,7 @@ class Skeleton:
         """
         lengths = np.zeros(self.n_joints)
         norms = np.linalg.norm(self.offsets, axis=1)
-        for j in range(1, self.n_joints):
-            p = self.parents[j]
-            lengths[p] = max(lengths[p], norms[j])
+        np.maximum.at(lengths, np.asarray(self.parents[1:], dtype=np.intp), norms[1:])
         for site in self.end_sites:
             lengths[site.parent] = max(lengths[site.parent], float(np.linalg.norm(site.offset)))
         return lengths
@@ -227,7 +225,7 @@ class Motion:
         normalises and freezes them in place instead of copying them (what the readers do: half the memory).
     """
 
-    __slots__ = ("skeleton", "rotations", "translations", "frame_time", "_travel")
+    __slots__ = ("skeleton", "rotations", "translations", "frame_time", "_travel", "_up")
 
     def __init__(
         self,

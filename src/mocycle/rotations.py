@@ -314,12 +314,83 @@ def svd_nearest_rotations(M: np.ndarray) -> np.ndarray:
 def nearest_rotations(M: np.ndarray) -> np.ndarray:
     """Project ``(..., 3, 3)`` matrices onto the nearest rotations (Frobenius, determinant +1).
 
-    The orthogonal polar factor by scaled Newton iterations (:func:`fast_nearest_rotation`, run until
-    it converges); matrices with ``det <= 0`` or that do not converge go to the SVD
-    (:func:`svd_nearest_rotations`).  The same matrices as the SVD within about 1e-12, several
-    times faster on many small matrices.
+    Matrices that are already nearly rotations (``|XᵀX - I|`` under :data:`NEAR_ORTHOGONAL` entry by entry,
+    ``det > 0``: a harmonic fit of rotation matrices, a blend of nearby rotations) take Newton–Schulz
+    steps ``X ← X (3I - XᵀX) / 2`` until ``XᵀX`` is the identity to 1e-8, then one more
+    (:func:`_newton_schulz`; the error squares at each step: 0.1, 7e-3, 4e-5, 1e-9, rounding); the others take the
+    scaled Newton polar iterations of :func:`fast_nearest_rotation`, run until they converge, and
+    matrices with ``det <= 0`` or that do not converge go to the SVD (:func:`svd_nearest_rotations`).
+    The same matrices as the SVD within about 1e-14, several times faster on many small matrices.
+    Blocks of :data:`_NEAREST_BLOCK` matrices at a time (each matrix's result does not depend on the
+    others): their temporaries stay in the cache.
     """
-    return fast_nearest_rotation(M)
+    M = np.asarray(M, dtype=np.float64)
+    flat = M.reshape(-1, 9)
+    out = np.empty(flat.shape)
+    for b in range(0, flat.shape[0], _NEAREST_BLOCK):
+        block = flat[b:b + _NEAREST_BLOCK]
+        near, R = _newton_schulz(block)
+        rows = out[b:b + _NEAREST_BLOCK]
+        rows[near] = R
+        if not near.all():
+            rows[~near] = fast_nearest_rotation(block[~near].reshape(-1, 3, 3)).reshape(-1, 9)
+    return out.reshape(M.shape)
+
+
+#: matrices per block of :func:`nearest_rotations` (1.3-1.5x faster than one block of 50 000 near-rotations)
+_NEAREST_BLOCK = 16384
+#: largest ``|XᵀX - I|`` entry of a matrix that :func:`nearest_rotations` orthogonalises by Newton–Schulz steps
+NEAR_ORTHOGONAL = 0.1
+
+
+def _gram(x: list) -> tuple:
+    """The six entries ``s00, s11, s22, s01, s02, s12`` of ``XᵀX`` from the nine entries of ``X`` (row-major)."""
+    a, b, c, d, e, f, g, h, i = x
+    return (a * a + d * d + g * g, b * b + e * e + h * h, c * c + f * f + i * i,
+            a * b + d * e + g * h, a * c + d * f + g * i, b * c + e * f + h * i)
+
+
+def _orthogonality_error(s: tuple) -> np.ndarray:
+    """The largest ``|XᵀX - I|`` entry from :func:`_gram`'s six entries."""
+    err = np.abs(s[0] - 1.0)
+    for v in (np.abs(s[1] - 1.0), np.abs(s[2] - 1.0), np.abs(s[3]), np.abs(s[4]), np.abs(s[5])):
+        np.maximum(err, v, out=err)
+    return err
+
+
+def _newton_schulz(flat: np.ndarray, max_steps: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """The orthogonal polar factors of the rows of ``flat`` ``(n, 9)`` that are near rotations.
+
+    Returns ``near`` ``(n,)`` (``|XᵀX - I| < NEAR_ORTHOGONAL`` and ``det X > 0``) and the rotations ``(k, 9)`` of
+    those rows: Newton–Schulz steps ``X ← X (3I - XᵀX) / 2`` (quadratic convergence to the polar factor when
+    ``|XᵀX - I| < 1``; the error after a step is about ``0.75 err²``) until every row is orthonormal to 1e-8,
+    then one more step, which leaves rounding."""
+    x = list(np.ascontiguousarray(flat.T))  # nine contiguous arrays: the entries, row-major
+    s = _gram(x)
+    a, b, c, d, e, f, g, h, i = x
+    det = a * (e * i - f * h) + b * (f * g - d * i) + c * (d * h - e * g)
+    near = (_orthogonality_error(s) < NEAR_ORTHOGONAL) & (det > 0)
+    if not near.all():
+        x = [v[near] for v in x]
+        s = tuple(v[near] for v in s)
+    settled = False
+    for _ in range(max_steps):
+        if not x[0].size:
+            break
+        settled = bool(_orthogonality_error(s).max() < 1e-8)
+        t00, t11, t22 = 1.5 - 0.5 * s[0], 1.5 - 0.5 * s[1], 1.5 - 0.5 * s[2]  # (3I - S) / 2
+        t01, t02, t12 = -0.5 * s[3], -0.5 * s[4], -0.5 * s[5]
+        a, b, c, d, e, f, g, h, i = x
+        x = [a * t00 + b * t01 + c * t02, a * t01 + b * t11 + c * t12, a * t02 + b * t12 + c * t22,
+             d * t00 + e * t01 + f * t02, d * t01 + e * t11 + f * t12, d * t02 + e * t12 + f * t22,
+             g * t00 + h * t01 + i * t02, g * t01 + h * t11 + i * t12, g * t02 + h * t12 + i * t22]
+        if settled:
+            break
+        s = _gram(x)
+    if not settled and x[0].size:  # not converged in max_steps (cannot happen from 0.1): the other method
+        near[np.flatnonzero(near)] = False
+        return near, np.zeros((0, 9))
+    return near, np.stack(x, axis=1)
 
 
 def matrix_quats(R: np.ndarray) -> np.ndarray:

@@ -228,3 +228,81 @@ def test_slow_is_measured_against_the_body_s_own_speed():
     assert not detect_contacts(glide).mask.any()                     # 0.25 is not slow in absolute terms
     assert not detect_contacts(glide, travel=0.2).mask.any()         # nor for a body this slow
     assert detect_contacts(glide, travel=1.2).mask.all(axis=0).all()  # slow for a body 1/1.2 times as fast
+
+
+def _rocking_run(fps=60.0):
+    """The synthetic run with its feet planted (:func:`plant_lowest_foot`) and its whole body rocking up
+    and down by 1.2 % of its height three times a step: a stance that rocks vertically faster than the
+    absolute ``CONTACT_RISE`` allows, as a fast run's fitted loop does (the jog 02_03 of the shared data)."""
+    from mocycle.contacts import body_height, plant_lowest_foot
+    from mocycle.datasets import synthetic_run
+
+    take = synthetic_run(n_frames=int(6 * fps), fps=fps)
+    m = plant_lowest_foot(take.motion)
+    t = m.translations.copy()
+    t[:, 0, 1] += 0.012 * body_height(m) * np.sin(2 * np.pi * 6 * take.unwrapped_phase)
+    return Motion(m.skeleton, m.rotations, t, m.frame_time)
+
+
+def test_a_run_whose_loop_loses_its_contacts_is_still_locked():
+    cycle = extract_cycle(_rocking_run())
+    ext = cycle.repeat(3, root="motion")
+    assert not detect_contacts(ext, relax=False).mask.any()   # the usual rules find no stance at all
+    con = detect_contacts(ext)
+    N = cycle.n_frames
+    for f in range(2):   # the rolling stance's rules: each foot planted in every cycle, for part of it
+        share = con.foot_mask(f)[N:2 * N].mean()
+        assert con.foot_ranges(f) and 0.05 < share < 0.6, share
+    before = skate(cycle.repeat(2, root="motion"))
+    kept, _ = lock_cycle(cycle, relax=False)
+    locked, _ = lock_cycle(cycle)
+    assert skate(kept.repeat(2, root="motion")) == pytest.approx(before)   # nothing held, nothing changed
+    assert skate(locked.repeat(2, root="motion")) < 0.8 * before
+
+
+def test_a_foot_held_up_is_not_planted_in_the_air(monkeypatch):
+    """Standing on the right leg, the left lower leg swinging slowly back and forth well above the floor:
+    the usual rules find no contact for it (it is slow only at the ends of its swing, high above its lowest
+    level), and the rolling stance's rules, which take each joint's floor where it is slow, must not plant
+    it there: its floor so found is far above the standing foot's."""
+    from mocycle.contacts import detect
+    from mocycle.rotations import axis_angle_quats
+
+    still = synthetic_still(n_frames=90, fps=30).motion
+    hip, knee = still.skeleton.index("LeftUpLeg"), still.skeleton.index("LeftLeg")
+    q = still.rotations.copy()
+    x = np.array([1.0, 0.0, 0.0])
+    q[:, knee] = axis_angle_quats(x, np.full(90, 1.0))                # bent: hip to ankle 0.49 rad back
+    q[:, hip] = axis_angle_quats(x, -0.49 - 0.5 * np.sin(2 * np.pi * np.arange(90) / 45))  # lowest mid-swing
+    held_up = Motion(still.skeleton, q, still.translations, still.frame_time)
+    up = np.array([0.0, 1.0, 0.0])
+    W = held_up.world_positions()
+    feet = find_feet(held_up.skeleton)
+    assert W[:, feet[0].ankle, 1].min() > W[:, feet[1].ankle, 1].max() + 10   # the left foot is up
+    con = detect_contacts(held_up, up=up)
+    assert not detect_contacts(held_up, up=up, relax=False).foot_mask(0).any()
+    assert not con.foot_mask(0).any()
+    assert con.foot_mask(1).all()
+    monkeypatch.setattr(detect, "RELAX_FLOOR", 1.0)   # without the floor check it would be planted in the air
+    assert detect_contacts(held_up, up=up).foot_mask(0).any()
+
+
+def test_a_low_frame_is_shifted_down_with_its_hold_only_near_the_contact():
+    """A heel coming in above the height it is held at during its contact: the low frames before the contact
+    keep its path horizontally held, and the downward shift eases out away from the contact (a heel coming in
+    at speed is not pulled down to skim the floor); a shift up is kept whole."""
+    from mocycle.contacts.lock import LOW, _own_holds
+
+    T, up = 40, np.array([0.0, 1.0, 0.0])
+    path = np.zeros((T, 3))
+    path[:20, 1] = np.linspace(2.0, 1.0, 20)         # coming down
+    path[20:30, 1] = np.linspace(1.0, 0.0, 10)       # the contact settles to 0: held at its lowest, 0
+    mask = np.zeros(T, bool)
+    mask[20:30] = True
+    corr, level = _own_holds(path, mask, [np.zeros(3)], up, low=3.0, near=10.0, n_extend=12)
+    assert np.all(level[8:20] == LOW) and np.all(level[:8] == 0)
+    assert corr[19, 1] < -0.9 and abs(corr[8, 1]) < 0.1      # full shift beside the contact, none 12 frames off
+    assert np.all(np.diff(corr[8:20, 1]) <= 1e-12)            # growing toward the contact
+    assert np.allclose(corr[8:20, [0, 2]], 0.0)               # held horizontally
+    corr, _ = _own_holds(path, mask, [np.array([0.0, 1.5, 0.0])], up, low=3.0, near=10.0, n_extend=12)
+    assert np.allclose(corr[8:20, 1], 0.5)                    # held higher than it came in: shifted up whole

@@ -126,3 +126,27 @@ def test_real_walk_loops_with_m1_near_m2():
     m2 = loop_metrics(motion, extract_cycle(motion, model="M2"))
     assert m1["template_error"] < 1.05 * m2["template_error"]
     assert m1["seam_pose"] <= 1.0 and m1["seam_velocity"] <= 1.0
+
+
+def test_loop_blocks_are_the_inplace_motions_features_and_travel_path():
+    """loop_blocks works on the decoded matrices and the travel joint's chain only: the same blocks as the
+    in-place motion's metric features and world positions, within rounding; a fresh cycle (replace) makes its
+    own, and every motion of the cycle has the same rotations apart from the travel joint's heading."""
+    from dataclasses import replace
+
+    from mocycle.cycle.extract import loop_blocks
+
+    walk = synthetic_walk(n_frames=300, fps=60, seed=4).motion
+    cycle = extract_cycle(walk)
+    C, path = loop_blocks(cycle)
+    inplace = cycle.motion("inplace")
+    np.testing.assert_allclose(C, metric_features(inplace), atol=1e-12)
+    np.testing.assert_allclose(path, inplace.world_positions()[:, cycle.space.travel], atol=1e-9)
+    assert loop_blocks(cycle)[0] is C  # kept on the cycle
+    moved = replace(cycle, L=cycle.L + np.array([1.0, 0.0, 0.0, 0.0]))
+    assert np.allclose(loop_blocks(moved)[1], path + [1.0, 0.0, 0.0]) and loop_blocks(moved)[0] is not C
+    twice = cycle.repeat(2, root="motion")
+    others = [j for j in range(walk.n_joints) if j != cycle.space.travel]
+    np.testing.assert_array_equal(twice.rotations[:cycle.n_frames, others], twice.rotations[cycle.n_frames:, others])
+    np.testing.assert_allclose(np.abs(twice.rotations[:cycle.n_frames, others]),
+                               np.abs(inplace.rotations[:, others]), atol=1e-15)

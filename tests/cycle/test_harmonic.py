@@ -89,3 +89,31 @@ def test_bad_options_say_the_limit():
     with pytest.raises(MocycleError, match="fit the regression"):
         HarmonicRegression(3).predict(x)
     assert max_harmonics(30) == 14 and max_harmonics(300, cycle_frames=25) == 12
+
+
+def test_least_squares_is_lstsq_also_without_full_rank():
+    from mocycle.cycle.harmonic import least_squares
+
+    rng = np.random.default_rng(3)
+    x = np.sort(rng.uniform(0, 3, 120))
+    Y = rng.normal(size=(120, 300))
+    for B in (harmonic_basis(x, 8), harmonic_basis(x, 8, derivative=1)[:, 1:],  # full rank
+              np.column_stack([harmonic_basis(x, 4), harmonic_basis(x, 4)[:, 1]])):  # a repeated column
+        np.testing.assert_allclose(least_squares(B, Y), np.linalg.lstsq(B, Y, rcond=None)[0], atol=1e-10)
+
+
+def test_still_columns_are_their_constant_exactly():
+    """A column that is one value on every row (a joint that never moves) is predicted as that value, bit for
+    bit, whatever the model; the moving columns get the fit they get alone (within rounding: BLAS may sum in
+    another order for another number of columns)."""
+    rng = np.random.default_rng(4)
+    x = np.linspace(0, 4, 240, endpoint=False)
+    moving = np.column_stack([np.sin(2 * np.pi * x), np.cos(4 * np.pi * x)]) + 0.01 * rng.normal(size=(240, 2))
+    Y = np.column_stack([moving[:, 0], np.full(240, 0.3), moving[:, 1], np.full(240, -1.7)])
+    xd, dY, ddY = x[HALF:-HALF], central_velocity(Y, 1 / 60), central_acceleration(Y, 1 / 60)
+    for model in ("M1", "M2", "M3"):
+        both = HarmonicRegression(6, model).fit(x, Y, xd, dY, ddY)
+        alone = HarmonicRegression(6, model).fit(x, moving, xd, dY[:, [0, 2]], ddY[:, [0, 2]])
+        fine = np.linspace(0, 1, 97)
+        assert np.array_equal(both.predict(fine)[:, [1, 3]], np.tile([0.3, -1.7], (97, 1)))
+        np.testing.assert_allclose(both.predict(fine)[:, [0, 2]], alone.predict(fine), rtol=1e-12, atol=1e-12)

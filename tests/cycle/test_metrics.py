@@ -87,3 +87,18 @@ def test_loop_metrics_has_every_number_the_cli_prints():
     # the template error and the phase-aligned RMSE measure the same fit two ways
     assert 0.5 < m["template_error"] / m["rmse_h"] < 2.0
     assert m["foot_sliding"] < m["input_foot_sliding"] * 1.5
+
+
+def test_foot_metrics_from_positions_the_caller_has_are_the_same():
+    """loop_metrics runs forward kinematics once per motion and hands the positions on: the same numbers as
+    each metric computing its own."""
+    from mocycle.contacts.feet import body_height
+    from mocycle.contacts.skate import skate
+
+    walk = synthetic_walk(n_frames=240, fps=60, seed=2).motion
+    up = np.array([0.0, 1.0, 0.0])
+    W = walk.world_positions(end_sites=True)
+    assert foot_points(walk, up, W) == foot_points(walk, up)
+    assert foot_sliding(walk, up, W) == foot_sliding(walk, up)
+    assert body_height(walk, up, W) == body_height(walk, up)
+    assert skate(walk, up=up, positions=W) == skate(walk, up=up)

@@ -58,3 +58,14 @@ def test_nearest_rotations_and_axis_rotations():
     assert np.abs(fixed - R).max() < 0.05
     A = axis_rotations(np.array([0.0, 0.0, 1.0]), np.array([np.pi / 2]))
     assert np.allclose(A[0] @ [1, 0, 0], [0, 1, 0])
+
+
+def test_decode_of_a_repeated_cycle_projects_once_and_gives_the_same_motion():
+    motion = synthetic_walk(n_frames=40, noise_deg=2).motion
+    space = CycleSpace.fit(motion)
+    P, L = space.encode(motion)
+    P = P + np.random.default_rng(0).normal(scale=0.01, size=P.shape)   # not rotations: decode projects them
+    L3 = np.vstack([L, L + 1.0, L + 2.0])
+    once = space.decode(np.tile(P, (3, 1)), L3, projected=np.tile(space.project(P), (3, 1, 1, 1)))
+    tiled = space.decode(np.tile(P, (3, 1)), L3)
+    assert np.array_equal(once.rotations, tiled.rotations) and np.array_equal(once.translations, tiled.translations)

@@ -204,3 +204,20 @@ def test_a_take_too_short_for_a_phase_has_no_periodic_motion():
 
     with pytest.raises(NoPeriodicMotion, match="needs at least"):
         find_phase(synthetic_walk(n_frames=20).motion)
+
+
+@pytest.mark.parametrize("frames, columns", [(157, 241), (40, 300), (300, 50), (20, 21)])
+def test_principal_components_are_the_svd_scores(frames, columns):
+    """Both scatter-matrix routes (fewer frames than columns: the Gram matrix) give the SVD's scores with
+    scikit-learn's sign rule."""
+    from scipy.linalg import svd
+
+    from mocycle.phase.analysis import _component_signs, principal_components
+
+    rng = np.random.default_rng(frames)
+    X = rng.standard_normal((frames, columns)) * np.linspace(3.0, 0.1, columns) + 5.0
+    U, S, Vt = svd(X - X.mean(axis=0), full_matrices=False)
+    expected = U[:, :8] * _component_signs(Vt[:8]) * S[:8]
+    got = principal_components(X, 8)
+    assert got.shape == (frames, 8)
+    np.testing.assert_allclose(got, expected, atol=1e-9 * np.abs(expected).max())

@@ -24,17 +24,19 @@ from ..cycle.extract import Cycle
 from ..rotations import axis_rotations
 from .detect import Contacts, detect_contacts
 from .feet import Foot
-from .lock import BLEND_SECONDS, REACH, lock_feet
+from .lock import BLEND_SECONDS, CLEARANCE, REACH, lock_feet
 
 
 def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend: float = BLEND_SECONDS,
-               reach: float = REACH, **detect_options) -> tuple[Cycle, Contacts]:
+               reach: float = REACH, clearance: float = CLEARANCE, **detect_options) -> tuple[Cycle, Contacts]:
     """The cycle with its feet locked, and its contacts over its ``N`` frames (a contact running over the
     last frame continues at frame 0)."""
     N = cycle.n_frames
     ext = cycle.repeat(3, root="motion")
+    detect_options.setdefault("up", cycle.space.world_up)   # the take's vertical (found once, by the fit)
     contacts = detect_contacts(ext, feet, **detect_options)
-    locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N, frames=slice(N, 2 * N))
+    locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N, frames=slice(N, 2 * N),
+                       clearance=clearance)
     P, L = cycle.space.encode(locked)
     turn, move = cycle.drift[3], cycle.drift[:3]
     R = axis_rotations(cycle.space.up, np.array([turn]))[0]

@@ -16,6 +16,16 @@ of frames), so 30, 60 and 120 fps agree.
   contacts shorter than ``min_contact`` seconds dropped.
 
 A foot is in contact while its ankle or its toe is.
+
+**A foot with no contact at all** over the motion is looked at again (a foot
+that never touches the floor while the other one walks or runs is nearly
+always a miss): a fast run's stance rolls from heel to toe, so the toe dips
+lowest while it pushes off at speed and rocks up and down while it rests, and
+a fitted loop or a 30 fps capture smooths that further.  For such a foot, each
+joint's floor is its lowest level while slow, and the vertical threshold is
+relative to the body's speed like the horizontal one (``_relaxed``).  A foot
+that is held up (its floor so found well above the other foot's) stays
+without contacts.
 """
 
 from __future__ import annotations
@@ -28,11 +38,13 @@ import numpy as np
 from ..errors import MocycleError
 from ..motion import Motion
 from .feet import Foot, body_height, chain_joints, chain_transforms, find_feet, up_axis
+from .smooth import gaussian
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
 CONTACT_SPEED = 0.15    # body heights per second, horizontal
 CONTACT_RISE = 0.05     # body heights per second, vertical: a heel that lifts faster is not planted
 TRAVEL_SHARE = 0.15     # or this share of the body's own horizontal speed (over TRAVEL_SECONDS), if faster
+RELAX_FLOOR = 0.05      # of the body height: a relaxed floor at most this above the lowest same joint of any foot
 TRAVEL_SECONDS = 0.5    # std of the Gaussian the body's speed is averaged with
 RELEASE = 1.5           # a contact ends above RELEASE × the thresholds
 SMOOTH_SECONDS = 1 / 60  # std of the Gaussian the positions are smoothed with before differencing
@@ -43,8 +55,8 @@ MIN_GAP = 0.06          # seconds
 def ranges(mask: np.ndarray) -> list[tuple[int, int]]:
     """``[(start, stop), ...]`` (stop exclusive) of the runs of True in a boolean ``(T,)`` array."""
     m = np.concatenate([[False], np.asarray(mask, bool), [False]])
-    edges = np.flatnonzero(m[1:] != m[:-1])
-    return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+    edges = np.flatnonzero(m[1:] != m[:-1]).tolist()
+    return list(zip(edges[::2], edges[1::2], strict=True))
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,9 +157,7 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
     h = P @ up
     h = h - h.min(axis=0)
     sigma = smooth / motion.frame_time
-    from scipy.ndimage import gaussian_filter1d  # only when feet are locked
-
-    Ps = gaussian_filter1d(P, sigma, axis=0, mode="nearest") if sigma >= 0.3 else P
+    Ps = gaussian(P, sigma) if sigma >= 0.3 else P
     if motion.n_frames < 2:
         return h, np.zeros_like(h), np.zeros_like(h)
     v = np.gradient(Ps, motion.frame_time, axis=0)
@@ -159,24 +169,35 @@ def _travel_speed(motion: Motion, W: np.ndarray, up: np.ndarray) -> np.ndarray:
     """``(T,)`` horizontal speed of the travel joint (units/s), averaged by a Gaussian of ``TRAVEL_SECONDS``."""
     if motion.n_frames < 2:
         return np.zeros(motion.n_frames)
-    from scipy.ndimage import gaussian_filter1d  # only when feet are locked
-
     p = W[:, motion.travel_joint]
     v = np.gradient(p, motion.frame_time, axis=0)
     v = np.linalg.norm(v - np.outer(v @ up, up), axis=1)
-    return gaussian_filter1d(v, TRAVEL_SECONDS / motion.frame_time, mode="nearest")
+    return gaussian(v, TRAVEL_SECONDS / motion.frame_time)
+
+
+def _find(h, v, vu, height, speed, rise, release, n_contact, n_gap) -> np.ndarray:
+    """``(T, C)`` contacts of the joints whose heights, horizontal and vertical speeds are ``h, v, vu``
+    ``(T, C)`` (body heights, per second): the thresholds with hysteresis and minimum durations (frames)."""
+    mask = np.zeros(h.shape, bool)
+    for c in range(h.shape[1]):
+        on = (h[:, c] < height) & (v[:, c] < speed) & (vu[:, c] < rise)
+        keep = (h[:, c] < release * height) & (v[:, c] < release * speed) & (vu[:, c] < release * rise)
+        mask[:, c] = _durations(_hysteresis(on, keep), n_contact, n_gap)
+    return mask
 
 
 def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = CONTACT_HEIGHT,
                     speed: float = CONTACT_SPEED, rise: float = CONTACT_RISE, release: float = RELEASE,
                     min_contact: float = MIN_CONTACT,
-                    min_gap: float = MIN_GAP, travel: float = TRAVEL_SHARE, up: np.ndarray | None = None) -> Contacts:
+                    min_gap: float = MIN_GAP, travel: float = TRAVEL_SHARE, up: np.ndarray | None = None,
+                    relax: bool = True) -> Contacts:
     """Contacts of every contact joint of ``feet`` (default: :func:`find_feet`; a string names them).
 
     ``height``: fraction of the body height above the joint's lowest level; ``speed``: body heights per
     second (horizontal), or ``travel`` times the body's own horizontal speed where that is more (averaged
     over ``TRAVEL_SECONDS``), ``rise``: body heights per second (vertical); ``release``: hysteresis factor (> 1);
-    ``min_contact``, ``min_gap``: seconds.
+    ``min_contact``, ``min_gap``: seconds; ``relax``: a foot with no contact at all is looked at again with
+    the rules for a rolling stance (:func:`_relaxed`).
     """
     if not (height > 0 and speed > 0 and rise > 0 and release >= 1 and min_contact >= 0 and min_gap >= 0
             and travel >= 0):
@@ -194,13 +215,45 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
     h, v, vu = h / body, v / body, vu / body
     # a foot under a running body is planted when it is slow for the body: a fitted or resampled stance
     # glides at a share of the travel speed
-    speed = np.maximum(speed, travel * _travel_speed(motion, W, up) / body)
-    fps = motion.fps
-    n_contact = max(1, int(round(min_contact * fps)))
-    n_gap = max(1, int(round(min_gap * fps)))
-    mask = np.zeros(h.shape, bool)
-    for c in range(len(joints)):
-        on = (h[:, c] < height) & (v[:, c] < speed) & (vu[:, c] < rise)
-        keep = (h[:, c] < release * height) & (v[:, c] < release * speed) & (vu[:, c] < release * rise)
-        mask[:, c] = _durations(_hysteresis(on, keep), n_contact, n_gap)
+    body_speed = travel * _travel_speed(motion, W, up) / body
+    speed = np.maximum(speed, body_speed)
+    n_contact, n_gap = (max(1, int(round(s * motion.fps))) for s in (min_contact, min_gap))
+
+    def find(h, v, vu, rise):
+        return _find(h, v, vu, height, speed, rise, release, n_contact, n_gap)
+
+    mask = find(h, v, vu, rise)
+    if relax:
+        lows = (W[:, list(joints)] @ up).min(axis=0) / body            # each joint's lowest level
+        kind = [0 if j == feet[f].ankle else 1 for j, f in zip(joints, foot_of, strict=True)]
+        ground = {k: min(lo for lo, kk in zip(lows, kind, strict=True) if kk == k) for k in set(kind)}
+        for f in range(len(feet)):
+            cols = [c for c, g in enumerate(foot_of) if g == f]
+            if not mask[:, cols].any():
+                mask[:, cols] = _relaxed(h[:, cols], v[:, cols], vu[:, cols], speed, rise, body_speed,
+                                         lows[cols] - np.array([ground[kind[c]] for c in cols]), find)
     return Contacts(feet, joints, foot_of, mask, up, body, motion.frame_time)
+
+
+def _relaxed(h, v, vu, speed, rise, body_speed, above, find):
+    """The contacts ``(T, k)`` of one foot that has none by the usual rules (its joints' ``h``, ``v``, ``vu``
+    ``(T, k)`` in body heights): a fast run's stance (or its fitted loop's, or a 30 fps capture's) rolls.
+
+    * each joint's floor is its lowest level **while slow** (horizontal speed under ``speed``), not its
+      lowest level overall: a toe that dips as the foot rolls over it at push-off, moving fast, is not
+      where it rests;
+    * the vertical test is relative to the body's speed like the horizontal one: ``rise`` or
+      ``body_speed`` (the horizontal threshold's share of the travel speed), if more — a rolling stance
+      rocks up and down at a share of the running speed.
+
+    A joint whose floor found so is more than ``RELAX_FLOOR`` above the lowest level of the same joint of
+    any foot (``above`` ``(k,)``: its own lowest level above that, body heights) gets no contact: a foot
+    held up (a hop on the other leg) is not planted in the air."""
+    slow = v < speed[:, None]
+    floor = np.where(slow.any(axis=0), np.where(slow, h, np.inf).min(axis=0), np.inf)
+    ok = above + floor <= RELAX_FLOOR
+    if not ok.any():
+        return np.zeros(h.shape, bool)
+    mask = find(h - np.where(ok, floor, 0.0), v, vu, np.maximum(rise, body_speed))
+    mask[:, ~ok] = False
+    return mask

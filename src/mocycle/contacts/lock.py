@@ -19,6 +19,9 @@
    ``EXTEND_DISTANCE`` of the held point (at most ``EXTEND_SECONDS``), it is
    held horizontally and keeps its own vertical path: a heel coming down or a
    toe lifting away moves straight down or up instead of gliding on the floor.
+   Its path is shifted vertically as at the contact's edge; a downward shift
+   (a contact held lower than the joint came in) eases out away from the
+   contact, so a heel coming in at speed is not pulled down to skim the floor.
    Where both joints of a foot are low, the one nearer its own contact leads
    and the other is carried with it; a joint handed over between its own hold
    and being carried is eased over ``blend`` seconds.
@@ -54,6 +57,7 @@ from scipy.spatial.transform import Rotation
 from ..motion import Motion
 from .detect import Contacts, ranges
 from .feet import chain_joints, chain_transforms
+from .smooth import maximum, uniform
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
 REACH = 0.995        # of hip-knee plus knee-ankle: farther goals lower the root
@@ -79,28 +83,36 @@ def _smoothstep(x: np.ndarray) -> np.ndarray:
     return x * x * (3.0 - 2.0 * x)
 
 
-def _holds(mask: np.ndarray, targets: list[np.ndarray], n_blend: int) -> tuple[np.ndarray, np.ndarray]:
-    """Weights ``(T,)`` and held points ``(T, 3)`` of one contact joint: 1 inside each contact, smoothstep
-    ramps of ``n_blend`` frames (at most half the gap to the neighbour contact) outside."""
+def _windows(first: np.ndarray, count: np.ndarray, step: int) -> tuple[np.ndarray, np.ndarray]:
+    """The frames ``(M,)`` of windows that start at ``first`` ``(k,)`` and run ``count`` ``(k,)`` frames on in the
+    direction ``step`` (+1 or -1), window after window, and the window ``(M,)`` each belongs to."""
+    count = np.maximum(count, 0)
+    owner = np.repeat(np.arange(first.size), count)
+    pos = np.arange(owner.size) - np.repeat(np.cumsum(count) - count, count)
+    return first[owner] + step * pos, owner
+
+
+def _contact_ends(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and stops ``(k,)`` (exclusive) of the contacts of one joint."""
+    rs = np.array(ranges(mask), dtype=int).reshape(-1, 2)
+    return rs[:, 0], rs[:, 1]
+
+
+def _hold_weights(mask: np.ndarray, n_blend: int) -> np.ndarray:
+    """Weights ``(T,)`` of one contact joint: 1 inside each contact, smoothstep ramps of ``n_blend`` frames
+    (at most half the gap to the neighbour contact) outside."""
     T = mask.shape[0]
-    rs = ranges(mask)
-    w = np.zeros(T)
-    hold = np.zeros((T, 3))
-    for k, ((a, b), target) in enumerate(zip(rs, targets, strict=True)):
-        before = a - (rs[k - 1][1] if k else -n_blend * 2)
-        after = (rs[k + 1][0] if k + 1 < len(rs) else T + n_blend * 2) - b
-        r_in, r_out = min(n_blend, before // 2), min(n_blend, after // 2)
-        w[a:b] = 1.0
-        hold[a:b] = target
-        if r_in > 0:
-            t = np.arange(max(0, a - r_in), a)
-            w[t] = _smoothstep((t - (a - r_in - 1)) / (r_in + 1))
-            hold[t] = target
-        if r_out > 0:
-            t = np.arange(b, min(T, b + r_out))
-            w[t] = _smoothstep((b + r_out - t) / (r_out + 1))
-            hold[t] = target
-    return w, hold
+    w = mask.astype(np.float64)
+    a, b = _contact_ends(mask)
+    if a.size == 0:
+        return w
+    r_in = np.minimum(n_blend, (a - np.concatenate([[-2 * n_blend], b[:-1]])) // 2)
+    r_out = np.minimum(n_blend, (np.concatenate([a[1:], [T + 2 * n_blend]]) - b) // 2)
+    t, k = _windows(a - 1, np.minimum(r_in, a), -1)
+    w[t] = _smoothstep((t - (a[k] - r_in[k] - 1)) / (r_in[k] + 1))
+    t, k = _windows(b, np.minimum(r_out, T - b), 1)
+    w[t] = _smoothstep((b[k] + r_out[k] - t) / (r_out[k] + 1))
+    return w
 
 
 def _normalize(v: np.ndarray) -> np.ndarray:
@@ -170,28 +182,41 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
     In each contact the correction takes the joint to its target (level ``HELD``).  Around it, while the
     joint stays within ``low`` of the target's height and within ``near`` of it horizontally (at most
     ``n_extend`` frames and a third of the gap to the neighbour contact), it is held horizontally and
-    keeps its own vertical path, shifted as at the contact's edge (level ``LOW``).
+    keeps its own vertical path, shifted as at the contact's edge (level ``LOW``); a downward shift eases
+    out over ``n_extend`` frames away from the contact.
     """
     T = path.shape[0]
     corr = np.full((T, 3), np.nan)
     level = np.zeros(T, dtype=int)
-    rs = ranges(mask)
+    a, b = _contact_ends(mask)
+    if a.size == 0:
+        return corr, level
+    targets = np.asarray(targets, dtype=np.float64).reshape(-1, 3)
+    held = np.flatnonzero(mask)
+    corr[held] = targets[np.repeat(np.arange(a.size), b - a)] - path[held]
+    level[held] = HELD
     height = path @ up
-    for k, ((a, b), target) in enumerate(zip(rs, targets, strict=True)):
-        corr[a:b] = target - path[a:b]
-        level[a:b] = HELD
-        n_before = n_extend if k == 0 else min(n_extend, (a - rs[k - 1][1]) // 3)
-        n_after = n_extend if k + 1 == len(rs) else min(n_extend, (rs[k + 1][0] - b) // 3)
-        top = target @ up + low
-        for frames, edge in ((range(a - 1, max(0, a - n_before) - 1, -1), a),
-                             (range(b, min(T, b + n_after)), b - 1)):
-            f = np.asarray(frames, dtype=int)
-            c = target - path[f]
-            cu = c @ up
-            ok = (height[f] < top) & (np.linalg.norm(c - np.outer(cu, up), axis=1) <= near)
-            f, c, cu = (x[:int(np.argmin(ok)) if not ok.all() else ok.size] for x in (f, c, cu))  # up to the first miss
-            corr[f] = c + np.outer(corr[edge] @ up - cu, up)
-            level[f] = LOW
+    third = (a[1:] - b[:-1]) // 3
+    n_before = np.minimum(np.minimum(n_extend, np.concatenate([[n_extend], third])), a)
+    n_after = np.minimum(np.minimum(n_extend, np.concatenate([third, [n_extend]])), T - b)
+    for first, count, edge, step in ((a - 1, n_before, a, -1), (b, n_after, b - 1, 1)):
+        f, k = _windows(first, count, step)
+        if f.size == 0:
+            continue
+        c = targets[k] - path[f]
+        cu = c @ up
+        ok = (height[f] < targets[k] @ up + low) & (np.linalg.norm(c - cu[:, None] * up, axis=1) <= near)
+        misses = np.cumsum(~ok)                                     # up to the first miss of each window
+        keep = misses == np.concatenate([[0], misses])[np.cumsum(count) - count][k]
+        f, k, c, cu = f[keep], k[keep], c[keep], cu[keep]
+        edge_u = (targets[k] - path[edge[k]]) @ up
+        # a joint held lower than it came in (or left) moves down with the hold only near the contact: the
+        # shift eases out over the low frames, so a heel coming in at speed is not pulled down to skim
+        # the floor from far away
+        ease = 1.0 - _smoothstep((np.abs(f - first[k]) + 1) / (n_extend + 1))
+        edge_u = np.where(edge_u < 0, edge_u * ease, edge_u)
+        corr[f] = c + (edge_u - cu)[:, None] * up
+        level[f] = LOW
     return corr, level
 
 
@@ -221,18 +246,19 @@ def _bridge(corr: np.ndarray, n_bridge: int, n_fade: int) -> np.ndarray:
     take, fades each side's correction to zero over ``n_fade`` frames."""
     out = corr.copy()
     T = corr.shape[0]
-    for p, q in ranges(np.isnan(corr[:, 0])):
-        t = np.arange(p, q)
-        c0 = corr[p - 1] if p > 0 else None
-        c1 = corr[q] if q < T else None
-        if c0 is not None and c1 is not None and q - p <= n_bridge:
-            out[p:q] = c0 + np.outer(_smoothstep((t - p + 1) / (q - p + 1)), c1 - c0)
-            continue
-        out[p:q] = 0.0
-        if c0 is not None:
-            out[p:q] += np.outer(_smoothstep((p + n_fade - t) / (n_fade + 1)), c0)
-        if c1 is not None:
-            out[p:q] += np.outer(_smoothstep((t - (q - 1 - n_fade)) / (n_fade + 1)), c1)
+    p, q = _contact_ends(np.isnan(corr[:, 0]))      # the gaps [p, q)
+    if p.size == 0:
+        return out
+    t, k = _windows(p, q - p, 1)
+    p, q = p[k], q[k]
+    before, after = p > 0, q < T
+    c0 = np.where(before[:, None], corr[np.maximum(p - 1, 0)], 0.0)
+    c1 = np.where(after[:, None], corr[np.minimum(q, T - 1)], 0.0)
+    bridged = before & after & (q - p <= n_bridge)
+    fade0 = np.where(before, _smoothstep((p + n_fade - t) / (n_fade + 1)), 0.0)
+    fade1 = np.where(after, _smoothstep((t - (q - 1 - n_fade)) / (n_fade + 1)), 0.0)
+    faded = fade0[:, None] * c0 + fade1[:, None] * c1
+    out[t] = np.where(bridged[:, None], c0 + _smoothstep((t - p + 1) / (q - p + 1))[:, None] * (c1 - c0), faded)
     return out
 
 
@@ -265,7 +291,7 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
 
 
 def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
-                reach: float):
+                reach: float, clearance: float = CLEARANCE):
     """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and ``(T,)`` True where the foot is held."""
     foot = contacts.feet[f]
     up, body = contacts.up, contacts.body
@@ -290,7 +316,8 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
         offsets = [np.zeros((e - s, 3))]
         for i, (k2, mid) in partner.items():
             if k2 == k:  # toe-only frames of the partner contact: the ankle follows the held toe
-                only = np.array([x for x in range(*rt[i]) if not ma[x]], dtype=int)
+                only = np.arange(*rt[i])
+                only = only[~ma[only]]
                 frames.append(only)
                 offsets.append((t[mid] - a[mid]) - (t[only] - a[only]))
         fr, off = np.concatenate(frames), np.concatenate(offsets)
@@ -301,7 +328,7 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
         corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body,
                                      low, near, n_extend, n_fade)
     corr_a = _bridge(corr_a, n_bridge, n_fade)
-    clear = CLEARANCE * body
+    clear = clearance * body
     corr_a += np.outer(_lift(a + corr_a, level_a, up, clear, body, contacts.frame_time), up)
     changed = np.any(corr_a != 0, axis=1)
     if corr_t is None:
@@ -327,16 +354,16 @@ def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, bod
     v = np.gradient(path, frame_time, axis=0)
     v = np.linalg.norm(v - np.outer(v @ up, up), axis=1) / body
     ramp = np.clip((v - SLOW_SPEED) / (SWING_SPEED - SLOW_SPEED), 0.0, 1.0)
-    swing = np.zeros(T, bool)
-    for p, q in ranges(level == 0):
-        swing[p:q] = p > 0 and q < T    # between two holds: a foot without contacts (or a missed stance) stays
+    holds = np.flatnonzero(level)
+    if holds.size == 0:   # a foot without contacts (or a missed stance) stays
+        return np.zeros(T)
+    frames = np.arange(T)
+    swing = (level == 0) & (frames > holds[0]) & (frames < holds[-1])   # between two holds
     lift = np.where(swing, np.maximum(clear - h, 0.0) * ramp, 0.0)
     rate = clear * frame_time / LIFT_SECONDS
-    for t in range(1, T):
-        lift[t] = min(lift[t], lift[t - 1] + rate)
-    for t in range(T - 2, -1, -1):
-        lift[t] = min(lift[t], lift[t + 1] + rate)
-    return lift
+    # rate-limited: lift[t] = min over s of lift[s] + rate |t - s| (a running minimum each way)
+    lift = np.minimum(lift, rate * frames + np.minimum.accumulate(lift - rate * frames))
+    return np.minimum(lift, np.minimum.accumulate((lift + rate * frames)[::-1])[::-1] - rate * frames)
 
 
 def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend,
@@ -426,9 +453,7 @@ def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weight
     if not need.any():
         return need
     width = 2 * max(1, n_blend) + 1
-    from scipy.ndimage import maximum_filter1d, uniform_filter1d  # only when feet are locked
-
-    delta = uniform_filter1d(maximum_filter1d(need, width, mode="nearest"), width, mode="nearest")
+    delta = uniform(maximum(need, width), width)
     return np.where(delta > 1e-9 * contacts.body, delta, 0.0)  # no round-off tails: untouched frames stay exact
 
 
@@ -460,12 +485,7 @@ def _knee_turn(u1: np.ndarray, u2: np.ndarray, n: np.ndarray, cos1: np.ndarray) 
 
 def _weights(contacts: Contacts, n_blend: int) -> np.ndarray:
     """Hold weights ``(T, C)`` of every contact joint: 1 in contact, smoothstep ramps around."""
-    T, C = contacts.mask.shape
-    w = np.zeros((T, C))
-    for c in range(C):
-        n = len(ranges(contacts.mask[:, c]))
-        w[:, c] = _holds(contacts.mask[:, c], [np.zeros(3)] * n, n_blend)[0]
-    return w
+    return np.stack([_hold_weights(m, n_blend) for m in contacts.mask.T], axis=1)
 
 
 def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | None) -> np.ndarray:
@@ -496,26 +516,26 @@ def _descendants(motion: Motion, joint: int) -> np.ndarray:
     return below
 
 
-def _move_travel(motion: Motion, Rw: np.ndarray, world: np.ndarray) -> Motion:
-    """``motion`` with its travel joint moved by ``world`` ``(T, 3)`` (world frame)."""
+def _move_travel(motion: Motion, trans: np.ndarray, Rw: np.ndarray, world: np.ndarray) -> None:
+    """Move ``motion``'s travel joint by ``world`` ``(T, 3)`` (world frame) in its translations ``trans``
+    ``(T, J, 3)`` (in place)."""
     travel = motion.travel_joint
     parent = int(motion.skeleton.parents[travel])
-    step = np.einsum("tji,tj->ti", Rw[:, parent], world) if parent >= 0 else world
-    trans = motion.translations.copy()
-    trans[:, travel] += step
-    return motion.replace(translations=trans, copy=False)
+    trans[:, travel] += np.einsum("tji,tj->ti", Rw[:, parent], world) if parent >= 0 else world
 
 
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
-              follow: bool = True, period: int | None = None, frames: slice | None = None) -> Motion:
+              follow: bool = True, period: int | None = None, frames: slice | None = None,
+              clearance: float = CLEARANCE) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
 
     ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
     beyond which the root is lowered; ``follow``: first move the root horizontally with the planted feet;
     ``period``: the motion is a loop repeated every ``period`` frames (at least three times), so the root
     correction keeps the travel of each period; ``frames``: solve and return only these frames (the rest
-    is context: the frames of a loop's repeat that are read back).  Returns a new Motion with the same
-    skeleton and frame time.
+    is context: the frames of a loop's repeat that are read back); ``clearance``: fraction of the body
+    height a swinging foot clears (0: no swing clearance).  Returns a new Motion with the same skeleton and
+    frame time.
     """
     if contacts.n_frames != motion.n_frames:
         raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
@@ -525,16 +545,17 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     chain = chain_joints(motion, legs)
     below = _descendants(motion, motion.travel_joint)
     Rw, W = chain_transforms(motion, chain)
+    trans = motion.translations.copy()
     if follow:
         shift = _root_shift(W, contacts, n_blend, period)
         if np.abs(shift).max() > 0:
-            motion = _move_travel(motion, Rw, shift)
+            _move_travel(motion, trans, Rw, shift)
             W[:, below] += shift[:, None]    # the travel joint and all below it move with it; no rotation changes
     n_extend = int(round(EXTEND_SECONDS / motion.frame_time))
     n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
     goals, toe_goals, held, changed = [], [], [], []
     for f in range(len(contacts.feet)):
-        g, gt, h, ch = _foot_goals(W, contacts, f, n_extend, n_bridge, n_blend, reach)
+        g, gt, h, ch = _foot_goals(W, contacts, f, n_extend, n_bridge, n_blend, reach, clearance)
         goals.append(g)
         toe_goals.append(gt)
         held.append(h)
@@ -543,7 +564,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     lowered = delta > 0
     if lowered.any():  # every foot keeps its goal in the world: a swing foot does not dip with the root
         down = -np.outer(delta, contacts.up)
-        motion = _move_travel(motion, Rw, down)
+        _move_travel(motion, trans, Rw, down)
         W[:, below] += down[:, None]
     for foot, g, h in zip(contacts.feet, goals, held, strict=True):  # goals not held: within reach, softly
         free = ~h
@@ -579,18 +600,19 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
             aim = _swing(W[t, foot.toe] - A, gt[t] - G)
         new_parent = R2 @ R1 @ Rw[t, ap]
         local[t, col[foot.ankle]] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
+    rotations = motion.rotations
     if frames is not None:
-        motion, local, lowered = motion[frames], local[frames], lowered[frames]
+        rotations, trans, local, lowered = rotations[frames], trans[frames], local[frames], lowered[frames]
         changed = [ch[frames] for ch in changed]
-    T = motion.n_frames
+    T = rotations.shape[0]
     quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, len(legs3), 4)
     # frames and joints not touched keep their exact quaternions
     touched = np.zeros((T, len(legs3)), bool)
     for foot, ch in zip(contacts.feet, changed, strict=True):
         touched[np.ix_(ch | lowered, [col[foot.hip], col[foot.knee], col[foot.ankle]])] = True
-    old = motion.rotations[:, legs3]
+    old = rotations[:, legs3]
     quats = np.where(touched[..., None], quats, old)
     sign = np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)
-    rotations = motion.rotations.copy()
+    rotations = rotations.copy()
     rotations[:, legs3] = quats * sign
-    return motion.replace(rotations=rotations, copy=False)
+    return Motion(motion.skeleton, rotations, trans, motion.frame_time, copy=False)

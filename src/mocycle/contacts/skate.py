@@ -21,16 +21,18 @@ SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual
 
 
 def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = SKATE_HEIGHT,
-          up: np.ndarray | None = None, per_joint: bool = False) -> float | dict[str, float]:
-    """The skate measure of the module docstring (units/s); ``per_joint=True``: a dict joint name -> value."""
+          up: np.ndarray | None = None, per_joint: bool = False,
+          positions: np.ndarray | None = None) -> float | dict[str, float]:
+    """The skate measure of the module docstring (units/s); ``per_joint=True``: a dict joint name -> value.
+    ``positions``: ``motion.world_positions(end_sites=True)`` when the caller has it (saves recomputing)."""
     if feet is None or isinstance(feet, str):
         feet = find_feet(motion.skeleton, feet)
     up = up_axis(motion) if up is None else np.asarray(up, dtype=np.float64)
-    H = height * body_height(motion, up)
+    H = height * body_height(motion, up, positions)
     joints = [j for f in feet for j in f.contact_joints]
     if motion.n_frames < 2:
         return {motion.skeleton.names[j]: 0.0 for j in joints} if per_joint else 0.0
-    P = motion.world_positions()[:, joints]                     # (T, C, 3)
+    P = (motion.world_positions() if positions is None else positions)[:, joints]  # (T, C, 3)
     h = P @ up
     h = h - h.min(axis=0)
     step = np.diff(P, axis=0)

@@ -61,7 +61,7 @@ from .. import _validate
 from ..errors import MocycleError, NoPeriodicMotion, OptionError
 from ..limits import check_frames
 from ..motion import Motion, Skeleton
-from ..rotations import axis_rotations, mean_rotations, nearest_rotations
+from ..rotations import axis_rotations, nearest_rotations
 from ..threads import limit_threads
 from .checks import check_loop
 from .extract import ROOT_MODES, Cycle, drifting_L, extract_cycle, loop_blocks, metric_features
@@ -349,7 +349,7 @@ def _blend_P(Ps: Sequence[np.ndarray], w: np.ndarray, n_joints: int) -> np.ndarr
 def cycle_seam(cycle: Cycle) -> dict[str, float]:
     """Seam ratios of a loop as :func:`~mocycle.cycle.loop_metrics` measures them (rotations in the metrics'
     rotation-matrix space, and the travel joint's in-place path; the larger of the two)."""
-    C, root = loop_blocks(cycle, mean_rotations(cycle.motion("inplace").rotations))
+    C, root = loop_blocks(cycle)
     seams = [seam_ratios(C), seam_ratios(root)]
     return {f"seam_{k}": max(r[k] for r in seams) for k in ("pose", "velocity", "pose_local", "velocity_local")}
 
@@ -457,7 +457,7 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     axis = TimeAxis(x=grid.copy(), regions=((0, N),), period_frames=period, method="blend")
     cycle = Cycle(space=space, P=P, L=L, drift=drift, method="blend", model=None, n_harmonics=None, axis=axis,
                   positions=np.arange(N, dtype=np.float64), periodic=None)
-    start = calmest_start(*loop_blocks(cycle, mean_rotations(cycle.motion("inplace").rotations))) if roll else 0
+    start = calmest_start(*loop_blocks(cycle)) if roll else 0
     cycle = cycle.rolled(start)
     cycle.seconds = time.perf_counter() - t0
     return BlendedCycle(cycle=cycle, weights=w, phase_offsets=offsets, start_phase=start / N, input_periods=periods,

@@ -39,7 +39,6 @@ import numpy as np
 from ..errors import LoopRefused, MocycleWarning
 from ..motion import Motion
 from ..phase.period import autocorrelation_period
-from ..rotations import mean_rotations
 from .extract import Cycle, loop_blocks, metric_features
 from .metrics import template_error
 from .seam import seam_ratios
@@ -98,13 +97,15 @@ def _plain_cut_error(Y: np.ndarray, period: float) -> tuple[float, int]:
     return template_error(Y, Y[a:a + lag])[0], lag
 
 
-def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = None) -> tuple[float, float]:
+def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = None,
+                   features: np.ndarray | None = None) -> tuple[float, float]:
     """``(template error of the best plain cut, its length in frames)`` on the cycle's longest excited
     region: the better of cuts near the cycle's period and near the region's own autocorrelation period
-    (paper 004 eq. 1 on the pose features; independent of the phase)."""
-    ref = mean_rotations(motion.rotations) if reference is None else reference
+    (paper 004 eq. 1 on the pose features; independent of the phase).  ``reference`` changes nothing
+    (:func:`~mocycle.cycle.extract.metric_features`); ``features``: the region's metric features when the
+    caller has them."""
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    Y = metric_features(motion, ref, slice(s, e))
+    Y = metric_features(motion, rows=slice(s, e)) if features is None else features
     candidates = [cycle.period_frames]
     if Y.shape[0] >= 8:
         min_lag = max(2, int(round(MIN_PERIOD_S / motion.frame_time)))
@@ -128,19 +129,17 @@ def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> li
             "length", float(cycle.n_frames), float(fitted),
             f"the cycle ({cycle.n_frames} frames) is longer than the {fitted} frames it was fitted on: the take "
             f"holds {cycle.n_periods:.2f} periods, not one whole cycle"))
-    ref = mean_rotations(motion.rotations)
-    C, root = loop_blocks(cycle, ref)
+    s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
+    Y = metric_features(motion, rows=slice(s, e))  # the longest excited region
     if metrics is not None:
         tmpl = metrics["template_error"]
         seam = max(metrics["seam_pose_local"], metrics["seam_velocity_local"])
     else:
-        tmpl = template_error(metric_features(motion, ref, slice(*max(cycle.axis.regions, key=lambda r: r[1] - r[0]))),
-                              C)[0]
+        C, root = loop_blocks(cycle)
+        tmpl = template_error(Y, C)[0]
         ratios = [seam_ratios(C), seam_ratios(root)]
         seam = max(max(r["pose_local"], r["velocity_local"]) for r in ratios)
-    cut, cut_period = best_cut_error(motion, cycle, ref)
-    s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    Y = metric_features(motion, ref, slice(s, e))
+    cut, cut_period = best_cut_error(motion, cycle, features=Y)
     mean = Y.mean(axis=0)
     spread = float(np.sqrt(sum(float(((Y[r:r + 8192] - mean) ** 2).sum()) for r in range(0, Y.shape[0], 8192))
                            / Y.shape[0]))

@@ -34,10 +34,12 @@ def _stencil(Y: np.ndarray, weights: np.ndarray, step: float, power: int) -> np.
     if rows < 1:
         raise MocycleError(f"differences need at least {weights.size} frames; got {Y.shape[0]}")
     out = np.zeros((rows,) + Y.shape[1:])
+    term = np.empty_like(out)  # one buffer for every weighted row block (they are as large as Y)
     for k, w in enumerate(weights):
         if w:
-            out += w * Y[k:k + rows]
-    return out / step ** power
+            out += np.multiply(w, Y[k:k + rows], out=term)
+    out /= step ** power
+    return out
 
 
 def central_velocity(Y: np.ndarray, step: float) -> np.ndarray:

@@ -46,7 +46,6 @@ FEW_PERIODS = 1.5        # fewer periods than this: warn
 CENTROID_SAMPLES = 500   # paper 001 §6: 500 sampled coordinate values
 CENTROID_NEIGHBOURS = 10  # paper 001 §6: 10 nearest neighbours
 SUBFRAMES = 10           # the harmonic cycle's start is chosen to a tenth of a frame
-BLOCK_ROWS = 8192        # rows of the harmonic fit read at a time
 
 
 @dataclass(kw_only=True)
@@ -75,6 +74,9 @@ class Cycle:
     periodic: PeriodicMotion
     regression: HarmonicRegression | None = field(default=None, repr=False)
     seconds: float = 0.0
+    #: :func:`loop_blocks` of this cycle and ``space.project(P)``, once made (not copied by ``dataclasses.replace``)
+    _blocks: tuple | None = field(default=None, init=False, repr=False, compare=False)
+    _projected: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         up = self.space.up
@@ -89,6 +91,14 @@ class Cycle:
     @property
     def n_frames(self) -> int:
         return self.P.shape[0]
+
+    def _rotations(self, count: int = 1) -> np.ndarray:
+        """``space.project(P)`` ``(N, J, 3, 3)``, made once, repeated ``count`` times: every motion of the
+        cycle (in place, moving on, repeated, the seam's blocks) has these rotations, only the travel joint's
+        heading differs."""
+        if self._projected is None:
+            self._projected = self.space.project(self.P)
+        return self._projected if count == 1 else np.tile(self._projected, (count, 1, 1, 1))
 
     @property
     def period_frames(self) -> float:
@@ -140,7 +150,7 @@ class Cycle:
     def motion(self, root: str = "inplace") -> Motion:
         """The cycle as a Motion; ``root="inplace"`` walks on the spot, ``"motion"`` moves on by ``drift``."""
         _check_choice(root, ROOT_MODES, "root")
-        return self.space.decode(self.P, self._inplace_L() if root == "inplace" else self.L)
+        return self.space.decode(self.P, self._inplace_L() if root == "inplace" else self.L, self._rotations())
 
     def repeat(self, count: int, root: str = "inplace") -> Motion:
         """The cycle ``count`` times, seamlessly; with ``root="motion"`` each repeat starts where the last ends."""
@@ -150,11 +160,11 @@ class Cycle:
                      f"{count} cycles of {self.n_frames} frames")
         P = np.tile(self.P, (count, 1))
         if root == "inplace":
-            return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)))
+            return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)), self._rotations(count))
         Ls = [self.L]
         for _ in range(count - 1):  # each repeat is the last one moved rigidly: a turning walk walks a circle
             Ls.append(self._next_repeat(Ls[-1]))
-        return self.space.decode(P, np.concatenate(Ls))
+        return self.space.decode(P, np.concatenate(Ls), self._rotations(count))
 
     def to_dict(self) -> dict:
         return {
@@ -198,36 +208,23 @@ def _check_choice(value, choices, name):
 
 
 # ------------------------------------------------------------------ harmonic
-def _derivative_blocks(Y: np.ndarray, axis: TimeAxis, rows: int = BLOCK_ROWS):
-    """Velocities and accelerations per period (eq. 3.23-3.25) on the interior frames of every region, as a
-    function that returns a new iterator of ``(x, dY, ddY)`` blocks of at most ``rows`` rows (each block reads
-    its rows of ``Y`` and the stencil's ``2 * HALF`` beyond)."""
-    def blocks():
-        for s, e in axis.regions:
-            if e - s < 2 * HALF + 1:
-                continue
-            n = e - s - 2 * HALF  # rows of this region: frames s + HALF .. e - HALF - 1
-            for r0 in range(0, n, rows):
-                r1 = min(n, r0 + rows)
-                a, b = s + r0, s + r1 + 2 * HALF  # the input frames the block's stencils read
-                if axis.method in ("smooth", "line"):  # the local tempo, frames per period, follows the axis
-                    rate = central_velocity(axis.x[a:b], 1.0)[:, 0]
-                else:                                  # the thesis: t = 1/N everywhere (eq. 3.25)
-                    rate = np.full(r1 - r0, 1.0 / axis.period_frames)
-                yield (axis.x[a + HALF:b - HALF], central_velocity(Y[a:b], 1.0) / rate[:, None],
-                       central_acceleration(Y[a:b], 1.0) / rate[:, None] ** 2)
-    return blocks
-
-
-def _position_blocks(Y: np.ndarray, axis: TimeAxis, rows: int = BLOCK_ROWS):
-    """A function that returns a new iterator of ``(x, Y)`` blocks over the axis' frames (``Y`` read a block
-    at a time, never copied whole)."""
-    def blocks():
-        for s, e in axis.regions:
-            for r0 in range(s, e, rows):
-                r1 = min(e, r0 + rows)
-                yield axis.x[r0:r1], Y[r0:r1]
-    return blocks
+def _derivative_rows(Y: np.ndarray, axis: TimeAxis):
+    """Velocities and accelerations per period (eq. 3.23-3.25) on the interior frames of every region."""
+    xs, dYs, ddYs = [], [], []
+    for s, e in axis.regions:
+        if e - s < 2 * HALF + 1:
+            continue
+        x = axis.x[s:e]
+        if axis.method in ("smooth", "line"):  # the local tempo, frames per period, follows the axis
+            rate = central_velocity(x, 1.0)[:, 0]
+        else:                                  # the thesis: t = 1/N everywhere (eq. 3.25)
+            rate = np.full(e - s - 2 * HALF, 1.0 / axis.period_frames)
+        xs.append(x[HALF:e - s - HALF])
+        dYs.append(central_velocity(Y[s:e], 1.0) / rate[:, None])
+        ddYs.append(central_acceleration(Y[s:e], 1.0) / rate[:, None] ** 2)
+    if not xs:
+        return None, None, None
+    return np.concatenate(xs), np.concatenate(dYs), np.concatenate(ddYs)
 
 
 def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
@@ -255,17 +252,13 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     N = int(round(axis.period_frames))
     K = _harmonics(n_harmonics, frames.size, N)
     x = axis.x[frames]
-    if model != "M2":
-        n_derivative = sum(max(0, e - s - 2 * HALF) for s, e in axis.regions)
-        if n_derivative < max(2 * K, 1):
-            raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the "
-                               f"excited regions are too short: use --model M2 or fewer harmonics")
-    # the rows are read block by block from P and L: no copy of P's frames or of its derivatives is held
-    fits = []
-    for Y, linear in ((P, False), (L, True)):
-        derivatives = _derivative_blocks(Y, axis) if model != "M2" else None
-        fits.append(HarmonicRegression(K, model, linear=linear).fit_blocks(_position_blocks(Y, axis), derivatives))
-    fit_p, fit_l = fits
+    xd, dP, ddP = _derivative_rows(P, axis) if model != "M2" else (None, None, None)
+    _, dL, ddL = _derivative_rows(L, axis) if model != "M2" else (None, None, None)
+    if model != "M2" and (xd is None or xd.size < 2 * K):
+        raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the excited "
+                           f"regions are too short: use --model M2 or fewer harmonics")
+    fit_p = HarmonicRegression(K, model).fit(x, P[frames], xd, dP, ddP)
+    fit_l = HarmonicRegression(K, model, linear=True).fit(x, L[frames], xd, dL, ddL)
     x0 = float(np.floor(x[0]))
     if reference is not None:  # start where the wrap is the calmest step, choosing between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
@@ -386,25 +379,42 @@ def metric_features(motion: Motion, reference: np.ndarray | None = None, rows: s
     ``rows``: only these frames (a slice), without copying the motion.  Computed block by block of frames:
     the same numbers as ``pose_matrix(motion, rep="rotmat", root="drop")[0] / √2``.
     """
-    skel = motion.skeleton
-    joints = [j for j in skel.select(None) if skel.euler_order(j)]
+    joints = _rotation_joints(motion.skeleton)
     if not joints:
         return pose_matrix(motion, rep="rotmat", root="drop")[0]  # raises: no features
     quats = motion.rotations[rows]
     T = quats.shape[0]
     out = np.empty((T, 9 * len(joints)))
     for f0 in range(0, T, 8192):
-        block = quats[f0:f0 + 8192][:, joints]
+        block = np.take(quats[f0:f0 + 8192], joints, axis=1)  # contiguous, unlike [:, joints]
         out[f0:f0 + 8192] = Rotation.from_quat(block.reshape(-1, 4)).as_matrix().reshape(block.shape[0], -1)
     out /= np.sqrt(2.0)
     return out
 
 
-def loop_blocks(cycle: Cycle, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _rotation_joints(skeleton) -> list[int]:
+    """The joints :func:`metric_features` measures: those with rotation channels."""
+    return [j for j in skeleton.select(None) if skeleton.euler_order(j)]
+
+
+def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """What the seam of a cycle is judged on: its in-place rotations as :func:`metric_features` ``(N, 9J)``
-    and the world path of its travel joint ``(N, 3)``."""
-    inplace = cycle.motion("inplace")
-    return metric_features(inplace, reference), inplace.world_positions()[:, cycle.space.travel]
+    and the world path of its travel joint ``(N, 3)``.
+
+    Made from the decoded rotation matrices directly (the numbers of ``metric_features`` and
+    ``world_positions`` of ``cycle.motion("inplace")`` within rounding, without building the motion or
+    running forward kinematics of every joint), and kept on the cycle: the metrics and the checks ask
+    for the same blocks.  ``reference`` changes nothing (see :func:`metric_features`)."""
+    if cycle._blocks is None:
+        space = cycle.space
+        joints = _rotation_joints(space.skeleton)
+        if not joints:
+            raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
+        L = cycle._inplace_L()
+        R = space.rotations(cycle.P, L, cycle._rotations())
+        C = (R if len(joints) == space.n_joints else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
+        cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L)))
+    return cycle._blocks
 
 
 def choose_periodic(result: PhaseResult, which: int | None = None) -> PeriodicMotion:

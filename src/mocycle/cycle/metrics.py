@@ -43,7 +43,6 @@ from scipy.linalg import solve_circulant
 from ..axes import vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion
-from ..rotations import mean_rotations
 from .differences import FORWARD_3, HALF, central_acceleration, central_velocity, forward_jerk
 from .extract import Cycle, loop_blocks, metric_features
 from .seam import seam_ratios
@@ -68,18 +67,19 @@ class PeriodicSpline:
         column = np.zeros(N)
         np.add.at(column, [0, 1 % N, -1 % N], [4.0, 1.0, 1.0])
         self.F, self.N = F, N
-        self.m = solve_circulant(column, 6.0 * (np.roll(F, 1, axis=0) - 2.0 * F + np.roll(F, -1, axis=0)))
+        self.m = m = solve_circulant(column, 6.0 * (np.roll(F, 1, axis=0) - 2.0 * F + np.roll(F, -1, axis=0)))
+        m1 = np.roll(m, -1, axis=0)  # each knot's polynomial, once (not once per point it is read at)
+        self.b = (np.roll(F, -1, axis=0) - F) - (2.0 * m + m1) / 6.0
+        self.c = m / 2.0
+        self.d = (m1 - m) / 6.0
 
     def __call__(self, x, nu: int = 0) -> np.ndarray:
         x = np.mod(np.asarray(x, dtype=np.float64), self.N)
         i = np.minimum(np.floor(x).astype(np.intp), self.N - 1)
-        j = (i + 1) % self.N
         t = (x - i)[:, None]
-        y0, y1, m0, m1 = self.F[i], self.F[j], self.m[i], self.m[j]
-        b = (y1 - y0) - (2.0 * m0 + m1) / 6.0
-        c = m0 / 2.0
-        d = (m1 - m0) / 6.0
+        b, c, d = self.b[i], self.c[i], self.d[i]
         if nu == 0:
+            y0 = self.F[i]
             return y0 + t * (b + t * (c + t * d))
         if nu == 1:
             return b + t * (2.0 * c + 3.0 * t * d)
@@ -142,10 +142,17 @@ def template_error(Y: np.ndarray, C: np.ndarray) -> tuple[float, int]:
     M, N = Y.shape[0], C.shape[0]
     c2 = (C ** 2).sum(1)[None, :]
 
+    made: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
     def d2_block(r0: int) -> tuple[np.ndarray, np.ndarray]:
+        if r0 in made:  # a take of one block: its distances are made once for both passes
+            return made.pop(r0)
         Yb = Y[r0:r0 + _ROWS]
         rows = np.arange(r0, r0 + Yb.shape[0])
-        return (Yb ** 2).sum(1)[:, None] + c2 - 2 * Yb @ C.T, rows  # squared distances
+        d2 = (Yb ** 2).sum(1)[:, None] + c2 - 2 * Yb @ C.T, rows  # squared distances
+        if M <= _ROWS:
+            made[r0] = d2
+        return d2
 
     total = np.zeros(N)
     for r0 in range(0, M, _ROWS):
@@ -174,13 +181,14 @@ def jerk_ratio(Y_regions: list[np.ndarray], C: np.ndarray, frame_time: float) ->
     return _rms(forward_jerk(C, frame_time, periodic=True)) / float(np.sqrt(total / rows))
 
 
-def foot_points(motion: Motion, up: np.ndarray | None = None) -> list[int]:
+def foot_points(motion: Motion, up: np.ndarray | None = None, positions: np.ndarray | None = None) -> list[int]:
     """Indices (in ``world_positions(end_sites=True)``) of the feet: in each of the two branches below the
     travel joint whose leaves hang lowest on average, the lowest leaf (joint without children, or End Site).
-    ``up``: the vertical axis (default: detected, :func:`~mocycle.axes.vertical_axis`)."""
+    ``up``: the vertical axis (default: detected, :func:`~mocycle.axes.vertical_axis`); ``positions``:
+    ``motion.world_positions(end_sites=True)`` when the caller has it."""
     skel = motion.skeleton
     up = vertical_axis(motion, up)
-    parents = list(skel.parents) + [site.parent for site in skel.end_sites]
+    parents = [int(p) for p in skel.parents] + [int(site.parent) for site in skel.end_sites]  # Python ints: fast
     has_child = np.zeros(len(parents), bool)
     for p in parents:
         if p >= 0:
@@ -195,7 +203,8 @@ def foot_points(motion: Motion, up: np.ndarray | None = None) -> list[int]:
         return path[path.index(travel) - 1] if travel in path and path.index(travel) > 0 else path[-1]
 
     step = max(1, motion.n_frames // 50)
-    heights = motion[::step].world_positions(end_sites=True).mean(axis=0) @ up
+    W = motion[::step].world_positions(end_sites=True) if positions is None else positions[::step]
+    heights = W.mean(axis=0) @ up
     lowest: dict[int, int] = {}
     for leaf in leaves:
         b = branch(leaf)
@@ -205,16 +214,17 @@ def foot_points(motion: Motion, up: np.ndarray | None = None) -> list[int]:
     return feet[:2]
 
 
-def foot_sliding(motion: Motion, up: np.ndarray | None = None) -> float:
+def foot_sliding(motion: Motion, up: np.ndarray | None = None, positions: np.ndarray | None = None) -> float:
     """Mean horizontal speed (units/s) of the feet while they touch the floor.
 
     A foot touches the floor on a frame step when it is, at both ends of the step, within
     ``CONTACT_HEIGHT`` of the body height above its own floor (its 5th-percentile height over the take).
-    ``up``: the vertical axis (default: detected).
+    ``up``: the vertical axis (default: detected); ``positions``: ``motion.world_positions(end_sites=True)``
+    when the caller has it.
     """
     up = vertical_axis(motion, up)
-    feet = foot_points(motion, up)
-    W = motion.world_positions(end_sites=True)
+    W = motion.world_positions(end_sites=True) if positions is None else positions
+    feet = foot_points(motion, up, W)
     body = np.ptp(W.mean(axis=0) @ up)
     speeds = []
     for f in feet:
@@ -229,11 +239,11 @@ def foot_sliding(motion: Motion, up: np.ndarray | None = None) -> float:
     return float(speeds.mean()) if speeds.size else float("nan")
 
 
-def _skate(motion: Motion, up: np.ndarray) -> float:
+def _skate(motion: Motion, up: np.ndarray, positions: np.ndarray | None = None) -> float:
     from ..contacts.skate import skate
 
     try:
-        return skate(motion, up=up)
+        return skate(motion, up=up, positions=positions)
     except MocycleError:  # no feet found by name
         return float("nan")
 
@@ -257,9 +267,8 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
     >>> metrics["template_error"] < 0.1, metrics["seam_pose"] <= 1.0
     (True, True)
     """
-    ref = mean_rotations(motion.rotations)
-    Y = metric_features(motion, ref)
-    C, root = loop_blocks(cycle, ref)
+    Y = metric_features(motion)
+    C, root = loop_blocks(cycle)
     frames = cycle.axis.frames()
     rate = cycle.n_frames / cycle.period_frames
     rmse_h, rmse_dh, rmse_ddh = regression_errors(Y, C, cycle.positions, cycle.axis.regions, frames,
@@ -271,6 +280,9 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
     seams = [seam_ratios(C), seam_ratios(root)]
     travelling = cycle.repeat(2, root="motion")
     captured = motion[frames[0]:frames[-1] + 1]
+    up = cycle.space.world_up
+    # every joint's world positions once per motion: the feet, the body's height and the skate all read them
+    W_travelling, W_captured = travelling.world_positions(end_sites=True), captured.world_positions(end_sites=True)
     return {
         "rmse_h": rmse_h,
         "rmse_dh": rmse_dh,
@@ -282,8 +294,8 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
         "seam_velocity": max(r["velocity"] for r in seams),
         "seam_pose_local": max(r["pose_local"] for r in seams),
         "seam_velocity_local": max(r["velocity_local"] for r in seams),
-        "foot_sliding": foot_sliding(travelling, cycle.space.world_up),
-        "input_foot_sliding": foot_sliding(captured, cycle.space.world_up),
-        "skate": _skate(travelling, cycle.space.world_up),
-        "input_skate": _skate(captured, cycle.space.world_up),
+        "foot_sliding": foot_sliding(travelling, up, W_travelling),
+        "input_foot_sliding": foot_sliding(captured, up, W_captured),
+        "skate": _skate(travelling, up, W_travelling),
+        "input_skate": _skate(captured, up, W_captured),
     }

@@ -180,27 +180,70 @@ class CycleSpace:
         return L, np.append(path[-1] - path[0], drift[3])
 
     # -- (P, L) -> motion -----------------------------------------------
-    def decode(self, P: np.ndarray, L: np.ndarray) -> Motion:
-        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``."""
+    def _check(self, P: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         P, L = np.asarray(P, dtype=np.float64), np.asarray(L, dtype=np.float64)
-        N, J = P.shape[0], self.n_joints
+        N = P.shape[0]
         if P.shape != (N, self.n_periodic) or L.shape != (N, self.n_drifting):
             raise MocycleError(f"expected P ({N}, {self.n_periodic}) and L ({N}, 4); got {P.shape}, {L.shape}")
-        quats = np.empty((N, J, 4))
-        trans = np.empty((N, J, 3))
-        for f0 in range(0, N, BLOCK_FRAMES):  # no (N, J, 3, 3) array of the whole take is held
-            quats[f0:f0 + BLOCK_FRAMES], trans[f0:f0 + BLOCK_FRAMES] = self.decode_rows(
-                P[f0:f0 + BLOCK_FRAMES], L[f0:f0 + BLOCK_FRAMES])
-        return Motion(self.skeleton, continuous_quats(quats, inplace=True), trans, self.frame_time, copy=False)
+        return P, L
+
+    def project(self, P: np.ndarray) -> np.ndarray:
+        """Each joint's block of ``P (N, n_periodic)`` projected onto the nearest rotation: ``(N, J, 3, 3)``
+        local rotation matrices, the travel joint's without its heading.  A joint whose block is the same
+        on every row (one that never moves) is projected once."""
+        P = np.asarray(P, dtype=np.float64)
+        N, J = P.shape[0], self.n_joints
+        M = P[:, : 9 * J].reshape(N, J, 3, 3)
+        still = np.all(P[:, : 9 * J] == P[:1, : 9 * J], axis=0).reshape(J, 9).all(axis=1) if N > 1 \
+            else np.zeros(J, dtype=bool)
+        if not still.any():
+            return nearest_rotations(M)
+        R = np.empty_like(M)
+        R[:, still] = nearest_rotations(M[0, still])
+        moving = np.flatnonzero(~still)
+        R[:, moving] = nearest_rotations(np.take(M, moving, axis=1))  # take: a contiguous copy, unlike M[:, moving]
+        return R
+
+    def rotations(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray | None = None) -> np.ndarray:
+        """The local rotation matrices ``(N, J, 3, 3)`` that :meth:`decode` puts in its motion:
+        :meth:`project` of ``P`` (or ``projected``, when the caller has it), the travel joint turned to the
+        heading ``L[:, 3]``."""
+        P, L = self._check(P, L)
+        R = self.project(P) if projected is None else projected.copy()
+        R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
+        return R
+
+    def translations(self, P: np.ndarray, L: np.ndarray) -> np.ndarray:
+        """The local translations ``(N, J, 3)`` that :meth:`decode` puts in its motion."""
+        P, L = self._check(P, L)
+        N, J = P.shape[0], self.n_joints
+        trans = np.broadcast_to(self.static_translations, (N, J, 3)).copy()
+        if self.moving:
+            trans[:, list(self.moving)] = P[:, 9 * J:].reshape(N, len(self.moving), 3)
+        trans[:, self.travel] = L[:, :3]
+        return trans
+
+    def travel_path(self, rotations: np.ndarray, translations: np.ndarray) -> np.ndarray:
+        """World positions ``(N, 3)`` of the travel joint from local ``rotations (N, J, 3, 3)`` and
+        ``translations (N, J, 3)``: forward kinematics along its chain from the root only (the products of
+        :meth:`Motion.world_positions <mocycle.motion.Motion.world_positions>` for that joint)."""
+        chain = [self.travel]
+        while self.skeleton.parents[chain[-1]] >= 0:
+            chain.append(int(self.skeleton.parents[chain[-1]]))
+        chain.reverse()
+        world_r, world_p = rotations[:, chain[0]], translations[:, chain[0]]
+        for j in chain[1:]:
+            world_p = world_p + (world_r @ translations[:, j, :, None])[..., 0]
+            world_r = world_r @ rotations[:, j]
+        return world_p
 
     def decode_rows(self, P: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The local quaternions ``(B, J, 4)`` (not yet made sign-continuous) and translations ``(B, J, 3)``
         of rows ``P (B, n_periodic)``, ``L (B, 4)``: :meth:`decode` a block of frames at a time."""
-        B, J = P.shape[0], self.n_joints
-        R = nearest_rotations(P[:, : 9 * J].reshape(B, J, 3, 3))
-        R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
-        trans = np.broadcast_to(self.static_translations, (B, J, 3)).copy()
-        if self.moving:
-            trans[:, list(self.moving)] = P[:, 9 * J:].reshape(B, len(self.moving), 3)
-        trans[:, self.travel] = L[:, :3]
-        return matrix_quats(R), trans
+        return matrix_quats(self.rotations(P, L)), self.translations(P, L)
+
+    def decode(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray | None = None) -> Motion:
+        """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``;
+        ``projected``: :meth:`project` of ``P`` when the caller has it."""
+        quats = continuous_quats(matrix_quats(self.rotations(P, L, projected)))
+        return Motion(self.skeleton, quats, self.translations(P, L), self.frame_time)

@@ -25,7 +25,7 @@ import os
 import sys
 from pathlib import Path
 
-from ..errors import MocycleError, MotionFileError
+from ..errors import MotionFileError
 from ..motion import Motion
 from .asfamc import AMC_FPS, read_amc, read_asf, read_asfamc
 from .atomic import atomic_write
@@ -135,22 +135,10 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: 
 
 
 def _read_json(p: Path):
-    """The swings records ``mocycle swings -o FILE.json`` writes, as a Segmentation."""
-    from ..swings.segment import Segmentation
+    """The swings records ``mocycle swings -o FILE.json`` writes, as a Segmentation (every field checked)."""
+    from .swings_json import read_swings_json
 
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise MotionFileError(f"cannot read file ({exc.strerror or exc})", p) from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise MotionFileError(f"not a JSON file ({exc})", p) from None
-    if not (isinstance(data, dict) and "skeleton_bvh" in data and "swings" in data):
-        raise MotionFileError("not a JSON file mocycle reads: expected the swings records that "
-                              "'mocycle swings -o FILE.json' writes (with 'skeleton_bvh' and 'swings')", p)
-    try:
-        return Segmentation.from_dict(data)
-    except MocycleError as exc:
-        raise MotionFileError(str(exc), p) from None
+    return read_swings_json(p)
 
 
 def write(obj, path: str | os.PathLike, *, clip=None, gltf_scale: float | str = "auto", gltf_up=None) -> Path:

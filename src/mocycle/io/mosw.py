@@ -182,43 +182,79 @@ def decode(data: bytes, path: str | os.PathLike | None = None) -> Segmentation:
             raise r.error(f"its {what} columns differ in length")
     if base.size != 3 * n or hm.size != 3 * m:
         raise r.error("its swing bases or hold rotations differ in length from the swings or holds")
-    _check_events(r, "swing", sj, ss, sl, T, J, min_length=1)
-    _check_events(r, "hold", hj, hs, hl, T, J, min_length=0)
-    _check_cover(r, np.concatenate([sj, hj]).astype(np.int64), np.concatenate([ss, hs]).astype(np.int64),
-                 np.concatenate([ss + sl, hs + hl]).astype(np.int64), T)
-    if len(set(joints)) != len(joints) or any(j >= J for j in joints):
-        raise r.error(f"its segmented joints repeat or exceed the skeleton's {J} joints")
-    if not (np.all(np.isfinite(v0)) and np.all(np.isfinite(v1))):
-        raise r.error("a swing's end speed is not a finite number")
-    if np.any(np.diff(tj.astype(np.int64)) <= 0) or np.any(tj >= J):
+    if np.any(np.diff(tj.astype(np.int64)) <= 0):
         raise r.error(f"its translated joints must be increasing joint numbers below {J}")
     for j, (f, v) in keys.items():
-        if v.size != 3 * f.size or f.size == 0:
+        if v.size != 3 * f.size:
             raise r.error(f"joint {j}'s translation keys: {f.size} frames but {v.size} values")
-        if f[0] != 0 or f[-1] >= T or np.any(np.diff(f) <= 0) or (f.size > 1 and f[-1] != T - 1):
-            raise r.error(f"joint {j}'s translation key frames must increase from 0 (to {T - 1} when they move)")
-        if not np.all(np.isfinite(v)) or np.abs(v).max() > MAX_VALUE:
-            raise r.error(f"joint {j}'s translation values are not finite numbers within ±{MAX_VALUE:g}")
         keys[j] = (f, v.reshape(-1, 3))
+    ss64, hs64 = ss.astype(np.int64), hs.astype(np.int64)
     axis = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
-    base, hm = base.reshape(-1, 3), hm.reshape(-1, 3)
+    swings = dict(joint=sj.astype(np.int64), start=ss64, end=ss64 + sl, axis=axis, start_angle=a0,
+                  end_angle=a0 + rng, start_speed=v0, end_speed=v1, base=base.reshape(-1, 3), error=errs)
+    holds = dict(joint=hj.astype(np.int64), start=hs64, end=hs64 + hl, mean=hm.reshape(-1, 3))
+    return checked_segmentation(r.error, skel, T, float(frame_time), float(threshold), float(window_s), joints,
+                                swings, holds, keys)
+
+
+def checked_segmentation(error, skel: Skeleton, T: int, frame_time: float, threshold: float, window_s: float,
+                         joints: list[int], swings: dict, holds: dict, keys: dict,
+                         params: dict | None = None) -> Segmentation:
+    """A :class:`Segmentation` from columns read out of a file, after checking every index, span and value.
+
+    ``error(reason)`` makes the :class:`MotionFileError` naming the file.  ``swings``: ``joint``, ``start``,
+    ``end`` ``(n,)`` int64, ``axis`` and ``base`` ``(n, 3)``, ``start_angle``, ``end_angle``, ``start_speed``,
+    ``end_speed``, ``error`` ``(n,)``; ``holds``: ``joint``, ``start``, ``end`` ``(m,)`` int64, ``mean``
+    ``(m, 3)``; ``keys``: joint -> (frames ``(k,)`` int64, values ``(k, 3)``).  Shared by the ``.mosw`` and
+    the JSON readers, so a damaged file of either gives one error and never a crash in playback.
+    """
+    J = skel.n_joints
+    sj, ss, se = swings["joint"], swings["start"], swings["end"]
+    hj, hs, he = holds["joint"], holds["start"], holds["end"]
+    _check_events(error, "swing", sj, ss, se - ss, T, J, min_length=1)
+    _check_events(error, "hold", hj, hs, he - hs, T, J, min_length=0)
+    _check_cover(error, np.concatenate([sj, hj]), np.concatenate([ss, hs]), np.concatenate([se, he]), T)
+    if len(set(joints)) != len(joints) or any(j >= J or j < 0 for j in joints):
+        raise error(f"its segmented joints repeat or exceed the skeleton's {J} joints")
+    for name in ("axis", "start_angle", "end_angle", "start_speed", "end_speed", "base", "error"):
+        v = swings[name]
+        if not np.all(np.isfinite(v)) or (v.size and np.abs(v).max() > MAX_VALUE):
+            raise error(f"a swing's {name.replace('_', ' ')} is not a finite number within ±{MAX_VALUE:g}")
+    norms = np.linalg.norm(swings["axis"], axis=1)
+    if np.any(np.abs(norms - 1.0) > 1e-3):
+        raise error("a swing's axis is not a unit vector")
+    axis = np.where(np.abs(norms - 1.0)[:, None] > 1e-12, swings["axis"] / norms[:, None], swings["axis"])
+    hm = holds["mean"]
+    if not np.all(np.isfinite(hm)) or (hm.size and np.abs(hm).max() > MAX_VALUE):
+        raise error(f"a hold's mean rotation is not a finite rotation vector within ±{MAX_VALUE:g}")
+    tj = np.array(sorted(keys), dtype=np.int64)
+    if np.any(tj >= J) or np.any(tj < 0):
+        raise error(f"its translated joints must be joint numbers below {J}")
+    for j, (f, v) in keys.items():
+        if f.size == 0 or v.shape != (f.size, 3):
+            raise error(f"joint {j}'s translation keys: {f.size} frames but {v.size} values")
+        if f[0] != 0 or f[-1] >= T or np.any(np.diff(f) <= 0) or (f.size > 1 and f[-1] != T - 1):
+            raise error(f"joint {j}'s translation key frames must increase from 0 (to {T - 1} when they move)")
+        if not np.all(np.isfinite(v)) or np.abs(v).max() > MAX_VALUE:
+            raise error(f"joint {j}'s translation values are not finite numbers within ±{MAX_VALUE:g}")
     names = skel.names
-    swings = [Swing(joint=int(sj[i]), name=names[sj[i]], start=int(ss[i]), end=int(ss[i] + sl[i]),
-                    axis=tuple(float(x) for x in axis[i]), start_angle=float(a0[i]),
-                    end_angle=float(a0[i] + rng[i]), start_speed=float(v0[i]), end_speed=float(v1[i]),
-                    base=tuple(float(x) for x in base[i]), error=float(errs[i])) for i in range(n)]
-    holds = [Hold(joint=int(hj[i]), name=names[hj[i]], start=int(hs[i]), end=int(hs[i] + hl[i]),
-                  mean=tuple(float(x) for x in hm[i])) for i in range(m)]
-    return Segmentation(skeleton=skel, n_frames=T, frame_time=float(frame_time), joints=joints,
-                        swings=swings, holds=holds, translation_keys=keys, threshold=float(threshold),
-                        window_s=float(window_s))
+    out_swings = [Swing(joint=int(sj[i]), name=names[sj[i]], start=int(ss[i]), end=int(se[i]),
+                        axis=tuple(float(x) for x in axis[i]), start_angle=float(swings["start_angle"][i]),
+                        end_angle=float(swings["end_angle"][i]), start_speed=float(swings["start_speed"][i]),
+                        end_speed=float(swings["end_speed"][i]), base=tuple(float(x) for x in swings["base"][i]),
+                        error=float(swings["error"][i])) for i in range(sj.size)]
+    out_holds = [Hold(joint=int(hj[i]), name=names[hj[i]], start=int(hs[i]), end=int(he[i]),
+                      mean=tuple(float(x) for x in hm[i])) for i in range(hj.size)]
+    return Segmentation(skeleton=skel, n_frames=T, frame_time=frame_time, joints=list(joints), swings=out_swings,
+                        holds=out_holds, translation_keys=keys, threshold=threshold, window_s=window_s,
+                        params=dict(params or {}))
 
 
 #: The largest translation a swings file may hold (file units): far above any take, far below overflow.
 MAX_VALUE = 1e12
 
 
-def _check_cover(r: _Reader, joint: np.ndarray, start: np.ndarray, end: np.ndarray, T: int) -> None:
+def _check_cover(error, joint: np.ndarray, start: np.ndarray, end: np.ndarray, T: int) -> None:
     """The swings and holds of every joint that has any run from frame 0 to the last frame (what
     :func:`~mocycle.swings.segment` writes): a frame count that no record reaches is damage."""
     if not joint.size:
@@ -229,10 +265,10 @@ def _check_cover(r: _Reader, joint: np.ndarray, start: np.ndarray, end: np.ndarr
     np.maximum.at(last, joint, end)
     used = np.unique(joint)
     if np.any(first[used] != 0) or np.any(last[used] != T - 1):
-        raise r.error(f"its swings and holds do not span the take's {T} frames (from 0 to {T - 1})")
+        raise error(f"its swings and holds do not span the take's {T} frames (from 0 to {T - 1})")
 
 
-def _check_events(r: _Reader, what: str, joint, start, length, T: int, J: int, min_length: int) -> None:
+def _check_events(error, what: str, joint, start, length, T: int, J: int, min_length: int) -> None:
     """Swings or holds: joints below ``J``, sorted by (joint, start), inside the take, not overlapping
     (a swing may start on the frame the one before it ends)."""
     if not joint.size:
@@ -241,12 +277,12 @@ def _check_events(r: _Reader, what: str, joint, start, length, T: int, J: int, m
     s = start.astype(np.int64)
     e = s + length.astype(np.int64)
     if j.max() >= J:
-        raise r.error(f"a {what} names joint {int(j.max())}; the skeleton has {J}")
-    if np.any(length < min_length) or e.max() >= T:
-        raise r.error(f"a {what} lies outside the take's {T} frames or is shorter than {min_length} frame(s)")
+        raise error(f"a {what} names joint {int(j.max())}; the skeleton has {J}")
+    if np.any(j < 0) or np.any(s < 0) or np.any(length < min_length) or e.max() >= T:
+        raise error(f"a {what} lies outside the take's {T} frames or is shorter than {min_length} frame(s)")
     same = j[1:] == j[:-1]
     if np.any(j[1:] < j[:-1]) or np.any(same & (s[1:] < e[:-1])):
-        raise r.error(f"its {what}s are not in time order per joint or overlap")
+        raise error(f"its {what}s are not in time order per joint or overlap")
 
 
 def write_swings(seg: Segmentation, path: str | os.PathLike) -> Path:

@@ -103,19 +103,25 @@ def principal_components(X: np.ndarray, n: int) -> np.ndarray:
 
     What scikit-learn's ``PCA(n_components=n, svd_solver="full").fit_transform(X)`` returns (centred, the sign
     of each component set by its largest coefficient), without importing scikit-learn, which takes longer than
-    a whole ``find_phase``.  With more frames than columns the components are the eigenvectors of the
-    ``(D, D)`` scatter matrix ``Xcᵀ Xc`` (``numpy.linalg.eigh``): the same scores within rounding, 5-8× faster
-    than the SVD of the ``(T, D)`` matrix, which short takes on wide rigs (T < D) still use.
+    a whole ``find_phase``.  The components come from the smaller of the two scatter matrices
+    (``numpy.linalg.eigh``): with more frames than columns the eigenvectors ``V`` of the ``(D, D)`` matrix
+    ``Xcᵀ Xc``; with fewer (short takes on wide rigs, e.g. 157 frames of a 100-joint rig) the eigenvectors
+    ``U`` of the ``(T, T)`` Gram matrix ``Xc Xcᵀ``, whose scores are ``U S`` and components ``Uᵀ Xc / S``.
+    Only the ``n`` largest eigenpairs are computed (LAPACK's ``syevr`` through ``scipy.linalg.eigh``).  The
+    same scores as the SVD of ``Xc`` within rounding, several times faster.
     """
+    from scipy.linalg import eigh
+
     Xc = X - X.mean(axis=0)
     if Xc.shape[0] < Xc.shape[1]:
-        from scipy.linalg import svd
-
-        U, S, Vt = svd(Xc, full_matrices=False)
-        signs = _component_signs(Vt[:n])
-        return U[:, :n] * signs * S[:n]
-    _, V = np.linalg.eigh(Xc.T @ Xc)
-    Vt = V[:, ::-1][:, :n].T  # largest first
+        G = Xc @ Xc.T
+        w, U = eigh(G, subset_by_index=[G.shape[0] - n, G.shape[0] - 1], driver="evr")
+        U, S = U[:, ::-1], np.sqrt(np.maximum(w[::-1], 0.0))  # largest first
+        Vt = (U.T @ Xc) / np.where(S > 0, S, 1.0)[:, None]
+        return U * _component_signs(Vt) * S
+    G = Xc.T @ Xc
+    _, V = eigh(G, subset_by_index=[G.shape[0] - n, G.shape[0] - 1], driver="evr")
+    Vt = V[:, ::-1].T  # largest first
     return Xc @ (Vt * _component_signs(Vt)[:, None]).T
 
 

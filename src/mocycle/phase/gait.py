@@ -81,23 +81,31 @@ def _world_chain(motion: Motion, joints: list[int]) -> tuple[dict[int, np.ndarra
             j = int(parents[j])
     Q: dict[int, np.ndarray] = {}
     P: dict[int, np.ndarray] = {}
+    R: dict[int, np.ndarray] = {}  # a parent's world matrices, made once for all its children
     for j in sorted(needed):  # parents come before their children
         p = int(parents[j])
         if p < 0:
             Q[j], P[j] = motion.rotations[:, j], motion.translations[:, j]
         else:
+            if p not in R:
+                R[p] = _matrices(Q[p])
             Q[j] = quat_multiply(Q[p], motion.rotations[:, j])
-            P[j] = P[p] + _rotate(Q[p], motion.translations[:, j])
+            P[j] = P[p] + np.einsum("...ij,...j->...i", R[p], motion.translations[:, j])
     return Q, P
 
 
-def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Vectors ``(..., 3)`` rotated by unit quaternions ``(..., 4)`` (broadcast), through their rotation matrices."""
+def _matrices(q: np.ndarray) -> np.ndarray:
+    """Rotation matrices ``(..., 3, 3)`` of unit quaternions ``(..., 4)``."""
     x, y, z, w = np.moveaxis(q, -1, 0)
     R = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
                   2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
                   2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1)
-    return np.einsum("...ij,...j->...i", R.reshape(R.shape[:-1] + (3, 3)), v)
+    return R.reshape(R.shape[:-1] + (3, 3))
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Vectors ``(..., 3)`` rotated by unit quaternions ``(..., 4)`` (broadcast), through their rotation matrices."""
+    return np.einsum("...ij,...j->...i", _matrices(q), v)
 
 
 def leg_sides(curves: np.ndarray, legs: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:

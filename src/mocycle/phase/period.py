@@ -252,7 +252,10 @@ def circular_autocorrelation(Y: np.ndarray, per_column: bool = False) -> np.ndar
 PEAK_TIE = 0.02
 
 
-#: Columns per block of :func:`autocorrelation_period`.
+#: Values (frames x columns) per block of :func:`autocorrelation_period`: at least 16 columns at a time, as
+#: many as fit in 2^18 values (2 MB; 1700 columns of a 150-frame region) so that a wide rig's features are
+#: not transformed 16 columns at a time, and a long take's temporaries stay small.
+_BLOCK_VALUES = 1 << 18
 _COLUMNS = 16
 
 
@@ -298,8 +301,9 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
         return float("nan")
     window = periodic_hann(T)
     r = np.zeros(T)
-    for c0 in range(0, finite.size, _COLUMNS):  # a few columns at a time: no temporaries as large as A
-        B = A[:, finite[c0:c0 + _COLUMNS]]
+    width = max(_COLUMNS, _BLOCK_VALUES // T)
+    for c0 in range(0, finite.size, width):  # a block of columns at a time: no temporaries as large as A
+        B = A[:, finite[c0:c0 + width]]
         B = B - B.mean(axis=0)
         B[:, np.ptp(B, axis=0) == 0.0] = 0.0  # exactly constant columns: remove the rounding left by centring
         r += circular_autocorrelation(B * window[:, None])  # sums over columns: blocks add up

@@ -199,22 +199,11 @@ class Segmentation:
 
     @classmethod
     def from_dict(cls, d: dict) -> Segmentation:
-        from ..io.mosw import skeleton_from_text
+        """The segmentation in :meth:`to_dict`'s document, every field checked (a damaged one raises
+        :class:`~mocycle.errors.MotionFileError`)."""
+        from ..io.swings_json import segmentation_from_dict
 
-        try:
-            skel = skeleton_from_text(d["skeleton_bvh"])
-            return cls(
-                skeleton=skel, n_frames=int(d["frames"]), frame_time=float(d["frame_time"]),
-                joints=[skel.index(n) for n in d["joints"]],
-                swings=[Swing(**{**s, "axis": tuple(s["axis"]), "base": tuple(s["base"])}) for s in d["swings"]],
-                holds=[Hold(**{**h, "mean": tuple(h["mean"])}) for h in d["holds"]],
-                translation_keys={int(j): (np.asarray(t["frames"], dtype=np.int64),
-                                           np.asarray(t["values"], dtype=np.float64).reshape(-1, 3))
-                                  for j, t in d["translation_keys"].items()},
-                threshold=float(d["threshold"]), window_s=float(d["window_s"]), params=dict(d.get("params", {})),
-            )
-        except (KeyError, TypeError, ValueError) as exc:
-            raise MocycleError(f"not a swings JSON document (missing or bad field: {exc})") from None
+        return segmentation_from_dict(d)
 
 
 # ---------------------------------------------------------------- the paper's steps
