@@ -209,22 +209,38 @@ def _check_choice(value, choices, name):
 
 # ------------------------------------------------------------------ harmonic
 def _derivative_rows(Y: np.ndarray, axis: TimeAxis):
-    """Velocities and accelerations per period (eq. 3.23-3.25) on the interior frames of every region."""
-    xs, dYs, ddYs = [], [], []
-    for s, e in axis.regions:
-        if e - s < 2 * HALF + 1:
-            continue
+    """Velocities and accelerations per period (eq. 3.23-3.25) on the interior frames of every region (written
+    region by region into one array each, divided in place: no per-region parts joined afterwards)."""
+    regions = [(s, e) for s, e in axis.regions if e - s >= 2 * HALF + 1]
+    if not regions:
+        return None, None, None
+    n = sum(e - s - 2 * HALF for s, e in regions)
+    xs = np.empty(n)
+    dY = np.empty((n,) + Y.shape[1:])
+    ddY = np.empty_like(dY)
+    r = 0
+    for s, e in regions:
+        m = e - s - 2 * HALF
         x = axis.x[s:e]
         if axis.method in ("smooth", "line"):  # the local tempo, frames per period, follows the axis
             rate = central_velocity(x, 1.0)[:, 0]
         else:                                  # the thesis: t = 1/N everywhere (eq. 3.25)
-            rate = np.full(e - s - 2 * HALF, 1.0 / axis.period_frames)
-        xs.append(x[HALF:e - s - HALF])
-        dYs.append(central_velocity(Y[s:e], 1.0) / rate[:, None])
-        ddYs.append(central_acceleration(Y[s:e], 1.0) / rate[:, None] ** 2)
-    if not xs:
-        return None, None, None
-    return np.concatenate(xs), np.concatenate(dYs), np.concatenate(ddYs)
+            rate = np.full(m, 1.0 / axis.period_frames)
+        xs[r:r + m] = x[HALF:e - s - HALF]
+        dY[r:r + m] = central_velocity(Y[s:e], 1.0)
+        dY[r:r + m] /= rate[:, None]
+        ddY[r:r + m] = central_acceleration(Y[s:e], 1.0)
+        ddY[r:r + m] /= rate[:, None] ** 2
+        r += m
+    return xs, dY, ddY
+
+
+def _rows(Y: np.ndarray, axis: TimeAxis, frames: np.ndarray) -> np.ndarray:
+    """``Y[frames]`` for the axis' frames: a view when they are one region (no copy of ``Y``)."""
+    if len(axis.regions) == 1:
+        s, e = axis.regions[0]
+        return Y[s:e]
+    return Y[frames]
 
 
 def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
@@ -257,8 +273,9 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     if model != "M2" and (xd is None or xd.size < 2 * K):
         raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the excited "
                            f"regions are too short: use --model M2 or fewer harmonics")
-    fit_p = HarmonicRegression(K, model).fit(x, P[frames], xd, dP, ddP)
-    fit_l = HarmonicRegression(K, model, linear=True).fit(x, L[frames], xd, dL, ddL)
+    fit_p = HarmonicRegression(K, model).fit(x, _rows(P, axis, frames), xd, dP, ddP)
+    del dP, ddP  # (T, D) each: not held while L is fitted
+    fit_l = HarmonicRegression(K, model, linear=True).fit(x, _rows(L, axis, frames), xd, dL, ddL)
     x0 = float(np.floor(x[0]))
     if reference is not None:  # start where the wrap is the calmest step, choosing between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
