@@ -309,7 +309,15 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
         r += circular_autocorrelation(B * window[:, None])  # sums over columns: blocks add up
     if not r[0] > 0.0:
         return float("nan")
-    r = r / r[0]
+    return period_from_autocorrelation(r / r[0], circular_autocorrelation(window), min_lag, max_lag, min_strength)
+
+
+def period_from_autocorrelation(r: np.ndarray, env: np.ndarray, min_lag: int, max_lag: int,
+                                min_strength: float) -> float:
+    """The cycle (frames) at the highest maximum of a normalised autocorrelation ``r`` ``(T,)`` in
+    ``[min_lag, max_lag]``, as :func:`autocorrelation_period` chooses and refines it (``env`` ``(T,)``: the
+    window's own circular autocorrelation); NaN when no maximum reaches ``min_strength``."""
+    T = r.size
     seg = r[: max_lag + 2]  # the peak's right neighbour must be inside
     peaks = local_maxima(seg)
     peaks = peaks[(peaks >= min_lag) & (peaks <= max_lag)]
@@ -327,7 +335,6 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
         p = int(level[whole][0])
     # Refine on r / (the window's own circular autocorrelation): the window's decay would pull the vertex
     # towards smaller lags by up to ~1 % of the period; the division undoes that bias for a stationary signal.
-    env = circular_autocorrelation(window)
     q = np.arange(p - 2, p + 3) % T  # r is circular
     u = r[q] / env[q]
     c = 1 + int(np.argmax(u[1:4]))  # the largest of lags p-1, p, p+1

@@ -39,7 +39,7 @@ from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
 from ..limits import check_frames
 from ..motion import JOINT_GROUPS, Motion, Skeleton, concatenate
-from ..phase.period import PEAK_TIE, autocorrelation_period, circular_autocorrelation, local_maxima, periodic_hann
+from ..phase.period import autocorrelation_period, circular_autocorrelation, period_from_autocorrelation, periodic_hann
 from ..rotations import axis_angle_quats, quat_conj, quat_exp, quat_log, quat_multiply
 from ..threads import limit_threads
 from .lct import block_edges, ilct, lct
@@ -165,36 +165,8 @@ def fundamental_cycles(X, min_strength: float = CURVE_MIN_STRENGTH) -> np.ndarra
     env = circular_autocorrelation(window)
     for k, d in enumerate(use.tolist()):
         if r[0, k] > 0.0:
-            out[d] = _cycle_from_autocorrelation(r[:, k] / r[0, k], env, 2, T // 2, min_strength)
+            out[d] = period_from_autocorrelation(r[:, k] / r[0, k], env, 2, T // 2, min_strength)
     return out
-
-
-def _cycle_from_autocorrelation(r: np.ndarray, env: np.ndarray, min_lag: int, max_lag: int,
-                                min_strength: float) -> float:
-    """The cycle (frames) at the highest maximum of a normalised autocorrelation ``r`` ``(T,)``, as
-    :func:`~mocycle.phase.period.autocorrelation_period` chooses and refines it (``env``: the window's own
-    circular autocorrelation); NaN when no maximum reaches ``min_strength``."""
-    T = r.size
-    seg = r[: max_lag + 2]
-    peaks = local_maxima(seg)
-    peaks = peaks[(peaks >= min_lag) & (peaks <= max_lag)]
-    peaks = peaks[seg[peaks] > min_strength]
-    if peaks.size == 0:
-        return float("nan")
-    p = int(peaks[np.argmax(seg[peaks])])
-    level = peaks[(seg[peaks] >= seg[p] - PEAK_TIE) & (peaks < p)]
-    times = p / np.maximum(level, 1)
-    whole = (np.round(times) >= 2) & (np.abs(times / np.maximum(np.round(times), 1) - 1) <= 0.1)
-    if whole.any():
-        p = int(level[whole][0])
-    q = np.arange(p - 2, p + 3) % T
-    u = r[q] / env[q]
-    c = 1 + int(np.argmax(u[1:4]))
-    p += c - 2
-    left, mid, right = u[c - 1], u[c], u[c + 1]
-    curvature = left - 2.0 * mid + right
-    shift = 0.5 * (left - right) / curvature if curvature < 0 else 0.0
-    return float(p + np.clip(shift, -0.5, 0.5))
 
 
 def group_cycle(X, min_strength: float = CURVE_MIN_STRENGTH, weak: float = WEAK_CURVE) -> float:
