@@ -78,6 +78,44 @@ def test_feet_are_one_per_leg_and_a_still_take_does_not_slide():
     assert foot_sliding(synthetic_still(noise_deg=0.0).motion) < 1e-6
 
 
+def _hip_under_root(motion):
+    """``motion`` with a joint inserted between the travel joint and all its children (iClone's
+    ``RL_BoneRoot`` -> ``CC_Base_Hip``): the travel joint then has a single child carrying legs and spine."""
+    from mocycle.motion import EndSite, Motion, Skeleton
+
+    skel = motion.skeleton
+    old = np.arange(skel.n_joints)
+    new_index = np.where(old == 0, 0, old + 1)  # joint 0 stays, the rest move down by one
+    parents = np.concatenate([[-1, 0], new_index[skel.parents[1:]]])
+    parents[2:][skel.parents[1:] == 0] = 1  # the root's children hang from the inserted joint
+    skeleton = Skeleton(names=(skel.names[0], "Hip") + skel.names[1:], parents=parents,
+                        offsets=np.vstack([skel.offsets[:1], np.zeros((1, 3)), skel.offsets[1:]]),
+                        channels=(skel.channels[0], ("Zrotation", "Yrotation", "Xrotation")) + skel.channels[1:],
+                        end_sites=tuple(EndSite(int(new_index[e.parent]), e.offset, e.name) for e in skel.end_sites))
+    T = motion.n_frames
+    identity = np.tile([0.0, 0.0, 0.0, 1.0], (T, 1, 1))
+    return Motion(skeleton, np.concatenate([motion.rotations[:, :1], identity, motion.rotations[:, 1:]], axis=1),
+                  np.concatenate([motion.translations[:, :1], np.zeros((T, 1, 3)), motion.translations[:, 1:]], axis=1),
+                  motion.frame_time)
+
+
+def test_feet_are_one_per_leg_when_the_travel_joint_has_a_single_child():
+    """The legs split at the hips (the leg fork), not below the travel joint: a rig whose travel joint carries
+    legs and spine through one child (iClone) still gets one foot per leg, the same points as without it."""
+    walk = synthetic_walk(n_frames=120).motion
+    wrapped = _hip_under_root(walk)
+    assert wrapped.travel_joint == 0 and list(wrapped.skeleton.parents).count(0) == 1
+    keep = [0] + list(range(2, wrapped.n_joints + len(wrapped.skeleton.end_sites)))  # all but the inserted joint
+    np.testing.assert_allclose(wrapped.world_positions(end_sites=True)[:, keep], walk.world_positions(end_sites=True),
+                               atol=1e-9)
+    names = wrapped.skeleton.names
+    n = wrapped.n_joints
+    sides = sorted(names[i if i < n else wrapped.skeleton.end_sites[i - n].parent][:4] for i in foot_points(wrapped))
+    assert sides == ["Left", "Righ"], sides
+    assert [i - 1 for i in foot_points(wrapped)] == foot_points(walk)
+    assert abs(foot_sliding(wrapped) - foot_sliding(walk)) < 1e-9
+
+
 def test_loop_metrics_has_every_number_the_cli_prints():
     take = synthetic_walk(n_frames=400, noise_deg=1.0)
     m = loop_metrics(take.motion, extract_cycle(take.motion))

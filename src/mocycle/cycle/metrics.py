@@ -48,6 +48,8 @@ from .extract import Cycle, loop_blocks, metric_features
 from .seam import seam_ratios
 
 CONTACT_HEIGHT = 0.02  # of the body height
+FORK_HEIGHT = 0.25  # of the body height: the leg fork (hips) is at least this far above the lowest leaf
+FOOT_BAND = 0.1  # of the body height: a branch whose lowest leaf is this close to the lowest one reaches the floor
 
 
 class PeriodicSpline:
@@ -182,18 +184,43 @@ def jerk_ratio(Y_regions: list[np.ndarray], C: np.ndarray, frame_time: float) ->
 
 
 def foot_points(motion: Motion, up: np.ndarray | None = None, positions: np.ndarray | None = None) -> list[int]:
-    """Indices (in ``world_positions(end_sites=True)``) of the feet: in each of the two branches below the
-    travel joint whose leaves hang lowest on average, the lowest leaf (joint without children, or End Site).
-    ``up``: the vertical axis (default: detected, :func:`~mocycle.axes.vertical_axis`); ``positions``:
-    ``motion.world_positions(end_sites=True)`` when the caller has it."""
+    """Indices (in ``world_positions(end_sites=True)``) of the feet: the lowest leaf (joint without children,
+    or End Site) on each side of the hips, by the skeleton's structure alone.
+
+    The hips are the *leg fork*: the lowest joint, at least ``FORK_HEIGHT`` of the body height above the
+    lowest leaf, with two child branches that each reach within ``FOOT_BAND`` of it (both legs); a knee or an
+    ankle is too low, the chest's branches do not reach the floor.  A rig without such a joint falls back to
+    the two branches below the travel joint whose leaves hang lowest.  The fork, not the travel joint, splits
+    the legs because on some rigs (iClone's ``RL_BoneRoot`` -> ``CC_Base_Hip``) the travel joint has a single
+    child that carries both legs and the spine.  ``up``: the vertical axis (default: detected,
+    :func:`~mocycle.axes.vertical_axis`); ``positions``: ``motion.world_positions(end_sites=True)`` when the
+    caller has it; heights are the mean pose's (of at most 50 frames)."""
     skel = motion.skeleton
     up = vertical_axis(motion, up)
     parents = [int(p) for p in skel.parents] + [int(site.parent) for site in skel.end_sites]  # Python ints: fast
-    has_child = np.zeros(len(parents), bool)
-    for p in parents:
+    children: dict[int, list[int]] = {}
+    for i, p in enumerate(parents):
         if p >= 0:
-            has_child[p] = True
-    leaves = [i for i in range(len(parents)) if not has_child[i]]
+            children.setdefault(p, []).append(i)
+    leaves = [i for i in range(len(parents)) if i not in children]
+    step = max(1, motion.n_frames // 50)
+    W = motion[::step].world_positions(end_sites=True) if positions is None else positions[::step]
+    heights = W.mean(axis=0) @ up
+    # the lowest leaf of each joint's subtree (joints before their children; End Sites after every joint)
+    low = [i if i not in children else -1 for i in range(len(parents))]
+    for i in range(len(parents) - 1, -1, -1):  # children before their parents
+        p = parents[i]
+        if p >= 0 and low[i] >= 0 and (low[p] < 0 or heights[low[i]] < heights[low[p]]):
+            low[p] = low[i]
+    floor = min(heights[i] for i in leaves)
+    body = float(np.ptp(heights))
+    forks = []
+    for j, kids in children.items():
+        reaching = sorted((heights[low[c]], low[c]) for c in kids if heights[low[c]] <= floor + FOOT_BAND * body)
+        if len(reaching) >= 2 and heights[j] >= floor + FORK_HEIGHT * body:
+            forks.append((heights[j], [leaf for _, leaf in reaching[:2]]))
+    if forks:
+        return sorted(min(forks)[1], key=lambda i: heights[i])
     travel = motion.travel_joint
 
     def branch(i: int) -> int:
@@ -202,9 +229,6 @@ def foot_points(motion: Motion, up: np.ndarray | None = None, positions: np.ndar
             path.append(parents[path[-1]])
         return path[path.index(travel) - 1] if travel in path and path.index(travel) > 0 else path[-1]
 
-    step = max(1, motion.n_frames // 50)
-    W = motion[::step].world_positions(end_sites=True) if positions is None else positions[::step]
-    heights = W.mean(axis=0) @ up
     lowest: dict[int, int] = {}
     for leaf in leaves:
         b = branch(leaf)
