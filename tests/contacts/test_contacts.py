@@ -39,6 +39,32 @@ def test_each_foot_is_planted_for_a_stance_of_every_step_at_any_frame_rate(fps):
         assert 0.3 < share < 0.75, share   # a walk's stance is about 60 % of the cycle
 
 
+def test_every_stance_is_found_on_a_drifting_floor(monkeypatch):
+    """A take whose floor drifts up by 4 % of the body height (a drifting capture, a gentle slope): every
+    stance is near its floor nearby (``local_floor``).  Measured from the lowest level of the whole take,
+    the stances of the last third sit above the contact height and were missed."""
+    from mocycle.contacts import body_height, detect
+
+    fps = 60.0
+    _, walk = _planted_walk(n_frames=int(8 * fps), fps=fps)   # 8 steps per foot
+    up = np.array([0.0, 1.0, 0.0])
+    t = walk.translations.copy()
+    t[:, 0, 1] += np.linspace(0.0, 0.04 * body_height(walk, up), walk.n_frames)
+    drifting = Motion(walk.skeleton, walk.rotations, t, walk.frame_time)
+
+    def stances(con, f):
+        return [r for r in con.foot_ranges(f) if r[0] > 0 and r[1] < con.n_frames]
+
+    flat = detect_contacts(walk, up=up)
+    con = detect_contacts(drifting, up=up)
+    for f in range(2):
+        assert len(stances(con, f)) == len(stances(flat, f)) >= 7
+        assert con.foot_ranges(f)[-1][0] > 0.8 * con.n_frames      # the last steps too
+    monkeypatch.setattr(detect, "FLOOR_SECONDS", 1e6)              # the whole take's lowest level
+    whole = detect_contacts(drifting, up=up)
+    assert all(not whole.foot_mask(f)[int(0.8 * whole.n_frames):].any() for f in range(2))
+
+
 def _slid_walk():
     """The synthetic walk with a deliberate slide: the root surges back and forth by 6 cm at the step
     frequency, so a planted foot slides with it."""

@@ -18,3 +18,15 @@ def test_maximum_and_uniform_are_scipy_s_with_nearest_ends(size):
     x = np.random.default_rng(2).normal(size=60)
     assert np.array_equal(maximum(x, size), ndimage.maximum_filter1d(x, size, mode="nearest"))
     assert np.abs(uniform(x, size) - ndimage.uniform_filter1d(x, size, mode="nearest")).max() < 1e-12
+
+
+@pytest.mark.parametrize("size", [1, 2, 3, 7, 12, 120, 200, 10**7])
+def test_minimum_is_scipy_s_in_linear_time(size):
+    """The running minimum (van Herk / Gil-Werman) equals minimum_filter1d with nearest ends, on (T,) and
+    (T, C); a window wider than the take (the floor of a short take) is the whole take's minimum."""
+    from mocycle.contacts.smooth import minimum
+
+    x = np.random.default_rng(3).normal(size=(97, 4)).cumsum(axis=0)
+    ref = ndimage.minimum_filter1d(x, min(size, 1000), axis=0, mode="nearest")
+    assert np.array_equal(minimum(x, size), ref)
+    assert np.array_equal(minimum(x[:, 0], size), ref[:, 0])

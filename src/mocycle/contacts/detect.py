@@ -1,7 +1,7 @@
 """Foot contacts: when each contact joint (ankle, toe) is planted.
 
 A contact joint is planted while it is **near its floor and slow**: its height
-above its lowest level is under ``height``, its horizontal speed under
+above its floor is under ``height``, its horizontal speed under
 ``speed`` and its vertical speed under ``rise`` (a heel that starts to lift or
 is still coming down is not planted).
 Both are fractions of the body height (and body heights per second), so the
@@ -16,6 +16,14 @@ of frames), so 30, 60 and 120 fps agree.
   contacts shorter than ``min_contact`` seconds dropped.
 
 A foot is in contact while its ankle or its toe is.
+
+**The floor** of a contact joint is its lowest level *nearby*: the lowest over
+``FLOOR_SECONDS`` about each frame, never more than ``FLOOR_DRIFT`` above its
+lowest level over the whole motion.  A capture whose floor drifts, a
+retargeted take whose stances sit at different heights (CMU on the iClone rig:
+up to 3-4 % of the body height apart within one take) or a gentle slope then
+keeps every stance near its floor; with the lowest level of the whole take,
+the stances above it were missed and stayed unlocked.
 
 **A foot with no contact at all** over the motion is looked at again (a foot
 that never touches the floor while the other one walks or runs is nearly
@@ -38,7 +46,7 @@ import numpy as np
 from ..errors import MocycleError
 from ..motion import Motion
 from .feet import Foot, body_height, chain_joints, chain_transforms, find_feet, up_axis
-from .smooth import gaussian
+from .smooth import gaussian, minimum
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
 CONTACT_SPEED = 0.15    # body heights per second, horizontal
@@ -50,6 +58,8 @@ RELEASE = 1.5           # a contact ends above RELEASE × the thresholds
 SMOOTH_SECONDS = 1 / 60  # std of the Gaussian the positions are smoothed with before differencing
 MIN_CONTACT = 0.03      # seconds
 MIN_GAP = 0.06          # seconds
+FLOOR_SECONDS = 2.0     # a contact joint's floor: its lowest level over this time about each frame ...
+FLOOR_DRIFT = 0.05      # ... at most this (of the body height) above its lowest level over the whole motion
 
 
 def ranges(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -165,6 +175,13 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
     return h, np.linalg.norm(v - vu[..., None] * up, axis=-1), np.abs(vu)
 
 
+def local_floor(h: np.ndarray, fps: float) -> np.ndarray:
+    """``(T, C)`` each contact joint's floor under heights ``h`` ``(T, C)`` (body heights above its lowest
+    level over the motion): its lowest level over ``FLOOR_SECONDS`` about each frame, at most
+    ``FLOOR_DRIFT``."""
+    return np.minimum(minimum(h, max(1, int(round(FLOOR_SECONDS * fps)))), FLOOR_DRIFT)
+
+
 def _travel_speed(motion: Motion, W: np.ndarray, up: np.ndarray) -> np.ndarray:
     """``(T,)`` horizontal speed of the travel joint (units/s), averaged by a Gaussian of ``TRAVEL_SECONDS``."""
     if motion.n_frames < 2:
@@ -193,7 +210,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
                     relax: bool = True) -> Contacts:
     """Contacts of every contact joint of ``feet`` (default: :func:`find_feet`; a string names them).
 
-    ``height``: fraction of the body height above the joint's lowest level; ``speed``: body heights per
+    ``height``: fraction of the body height above the joint's floor (:func:`local_floor`); ``speed``: body heights per
     second (horizontal), or ``travel`` times the body's own horizontal speed where that is more (averaged
     over ``TRAVEL_SECONDS``), ``rise``: body heights per second (vertical); ``release``: hysteresis factor (> 1);
     ``min_contact``, ``min_gap``: seconds; ``relax``: a foot with no contact at all is looked at again with
@@ -213,6 +230,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
     W = chain_transforms(motion, chain_joints(motion, joints))[1]   # the feet and the travel joint only
     h, v, vu = heights_and_speeds(motion, joints, up, positions=W)
     h, v, vu = h / body, v / body, vu / body
+    h = h - local_floor(h, motion.fps)
     # a foot under a running body is planted when it is slow for the body: a fitted or resampled stance
     # glides at a share of the travel speed
     body_speed = travel * _travel_speed(motion, W, up) / body
