@@ -136,7 +136,7 @@ def blends(data: Path, quick: bool) -> list[dict]:
             print(f"{path.name:34s} no blend: {exc}")
             continue
         t0 = time.perf_counter()
-        cleaned, _ = lock_cycle(blend.cycle, **LOCK)
+        cleaned, _ = lock_cycle(blend.cycle, reference=[a, b], **LOCK)
         t_lock = time.perf_counter() - t0
         s_in = float(np.mean([skate(a), skate(b)]))  # the two captures
         before, after = blend.cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
@@ -192,7 +192,8 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--part", choices=("all", "loops", "blends", "stretch"), default="all")
     ap.add_argument("--clearance", type=float, default=None,
-                    help="swing clearance, fraction of the body height (default: lock's CLEARANCE; 0: off)")
+                    help="one swing clearance for every foot, fraction of the body height (default: each take's "
+                         "own, contacts.clearance.swing_clearance; 0: off)")
     ap.add_argument("--skate-height", type=float, default=None,
                     help="H of the skate measure, fraction of the body height (default 0.015, the issue's)")
     ap.add_argument("--data", type=Path, default=Path(__file__).resolve().parents[1].parent / "shared" / "data")
@@ -226,9 +227,9 @@ def loops(args) -> None:
             print(f"{path.name:34s} no loop: {exc}")
             continue
         t1 = time.perf_counter()
-        cleaned, contacts = lock_cycle(cycle, **LOCK)
-        t2 = time.perf_counter()
         frames = cycle.axis.frames()
+        cleaned, contacts = lock_cycle(cycle, reference=motion[frames[0]:frames[-1] + 1], **LOCK)
+        t2 = time.perf_counter()
         s_in = skate(motion[frames[0]:frames[-1] + 1])
         before, after = cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
         s_fit, s_out = skate(before), skate(after)

@@ -186,11 +186,11 @@ def test_far_from_its_holds_a_leg_is_unchanged():
 
 
 def test_a_swinging_foot_clears_the_floor_and_a_held_or_unbounded_one_does_not():
-    from mocycle.contacts.lock import CLEARANCE, HELD, LIFT_SECONDS, LOW, _lift
+    from mocycle.contacts.lock import HELD, LIFT_SECONDS, LOW, _lift
 
     T, dt, body = 60, 1 / 60, 170.0
     up = np.array([0.0, 1.0, 0.0])
-    clear = CLEARANCE * body
+    clear = 0.015 * body
     path = np.zeros((T, 3))
     path[:, 2] = np.arange(T) * 1.5 * body * dt      # 1.5 body heights/s along the floor: a swing, not a stance
     level = np.zeros(T, dtype=int)

@@ -21,20 +21,32 @@ from dataclasses import replace
 import numpy as np
 
 from ..cycle.extract import Cycle
+from ..motion import Motion
 from ..rotations import axis_rotations
+from .clearance import swing_clearance
 from .detect import Contacts, detect_contacts
 from .feet import Foot
-from .lock import BLEND_SECONDS, CLEARANCE, REACH, lock_feet
+from .lock import BLEND_SECONDS, REACH, lock_feet
 
 
 def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend: float = BLEND_SECONDS,
-               reach: float = REACH, clearance: float = CLEARANCE, **detect_options) -> tuple[Cycle, Contacts]:
+               reach: float = REACH, clearance: float | np.ndarray | None = None,
+               reference: Motion | Sequence[Motion] | None = None, **detect_options) -> tuple[Cycle, Contacts]:
     """The cycle with its feet locked, and its contacts over its ``N`` frames (a contact running over the
-    last frame continues at frame 0)."""
+    last frame continues at frame 0).
+
+    ``clearance``: as :func:`~mocycle.contacts.lock_feet`'s; by default the swing clearance of ``reference``,
+    the take (or takes) the cycle was made from, or of the cycle itself without one (a fitted cycle's
+    swinging feet skim lower than the capture's: pass the take)."""
     N = cycle.n_frames
     ext = cycle.repeat(3, root="motion")
     detect_options.setdefault("up", cycle.space.world_up)   # the take's vertical (found once, by the fit)
     contacts = detect_contacts(ext, feet, **detect_options)
+    if clearance is None:
+        clearance = swing_clearance(ext if reference is None else reference, contacts.feet,
+                                    up=detect_options["up"], body=contacts.body)
+    contacts = replace(contacts, clearance=np.broadcast_to(np.asarray(clearance, dtype=np.float64),
+                                                           (len(contacts.joints),)).copy())
     locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N, frames=slice(N, 2 * N),
                        clearance=clearance)
     P, L = cycle.space.encode(locked)

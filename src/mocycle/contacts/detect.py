@@ -75,7 +75,8 @@ class Contacts:
 
     ``joints``: the contact joints ``(C,)`` (each foot's ankle, then its toe if any); ``foot_of``: the foot
     (index into ``feet``) of each; ``mask``: ``(T, C)`` True while planted; ``up``: world up ``(3,)``;
-    ``body``: the body height (file units); ``frame_time``: seconds.
+    ``body``: the body height (file units); ``frame_time``: seconds; ``clearance``: ``(C,)`` the swing
+    clearance foot locking used (fraction of the body height), when the contacts were locked.
     """
 
     feet: tuple[Foot, ...]
@@ -85,6 +86,7 @@ class Contacts:
     up: np.ndarray
     body: float
     frame_time: float
+    clearance: np.ndarray | None = None
 
     @property
     def n_frames(self) -> int:
@@ -104,7 +106,7 @@ class Contacts:
     def window(self, start: int, stop: int) -> Contacts:
         """The contacts of frames ``start .. stop-1``."""
         return Contacts(self.feet, self.joints, self.foot_of, self.mask[start:stop], self.up, self.body,
-                        self.frame_time)
+                        self.frame_time, self.clearance)
 
     def to_dict(self, names: Sequence[str], period: int | None = None) -> dict:
         """Per foot (by side): its joints and its contacts as ``[start, stop]`` frame ranges (stop exclusive).

@@ -271,9 +271,10 @@ def chain_transforms(motion: Motion, chain: list[int]) -> tuple[ChainRotations, 
     parents = motion.skeleton.parents
     Rw = ChainRotations(T, chain)
     W = np.full((T, J, 3), np.nan)
+    locals_ = Rotation.from_quat(motion.rotations[:, chain].reshape(-1, 4)).as_matrix().reshape(T, len(chain), 3, 3)
     for i, j in enumerate(chain):
         p = int(parents[j])
-        local = Rotation.from_quat(motion.rotations[:, j]).as_matrix()
+        local = locals_[:, i]
         if p < 0:
             Rw.data[:, i] = local
             W[:, j] = motion.translations[:, j]

@@ -30,8 +30,9 @@
    by a smoothstep, so a swing foot keeps the shape of its world path, only
    shifted; longer gaps and the ends of a take fade the correction out over
    ``blend`` seconds.  A joint between two holds that moves faster than
-   ``SWING_SPEED`` clears ``CLEARANCE`` of the body height above its lowest
-   level (a swinging foot does not skim the floor; the lift is rate-limited).
+   ``SWING_SPEED`` clears its *swing clearance* above its lowest level (a
+   swinging foot does not skim the floor; the lift is rate-limited): by
+   default the capture's own (:mod:`~mocycle.contacts.clearance`).
 5. **Root lowering.** Where a held ankle goal is still farther from its hip
    than ``reach`` of the leg's length, the root goes down along the vertical
    (smoothed over the blend window so it never jumps and is never less than
@@ -55,6 +56,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
+from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
 from .feet import chain_joints, chain_transforms
 from .smooth import maximum, uniform
@@ -67,11 +69,8 @@ EXTEND_HEIGHT = 0.025  # of the body height above the held height: "low" (the co
 EXTEND_DISTANCE = 0.03  # of the body height: "near" the held point horizontally (farther: no early plant)
 STRAIGHT_KNEE = 0.1   # sine of the knee angle below which the bend axis eases to the leg's usual one
 SOFT_ZONE = 0.03      # of the leg's length: a free goal this close to the reach eases in (soft IK)
-CLEARANCE = 0.015      # of the body height: a swinging foot clears this (the skate measure's H: below it a
-                       # foot counts as on the floor)
 SLOW_SPEED = 0.25      # body heights/s: a free foot this slow is not lifted (it may be a stance the detector missed)
-SWING_SPEED = 0.5      # body heights/s: a free foot this fast is lifted fully
-LIFT_SECONDS = 0.1     # the lift changes by at most CLEARANCE in this time
+LIFT_SECONDS = 0.1     # the lift changes by at most the clearance in this time
 BRIDGE_SECONDS = 0.6   # a gap between holds this short (a swing) is bridged; longer ones fade over the blend
 #: how firmly a contact joint is held on a frame: its own contact, its foot's other joint's contact (carried
 #: rigidly), its own low frames around a contact (held horizontally), the other joint's low frames
@@ -291,7 +290,7 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
 
 
 def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
-                reach: float, clearance: float = CLEARANCE):
+                reach: float, clearance: np.ndarray):
     """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and ``(T,)`` True where the foot is held."""
     foot = contacts.feet[f]
     up, body = contacts.up, contacts.body
@@ -329,12 +328,13 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
                                      low, near, n_extend, n_fade)
     corr_a = _bridge(corr_a, n_bridge, n_fade)
     clear = clearance * body
-    corr_a += np.outer(_lift(a + corr_a, level_a, up, clear, body, contacts.frame_time), up)
+    clear_a, clear_t = clear[cols[foot.ankle]], clear[cols[foot.toe]] if foot.toe is not None else 0.0
+    corr_a += np.outer(_lift(a + corr_a, level_a, up, clear_a, body, contacts.frame_time), up)
     changed = np.any(corr_a != 0, axis=1)
     if corr_t is None:
         return a + corr_a, None, level_a >= FOLLOW, changed
     corr_t = _bridge(corr_t, n_bridge, n_fade)
-    corr_t += np.outer(_lift(t + corr_t, level_t, up, clear, body, contacts.frame_time), up)
+    corr_t += np.outer(_lift(t + corr_t, level_t, up, clear_t, body, contacts.frame_time), up)
     return a + corr_a, t + corr_t, level_a >= FOLLOW, changed | np.any(corr_t != 0, axis=1)
 
 
@@ -526,20 +526,25 @@ def _move_travel(motion: Motion, trans: np.ndarray, Rw: np.ndarray, world: np.nd
 
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
               follow: bool = True, period: int | None = None, frames: slice | None = None,
-              clearance: float = CLEARANCE) -> Motion:
+              clearance: float | np.ndarray | None = None) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
 
     ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
     beyond which the root is lowered; ``follow``: first move the root horizontally with the planted feet;
     ``period``: the motion is a loop repeated every ``period`` frames (at least three times), so the root
     correction keeps the travel of each period; ``frames``: solve and return only these frames (the rest
-    is context: the frames of a loop's repeat that are read back); ``clearance``: fraction of the body
-    height a swinging foot clears (0: no swing clearance).  Returns a new Motion with the same skeleton and
+    is context: the frames of a loop's repeat that are read back); ``clearance``: the fraction of the body
+    height a swinging foot clears, one for all contact joints or ``(C,)`` one per joint of ``contacts``
+    (0: no swing clearance; default: the motion's own, :func:`~mocycle.contacts.clearance.swing_clearance`).
+    Returns a new Motion with the same skeleton and
     frame time.
     """
     if contacts.n_frames != motion.n_frames:
         raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
     n_blend = max(1, int(round(blend / motion.frame_time)))
+    if clearance is None:
+        clearance = swing_clearance(motion, contacts.feet, up=contacts.up, body=contacts.body)
+    clearance = np.broadcast_to(np.asarray(clearance, dtype=np.float64), (len(contacts.joints),))
     skel = motion.skeleton
     legs = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle) + f.contact_joints})
     chain = chain_joints(motion, legs)

@@ -67,7 +67,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
                               method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force,
                               **phase_options(o))
         with rec.part("feet"):
-            cleaned, feet_facts, _ = clean_feet(result.cycle, o.feet, o.root, o.foot_joints)
+            cleaned, feet_facts, _ = clean_feet(result.cycle, o.feet, o.root, o.foot_joints, reference=motions)
         result = dataclasses.replace(result, cycle=cleaned)
         loop = result.repeat(o.cycles, root=o.root)
         facts = {

@@ -14,8 +14,9 @@ FOOT_JOINTS_HELP = ("Name the feet when the name patterns fail: ANKLE[:TOE],ANKL
                     "lfoot:ltoes,rfoot:rtoes).")
 
 
-def clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
-    """The cycle with its feet locked (or not), and what the JSON says about it."""
+def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=None):
+    """The cycle with its feet locked (or not), and what the JSON says about it.  ``reference``: the take (or
+    takes) the cycle was made from, whose swing clearance the locked feet keep."""
     from ..contacts import find_feet, largest_leg_step, lock_cycle, skate
 
     if mode == "auto":
@@ -27,12 +28,13 @@ def clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
                 warnings.warn(f"feet not locked: {exc}", MocycleWarning, stacklevel=2)
             mode = "keep"
     facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
-             "largest_leg_step_before": None, "largest_leg_step_after": None, "seconds": 0.0}
+             "largest_leg_step_before": None, "largest_leg_step_after": None, "clearance": None, "seconds": 0.0}
     if mode == "keep":
         return cycle, facts, None
     t0 = time.perf_counter()
-    cleaned, contacts = lock_cycle(cycle, foot_joints)
+    cleaned, contacts = lock_cycle(cycle, foot_joints, reference=reference)
     facts["seconds"] = time.perf_counter() - t0
+    facts["clearance"] = _clearance_facts(contacts, contacts.clearance, cycle.space.skeleton.names)
     before, after = cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
     names = cycle.space.skeleton.names
     facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=skate(before, contacts.feet),
@@ -40,6 +42,11 @@ def clean_feet(cycle, mode: str, root: str, foot_joints: str | None):
                  largest_leg_step_before=largest_leg_step(before, contacts.feet),
                  largest_leg_step_after=largest_leg_step(after, contacts.feet))
     return cleaned, facts, contacts
+
+
+def _clearance_facts(contacts, clearance, names) -> dict:
+    """Joint name -> swing clearance (fraction of the body height) for the JSON."""
+    return {names[j]: round(float(c), 6) for j, c in zip(contacts.joints, clearance, strict=True)}
 
 
 def travels(motion) -> bool:
@@ -58,6 +65,7 @@ def lock_motion(motion, mode: str, foot_joints: str | None, moves: bool):
     """Any motion with its feet locked (``mode`` lock, or auto when ``moves`` and feet are found) and what the
     JSON says about it: a thin wrapper over :func:`mocycle.contacts.detect_contacts` and ``lock_feet``."""
     from ..contacts import detect_contacts, find_feet, largest_leg_step, lock_feet, skate
+    from ..contacts.clearance import swing_clearance
 
     if mode == "auto":
         try:
@@ -68,13 +76,15 @@ def lock_motion(motion, mode: str, foot_joints: str | None, moves: bool):
                 warnings.warn(f"feet not locked: {exc}", MocycleWarning, stacklevel=2)
             mode = "keep"
     facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
-             "largest_leg_step_before": None, "largest_leg_step_after": None, "seconds": 0.0}
+             "largest_leg_step_before": None, "largest_leg_step_after": None, "clearance": None, "seconds": 0.0}
     if mode == "keep":
         return motion, facts
     t0 = time.perf_counter()
     contacts = detect_contacts(motion, foot_joints)
-    locked = lock_feet(motion, contacts)
+    clearance = swing_clearance(motion, contacts.feet, up=contacts.up, body=contacts.body)
+    locked = lock_feet(motion, contacts, clearance=clearance)
     facts["seconds"] = time.perf_counter() - t0
+    facts["clearance"] = _clearance_facts(contacts, clearance, motion.skeleton.names)
     facts.update(contacts=contacts.to_dict(motion.skeleton.names), skate_before=skate(motion, contacts.feet),
                  skate_after=skate(locked, contacts.feet),
                  largest_leg_step_before=largest_leg_step(motion, contacts.feet),

@@ -121,7 +121,9 @@ def run(take, options: Options | None = None) -> Report:
                 fitted = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
                                        time_axis_method=o.time_axis, which=k, phase=phase)
             with rec.part("feet"):
-                cycle, feet_facts, contacts = clean_feet(fitted, o.feet, o.root, o.foot_joints)
+                frames = fitted.axis.frames()   # the swing clearance of the looped region of the take
+                cycle, feet_facts, contacts = clean_feet(fitted, o.feet, o.root, o.foot_joints,
+                                                         reference=motion[frames[0]:frames[-1] + 1])
             with rec.part("cycle"):
                 result = cycle.repeat(o.cycles, root=o.root)
             with rec.part("metrics"):
