@@ -59,6 +59,10 @@ def swing_clearance(motion: Motion | Sequence[Motion], feet: Sequence[Foot] | st
     enough = max(3, int(round(MIN_SWING_SECONDS * motion.fps)))
     out = np.zeros(len(joints))
     for c in range(len(joints)):
-        if swinging[:, c].sum() >= enough:
-            out[c] = min(float(np.quantile(h[swinging[:, c], c], quantile)), MAX_CLEARANCE)
+        x = np.sort(h[swinging[:, c], c])
+        if x.size >= enough:   # numpy's quantile ("linear"), without its overhead on a few hundred values
+            at = quantile * (x.size - 1)
+            lo = int(at)
+            value = x[lo] + (at - lo) * (x[min(lo + 1, x.size - 1)] - x[lo])
+            out[c] = min(float(value), MAX_CLEARANCE)
     return out

@@ -25,7 +25,7 @@ from ..motion import Motion
 from ..rotations import axis_rotations
 from .clearance import swing_clearance
 from .detect import Contacts, detect_contacts
-from .feet import Foot
+from .feet import Foot, chain_joints, chain_transforms, find_feet
 from .lock import BLEND_SECONDS, REACH, lock_feet
 
 
@@ -41,14 +41,18 @@ def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend:
     N = cycle.n_frames
     ext = cycle.repeat(3, root="motion")
     detect_options.setdefault("up", cycle.space.world_up)   # the take's vertical (found once, by the fit)
-    contacts = detect_contacts(ext, feet, **detect_options)
+    if feet is None or isinstance(feet, str):
+        feet = find_feet(ext.skeleton, feet)
+    legs = sorted({j for f in feet for j in (f.hip, f.knee, f.ankle) + f.contact_joints})
+    Rw, W = chain_transforms(ext, chain_joints(ext, legs))   # once for detection and locking
+    contacts = detect_contacts(ext, feet, positions=W, **detect_options)
     if clearance is None:
         clearance = swing_clearance(ext if reference is None else reference, contacts.feet,
                                     up=detect_options["up"], body=contacts.body)
     contacts = replace(contacts, clearance=np.broadcast_to(np.asarray(clearance, dtype=np.float64),
                                                            (len(contacts.joints),)).copy())
     locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N, frames=slice(N, 2 * N),
-                       clearance=clearance)
+                       clearance=clearance, transforms=(Rw, W))
     P, L = cycle.space.encode(locked)
     turn, move = cycle.drift[3], cycle.drift[:3]
     R = axis_rotations(cycle.space.up, np.array([turn]))[0]

@@ -209,14 +209,16 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
                     speed: float = CONTACT_SPEED, rise: float = CONTACT_RISE, release: float = RELEASE,
                     min_contact: float = MIN_CONTACT,
                     min_gap: float = MIN_GAP, travel: float = TRAVEL_SHARE, up: np.ndarray | None = None,
-                    relax: bool = True) -> Contacts:
+                    relax: bool = True, positions: np.ndarray | None = None) -> Contacts:
     """Contacts of every contact joint of ``feet`` (default: :func:`find_feet`; a string names them).
 
     ``height``: fraction of the body height above the joint's floor (:func:`local_floor`); ``speed``: body heights per
     second (horizontal), or ``travel`` times the body's own horizontal speed where that is more (averaged
     over ``TRAVEL_SECONDS``), ``rise``: body heights per second (vertical); ``release``: hysteresis factor (> 1);
     ``min_contact``, ``min_gap``: seconds; ``relax``: a foot with no contact at all is looked at again with
-    the rules for a rolling stance (:func:`_relaxed`).
+    the rules for a rolling stance (:func:`_relaxed`); ``positions``: world positions ``(T, J, 3)`` of at
+    least the feet's chains and the travel joint (:func:`~mocycle.contacts.feet.chain_transforms`), when the
+    caller has them.
     """
     if not (height > 0 and speed > 0 and rise > 0 and release >= 1 and min_contact >= 0 and min_gap >= 0
             and travel >= 0):
@@ -229,7 +231,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
     body = body_height(motion, up)
     joints = tuple(j for f in feet for j in f.contact_joints)
     foot_of = tuple(i for i, f in enumerate(feet) for _ in f.contact_joints)
-    W = chain_transforms(motion, chain_joints(motion, joints))[1]   # the feet and the travel joint only
+    W = chain_transforms(motion, chain_joints(motion, joints))[1] if positions is None else positions  # legs only
     h, v, vu = heights_and_speeds(motion, joints, up, positions=W)
     h, v, vu = h / body, v / body, vu / body
     h = h - local_floor(h, motion.fps)

@@ -526,7 +526,7 @@ def _move_travel(motion: Motion, trans: np.ndarray, Rw: np.ndarray, world: np.nd
 
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
               follow: bool = True, period: int | None = None, frames: slice | None = None,
-              clearance: float | np.ndarray | None = None) -> Motion:
+              clearance: float | np.ndarray | None = None, transforms: tuple | None = None) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
 
     ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
@@ -535,8 +535,9 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     correction keeps the travel of each period; ``frames``: solve and return only these frames (the rest
     is context: the frames of a loop's repeat that are read back); ``clearance``: the fraction of the body
     height a swinging foot clears, one for all contact joints or ``(C,)`` one per joint of ``contacts``
-    (0: no swing clearance; default: the motion's own, :func:`~mocycle.contacts.clearance.swing_clearance`).
-    Returns a new Motion with the same skeleton and
+    (0: no swing clearance; default: the motion's own, :func:`~mocycle.contacts.clearance.swing_clearance`);
+    ``transforms``: ``chain_transforms(motion, chain_joints(motion, legs))`` when the caller has them (they are
+    changed in place).  Returns a new Motion with the same skeleton and
     frame time.
     """
     if contacts.n_frames != motion.n_frames:
@@ -549,7 +550,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     legs = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle) + f.contact_joints})
     chain = chain_joints(motion, legs)
     below = _descendants(motion, motion.travel_joint)
-    Rw, W = chain_transforms(motion, chain)
+    Rw, W = chain_transforms(motion, chain) if transforms is None else transforms
     trans = motion.translations.copy()
     if follow:
         shift = _root_shift(W, contacts, n_blend, period)

@@ -17,7 +17,7 @@ FOOT_JOINTS_HELP = ("Name the feet when the name patterns fail: ANKLE[:TOE],ANKL
 def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=None):
     """The cycle with its feet locked (or not), and what the JSON says about it.  ``reference``: the take (or
     takes) the cycle was made from, whose swing clearance the locked feet keep."""
-    from ..contacts import find_feet, largest_leg_step, lock_cycle, skate
+    from ..contacts import find_feet, largest_leg_step, lock_cycle
 
     if mode == "auto":
         try:
@@ -37,11 +37,18 @@ def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=N
     facts["clearance"] = _clearance_facts(contacts, contacts.clearance, cycle.space.skeleton.names)
     before, after = cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
     names = cycle.space.skeleton.names
-    facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=skate(before, contacts.feet),
-                 skate_after=skate(after, contacts.feet),
+    facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=_skate(before, contacts),
+                 skate_after=_skate(after, contacts),
                  largest_leg_step_before=largest_leg_step(before, contacts.feet),
                  largest_leg_step_after=largest_leg_step(after, contacts.feet))
     return cleaned, facts, contacts
+
+
+def _skate(motion, contacts) -> float:
+    """The skate measure of ``motion`` on the feet and vertical of ``contacts``, from one forward kinematics."""
+    from ..contacts import skate
+
+    return skate(motion, contacts.feet, up=contacts.up, positions=motion.world_positions(end_sites=True))
 
 
 def _clearance_facts(contacts, clearance, names) -> dict:
@@ -64,7 +71,7 @@ def travels(motion) -> bool:
 def lock_motion(motion, mode: str, foot_joints: str | None, moves: bool):
     """Any motion with its feet locked (``mode`` lock, or auto when ``moves`` and feet are found) and what the
     JSON says about it: a thin wrapper over :func:`mocycle.contacts.detect_contacts` and ``lock_feet``."""
-    from ..contacts import detect_contacts, find_feet, largest_leg_step, lock_feet, skate
+    from ..contacts import detect_contacts, find_feet, largest_leg_step, lock_feet
     from ..contacts.clearance import swing_clearance
 
     if mode == "auto":
@@ -85,8 +92,8 @@ def lock_motion(motion, mode: str, foot_joints: str | None, moves: bool):
     locked = lock_feet(motion, contacts, clearance=clearance)
     facts["seconds"] = time.perf_counter() - t0
     facts["clearance"] = _clearance_facts(contacts, clearance, motion.skeleton.names)
-    facts.update(contacts=contacts.to_dict(motion.skeleton.names), skate_before=skate(motion, contacts.feet),
-                 skate_after=skate(locked, contacts.feet),
+    facts.update(contacts=contacts.to_dict(motion.skeleton.names), skate_before=_skate(motion, contacts),
+                 skate_after=_skate(locked, contacts),
                  largest_leg_step_before=largest_leg_step(motion, contacts.feet),
                  largest_leg_step_after=largest_leg_step(locked, contacts.feet))
     return locked, facts
