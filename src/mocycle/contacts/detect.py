@@ -59,7 +59,7 @@ SMOOTH_SECONDS = 1 / 60  # std of the Gaussian the positions are smoothed with b
 MIN_CONTACT = 0.03      # seconds
 MIN_GAP = 0.06          # seconds
 FLOOR_SECONDS = 2.0     # a contact joint's floor: its lowest level over this time about each frame ...
-FLOOR_DRIFT = 0.05      # ... at most this (of the body height) above its lowest level over the whole motion
+FLOOR_DRIFT = 0.10      # ... at most this (of the body height) above its lowest level over the whole motion
 
 
 def ranges(mask: np.ndarray) -> list[tuple[int, int]]:
