@@ -10,19 +10,24 @@ from .figure import save, subplots
 
 
 def plot_contacts(motion, contacts, path: str | os.PathLike, title: str = "", before=None) -> None:
-    """One row per contact joint of ``contacts`` over the frames of ``motion``: height above the lowest level
-    and horizontal speed (file units, units/s), the contact frames shaded; ``before``: the motion before
-    clean-up, drawn dashed."""
-    from ..contacts.detect import heights_and_speeds
+    """One row per contact joint of ``contacts`` over the frames of ``motion``: height above its floor (the
+    detector's local floor) and horizontal speed (file units, units/s), the contact frames shaded;
+    ``before``: the motion before clean-up, drawn dashed."""
+    from ..contacts.detect import heights_and_speeds, local_floor
+
+    def above_floor(h):
+        return h - contacts.body * local_floor(h / contacts.body, motion.fps)
 
     names = motion.skeleton.names
     C = len(contacts.joints)
     fig, axes = subplots(C, 1, figsize=(10, 1.8 * C + 0.6), sharex=True, squeeze=False)
     frames = np.arange(motion.n_frames)
     h, v, _ = heights_and_speeds(motion, contacts.joints, contacts.up)
+    h = above_floor(h)
     hb = vb = None
     if before is not None:
         hb, vb, _ = heights_and_speeds(before, contacts.joints, contacts.up)
+        hb = above_floor(hb)
     for c, ax in enumerate(axes[:, 0]):
         for s, e in contacts.joint_ranges(c):
             ax.axvspan(s - 0.5, e - 0.5, color="tab:green", alpha=0.2, lw=0)
