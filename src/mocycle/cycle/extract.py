@@ -282,11 +282,19 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
         trial = Cycle(space=space, P=fit_p.predict(fine), L=fit_l.predict(fine), drift=fit_l.drift_,
                       method="harmonic", model=model, n_harmonics=K, axis=axis, positions=np.zeros(0),
                       periodic=periodic)
-        x0 += calmest_start(*loop_blocks(trial, reference), stride=SUBFRAMES) / (SUBFRAMES * N)
+        start = calmest_start(*loop_blocks(trial, reference), stride=SUBFRAMES)
+        x0 += start / (SUBFRAMES * N)
+        # the cycle's frames are trial samples start, start + 10, ... (one period on, where they pass its end:
+        # the periodic block and its projection are the same there): taken, not fitted and projected again
+        rows = (start + SUBFRAMES * np.arange(N)) % (SUBFRAMES * N)
+        P, projected = trial.P[rows], trial._rotations()[rows]
+    else:
+        P, projected = fit_p.predict(x0 + np.arange(N) / N), None
     xs = x0 + np.arange(N) / N
-    return Cycle(space=space, P=fit_p.predict(xs), L=fit_l.predict(xs), drift=fit_l.drift_, method="harmonic",
-                 model=model, n_harmonics=K, axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic,
-                 regression=fit_p)
+    cycle = Cycle(space=space, P=P, L=fit_l.predict(xs), drift=fit_l.drift_, method="harmonic", model=model,
+                  n_harmonics=K, axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic, regression=fit_p)
+    cycle._projected = projected
+    return cycle
 
 
 # ------------------------------------------------------------------ centroid
@@ -428,9 +436,14 @@ def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.n
         if not joints:
             raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
         L = cycle._inplace_L()
-        R = space.rotations(cycle.P, L, cycle._rotations())
-        C = (R if len(joints) == space.n_joints else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
-        cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L)))
+        R = cycle._rotations()  # local rotations; the travel joint's without its heading, which is put in below
+        travel = space.heading_rotations(L) @ R[:, space.travel]
+        every = len(joints) == space.n_joints
+        C = (R if every else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
+        if space.travel in joints:
+            at = space.travel if every else joints.index(space.travel)
+            C[:, 9 * at:9 * at + 9] = travel.reshape(-1, 9) / np.sqrt(2.0)
+        cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L), travel))
     return cycle._blocks
 
 
@@ -535,6 +548,8 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     else:
         cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion, reference))
     path, drift = space.bend(cycle.L, cycle.drift, space.heading_trend(L[:, 3], axis.period_frames)[0])
-    cycle = replace(cycle, L=path, drift=drift)
+    bent = replace(cycle, L=path, drift=drift)
+    bent._projected = cycle._projected  # the same P: the same projection
+    cycle = bent
     cycle.seconds = time.perf_counter() - t0
     return cycle

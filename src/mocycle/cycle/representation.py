@@ -210,8 +210,13 @@ class CycleSpace:
         heading ``L[:, 3]``."""
         P, L = self._check(P, L)
         R = self.project(P) if projected is None else projected.copy()
-        R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
+        R[:, self.travel] = self.heading_rotations(L) @ R[:, self.travel]
         return R
+
+    def heading_rotations(self, L: np.ndarray) -> np.ndarray:
+        """``(N, 3, 3)`` the turns about the vertical by the headings ``L[:, 3]`` that :meth:`rotations` puts
+        on the travel joint (in its parent's frame)."""
+        return axis_rotations(self.up, L[:, 3])
 
     def translations(self, P: np.ndarray, L: np.ndarray) -> np.ndarray:
         """The local translations ``(N, J, 3)`` that :meth:`decode` puts in its motion."""
@@ -223,18 +228,24 @@ class CycleSpace:
         trans[:, self.travel] = L[:, :3]
         return trans
 
-    def travel_path(self, rotations: np.ndarray, translations: np.ndarray) -> np.ndarray:
+    def travel_path(self, rotations: np.ndarray, translations: np.ndarray,
+                    travel_rotation: np.ndarray | None = None) -> np.ndarray:
         """World positions ``(N, 3)`` of the travel joint from local ``rotations (N, J, 3, 3)`` and
         ``translations (N, J, 3)``: forward kinematics along its chain from the root only (the products of
-        :meth:`Motion.world_positions <mocycle.motion.Motion.world_positions>` for that joint)."""
+        :meth:`Motion.world_positions <mocycle.motion.Motion.world_positions>` for that joint).
+        ``travel_rotation`` ``(N, 3, 3)``: the travel joint's rotation, in place of ``rotations[:, travel]``."""
         chain = [self.travel]
         while self.skeleton.parents[chain[-1]] >= 0:
             chain.append(int(self.skeleton.parents[chain[-1]]))
         chain.reverse()
-        world_r, world_p = rotations[:, chain[0]], translations[:, chain[0]]
+
+        def local(j):
+            return travel_rotation if j == self.travel and travel_rotation is not None else rotations[:, j]
+
+        world_r, world_p = local(chain[0]), translations[:, chain[0]]
         for j in chain[1:]:
             world_p = world_p + (world_r @ translations[:, j, :, None])[..., 0]
-            world_r = world_r @ rotations[:, j]
+            world_r = world_r @ local(j)
         return world_p
 
     def decode_rows(self, P: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
