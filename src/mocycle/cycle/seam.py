@@ -18,11 +18,24 @@ LOCAL = 4  # frames on each side of the wrap for the local ratio
 
 def _changes(C: np.ndarray, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """``step[k]`` into sample k and ``acc[k]`` at sample k, ``(N,)`` each, wrapping around; one frame is
-    ``stride`` samples."""
+    ``stride`` samples.  The second difference ``C[k+s] - 2 C[k] + C[k-s]`` is taken as the change of the
+    first, ``D[k+s] - D[k]`` with ``D[k] = C[k] - C[k-s]`` (no rolled copies of ``C``)."""
     C = np.asarray(C, dtype=np.float64).reshape(C.shape[0], -1)
-    step = np.linalg.norm(C - np.roll(C, stride, axis=0), axis=1)
-    acc = np.linalg.norm(np.roll(C, -stride, axis=0) - 2 * C + np.roll(C, stride, axis=0), axis=1)
-    return step, acc
+    N = C.shape[0]
+    s = stride % N
+    D = np.empty_like(C)
+    np.subtract(C[s:], C[:N - s], out=D[s:])
+    np.subtract(C[:s], C[N - s:], out=D[:s])
+    A = np.empty_like(D)
+    np.subtract(D[s:], D[:N - s], out=A[:N - s])
+    np.subtract(D[:s], D[N - s:], out=A[N - s:])
+    return _row_norms(D), _row_norms(A)
+
+
+def _row_norms(X: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(X, axis=1)`` of ``X`` ``(N, D)``, squaring in place (``X`` is a temporary)."""
+    np.multiply(X, X, out=X)
+    return np.sqrt(np.add.reduce(X, axis=1))
 
 
 def _ratio(value: float, reference: float) -> float:
