@@ -88,6 +88,10 @@ class Cycle:
             self.drift = self.drift.copy()
             self.drift[:3] -= rise * up
 
+    def __getstate__(self) -> dict:
+        """Pickled without the caches ``_blocks`` and ``_projected`` (made again from ``P`` when asked for)."""
+        return {**self.__dict__, "_blocks": None, "_projected": None}
+
     @property
     def n_frames(self) -> int:
         return self.P.shape[0]
