@@ -28,7 +28,7 @@ from .. import _validate
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
 from ..limits import check_frames
-from ..motion import Motion
+from ..motion import ROTATION_CHANNELS, Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
 from ..rotations import axis_rotations, mean_rotations
@@ -423,7 +423,7 @@ def metric_features(motion: Motion, reference: np.ndarray | None = None, rows: s
 
 def _rotation_joints(skeleton) -> list[int]:
     """The joints :func:`metric_features` measures: those with rotation channels."""
-    return [j for j in skeleton.select(None) if skeleton.euler_order(j)]
+    return [j for j, channels in enumerate(skeleton.channels) if any(c in ROTATION_CHANNELS for c in channels)]
 
 
 def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
