@@ -31,7 +31,7 @@ from ..limits import check_frames
 from ..motion import ROTATION_CHANNELS, Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
-from ..rotations import axis_rotations, mean_rotations
+from ..rotations import axis_rotations
 from ..threads import limit_threads
 from .differences import HALF, central_acceleration, central_velocity
 from .harmonic import MODELS, HarmonicRegression, max_harmonics
@@ -261,11 +261,13 @@ def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
 
 
 def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, periodic: PeriodicMotion,
-                   model: str = "M1", n_harmonics: int | str = "auto", reference: np.ndarray | None = None) -> Cycle:
+                   model: str = "M1", n_harmonics: int | str = "auto", reference: np.ndarray | None = None,
+                   *, calmest: bool | None = None) -> Cycle:
     """Fit ``P`` periodically and ``L`` with a linear term on ``axis``, sample one period at ``N`` frames.
 
-    With ``reference`` (the input's mean rotation per joint, ``(J, 4)``) the cycle starts at its calmest
-    point, chosen to a tenth of a frame; without, at phase 0 of the axis.
+    With ``calmest`` (default: when a ``reference`` is given, the input's mean rotation per joint ``(J, 4)``,
+    whose value changes nothing) the cycle starts at its calmest point, chosen to a tenth of a frame;
+    without, at phase 0 of the axis.
     """
     _check_choice(model, MODELS, "model")
     frames = axis.frames()
@@ -281,12 +283,12 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     del dP, ddP  # (T, D) each: not held while L is fitted
     fit_l = HarmonicRegression(K, model, linear=True).fit(x, _rows(L, axis, frames), xd, dL, ddL)
     x0 = float(np.floor(x[0]))
-    if reference is not None:  # start where the wrap is the calmest step, choosing between frames too
+    if calmest or (calmest is None and reference is not None):  # start at the calmest step, between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
         trial = Cycle(space=space, P=fit_p.predict(fine), L=fit_l.predict(fine), drift=fit_l.drift_,
                       method="harmonic", model=model, n_harmonics=K, axis=axis, positions=np.zeros(0),
                       periodic=periodic)
-        start = calmest_start(*loop_blocks(trial, reference), stride=SUBFRAMES)
+        start = calmest_start(*loop_blocks(trial), stride=SUBFRAMES)
         x0 += start / (SUBFRAMES * N)
         # the cycle's frames are trial samples start, start + 10, ... (one period on, where they pass its end:
         # the periodic block and its projection are the same there): taken, not fitted and projected again
@@ -542,15 +544,14 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     P, L = space.encode(motion)
     # The path is fitted straightened (periodic plus a line) and turned back along the cycle's heading.
     Q = space.straighten(L, axis.period_frames)
-    reference = mean_rotations(motion.rotations)
     # The cut's wrap is its seam; the others have none, so they start at the calmest point.
     if method == "harmonic":
-        cycle = harmonic_cycle(space, P, Q, axis, periodic, model, n_harmonics, reference)
+        cycle = harmonic_cycle(space, P, Q, axis, periodic, model, n_harmonics, calmest=True)
     elif method == "centroid":
         cycle = centroid_cycle(space, P, Q, axis, periodic)
-        cycle = cycle.rolled(calmest_start(*loop_blocks(cycle, reference)))
+        cycle = cycle.rolled(calmest_start(*loop_blocks(cycle)))
     else:
-        cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion, reference))
+        cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion))
     path, drift = space.bend(cycle.L, cycle.drift, space.heading_trend(L[:, 3], axis.period_frames)[0])
     bent = replace(cycle, L=path, drift=drift)
     bent._projected = cycle._projected  # the same P: the same projection
