@@ -64,25 +64,28 @@ class FailedCheck:
         return {"check": self.name, "value": self.value, "limit": self.limit, "reason": self.reason}
 
 
-def _plain_cut_error(Y: np.ndarray, period: float) -> tuple[float, int]:
+def _plain_cut_error(Y: np.ndarray, period: float, differences: dict | None = None) -> tuple[float, int]:
     """Template error of the best plain cut of ``Y (M, D)`` with a lag within :data:`CUT_SPAN` of ``period``.
 
     The cut is frames ``a .. a+lag-1`` between the two windows (a fifth of a period wide) that are most
     alike ``lag`` frames apart, as :func:`~mocycle.cycle.extract.cut_cycle` picks them, without its
-    cross-fade.  Returns ``(error, lag)``; NaN error when the frames hold no such pair.
+    cross-fade.  Returns ``(error, lag)``; NaN error when the frames hold no such pair.  ``differences``:
+    lag -> :func:`_lag_differences`, filled and reused across calls on the same ``Y`` (two period estimates
+    close together search the same lags).
     """
     M = Y.shape[0]
     if not np.isfinite(period) or period < 2:
         return float("nan"), 0
+    differences = {} if differences is None else differences
     lags = np.arange(max(2, int(np.floor((1 - CUT_SPAN) * period))), int(np.ceil((1 + CUT_SPAN) * period)) + 1)
     lags = lags[lags < M - 1]
     h = max(1, int(round(0.1 * period)))
     best = (np.inf, 0, 0)
     for lag in lags:
-        d = np.empty(M - lag)
-        for r in range(0, M - lag, 8192):  # in blocks of rows: no temporaries as large as Y
-            r1 = min(r + 8192, M - lag)
-            d[r:r1] = ((Y[r:r1] - Y[r + lag:r1 + lag]) ** 2).sum(axis=1)
+        lag = int(lag)
+        if lag not in differences:
+            differences[lag] = _lag_differences(Y, lag)
+        d = differences[lag]
         if d.size < 2 * h + 1:
             continue
         c = np.concatenate([[0.0], np.cumsum(d)])
@@ -97,23 +100,43 @@ def _plain_cut_error(Y: np.ndarray, period: float) -> tuple[float, int]:
     return template_error(Y, Y[a:a + lag])[0], lag
 
 
+def _lag_differences(Y: np.ndarray, lag: int) -> np.ndarray:
+    """``(M - lag,)`` squared distances between the rows of ``Y (M, D)`` ``lag`` rows apart, in blocks of rows
+    (no temporaries as large as ``Y``)."""
+    M = Y.shape[0]
+    d = np.empty(M - lag)
+    for r in range(0, M - lag, 8192):
+        r1 = min(r + 8192, M - lag)
+        d[r:r1] = ((Y[r:r1] - Y[r + lag:r1 + lag]) ** 2).sum(axis=1)
+    return d
+
+
+def moving_columns(Y: np.ndarray) -> np.ndarray:
+    """``Y (M, D)`` without its columns that hold one value on every row (joints that never move, the fixed
+    entries of a joint turning about one axis): they add exactly nothing to a distance between two of its
+    rows, and only rounding to a distance from a cycle fitted to it.  ``Y`` itself when every column moves."""
+    moving = np.ptp(Y, axis=0) > 0 if Y.shape[0] else np.ones(Y.shape[1], dtype=bool)
+    return Y if moving.all() else Y[:, moving]
+
+
 def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = None,
                    features: np.ndarray | None = None) -> tuple[float, float]:
     """``(template error of the best plain cut, its length in frames)`` on the cycle's longest excited
     region: the better of cuts near the cycle's period and near the region's own autocorrelation period
     (paper 004 eq. 1 on the pose features; independent of the phase).  ``reference`` changes nothing
     (:func:`~mocycle.cycle.extract.metric_features`); ``features``: the region's metric features when the
-    caller has them."""
+    caller has them (its still columns may be left out: :func:`moving_columns`)."""
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    Y = metric_features(motion, rows=slice(s, e)) if features is None else features
+    Y = moving_columns(metric_features(motion, rows=slice(s, e)) if features is None else features)
     candidates = [cycle.period_frames]
     if Y.shape[0] >= 8:
         min_lag = max(2, int(round(MIN_PERIOD_S / motion.frame_time)))
         if min_lag <= Y.shape[0] // 2:
             candidates.append(autocorrelation_period(Y, min_lag=min_lag))
     best = (float("nan"), float("nan"))
+    differences: dict = {}
     for p in candidates:
-        err, lag = _plain_cut_error(Y, p)
+        err, lag = _plain_cut_error(Y, p, differences)
         if np.isfinite(err) and not err >= best[0]:
             best = (err, float(lag))
     return best
@@ -139,6 +162,7 @@ def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> li
         tmpl = template_error(Y, C)[0]
         ratios = [seam_ratios(C), seam_ratios(root)]
         seam = max(max(r["pose_local"], r["velocity_local"]) for r in ratios)
+    Y = moving_columns(Y)  # the cut and the spread: still columns add nothing
     cut, cut_period = best_cut_error(motion, cycle, features=Y)
     mean = Y.mean(axis=0)
     spread = float(np.sqrt(sum(float(((Y[r:r + 8192] - mean) ** 2).sum()) for r in range(0, Y.shape[0], 8192))

@@ -28,10 +28,10 @@ from .. import _validate
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..features import pose_matrix
 from ..limits import check_frames
-from ..motion import Motion
+from ..motion import ROTATION_CHANNELS, Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
-from ..rotations import axis_rotations, mean_rotations
+from ..rotations import axis_rotations
 from ..threads import limit_threads
 from .differences import HALF, central_acceleration, central_velocity
 from .harmonic import MODELS, HarmonicRegression, max_harmonics
@@ -87,6 +87,10 @@ class Cycle:
             self.L[:, :3] -= ramp * (rise * up)
             self.drift = self.drift.copy()
             self.drift[:3] -= rise * up
+
+    def __getstate__(self) -> dict:
+        """Pickled without the caches ``_blocks`` and ``_projected`` (made again from ``P`` when asked for)."""
+        return {**self.__dict__, "_blocks": None, "_projected": None}
 
     @property
     def n_frames(self) -> int:
@@ -257,11 +261,13 @@ def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
 
 
 def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, periodic: PeriodicMotion,
-                   model: str = "M1", n_harmonics: int | str = "auto", reference: np.ndarray | None = None) -> Cycle:
+                   model: str = "M1", n_harmonics: int | str = "auto", reference: np.ndarray | None = None,
+                   *, calmest: bool | None = None) -> Cycle:
     """Fit ``P`` periodically and ``L`` with a linear term on ``axis``, sample one period at ``N`` frames.
 
-    With ``reference`` (the input's mean rotation per joint, ``(J, 4)``) the cycle starts at its calmest
-    point, chosen to a tenth of a frame; without, at phase 0 of the axis.
+    With ``calmest`` (default: when a ``reference`` is given, the input's mean rotation per joint ``(J, 4)``,
+    whose value changes nothing) the cycle starts at its calmest point, chosen to a tenth of a frame;
+    without, at phase 0 of the axis.
     """
     _check_choice(model, MODELS, "model")
     frames = axis.frames()
@@ -277,16 +283,24 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     del dP, ddP  # (T, D) each: not held while L is fitted
     fit_l = HarmonicRegression(K, model, linear=True).fit(x, _rows(L, axis, frames), xd, dL, ddL)
     x0 = float(np.floor(x[0]))
-    if reference is not None:  # start where the wrap is the calmest step, choosing between frames too
+    if calmest or (calmest is None and reference is not None):  # start at the calmest step, between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
         trial = Cycle(space=space, P=fit_p.predict(fine), L=fit_l.predict(fine), drift=fit_l.drift_,
                       method="harmonic", model=model, n_harmonics=K, axis=axis, positions=np.zeros(0),
                       periodic=periodic)
-        x0 += calmest_start(*loop_blocks(trial, reference), stride=SUBFRAMES) / (SUBFRAMES * N)
+        start = calmest_start(*loop_blocks(trial), stride=SUBFRAMES)
+        x0 += start / (SUBFRAMES * N)
+        # the cycle's frames are trial samples start, start + 10, ... (one period on, where they pass its end:
+        # the periodic block and its projection are the same there): taken, not fitted and projected again
+        rows = (start + SUBFRAMES * np.arange(N)) % (SUBFRAMES * N)
+        P, projected = trial.P[rows], trial._rotations()[rows]
+    else:
+        P, projected = fit_p.predict(x0 + np.arange(N) / N), None
     xs = x0 + np.arange(N) / N
-    return Cycle(space=space, P=fit_p.predict(xs), L=fit_l.predict(xs), drift=fit_l.drift_, method="harmonic",
-                 model=model, n_harmonics=K, axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic,
-                 regression=fit_p)
+    cycle = Cycle(space=space, P=P, L=fit_l.predict(xs), drift=fit_l.drift_, method="harmonic", model=model,
+                  n_harmonics=K, axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic, regression=fit_p)
+    cycle._projected = projected
+    return cycle
 
 
 # ------------------------------------------------------------------ centroid
@@ -411,7 +425,7 @@ def metric_features(motion: Motion, reference: np.ndarray | None = None, rows: s
 
 def _rotation_joints(skeleton) -> list[int]:
     """The joints :func:`metric_features` measures: those with rotation channels."""
-    return [j for j in skeleton.select(None) if skeleton.euler_order(j)]
+    return [j for j, channels in enumerate(skeleton.channels) if any(c in ROTATION_CHANNELS for c in channels)]
 
 
 def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -428,9 +442,14 @@ def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.n
         if not joints:
             raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
         L = cycle._inplace_L()
-        R = space.rotations(cycle.P, L, cycle._rotations())
-        C = (R if len(joints) == space.n_joints else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
-        cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L)))
+        R = cycle._rotations()  # local rotations; the travel joint's without its heading, which is put in below
+        travel = space.heading_rotations(L) @ R[:, space.travel]
+        every = len(joints) == space.n_joints
+        C = (R if every else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
+        if space.travel in joints:
+            at = space.travel if every else joints.index(space.travel)
+            C[:, 9 * at:9 * at + 9] = travel.reshape(-1, 9) / np.sqrt(2.0)
+        cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L), travel))
     return cycle._blocks
 
 
@@ -525,16 +544,17 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     P, L = space.encode(motion)
     # The path is fitted straightened (periodic plus a line) and turned back along the cycle's heading.
     Q = space.straighten(L, axis.period_frames)
-    reference = mean_rotations(motion.rotations)
     # The cut's wrap is its seam; the others have none, so they start at the calmest point.
     if method == "harmonic":
-        cycle = harmonic_cycle(space, P, Q, axis, periodic, model, n_harmonics, reference)
+        cycle = harmonic_cycle(space, P, Q, axis, periodic, model, n_harmonics, calmest=True)
     elif method == "centroid":
         cycle = centroid_cycle(space, P, Q, axis, periodic)
-        cycle = cycle.rolled(calmest_start(*loop_blocks(cycle, reference)))
+        cycle = cycle.rolled(calmest_start(*loop_blocks(cycle)))
     else:
-        cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion, reference))
+        cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion))
     path, drift = space.bend(cycle.L, cycle.drift, space.heading_trend(L[:, 3], axis.period_frames)[0])
-    cycle = replace(cycle, L=path, drift=drift)
+    bent = replace(cycle, L=path, drift=drift)
+    bent._projected = cycle._projected  # the same P: the same projection
+    cycle = bent
     cycle.seconds = time.perf_counter() - t0
     return cycle

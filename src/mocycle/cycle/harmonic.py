@@ -142,27 +142,32 @@ class HarmonicRegression:
         """Fit positions ``Y (M, D)`` at times ``x (M,)`` (periods); velocities ``dY`` and accelerations
         ``ddY`` ``(M', D)`` per period (and per period²) at times ``xd (M',)`` for M1 and M3."""
         x, Y, xd, dY, ddY = self._check(x, Y, xd, dY, ddY)
+        P = harmonic_basis(x, self.n_harmonics, 0, self.linear)
         still = np.all(Y == Y[:1], axis=0)
         if still.any():
-            return self._fit_moving(~still, x, Y, xd, dY, ddY)
+            self._fit_moving(~still, P, xd, Y, dY, ddY)
+        else:
+            self._fit_all(P, xd, Y, dY, ddY)
+        self.rmse_ = self._rmse(P, Y, xd, dY, ddY)
+        return self
+
+    def _fit_all(self, P, xd, Y, dY, ddY) -> None:
+        """``coef_``, ``alpha_``, ``gamma_``, ``sigma2_`` of every column of ``Y`` (design ``P`` of the positions)."""
         K, lin, D = self.n_harmonics, self.linear, Y.shape[1]
-        P = harmonic_basis(x, K, 0, lin)
         if self.model == "M2":
             self.coef_ = np.linalg.lstsq(P, Y, rcond=None)[0]
             self.alpha_, self.gamma_ = np.zeros(D), np.zeros(D)
             self.sigma2_ = np.full((3, D), np.nan)
+            return
+        V, A = harmonic_basis(xd, K, 1, lin), harmonic_basis(xd, K, 2, lin)
+        if self.model == "M3":
+            self.alpha_, self.gamma_ = np.ones(D), np.ones(D)
+            self.sigma2_ = np.full((3, D), np.nan)
+            self.coef_ = np.linalg.lstsq(np.vstack([P, V, A]), np.vstack([Y, dY, ddY]), rcond=None)[0]
         else:
-            V, A = harmonic_basis(xd, K, 1, lin), harmonic_basis(xd, K, 2, lin)
-            if self.model == "M3":
-                self.alpha_, self.gamma_ = np.ones(D), np.ones(D)
-                self.sigma2_ = np.full((3, D), np.nan)
-                self.coef_ = np.linalg.lstsq(np.vstack([P, V, A]), np.vstack([Y, dY, ddY]), rcond=None)[0]
-            else:
-                self._fit_fgls(P, V, A, Y, dY, ddY)
-        self.rmse_ = self._rmse(P, Y, xd, dY, ddY)
-        return self
+            self._fit_fgls(P, V, A, Y, dY, ddY)
 
-    def _fit_moving(self, moving: np.ndarray, x, Y, xd, dY, ddY) -> HarmonicRegression:
+    def _fit_moving(self, moving: np.ndarray, P, xd, Y, dY, ddY) -> None:
         """Fit the columns where ``moving`` ``(D,)`` is set; every other column of ``Y`` is one value on every
         row (a joint that never moves): its curve is that constant (``coef_`` ``[c, 0, ..., 0]``, so
         :meth:`predict` gives ``c`` exactly), with the weights a still curve gets (``alpha_``, ``gamma_``
@@ -170,8 +175,8 @@ class HarmonicRegression:
         D = Y.shape[1]
         sub = HarmonicRegression(self.n_harmonics, self.model, self.linear)
         if moving.any():
-            sub.fit(x, Y[:, moving], xd, None if dY is None else dY[:, moving],
-                    None if ddY is None else ddY[:, moving])
+            sub._fit_all(P, xd, Y[:, moving], None if dY is None else dY[:, moving],
+                         None if ddY is None else ddY[:, moving])
         p = 2 * self.n_harmonics + 1 + int(self.linear)
         self.coef_ = np.zeros((p, D))
         self.coef_[0] = Y[0]
@@ -182,8 +187,6 @@ class HarmonicRegression:
             self.coef_[:, moving] = sub.coef_
             self.alpha_[moving], self.gamma_[moving] = sub.alpha_, sub.gamma_
             self.sigma2_[:, moving] = sub.sigma2_
-        self.rmse_ = self._rmse(harmonic_basis(x, self.n_harmonics, 0, self.linear), Y, xd, dY, ddY)
-        return self
 
     def _fit_fgls(self, P, V, A, Y, dY, ddY) -> None:
         """M1: group variances from separate OLS fits (eq. 3.11-3.13), then WLS (eq. 3.19), all DOFs at once."""
@@ -206,12 +209,13 @@ class HarmonicRegression:
         b = (P.T @ Y).T + self.alpha_[:, None] * (V.T @ dY).T + self.gamma_[:, None] * (A.T @ ddY).T  # (D, p)
         # A tiny ridge keeps DOFs that never move (all-zero rows and columns but the constant) solvable.
         ridge = 1e-12 * np.trace(PtP) / PtP.shape[0] * np.eye(PtP.shape[0])
+        # every DOF's normal matrix PtP + ridge + alpha VtV + gamma AtA as one product (D, 3) @ (3, p²)
+        grams = np.stack([PtP + ridge, VtV, AtA]).reshape(3, -1)
         coef = np.empty(b.shape)
         for d in range(0, b.shape[0], _SOLVE_BLOCK):  # (block, p, p) normal matrices that stay in the cache
             block = slice(d, d + _SOLVE_BLOCK)
-            G = PtP + self.alpha_[block, None, None] * VtV
-            G += self.gamma_[block, None, None] * AtA
-            G += ridge
+            weights = np.column_stack([np.ones(b[block].shape[0]), self.alpha_[block], self.gamma_[block]])
+            G = (weights @ grams).reshape(-1, *PtP.shape)
             coef[block] = np.linalg.solve(G, b[block, :, None])[..., 0]
         self.coef_ = coef.T
 

@@ -38,6 +38,8 @@ from ..rotations import axis_rotations, continuous_quats, matrix_quats, nearest_
 
 #: frames encoded at a time (the rotation matrices of a block, not of the take, are temporaries)
 BLOCK_FRAMES = 8192
+#: matrices projected at a time by :meth:`CycleSpace.project`
+PROJECT_MATRICES = 8192
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -196,12 +198,18 @@ class CycleSpace:
         M = P[:, : 9 * J].reshape(N, J, 3, 3)
         still = np.all(P[:, : 9 * J] == P[:1, : 9 * J], axis=0).reshape(J, 9).all(axis=1) if N > 1 \
             else np.zeros(J, dtype=bool)
-        if not still.any():
-            return nearest_rotations(M)
         R = np.empty_like(M)
-        R[:, still] = nearest_rotations(M[0, still])
+        if still.any():
+            R[:, still] = nearest_rotations(M[0, still])
         moving = np.flatnonzero(~still)
-        R[:, moving] = nearest_rotations(np.take(M, moving, axis=1))  # take: a contiguous copy, unlike M[:, moving]
+        # a few thousand matrices at a time: the copies and results stay small (the whole trial cycle of a
+        # 100-joint rig at once, 3.6 MB per array, spent a quarter of its time on fresh pages)
+        rows = max(1, PROJECT_MATRICES // max(1, moving.size))
+        for r in range(0, N, rows):
+            if moving.size == J:
+                R[r:r + rows] = nearest_rotations(M[r:r + rows])
+            elif moving.size:  # take: a contiguous copy, unlike M[:, moving]
+                R[r:r + rows, moving] = nearest_rotations(np.take(M[r:r + rows], moving, axis=1))
         return R
 
     def rotations(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray | None = None) -> np.ndarray:
@@ -210,8 +218,13 @@ class CycleSpace:
         heading ``L[:, 3]``."""
         P, L = self._check(P, L)
         R = self.project(P) if projected is None else projected.copy()
-        R[:, self.travel] = axis_rotations(self.up, L[:, 3]) @ R[:, self.travel]
+        R[:, self.travel] = self.heading_rotations(L) @ R[:, self.travel]
         return R
+
+    def heading_rotations(self, L: np.ndarray) -> np.ndarray:
+        """``(N, 3, 3)`` the turns about the vertical by the headings ``L[:, 3]`` that :meth:`rotations` puts
+        on the travel joint (in its parent's frame)."""
+        return axis_rotations(self.up, L[:, 3])
 
     def translations(self, P: np.ndarray, L: np.ndarray) -> np.ndarray:
         """The local translations ``(N, J, 3)`` that :meth:`decode` puts in its motion."""
@@ -223,18 +236,24 @@ class CycleSpace:
         trans[:, self.travel] = L[:, :3]
         return trans
 
-    def travel_path(self, rotations: np.ndarray, translations: np.ndarray) -> np.ndarray:
+    def travel_path(self, rotations: np.ndarray, translations: np.ndarray,
+                    travel_rotation: np.ndarray | None = None) -> np.ndarray:
         """World positions ``(N, 3)`` of the travel joint from local ``rotations (N, J, 3, 3)`` and
         ``translations (N, J, 3)``: forward kinematics along its chain from the root only (the products of
-        :meth:`Motion.world_positions <mocycle.motion.Motion.world_positions>` for that joint)."""
+        :meth:`Motion.world_positions <mocycle.motion.Motion.world_positions>` for that joint).
+        ``travel_rotation`` ``(N, 3, 3)``: the travel joint's rotation, in place of ``rotations[:, travel]``."""
         chain = [self.travel]
         while self.skeleton.parents[chain[-1]] >= 0:
             chain.append(int(self.skeleton.parents[chain[-1]]))
         chain.reverse()
-        world_r, world_p = rotations[:, chain[0]], translations[:, chain[0]]
+
+        def local(j):
+            return travel_rotation if j == self.travel and travel_rotation is not None else rotations[:, j]
+
+        world_r, world_p = local(chain[0]), translations[:, chain[0]]
         for j in chain[1:]:
             world_p = world_p + (world_r @ translations[:, j, :, None])[..., 0]
-            world_r = world_r @ rotations[:, j]
+            world_r = world_r @ local(j)
         return world_p
 
     def decode_rows(self, P: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
