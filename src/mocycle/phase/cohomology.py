@@ -195,13 +195,25 @@ def greedy_permutation(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     distances ``(n, N)`` (to about 1e-7 of the rows' spread near zero; a landmark's distance to itself is 0).
     ripser's ``n_perm`` does the same but calls
     scikit-learn's ``pairwise_distances`` (with its input checks) once per
-    landmark, which was 85 % of the time of a whole fit.  Each pass is one matrix-vector product of the
-    centred rows, ``|x|² - 2 x·l + |l|²`` (3× the passes over ``X - l`` of the same rows): the same
-    landmarks unless two rows are as far to within rounding.
+    landmark, which was 85 % of the time of a whole fit.
+    """
+    idx, dist, _ = _greedy(X, n)
+    return idx, dist
+
+
+def _greedy(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """:func:`greedy_permutation` and the largest distance from a row to its nearest landmark.
+
+    Each pass is one matrix-vector product of the centred rows, ``|x|² - 2 x·l + |l|²`` (a third of the
+    time of the passes over ``X - l``).  Its rounding could pick another of two rows that are equally far
+    to within 1e-13, so the next landmark is chosen by :func:`_farthest` among the rows within that
+    rounding of the farthest, on ``|x - l|`` row by row: the landmarks of the plain algorithm, to the bit.
     """
     N = X.shape[0]
     Xc = X - X.mean(axis=0)  # centred: |x|² stays of the order of the distances, so does the rounding
     sq = np.einsum("nd,nd->n", Xc, Xc)
+    # a bound on the rounding of the squared distances below: a few ulps of the largest term, per column
+    tol = 8.0 * (X.shape[1] + 2) * np.finfo(np.float64).eps * (2.0 * float(sq.max()) + 1e-300)
     idx = np.zeros(n, dtype=np.int64)
     dist = np.empty((n, N))
     nearest = np.full(N, np.inf)
@@ -213,11 +225,25 @@ def greedy_permutation(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
         row += sq[idx[i]]
         np.minimum(nearest, row, out=nearest)
         if i + 1 < n:
-            idx[i + 1] = int(np.argmax(nearest))
+            far = int(np.argmax(nearest))
+            level = nearest[far] - 2.0 * tol
+            idx[i + 1] = far if np.count_nonzero(nearest >= level) == 1 else _farthest(X, idx[: i + 1], nearest, tol)[0]
+    radius = _farthest(X, idx, nearest, tol)[1]
     np.maximum(dist, 0.0, out=dist)
     np.sqrt(dist, out=dist)
     dist[np.arange(n), idx] = 0.0
-    return idx, dist
+    return idx, dist, radius
+
+
+def _farthest(X: np.ndarray, landmarks: np.ndarray, nearest2: np.ndarray, tol: float) -> tuple[int, float]:
+    """The row of ``X`` farthest from its nearest landmark (the first of equals) and that distance, measured
+    as ``|x - l|`` on the rows whose rounded squared distance ``nearest2`` ``(N,)`` is within ``2 tol`` of
+    the largest (``tol``: the rounding bound), so the one the exact distances pick is among them."""
+    cand = np.flatnonzero(nearest2 >= nearest2.max() - 2.0 * tol)
+    diff = X[cand][:, None, :] - X[landmarks][None, :, :]
+    exact = np.sqrt(np.einsum("cld,cld->cl", diff, diff)).min(axis=1)
+    k = int(np.argmax(exact))
+    return int(cand[k]), float(exact[k])
 
 
 def landmark_distances(points: np.ndarray) -> np.ndarray:
@@ -471,10 +497,10 @@ class CohomologyFit:
         N = X.shape[0]
         L = int(min(self.n_landmarks, N))
         pool = landmark_pool(N)
-        picked, dist = greedy_permutation(X[pool] if pool.size < N else X, L)  # (L,), (L, M)
+        picked, _, radius = _greedy(X[pool] if pool.size < N else X, L)  # (L,), (L, M), pool's cover radius
         idx = pool[picked]
         dist_ll = landmark_distances(X[idx])
-        r_cover = float(dist.min(axis=0).max()) if pool.size == N else cover_radius(X, X[idx])
+        r_cover = radius if pool.size == N else cover_radius(X, X[idx])
         primes = [self.prime] + [p for p in PRIMES if p != self.prime]
         for prime in primes:
             barcode, cocycles = rips_h1(dist_ll, prime)
