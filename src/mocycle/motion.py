@@ -225,7 +225,7 @@ class Motion:
         normalises and freezes them in place instead of copying them (what the readers do: half the memory).
     """
 
-    __slots__ = ("skeleton", "rotations", "translations", "frame_time", "_travel", "_up")
+    __slots__ = ("skeleton", "rotations", "translations", "frame_time", "_travel", "_up", "_heading")
 
     def __init__(
         self,
