@@ -273,7 +273,12 @@ def _is_cocycle(Z: np.ndarray, adjacent: np.ndarray) -> bool:
     ``Z`` holds small integers, so the sum over every triangle ``a-b-c`` of ``(z_ab + z_bc + z_ca)²``,
     one entry per edge ``a-c``, is exact in floating point: expanded, it is a few matrix products.
     """
-    A = adjacent.astype(np.float64)
+    # Every partial sum is an integer below L (3 max|z|)²: single precision is exact while that stays under
+    # 2^24 (120 landmarks, |z| <= 23: 571 000), and its matrix products take half the time.
+    exact32 = Z.shape[0] * (3.0 * float(np.abs(Z).max(initial=0.0))) ** 2 < 2.0**24
+    dtype = np.float32 if exact32 else np.float64
+    Z = Z.astype(dtype)
+    A = adjacent.astype(dtype)
     B = A * Z  # z on the edges
     B2 = B * Z
     Zca = Z.T  # z(c, a) at [a, c]
