@@ -68,7 +68,7 @@ def leg_curves(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
     # The lateral direction: from one top leg joint (its parent is no leg joint: the hips) to the other.
     tops = [k for k, j in enumerate(legs) if int(skel.parents[j]) not in set(legs.tolist())]
     if len(tops) >= 2:
-        mean = xyz.mean(axis=0)[:, [0, 2]]
+        mean = _frame_mean(xyz)[:, [0, 2]]
         gaps = mean[tops][:, None] - mean[tops][None]
         i, j = np.unravel_index(np.argmax(np.linalg.norm(gaps, axis=2)), gaps.shape[:2])
         side = gaps[i, j]
@@ -146,7 +146,7 @@ def leg_sides(curves: np.ndarray, legs: np.ndarray | None = None) -> tuple[np.nd
     joint of one side is paired with the joint of the other side whose mean position, laterally mirrored,
     is nearest.  Empty arrays when the legs do not split into two sides.
     """
-    mean = curves.mean(axis=0)                                      # (n, 3)
+    mean = _frame_mean(curves)                                      # (n, 3)
     lat = mean[:, 2]
     if lat.size == 0 or not np.abs(lat).max() > 0:
         return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
@@ -182,18 +182,6 @@ def legs_period(motion: Motion, curves: np.ndarray | None = None) -> float:
     return autocorrelation_period(curves.reshape(T, -1), min_lag=min_lag)
 
 
-def _shifted(Y: np.ndarray, lag: float) -> tuple[np.ndarray, np.ndarray]:
-    """Rows ``t`` and rows ``t + lag`` (linear interpolation) of ``Y`` ``(T, ...)`` for every valid ``t``."""
-    T = Y.shape[0]
-    k = int(np.floor(lag))
-    f = lag - k
-    n = T - k - 1
-    if n < 1:
-        return Y[:0], Y[:0]
-    later = (1.0 - f) * Y[k: k + n] + f * Y[k + 1: k + 1 + n]
-    return Y[:n], later
-
-
 @dataclass(frozen=True)
 class SideSwap:
     """Result of :func:`sides_swap`: mean squared distances (file units²) one period apart.
@@ -221,10 +209,28 @@ def sides_swap(curves: np.ndarray, period: float, frames: np.ndarray | slice | N
     if a.size == 0 or not np.isfinite(period) or period <= 0:
         return SideSwap(float("nan"), float("nan"), 0)
     Y = curves if frames is None else curves[frames]
-    Y = Y[:, :, :2] - Y[:, :, :2].mean(axis=0)
-    now, later = _shifted(Y, float(period))
-    if now.shape[0] < 2:
+    k = int(np.floor(period))
+    f = float(period) - k
+    n = Y.shape[0] - k - 1  # frames t with t + period inside (as _shifted)
+    if n < 2:
         return SideSwap(float("nan"), float("nan"), 0)
-    same = np.mean((later[:, a] - now[:, a]) ** 2) + np.mean((later[:, b] - now[:, b]) ** 2)
-    swapped = np.mean((later[:, a] - now[:, b]) ** 2) + np.mean((later[:, b] - now[:, a]) ** 2)
-    return SideSwap(float(same), float(swapped), int(a.size))
+    # forward and up of each side's joints as rows (2k, T): every step below runs along contiguous rows
+    sides = [np.ascontiguousarray(Y[:, j, :2].reshape(Y.shape[0], -1).T) for j in (a, b)]
+    sides = [S - S.mean(axis=1, keepdims=True) for S in sides]
+    now = [S[:, :n] for S in sides]
+    later = [(1.0 - f) * S[:, k: k + n] + f * S[:, k + 1: k + 1 + n] for S in sides]
+    same = _sum_squares(later[0] - now[0]) + _sum_squares(later[1] - now[1])
+    swapped = _sum_squares(later[0] - now[1]) + _sum_squares(later[1] - now[0])
+    count = n * a.size * 2
+    return SideSwap(same / count, swapped / count, int(a.size))
+
+
+def _frame_mean(curves: np.ndarray) -> np.ndarray:
+    """The mean over frames ``(n, 3)`` of curves ``(T, n, 3)``, as rows of a ``(T, 3n)`` matrix (numpy reduces
+    those several times faster than the first axis of a 3-D array with 3-element rows)."""
+    return curves.reshape(curves.shape[0], -1).mean(axis=0).reshape(curves.shape[1:])
+
+
+def _sum_squares(d: np.ndarray) -> float:
+    """The sum of the squares of ``d`` ``(m, n)``."""
+    return float(np.einsum("ij,ij->", d, d))
