@@ -54,6 +54,8 @@ from .period import autocorrelation_period
 
 PRIMES = (47, 43, 41, 37, 31, 29, 23, 19, 17, 13)
 MIN_FRAMES = 20
+#: Up to this many rows the greedy permutation measures every pair at once (8 MB), then only picks.
+FULL_MATRIX_ROWS = 1024
 
 
 def __getattr__(name: str):
@@ -204,7 +206,8 @@ def greedy_permutation(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
 def _greedy(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, float]:
     """:func:`greedy_permutation` and the largest distance from a row to its nearest landmark.
 
-    Each pass is one matrix-vector product of the centred rows, ``|x|² - 2 x·l + |l|²`` (a third of the
+    Each pass is one matrix-vector product of the centred rows (up to :data:`FULL_MATRIX_ROWS` rows, one
+    matrix product for all pairs first), ``|x|² - 2 x·l + |l|²`` (a third of the
     time of the passes over ``X - l``).  Its rounding could pick another of two rows that are equally far
     to within 1e-13, so the next landmark is chosen by :func:`_farthest` among the rows within that
     rounding of the farthest, on ``|x - l|`` row by row: the landmarks of the plain algorithm, to the bit.
@@ -215,20 +218,32 @@ def _greedy(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, float]:
     # a bound on the rounding of the squared distances below: a few ulps of the largest term, per column
     tol = 8.0 * (X.shape[1] + 2) * np.finfo(np.float64).eps * (2.0 * float(sq.max()) + 1e-300)
     idx = np.zeros(n, dtype=np.int64)
-    dist = np.empty((n, N))
     nearest = np.full(N, np.inf)
+    full = None
+    if N <= FULL_MATRIX_ROWS:  # a short take: every pair by one matrix product, then only the loop's choices
+        full = Xc @ Xc.T
+        full *= -2.0
+        full += sq[:, None]
+        full += sq[None, :]
+    else:
+        dist = np.empty((n, N))
     for i in range(n):
-        row = dist[i]
-        np.dot(Xc, Xc[idx[i]], out=row)
-        row *= -2.0
-        row += sq
-        row += sq[idx[i]]
+        if full is not None:
+            row = full[idx[i]]
+        else:
+            row = dist[i]
+            np.dot(Xc, Xc[idx[i]], out=row)
+            row *= -2.0
+            row += sq
+            row += sq[idx[i]]
         np.minimum(nearest, row, out=nearest)
         if i + 1 < n:
             far = int(np.argmax(nearest))
             level = nearest[far] - 2.0 * tol
             idx[i + 1] = far if np.count_nonzero(nearest >= level) == 1 else _farthest(X, idx[: i + 1], nearest, tol)[0]
     radius = _farthest(X, idx, nearest, tol)[1]
+    if full is not None:
+        dist = full[idx]
     np.maximum(dist, 0.0, out=dist)
     np.sqrt(dist, out=dist)
     dist[np.arange(n), idx] = 0.0
