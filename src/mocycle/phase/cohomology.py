@@ -44,6 +44,7 @@ second of start-up (``docs/performance.md``).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -91,12 +92,30 @@ def rips_h1(dist: np.ndarray, prime: int) -> tuple[np.ndarray, list[np.ndarray]]
     births_deaths = res["births_and_deaths_by_dim"]
     bars = np.reshape(np.array(births_deaths[1]), [len(births_deaths[1]) // 2, 2]) if len(births_deaths) > 1 \
         else np.zeros((0, 2))
-    cocycles = []
-    for ccl in (res["cocycles_by_dim"][1] if len(res["cocycles_by_dim"]) > 1 else []):
-        ccl = np.reshape(np.array(ccl, dtype=np.int64), [len(ccl) // 3, 3])
-        ccl[:, -1] = np.mod(ccl[:, -1], prime)
-        cocycles.append(ccl)
+    cocycles = _Cocycles(res["cocycles_by_dim"][1] if len(res["cocycles_by_dim"]) > 1 else [], prime)
     return np.asarray(bars, dtype=float).reshape(-1, 2), cocycles
+
+
+class _Cocycles(Sequence):
+    """ripser's flat cocycle lists as ``(n, 3)`` integer arrays ``[i, j, value mod p]``, each converted when it is
+    first read (a fit reads the chosen bars' only, 1 or 2 of some 70)."""
+
+    def __init__(self, flat: list, prime: int):
+        self._flat, self._prime, self._done = flat, prime, {}
+
+    def __len__(self) -> int:
+        return len(self._flat)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(len(self))[i]]
+        i = range(len(self))[i]  # negative indices, IndexError
+        if i not in self._done:
+            ccl = self._flat[i]
+            ccl = np.reshape(np.array(ccl, dtype=np.int64), [len(ccl) // 3, 3])
+            ccl[:, -1] = np.mod(ccl[:, -1], self._prime)
+            self._done[i] = ccl
+        return self._done[i]
 
 
 @dataclass(frozen=True)
@@ -238,7 +257,7 @@ def _greedy(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, float]:
             row += sq[idx[i]]
         np.minimum(nearest, row, out=nearest)
         if i + 1 < n:
-            far = int(np.argmax(nearest))
+            far = int(nearest.argmax())
             level = nearest[far] - 2.0 * tol
             idx[i + 1] = far if np.count_nonzero(nearest >= level) == 1 else _farthest(X, idx[: i + 1], nearest, tol)[0]
     radius = _farthest(X, idx, nearest, tol)[1]
