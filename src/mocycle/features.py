@@ -435,13 +435,16 @@ def pose_matrix(
     D = raw.shape[1]
     mean = np.zeros(D)
     scale = np.ones(D)
+    centred = raw
     if normalize:
         mean = raw.mean(axis=0)
-        std = raw.std(axis=0)
+        centred = raw - mean
+        # raw.std(axis=0) from the centred rows numpy's _var makes anyway (the same operations, the same bits)
+        std = np.sqrt(np.add.reduce(np.square(centred), axis=0) / raw.shape[0])
         scale = np.where(std > 1e-12 * (1.0 + np.abs(mean)), std, 1.0)
     w = _joint_weights(motion, weights, chosen)
     scale = scale / w[owner_arr]
-    X = (raw - mean) / scale
+    X = np.divide(centred, scale, out=centred if normalize else None)
     decoder = PoseDecoder(template=motion, rep=rep, root=root, joints=chosen, columns=tuple(columns),
                           dof_joint=owner_arr, mean=mean, scale=scale, reference=ref, travel=travel,
                           frame=frame)
