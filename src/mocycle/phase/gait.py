@@ -52,9 +52,10 @@ def leg_curves(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
     basis = np.stack([frame.e1, frame.up, frame.e2])  # (3, 3): rows e1, up, e2 in the parent frame
     T = motion.n_frames
     xyz = np.empty((T, legs.size, 3))
+    fixed = _fixed_offsets(motion, chain)
     for a in range(0, T, _BLOCK):  # blocks of frames: the (T,) temporaries stay in the cache
         frames = slice(a, min(a + _BLOCK, T))
-        Q, P = _world_chain(motion, chain, frames)
+        Q, P = _world_chain(motion, chain, frames, fixed)
         c, s = np.cos(psi[frames]), np.sin(psi[frames])
         for k, j in enumerate(legs.tolist()):
             rel = P[j] - P[travel]                                  # (3, n) world
@@ -86,30 +87,47 @@ def leg_curves(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
 _BLOCK = 4096
 
 
-def _world_chain(motion: Motion, joints: list[int], frames: slice = slice(None)
-                 ) -> tuple[dict[int, np.ndarray], dict[int, np.ndarray]]:
-    """World rotations (quaternion components ``(4, T)``: x, y, z, w) and positions ``(3, T)`` of ``joints``
-    and their ancestors only (a leg chain, not the whole rig: forward kinematics by quaternion products),
-    keyed by joint index, on ``frames``.  A joint whose local translation is the same in every frame (a bone offset) is
-    turned as one ``(3, 1)`` vector."""
+def _chain(motion: Motion, joints: list[int]) -> list[int]:
+    """``joints`` and their ancestors, parents before children."""
     parents = motion.skeleton.parents
     needed: set[int] = set()
     for j in joints:
         while j >= 0 and j not in needed:
             needed.add(j)
             j = int(parents[j])
+    return sorted(needed)
+
+
+def _fixed_offsets(motion: Motion, joints: list[int]) -> dict[int, np.ndarray]:
+    """The local translation ``(3, 1)`` of each joint of the chain of ``joints`` that has the same one in every
+    frame (a bone offset: turned as one vector, not one per frame)."""
+    out = {}
+    for j in _chain(motion, joints):
+        t = motion.translations[:, j]
+        if np.array_equal(t, np.broadcast_to(t[0], t.shape)):
+            out[j] = t[0][:, None].copy()
+    return out
+
+
+def _world_chain(motion: Motion, joints: list[int], frames: slice = slice(None),
+                 fixed: dict[int, np.ndarray] | None = None) -> tuple[dict[int, np.ndarray], dict[int, np.ndarray]]:
+    """World rotations (quaternion components ``(4, T)``: x, y, z, w) and positions ``(3, T)`` of ``joints``
+    and their ancestors only (a leg chain, not the whole rig: forward kinematics by quaternion products),
+    keyed by joint index, on ``frames``.  ``fixed``: :func:`_fixed_offsets` of the chain, if known."""
+    if fixed is None:
+        fixed = _fixed_offsets(motion, joints)
+    parents = motion.skeleton.parents
     Q: dict[int, np.ndarray] = {}
     P: dict[int, np.ndarray] = {}
-    for j in sorted(needed):  # parents come before their children
+    for j in _chain(motion, joints):  # parents come before their children
         p = int(parents[j])
         q = np.ascontiguousarray(motion.rotations[frames, j].T)  # one gather, then contiguous components
-        t = motion.translations[frames, j]
         if p < 0:
-            Q[j], P[j] = q, np.ascontiguousarray(t.T)
+            Q[j], P[j] = q, np.ascontiguousarray(motion.translations[frames, j].T)
         else:
             Q[j] = _multiply(Q[p], q)
-            offset = t[:1].T if np.all(t == t[0]) else np.ascontiguousarray(t.T)
-            P[j] = P[p] + _rotate(Q[p], offset)
+            offset = fixed[j] if j in fixed else np.ascontiguousarray(motion.translations[frames, j].T)
+            P[j] = _rotate(Q[p], offset, add=P[p])
     return Q, P
 
 
@@ -125,9 +143,10 @@ def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def _rotate(q: np.ndarray, v: np.ndarray, inverse: bool = False) -> np.ndarray:
+def _rotate(q: np.ndarray, v: np.ndarray, inverse: bool = False, add: np.ndarray | None = None) -> np.ndarray:
     """Vectors ``v`` (components ``(3, T)`` or ``(3, 1)``) turned by unit quaternions ``q`` (components
-    ``(4, T)``; ``inverse``: by their conjugates): ``v + 2w (u × v) + 2 u × (u × v)``, ``u`` the vector part."""
+    ``(4, T)``; ``inverse``: by their conjugates): ``v + 2w (u × v) + 2 u × (u × v)``, ``u`` the vector part;
+    plus ``add`` ``(3, T)`` when given."""
     x, y, z, w = q
     if inverse:
         x, y, z = -x, -y, -z
@@ -135,8 +154,13 @@ def _rotate(q: np.ndarray, v: np.ndarray, inverse: bool = False) -> np.ndarray:
     tx = 2.0 * (y * vz - z * vy)
     ty = 2.0 * (z * vx - x * vz)
     tz = 2.0 * (x * vy - y * vx)
-    return np.stack([vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz),
-                     vz + w * tz + (x * ty - y * tx)])
+    out = np.empty((3, q.shape[1]))
+    np.add(vx + w * tx, y * tz - z * ty, out=out[0])
+    np.add(vy + w * ty, z * tx - x * tz, out=out[1])
+    np.add(vz + w * tz, x * ty - y * tx, out=out[2])
+    if add is not None:
+        out += add
+    return out
 
 
 def leg_sides(curves: np.ndarray, legs: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
