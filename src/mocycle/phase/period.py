@@ -143,7 +143,7 @@ def fit_period(unwrapped, frame_time: float | None = None, frames=None) -> Perio
         else:
             raise MocycleError(f"frames must be integer frame indices, a boolean mask or a slice; got dtype "
                                f"{sel.dtype}")
-    if np.unique(idx).size < 2:
+    if idx.size < 2 or idx.min() == idx.max():  # fewer than two distinct frames (without np.unique's sort)
         raise MocycleError(f"fitting a period needs at least two distinct frames; got {np.unique(idx).size}")
     y = y_all[idx]
     x = idx.astype(np.float64)
