@@ -101,12 +101,10 @@ def _chain(motion: Motion, joints: list[int]) -> list[int]:
 def _fixed_offsets(motion: Motion, joints: list[int]) -> dict[int, np.ndarray]:
     """The local translation ``(3, 1)`` of each joint of the chain of ``joints`` that has the same one in every
     frame (a bone offset: turned as one vector, not one per frame)."""
-    out = {}
-    for j in _chain(motion, joints):
-        t = motion.translations[:, j]
-        if np.array_equal(t, np.broadcast_to(t[0], t.shape)):
-            out[j] = t[0][:, None].copy()
-    return out
+    chain = _chain(motion, joints)
+    t = motion.translations[:, chain]  # one pass over the frames' rows for the whole chain
+    same = (t == t[0]).all(axis=(0, 2))
+    return {j: t[0, k][:, None].copy() for k, j in enumerate(chain) if same[k]}
 
 
 def _world_chain(motion: Motion, joints: list[int], frames: slice = slice(None),
