@@ -239,6 +239,7 @@ def _greedy(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, float]:
     tol = 8.0 * (X.shape[1] + 2) * np.finfo(np.float64).eps * (2.0 * float(sq.max()) + 1e-300)
     idx = np.zeros(n, dtype=np.int64)
     nearest = np.full(N, np.inf)
+    groups: list = []  # the rows' duplicate groups, found when first needed (_farthest)
     full = None
     if N <= FULL_MATRIX_ROWS:  # a short take: every pair by one matrix product, then only the loop's choices
         full = Xc @ Xc.T
@@ -260,8 +261,9 @@ def _greedy(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, float]:
         if i + 1 < n:
             far = int(nearest.argmax())
             level = nearest[far] - 2.0 * tol
-            idx[i + 1] = far if np.count_nonzero(nearest >= level) == 1 else _farthest(X, idx[: i + 1], nearest, tol)[0]
-    radius = _farthest(X, idx, nearest, tol)[1]
+            idx[i + 1] = far if np.count_nonzero(nearest >= level) == 1 else \
+                _farthest(X, idx[: i + 1], nearest, tol, groups)[0]
+    radius = _farthest(X, idx, nearest, tol, groups)[1]
     if full is not None:
         dist = full[idx]
     np.maximum(dist, 0.0, out=dist)
@@ -270,15 +272,39 @@ def _greedy(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, float]:
     return idx, dist, radius
 
 
-def _farthest(X: np.ndarray, landmarks: np.ndarray, nearest2: np.ndarray, tol: float) -> tuple[int, float]:
+def _farthest(X: np.ndarray, landmarks: np.ndarray, nearest2: np.ndarray, tol: float,
+              groups: list | None = None) -> tuple[int, float]:
     """The row of ``X`` farthest from its nearest landmark (the first of equals) and that distance, measured
     as ``|x - l|`` on the rows whose rounded squared distance ``nearest2`` ``(N,)`` is within ``2 tol`` of
-    the largest (``tol``: the rounding bound), so the one the exact distances pick is among them."""
+    the largest (``tol``: the rounding bound), so the one the exact distances pick is among them.
+
+    Many such rows are copies of a few (a held pose, a constant input): then each distinct row is measured
+    once, at its first copy (copies are as far, and the first of equals wins); ``groups`` keeps
+    ``np.unique``'s first copies and inverse for the next call (an empty list: not known yet)."""
     cand = np.flatnonzero(nearest2 >= nearest2.max() - 2.0 * tol)
-    diff = X[cand][:, None, :] - X[landmarks][None, :, :]
-    exact = np.sqrt(np.einsum("cld,cld->cl", diff, diff)).min(axis=1)
+    if cand.size > _DEDUPLICATE and groups is not None:
+        if not groups:
+            groups.extend(np.unique(X, axis=0, return_index=True, return_inverse=True)[1:])
+        first, inverse = groups
+        cand = np.sort(first[np.unique(inverse.ravel()[cand])])
+    exact = _nearest_exact(X[cand], X[landmarks])
     k = int(np.argmax(exact))
     return int(cand[k]), float(exact[k])
+
+
+#: Above this many tied rows, :func:`_farthest` measures each distinct row once.
+_DEDUPLICATE = 64
+
+
+def _nearest_exact(rows: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """``(c,)``: each row's distance ``|x - l|`` to the nearest of ``points`` ``(L, D)``, by blocks of points
+    (temporaries of at most about 2^20 values)."""
+    out = np.full(rows.shape[0], np.inf)
+    step = max(1, (1 << 20) // max(1, rows.shape[0] * rows.shape[1]))
+    for a in range(0, points.shape[0], step):
+        diff = rows[:, None, :] - points[None, a: a + step, :]
+        np.minimum(out, np.sqrt(np.einsum("cld,cld->cl", diff, diff)).min(axis=1), out=out)
+    return out
 
 
 def landmark_distances(points: np.ndarray) -> np.ndarray:
