@@ -17,7 +17,8 @@ it) the processes' CPU time, which moves less when other work shares the machine
 timing); the keyframes' all-pairs pose distance matrix (every second frame of cmu/01_01).
 
 **phase**: seeded synthetic walks (``mocycle.datasets.synthetic_walk``, 1 degree of noise, seed 7) of
-each size; per size, alternately: ``find_phase(motion)`` (everything: features, coordinates, periods),
+each size; per size, alternately: ``find_phase(motion)`` (everything: features, coordinates, periods; on a
+fresh ``motion.replace()`` each round, so nothing a motion caches, e.g. its heading frame, carries over),
 ``CircularCoordinates`` on the prepared point cloud of ``benchmarks/phase.py`` and DREiMac's
 ``CircularCoords`` on the same cloud.  DREiMac 0.3 compiles its numba helpers again on every call; its
 *warm* time is the call minus numba's compile events.  Period error: the found period against the
@@ -232,8 +233,9 @@ def phase(sizes: list[int], repeats: int) -> list[tuple[str, float, float, bool]
         for _ in range(repeats if n < BIG else 1):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
+                fresh = walk.motion.replace()  # the same arrays, nothing cached on the motion by an earlier call
                 t0 = time.perf_counter()
-                res = find_phase(walk.motion)
+                res = find_phase(fresh)
                 t["fp"].append(time.perf_counter() - t0)
                 t0 = time.perf_counter()
                 bench_phase.run_mocycle(X)

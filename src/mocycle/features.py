@@ -195,6 +195,14 @@ class HeadingFrame:
 
     @classmethod
     def fit(cls, motion: Motion) -> HeadingFrame:
+        """The frame of ``motion``, fitted once per motion (its arrays are read-only), as its :meth:`tilt`."""
+        known = getattr(motion, "_heading", None)
+        if known is None:
+            known = motion._heading = [cls._fit(motion), None]
+        return known[0]
+
+    @classmethod
+    def _fit(cls, motion: Motion) -> HeadingFrame:
         travel = motion.travel_joint
         up = up_in_parent_frame(motion, travel, vertical_axis(motion))  # the one detection (Y-up, Z-up rigs)
         e1, e2 = horizontal_basis(up)
@@ -216,10 +224,20 @@ class HeadingFrame:
         return v * c + (v @ cross.T) * s + (v @ u)[:, None] * u * (1.0 - c)
 
     def tilt(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
-        """The travel joint's rotation without its heading ``(T, 4)`` and the unwrapped heading ``(T,)`` rad."""
+        """The travel joint's rotation without its heading ``(T, 4)`` and the unwrapped heading ``(T,)`` rad
+        (read-only arrays: computed once per motion and frame, as the phase's features and its leg curves
+        both need them)."""
+        known = getattr(motion, "_heading", None)
+        if known is not None and known[0] is self and known[1] is not None:
+            return known[1]
         q = motion.rotations[:, self.travel]
         psi = heading_angles(Rotation.from_quat(q).apply(self.forward), self.e1, self.e2)
-        return quat_multiply(axis_angle_quats(self.up, -psi), q), psi
+        tilt = quat_multiply(axis_angle_quats(self.up, -psi), q)
+        tilt.setflags(write=False)
+        psi.setflags(write=False)
+        if known is not None and known[0] is self:
+            known[1] = (tilt, psi)
+        return tilt, psi
 
     def turn(self, quats: np.ndarray, angles: np.ndarray) -> np.ndarray:
         """Tilt quaternions ``(T, 4)`` turned to the headings ``angles`` ``(T,)`` rad."""
@@ -417,13 +435,16 @@ def pose_matrix(
     D = raw.shape[1]
     mean = np.zeros(D)
     scale = np.ones(D)
+    centred = raw
     if normalize:
         mean = raw.mean(axis=0)
-        std = raw.std(axis=0)
+        centred = raw - mean
+        # raw.std(axis=0) from the centred rows numpy's _var makes anyway (the same operations, the same bits)
+        std = np.sqrt(np.add.reduce(np.square(centred), axis=0) / raw.shape[0])
         scale = np.where(std > 1e-12 * (1.0 + np.abs(mean)), std, 1.0)
     w = _joint_weights(motion, weights, chosen)
     scale = scale / w[owner_arr]
-    X = (raw - mean) / scale
+    X = np.divide(centred, scale, out=centred if normalize else None)
     decoder = PoseDecoder(template=motion, rep=rep, root=root, joints=chosen, columns=tuple(columns),
                           dof_joint=owner_arr, mean=mean, scale=scale, reference=ref, travel=travel,
                           frame=frame)

@@ -257,19 +257,33 @@ def continuous_rotvec(quats: np.ndarray) -> np.ndarray:
     # scale per (frame, joint), by blocks of frames that stay in the cache
     for a in range(0, T, _BLOCK):
         b = min(a + _BLOCK, T)
-        block = q[a:b]
         lo = max(a - 1, 0)
-        flip = np.einsum("tnk,tnk->tn", q[lo + 1:b], q[lo:b - 1]) < 0  # frame t against t - 1, t in (lo, b)
+        # the four components of frames lo..b-1 as contiguous (frames, N) arrays: every step below is a
+        # plain elementwise pass (numpy's reductions over a 4-element last axis pay per quaternion)
+        x, y, z, w = (np.ascontiguousarray(q[lo:b, :, k]) for k in range(4))
+        dots = x[1:] * x[:-1]  # frame t against t - 1, t in (lo, b), summed in einsum's order
+        dots += y[1:] * y[:-1]
+        dots += z[1:] * z[:-1]
+        dots += w[1:] * w[:-1]
+        flip = dots < 0
         if a == 0:
             flip = np.concatenate([np.zeros((1, N), dtype=bool), flip])
+        else:  # drop frame lo = a - 1
+            x, y, z, w = x[1:], y[1:], z[1:], w[1:]
         signs = sign * (1.0 - 2.0 * (np.cumsum(flip, axis=0) % 2)) if flip.any() else np.broadcast_to(sign, (b - a, N))
         sign = signs[-1].copy()
-        s = np.sqrt(np.einsum("tnk,tnk->tn", block[..., :3], block[..., :3]))
-        w = signs * block[..., 3]
+        s = x * x
+        s += y * y
+        s += z * z
+        np.sqrt(s, out=s)
+        w = signs * w
         angle = 2.0 * np.arctan2(s, w)  # continuous while it stays in [0, 2π]
         turned |= (angle > 0.5 * np.pi).any(axis=0)
         scale = np.where(s > 1e-12, angle / np.maximum(s, 1e-300), 2.0 * np.sign(w + 1e-300))  # as quat_log
-        np.multiply(block[..., :3], (signs * scale)[..., None], out=v[a:b])
+        scale *= signs
+        np.multiply(x, scale, out=v[a:b, :, 0])
+        np.multiply(y, scale, out=v[a:b, :, 1])
+        np.multiply(z, scale, out=v[a:b, :, 2])
     if T < 2:
         return v
     # a jump (> π between frames) needs an angle above π/2 at one of its two frames: only those joints are checked

@@ -138,6 +138,32 @@ def test_greedy_permutation_picks_farthest_points_and_reports_distances():
     assert np.allclose(dist, np.abs(X[idx, 0][:, None] - X[:, 0][None, :]))
 
 
+def _plain_greedy(X, n):
+    """The textbook farthest-point loop on |x - l| (what greedy_permutation must pick)."""
+    idx = [0]
+    nearest = np.full(X.shape[0], np.inf)
+    for _ in range(n - 1):
+        nearest = np.minimum(nearest, np.sqrt(((X - X[idx[-1]]) ** 2).sum(axis=1)))
+        idx.append(int(np.argmax(nearest)))
+    return np.array(idx)
+
+
+@pytest.mark.parametrize("case", ["lattice", "held poses", "repeated cycle", "constant", "noise", "small"])
+def test_greedy_permutation_picks_the_plain_algorithms_landmarks_on_ties_and_copies(case):
+    rng = np.random.default_rng(1)
+    X = {"lattice": lambda: rng.integers(0, 3, size=(1500, 4)).astype(float),  # many rows equally far
+         "held poses": lambda: np.r_[np.zeros((700, 6)), rng.normal(size=(300, 6))],
+         "repeated cycle": lambda: np.tile(rng.normal(size=(60, 8)), (20, 1)),  # exact copies, 20 of each row
+         "constant": lambda: np.ones((800, 5)),
+         "noise": lambda: rng.normal(size=(2000, 24)),
+         "small": lambda: rng.normal(size=(300, 3))}[case]()
+    n = min(120, X.shape[0])
+    idx, dist = greedy_permutation(X, n)
+    np.testing.assert_array_equal(idx, _plain_greedy(X, n))
+    full = np.sqrt(((X[idx][:, None] - X[None]) ** 2).sum(-1))
+    assert np.abs(dist - full).max() < 1e-6 * (1.0 + full.max())
+
+
 # -- the scikit-learn estimator contract ---------------------------------------------------------------------------
 # CircularCoordinates is a scikit-learn transformer and passes check_estimator except for these documented checks:
 EXPECTED_FAILED_CHECKS = {

@@ -86,7 +86,8 @@ def phase_features(motion: Motion, *, joints: str | Iterable[str] | None = None,
     moving = np.ptp(X, axis=0) > 1e-12
     if not moving.any():
         raise MocycleError("nothing moves in this take: every pose feature is constant")
-    X = X[:, moving]
+    if not moving.all():
+        X = X[:, moving]
     if pca == "auto":
         pca = DEFAULT_PCA
     if pca:

@@ -44,6 +44,7 @@ second of start-up (``docs/performance.md``).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,6 +55,9 @@ from .period import autocorrelation_period
 
 PRIMES = (47, 43, 41, 37, 31, 29, 23, 19, 17, 13)
 MIN_FRAMES = 20
+#: Up to this many rows the greedy permutation measures every pair at once (2 MB), then only picks (faster
+#: than 120 matrix-vector products below about 500 rows, slower above).
+FULL_MATRIX_ROWS = 512
 
 
 def __getattr__(name: str):
@@ -89,12 +93,30 @@ def rips_h1(dist: np.ndarray, prime: int) -> tuple[np.ndarray, list[np.ndarray]]
     births_deaths = res["births_and_deaths_by_dim"]
     bars = np.reshape(np.array(births_deaths[1]), [len(births_deaths[1]) // 2, 2]) if len(births_deaths) > 1 \
         else np.zeros((0, 2))
-    cocycles = []
-    for ccl in (res["cocycles_by_dim"][1] if len(res["cocycles_by_dim"]) > 1 else []):
-        ccl = np.reshape(np.array(ccl, dtype=np.int64), [len(ccl) // 3, 3])
-        ccl[:, -1] = np.mod(ccl[:, -1], prime)
-        cocycles.append(ccl)
+    cocycles = _Cocycles(res["cocycles_by_dim"][1] if len(res["cocycles_by_dim"]) > 1 else [], prime)
     return np.asarray(bars, dtype=float).reshape(-1, 2), cocycles
+
+
+class _Cocycles(Sequence):
+    """ripser's flat cocycle lists as ``(n, 3)`` integer arrays ``[i, j, value mod p]``, each converted when it is
+    first read (a fit reads the chosen bars' only, 1 or 2 of some 70)."""
+
+    def __init__(self, flat: list, prime: int):
+        self._flat, self._prime, self._done = flat, prime, {}
+
+    def __len__(self) -> int:
+        return len(self._flat)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(len(self))[i]]
+        i = range(len(self))[i]  # negative indices, IndexError
+        if i not in self._done:
+            ccl = self._flat[i]
+            ccl = np.reshape(np.array(ccl, dtype=np.int64), [len(ccl) // 3, 3])
+            ccl[:, -1] = np.mod(ccl[:, -1], self._prime)
+            self._done[i] = ccl
+        return self._done[i]
 
 
 @dataclass(frozen=True)
@@ -192,22 +214,104 @@ def greedy_permutation(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Farthest-point (greedy permutation) landmarks, starting at row 0.
 
     Returns the landmark row indices ``(n,)`` and the landmark-to-row
-    distances ``(n, N)``.  ripser's ``n_perm`` does the same but calls
+    distances ``(n, N)`` (to about 1e-7 of the rows' spread near zero; a landmark's distance to itself is 0).
+    ripser's ``n_perm`` does the same but calls
     scikit-learn's ``pairwise_distances`` (with its input checks) once per
     landmark, which was 85 % of the time of a whole fit.
     """
-    N = X.shape[0]
-    idx = np.zeros(n, dtype=np.int64)
-    dist = np.empty((n, N))
-    nearest = np.full(N, np.inf)
-    diff = np.empty_like(X)
-    for i in range(n):
-        np.subtract(X, X[idx[i]], out=diff)
-        np.sqrt(np.einsum("nd,nd->n", diff, diff), out=dist[i])
-        np.minimum(nearest, dist[i], out=nearest)
-        if i + 1 < n:
-            idx[i + 1] = int(np.argmax(nearest))
+    idx, dist, _ = _greedy(X, n)
     return idx, dist
+
+
+def _greedy(X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """:func:`greedy_permutation` and the largest distance from a row to its nearest landmark.
+
+    Each pass is one matrix-vector product of the centred rows (up to :data:`FULL_MATRIX_ROWS` rows, one
+    matrix product for all pairs first), ``|x|² - 2 x·l + |l|²`` (a third of the
+    time of the passes over ``X - l``).  Its rounding could pick another of two rows that are equally far
+    to within 1e-13, so the next landmark is chosen by :func:`_farthest` among the rows within that
+    rounding of the farthest, on ``|x - l|`` row by row: the landmarks of the plain algorithm, to the bit.
+    """
+    N = X.shape[0]
+    Xc = X - X.mean(axis=0)  # centred: |x|² stays of the order of the distances, so does the rounding
+    sq = np.einsum("nd,nd->n", Xc, Xc)
+    # a bound on the rounding of the squared distances below: a few ulps of the largest term, per column
+    tol = 8.0 * (X.shape[1] + 2) * np.finfo(np.float64).eps * (2.0 * float(sq.max()) + 1e-300)
+    idx = np.zeros(n, dtype=np.int64)
+    nearest = np.full(N, np.inf)
+    groups: list = []  # the rows' duplicate groups, found when first needed (_farthest)
+    full = None
+    if N <= FULL_MATRIX_ROWS:  # a short take: every pair by one matrix product, then only the loop's choices
+        full = Xc @ Xc.T
+        full *= -2.0
+        full += sq[:, None]
+        full += sq[None, :]
+    else:
+        dist = np.empty((n, N))
+    for i in range(n):
+        if full is not None:
+            row = full[idx[i]]
+        else:
+            row = dist[i]
+            np.dot(Xc, Xc[idx[i]], out=row)
+            row *= -2.0
+            row += sq
+            row += sq[idx[i]]
+        np.minimum(nearest, row, out=nearest)
+        if i + 1 < n:
+            far = int(nearest.argmax())
+            level = nearest[far] - 2.0 * tol
+            idx[i + 1] = far if np.count_nonzero(nearest >= level) == 1 else \
+                _farthest(X, idx[: i + 1], nearest, tol, groups)[0]
+    radius = _farthest(X, idx, nearest, tol, groups)[1]
+    if full is not None:
+        dist = full[idx]
+    np.maximum(dist, 0.0, out=dist)
+    np.sqrt(dist, out=dist)
+    dist[np.arange(n), idx] = 0.0
+    return idx, dist, radius
+
+
+def _farthest(X: np.ndarray, landmarks: np.ndarray, nearest2: np.ndarray, tol: float,
+              groups: list | None = None) -> tuple[int, float]:
+    """The row of ``X`` farthest from its nearest landmark (the first of equals) and that distance, measured
+    as ``|x - l|`` on the rows whose rounded squared distance ``nearest2`` ``(N,)`` is within ``2 tol`` of
+    the largest (``tol``: the rounding bound), so the one the exact distances pick is among them.
+
+    Many such rows are copies of a few (a held pose, a constant input): then each distinct row is measured
+    once, at its first copy (copies are as far, and the first of equals wins); ``groups`` keeps
+    ``np.unique``'s first copies and inverse for the next call (an empty list: not known yet)."""
+    cand = np.flatnonzero(nearest2 >= nearest2.max() - 2.0 * tol)
+    if cand.size > _DEDUPLICATE and groups is not None:
+        if not groups:
+            groups.extend(np.unique(X, axis=0, return_index=True, return_inverse=True)[1:])
+        first, inverse = groups
+        cand = np.sort(first[np.unique(inverse.ravel()[cand])])
+    exact = _nearest_exact(X[cand], X[landmarks])
+    k = int(np.argmax(exact))
+    return int(cand[k]), float(exact[k])
+
+
+#: Above this many tied rows, :func:`_farthest` measures each distinct row once.
+_DEDUPLICATE = 64
+
+
+def _nearest_exact(rows: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """``(c,)``: each row's distance ``|x - l|`` to the nearest of ``points`` ``(L, D)``, by blocks of points
+    (temporaries of at most about 2^20 values)."""
+    out = np.full(rows.shape[0], np.inf)
+    step = max(1, (1 << 20) // max(1, rows.shape[0] * rows.shape[1]))
+    for a in range(0, points.shape[0], step):
+        diff = rows[:, None, :] - points[None, a: a + step, :]
+        np.minimum(out, np.sqrt(np.einsum("cld,cld->cl", diff, diff)).min(axis=1), out=out)
+    return out
+
+
+def landmark_distances(points: np.ndarray) -> np.ndarray:
+    """``(L, L)`` Euclidean distances between the rows of ``points`` ``(L, D)``, exact to rounding (zero
+    diagonal, symmetric): the matrix ripser gets."""
+    diff = points[:, None, :] - points[None, :, :]
+    return np.sqrt(np.einsum("ijd,ijd->ij", diff, diff))
 
 
 def _lift(cocycle: np.ndarray, prime: int, L: int) -> np.ndarray:
@@ -230,7 +334,12 @@ def _is_cocycle(Z: np.ndarray, adjacent: np.ndarray) -> bool:
     ``Z`` holds small integers, so the sum over every triangle ``a-b-c`` of ``(z_ab + z_bc + z_ca)²``,
     one entry per edge ``a-c``, is exact in floating point: expanded, it is a few matrix products.
     """
-    A = adjacent.astype(np.float64)
+    # Every partial sum is an integer below L (3 max|z|)²: single precision is exact while that stays under
+    # 2^24 (120 landmarks, |z| <= 23: 571 000), and its matrix products take half the time.
+    exact32 = Z.shape[0] * (3.0 * float(np.abs(Z).max(initial=0.0))) ** 2 < 2.0**24
+    dtype = np.float32 if exact32 else np.float64
+    Z = Z.astype(dtype)
+    A = adjacent.astype(dtype)
     B = A * Z  # z on the edges
     B2 = B * Z
     Zca = Z.T  # z(c, a) at [a, c]
@@ -454,10 +563,10 @@ class CohomologyFit:
         N = X.shape[0]
         L = int(min(self.n_landmarks, N))
         pool = landmark_pool(N)
-        picked, dist = greedy_permutation(X[pool] if pool.size < N else X, L)  # (L,), (L, M)
+        picked, _, radius = _greedy(X[pool] if pool.size < N else X, L)  # (L,), (L, M), pool's cover radius
         idx = pool[picked]
-        dist_ll = dist[:, picked]
-        r_cover = float(dist.min(axis=0).max()) if pool.size == N else cover_radius(X, X[idx])
+        dist_ll = landmark_distances(X[idx])
+        r_cover = radius if pool.size == N else cover_radius(X, X[idx])
         primes = [self.prime] + [p for p in PRIMES if p != self.prime]
         for prime in primes:
             barcode, cocycles = rips_h1(dist_ll, prime)

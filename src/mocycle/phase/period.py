@@ -143,7 +143,7 @@ def fit_period(unwrapped, frame_time: float | None = None, frames=None) -> Perio
         else:
             raise MocycleError(f"frames must be integer frame indices, a boolean mask or a slice; got dtype "
                                f"{sel.dtype}")
-    if np.unique(idx).size < 2:
+    if idx.size < 2 or idx.min() == idx.max():  # fewer than two distinct frames (without np.unique's sort)
         raise MocycleError(f"fitting a period needs at least two distinct frames; got {np.unique(idx).size}")
     y = y_all[idx]
     x = idx.astype(np.float64)
@@ -490,11 +490,15 @@ def self_similarity(X, lag: float) -> float:
     n = A.shape[0] - k - 1
     if n < 2:
         return float("nan")
-    later = (1.0 - f) * A[k: k + n] + f * A[k + 1: k + 1 + n]
     var = float(A.var(axis=0).sum())
     if not var > 0:
         return float("nan")
-    return float(np.mean(np.sum((later - A[:n]) ** 2, axis=1)) / (2.0 * var))
+    # x(t + lag) - x(t) = x(t + k) + f (x(t + k + 1) - x(t + k)) - x(t), in one buffer
+    diff = np.subtract(A[k + 1: k + 1 + n], A[k: k + n])
+    diff *= f
+    diff += A[k: k + n]
+    diff -= A[:n]
+    return float(np.einsum("ij,ij->", diff, diff) / n / (2.0 * var))
 
 
 def repetition_distance(X, period: float, smooth: int = 1) -> np.ndarray:
