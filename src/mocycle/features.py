@@ -57,6 +57,8 @@ from .rotations import (
 
 REPS = ("euler", "expmap", "quatlog", "rotmat")
 ROOTS = ("keep", "velocity", "heading", "drop")
+#: frames decoded at a time by :meth:`PoseDecoder.decode_arrays` (its temporaries stay a block's size)
+DECODE_BLOCK = 8192
 _AXES = ("x", "y", "z")
 
 
@@ -119,7 +121,11 @@ class PoseDecoder:
             raise MocycleError(f"X must have shape (T, {self.n_features}); got {X.shape}")
         if not np.all(np.isfinite(X)):
             raise MocycleError("X contains NaN or infinite values")
-        raw = X * self.scale + self.mean
+
+        def raw(c0: int, c1: int, rows: slice = slice(None)) -> np.ndarray:
+            """Columns ``c0:c1`` of the features before normalising (a block of them: no ``(T, D)`` copy)."""
+            return X[rows, c0:c1] * self.scale[c0:c1] + self.mean[c0:c1]
+
         tpl = self.template
         T, J = X.shape[0], tpl.n_joints
         same_length = T == tpl.n_frames
@@ -144,34 +150,36 @@ class PoseDecoder:
         if self.rep == "euler":
             for order, joints in _joints_by_order(skel, self.joints).items():
                 k = len(order)
-                block = np.stack([raw[:, col + i * k: col + (i + 1) * k] for i in range(len(joints))], 1)
+                block = np.stack([raw(col + i * k, col + (i + 1) * k) for i in range(len(joints))], 1)
                 quats[:, joints] = euler_to_quats(block, order)
                 col += k * len(joints)
         else:
             n = len(self.joints)
             width = 9 if self.rep == "rotmat" else 3
-            block = raw[:, col: col + width * n].reshape(T, n, width)
-            col += width * n
             js = list(self.joints)
-            if self.rep == "expmap":
-                quats[:, js] = quat_exp(block)
-            elif self.rep == "quatlog":
-                ref = self.reference[js] / np.linalg.norm(self.reference[js], axis=-1, keepdims=True)
-                quats[:, js] = quat_multiply(ref, quat_exp(2.0 * block))
-            else:
-                quats[:, js] = matrix_quats(nearest_rotations(block.reshape(T, n, 3, 3)))
+            ref = self.reference[js] / np.linalg.norm(self.reference[js], axis=-1, keepdims=True)
+            for f0 in range(0, T, DECODE_BLOCK):  # blocks of frames: every frame is decoded on its own
+                rows = slice(f0, min(f0 + DECODE_BLOCK, T))
+                block = raw(col, col + width * n, rows).reshape(-1, n, width)
+                if self.rep == "expmap":
+                    quats[rows, js] = quat_exp(block)
+                elif self.rep == "quatlog":
+                    quats[rows, js] = quat_multiply(ref, quat_exp(2.0 * block))
+                else:
+                    quats[rows, js] = matrix_quats(nearest_rotations(block.reshape(-1, n, 3, 3)))
+            col += width * n
         if self.root == "keep" and trans is not None:
-            trans[:, self.travel] = raw[:, col: col + 3]
+            trans[:, self.travel] = raw(col, col + 3)
         elif self.root == "velocity" and trans is not None:
-            v = raw[:, col: col + 3]
+            v = raw(col, col + 3)
             start = tpl.translations[0, self.travel]
             trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
         elif self.root == "heading":
             _, psi = self.frame.tilt(tpl[:1])
-            psi = psi[0] + np.concatenate([[0.0], np.cumsum(raw[1:, col + 3])])
+            psi = psi[0] + np.concatenate([[0.0], np.cumsum(raw(col + 3, col + 4, slice(1, None))[:, 0])])
             quats[:, self.travel] = self.frame.turn(quats[:, self.travel], psi)
             if trans is not None:
-                v = self.frame.to_world(raw[1:, col: col + 3], 0.5 * (psi[1:] + psi[:-1]))
+                v = self.frame.to_world(raw(col, col + 3, slice(1, None)), 0.5 * (psi[1:] + psi[:-1]))
                 start = tpl.translations[0, self.travel]
                 trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v, axis=0)])
         return quats, trans

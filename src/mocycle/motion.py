@@ -255,17 +255,15 @@ class Motion:
         T = rot.shape[0]
         if T < 1:
             raise MocycleError("a motion needs at least one frame")
-        # a NaN or infinite component makes the norm NaN or infinite: one (T, J) check instead of (T, J, 4)
-        norms = np.empty(rot.shape[:-1] + (1,))
-        for f0 in range(0, T, 4096):  # in blocks of frames: numpy's norm makes a temporary as large as its input
-            norms[f0:f0 + 4096] = vector_norms(rot[f0:f0 + 4096], keepdims=True)
-        if not np.all(np.isfinite(norms)) or np.any(norms < 1e-12):
-            raise MocycleError("rotations contain NaN, infinite or zero quaternions")
-        if copy or rot is not rotations or not rot.flags.writeable:
-            rot = rot / norms
-        else:  # the caller hands its float64 array over (readers): normalised in place, no copy
-            rot /= norms
-        rot = continuous_quats(rot, inplace=True)
+        # the caller hands its float64 array over (readers): normalised in place, no copy
+        out = np.empty(rot.shape) if copy or rot is not rotations or not rot.flags.writeable else rot
+        for f0 in range(0, T, 4096):  # in blocks of frames: the norms and numpy's temporaries stay small
+            norms = vector_norms(rot[f0:f0 + 4096], keepdims=True)
+            # a NaN or infinite component makes the norm NaN or infinite: a (T, J) check instead of (T, J, 4)
+            if not np.all(np.isfinite(norms)) or np.any(norms < 1e-12):
+                raise MocycleError("rotations contain NaN, infinite or zero quaternions")
+            np.divide(rot[f0:f0 + 4096], norms, out=out[f0:f0 + 4096])
+        rot = continuous_quats(out, inplace=True)
         if translations is None:
             trans = np.broadcast_to(skeleton.offsets, (T, J, 3)).copy()
         else:

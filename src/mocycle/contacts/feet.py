@@ -247,39 +247,60 @@ def chain_joints(motion: Motion, joints) -> list[int]:
     return sorted(out)
 
 
-class ChainRotations:
-    """World rotation matrices of the joints of a chain, read as a ``(T, J, 3, 3)`` array would be,
-    ``rotations[frames, joint]`` (NaN for a joint outside the chain), but holding the chain's joints only."""
+class ChainArray:
+    """Per-joint arrays of the joints of a chain, read as a ``(T, J, ...)`` array would be,
+    ``array[frames, joint]`` or ``array[frames, [joints]]`` (NaN for a joint outside the chain), but holding
+    the chain's joints only (``data``: ``(T, len(chain), ...)``)."""
 
-    def __init__(self, n_frames: int, chain: list[int]):
+    def __init__(self, n_frames: int, chain: list[int], tail: tuple[int, ...]):
         self.column = {int(j): i for i, j in enumerate(chain)}
-        self.data = np.empty((n_frames, len(chain), 3, 3))
+        self.data = np.empty((n_frames, len(chain)) + tuple(tail))
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """The shape of the ``(T, J, ...)`` array it stands for (J: one past the chain's last joint)."""
+        return (self.data.shape[0], max(self.column, default=-1) + 1) + self.data.shape[2:]
 
     def __getitem__(self, key) -> np.ndarray:
-        rows, joint = key
-        i = self.column.get(int(joint))
-        if i is None:
-            return np.full(self.data[rows, 0].shape, np.nan)
-        return self.data[rows, i]
+        rows, joints = key
+        if np.ndim(joints) == 0:
+            i = self.column.get(int(joints))
+            if i is None:
+                return np.full(self.data[rows, 0].shape, np.nan)
+            return self.data[rows, i]
+        cols = [self.column.get(int(j)) for j in joints]
+        if None not in cols:
+            return self.data[rows][:, cols]
+        return np.stack([self[rows, j] for j in joints], axis=1)
+
+    def add(self, joints: np.ndarray, value: np.ndarray) -> None:
+        """``array[:, joints] += value[:, None]`` for the chain's joints among ``joints`` (a ``(J,)`` mask)."""
+        cols = [i for j, i in self.column.items() if j < len(joints) and joints[j]]
+        if cols:
+            self.data[:, cols] += value[:, None]
 
 
-def chain_transforms(motion: Motion, chain: list[int]) -> tuple[ChainRotations, np.ndarray]:
-    """World rotations (:class:`ChainRotations`, ``[frames, joint]`` -> ``(..., 3, 3)``) and positions
-    ``(T, J, 3)`` of the joints of ``chain`` (NaN for the others): forward kinematics of the legs only, not of
-    a 100-joint rig's fingers and face."""
-    T, J = motion.n_frames, motion.n_joints
+#: the world rotations of a chain (``tail`` (3, 3))
+ChainRotations = ChainArray
+
+
+def chain_transforms(motion: Motion, chain: list[int]) -> tuple[ChainArray, ChainArray]:
+    """World rotations (``[frames, joint]`` -> ``(..., 3, 3)``) and positions (``[frames, joint]`` ->
+    ``(..., 3)``) of the joints of ``chain`` (:class:`ChainArray`, NaN for the others): forward kinematics of
+    the legs only, not of a 100-joint rig's fingers and face, held for the chain's joints only."""
+    T = motion.n_frames
     parents = motion.skeleton.parents
-    Rw = ChainRotations(T, chain)
-    W = np.full((T, J, 3), np.nan)
+    Rw = ChainArray(T, chain, (3, 3))
+    W = ChainArray(T, chain, (3,))
     locals_ = Rotation.from_quat(motion.rotations[:, chain].reshape(-1, 4)).as_matrix().reshape(T, len(chain), 3, 3)
     for i, j in enumerate(chain):
         p = int(parents[j])
         local = locals_[:, i]
         if p < 0:
             Rw.data[:, i] = local
-            W[:, j] = motion.translations[:, j]
+            W.data[:, i] = motion.translations[:, j]
         else:
             Rp = Rw[:, p]
             Rw.data[:, i] = Rp @ local
-            W[:, j] = W[:, p] + (Rp @ motion.translations[:, j, :, None])[..., 0]
+            W.data[:, i] = W[:, p] + (Rp @ motion.translations[:, j, :, None])[..., 0]
     return Rw, W

@@ -556,7 +556,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         shift = _root_shift(W, contacts, n_blend, period)
         if np.abs(shift).max() > 0:
             _move_travel(motion, trans, Rw, shift)
-            W[:, below] += shift[:, None]    # the travel joint and all below it move with it; no rotation changes
+            W.add(below, shift)    # the travel joint and all below it move with it; no rotation changes
     n_extend = int(round(EXTEND_SECONDS / motion.frame_time))
     n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
     goals, toe_goals, held, changed = [], [], [], []
@@ -571,7 +571,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     if lowered.any():  # every foot keeps its goal in the world: a swing foot does not dip with the root
         down = -np.outer(delta, contacts.up)
         _move_travel(motion, trans, Rw, down)
-        W[:, below] += down[:, None]
+        W.add(below, down)
     for foot, g, h in zip(contacts.feet, goals, held, strict=True):  # goals not held: within reach, softly
         free = ~h
         base, hips = W[free, foot.ankle], W[free, foot.hip]
@@ -606,19 +606,23 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
             aim = _swing(W[t, foot.toe] - A, gt[t] - G)
         new_parent = R2 @ R1 @ Rw[t, ap]
         local[t, col[foot.ankle]] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
+    del W, Rw  # the chain's world positions and rotations: not needed for the quaternions (memory)
     rotations = motion.rotations
     if frames is not None:
         rotations, trans, local, lowered = rotations[frames], trans[frames], local[frames], lowered[frames]
         changed = [ch[frames] for ch in changed]
     T = rotations.shape[0]
     quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, len(legs3), 4)
+    del local
     # frames and joints not touched keep their exact quaternions
     touched = np.zeros((T, len(legs3)), bool)
     for foot, ch in zip(contacts.feet, changed, strict=True):
         touched[np.ix_(ch | lowered, [col[foot.hip], col[foot.knee], col[foot.ankle]])] = True
     old = rotations[:, legs3]
-    quats = np.where(touched[..., None], quats, old)
-    sign = np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    np.copyto(quats, old, where=~touched[..., None])
+    quats *= np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)  # the sign of the old
+    del old
     rotations = rotations.copy()
-    rotations[:, legs3] = quats * sign
+    rotations[:, legs3] = quats
+    del quats
     return Motion(motion.skeleton, rotations, trans, motion.frame_time, copy=False)

@@ -29,16 +29,18 @@ def _file_mode(path: Path) -> int:
         return 0o666 & ~mask
 
 
-def atomic_write(path: str | os.PathLike, data: str | bytes | Iterable[str]) -> Path:
+def atomic_write(path: str | os.PathLike, data: str | bytes | Iterable[str] | Iterable[bytes],
+                 binary: bool = False) -> Path:
     """Write ``data`` to ``path`` so that ``path`` is either the old file or the whole new one.
 
-    ``data`` may also be an iterable of text pieces (a long file written without holding it whole).
+    ``data`` may also be an iterable of text pieces (a long file written without holding it whole), or of
+    bytes-like pieces with ``binary``.
 
     A failure part-way (disk full, an exception while writing) leaves no
     half-written file and no temporary file behind.
     """
     path = Path(path)
-    mode = "wb" if isinstance(data, bytes) else "w"
+    mode = "wb" if binary or isinstance(data, bytes) else "w"
     clean_stale(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent or ".")
     try:

@@ -194,7 +194,7 @@ class _Blob:
         data = a.tobytes()
         self.gl.bufferViews.append(BufferView(buffer=0, byteOffset=self.length, byteLength=len(data), target=target))
         pad = (-len(data)) % 4
-        self.parts.append(data + b"\0" * pad)
+        self.parts += [data, b"\0" * pad]
         self.length += len(data) + pad
         width = {"SCALAR": 1, "VEC3": 3, "VEC4": 4, "MAT4": 16}[kind]
         flat = a.reshape(-1, width)
@@ -205,6 +205,20 @@ class _Blob:
 
     def bytes(self) -> bytes:
         return b"".join(self.parts)
+
+
+def _glb_pieces(gl, blob: _Blob):
+    """The binary glTF container of ``gl`` (its one buffer: ``blob``, views laid out 4-byte aligned) piece by
+    piece: the bytes pygltflib's ``save_to_bytes`` gives, without joining the blob into one copy and then a
+    second (a long take's animation is most of the file)."""
+    import struct
+
+    text = gl.gltf_to_json(separators=(",", ":"), indent=None).encode("utf-8")
+    text += b" " * (-(12 + len(text)) % 4)  # the binary chunk's data starts 4-byte aligned
+    yield b"glTF" + struct.pack("<II", 2, 12 + 2 * 8 + len(text) + blob.length)
+    yield struct.pack("<I", len(text)) + b"JSON" + text
+    yield struct.pack("<I", blob.length) + b"BIN\0"
+    yield from blob.parts
 
 
 def _stick_figure(points: np.ndarray, parents: np.ndarray, size: float):
@@ -303,13 +317,15 @@ def write_gltf(motion: Motion, path: str | os.PathLike, *, clip: Clip | None = N
         world[i] = local if parents[i] < 0 else world[parents[i]] @ local
     inverse_bind = np.linalg.inv(world)
 
-    # animation in glTF units
-    quats = motion.rotations.copy()
-    quats[:, 0] = quat_multiply(np.broadcast_to(r_quat, (T, 4)), quats[:, 0])
-    trans = motion.translations * frame.scale
-    trans[:, 0] = frame.point(motion.translations[:, 0])
+    # animation in glTF units (joint by joint: the translations of the joints that move are kept, as float32
+    # like the rotations, so no float64 copy of the take is made)
     tol = 1e-7 * max(frame.body_size * frame.scale, 1e-9)
-    moves = [j for j in range(J) if np.abs(trans[:, j] - rest_t[j]).max() > tol]
+    trans32: dict[int, np.ndarray] = {}
+    for j in range(J):
+        tj = frame.point(motion.translations[:, j]) if j == 0 else motion.translations[:, j] * frame.scale
+        if np.abs(tj - rest_t[j]).max() > tol:
+            trans32[j] = tj.astype(np.float32)
+    moves = list(trans32)
 
     gl = g.GLTF2(asset=g.Asset(version="2.0", generator=generator))
     blob = _Blob(gl)
@@ -343,15 +359,16 @@ def write_gltf(motion: Motion, path: str | os.PathLike, *, clip: Clip | None = N
         raise MotionFileError(f"{T} frames of {motion.frame_time:g} s do not fit glTF's 32-bit key times", p)
     t_acc = blob.add(times, "SCALAR", _FLOAT, bounds=True)
     samplers, channels = [], []
-    q32 = quats.astype(np.float32)
-    q32 /= np.linalg.norm(q32, axis=-1, keepdims=True)
     for j in range(J):
-        samplers.append(g.AnimationSampler(input=t_acc, output=blob.add(q32[:, j], "VEC4", _FLOAT),
+        q32 = (quat_multiply(np.broadcast_to(r_quat, (T, 4)), motion.rotations[:, 0]) if j == 0
+               else motion.rotations[:, j]).astype(np.float32)
+        q32 /= np.linalg.norm(q32, axis=-1, keepdims=True)
+        samplers.append(g.AnimationSampler(input=t_acc, output=blob.add(q32, "VEC4", _FLOAT),
                                            interpolation="LINEAR"))
         channels.append(g.AnimationChannel(sampler=len(samplers) - 1, target=g.AnimationChannelTarget(
             node=j, path="rotation")))
     for j in moves:
-        samplers.append(g.AnimationSampler(input=t_acc, output=blob.add(trans[:, j], "VEC3", _FLOAT),
+        samplers.append(g.AnimationSampler(input=t_acc, output=blob.add(trans32.pop(j), "VEC3", _FLOAT),
                                            interpolation="LINEAR"))
         channels.append(g.AnimationChannel(sampler=len(samplers) - 1, target=g.AnimationChannelTarget(
             node=j, path="translation")))
@@ -361,10 +378,8 @@ def write_gltf(motion: Motion, path: str | os.PathLike, *, clip: Clip | None = N
     gl.scenes = [g.Scene(name=clip.name, nodes=scene_nodes,
                          extras={"mocycle": jsonable({"units": frame.to_dict(), "clips": [meta]})})]
     gl.scene = 0
-    data = blob.bytes()
-    gl.buffers = [g.Buffer(byteLength=len(data))]
-    gl.set_binary_blob(data)
+    gl.buffers = [g.Buffer(byteLength=blob.length)]
     try:
-        return atomic_write(p, b"".join(gl.save_to_bytes()))
+        return atomic_write(p, _glb_pieces(gl, blob), binary=True)
     except OSError as exc:
         raise MotionFileError(f"cannot write file ({exc.strerror or exc})", p) from None

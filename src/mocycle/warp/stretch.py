@@ -42,6 +42,7 @@ from ..motion import JOINT_GROUPS, Motion, Skeleton, concatenate
 from ..phase.period import autocorrelation_period, circular_autocorrelation, period_from_autocorrelation, periodic_hann
 from ..rotations import axis_angle_quats, quat_conj, quat_exp, quat_log, quat_multiply
 from ..threads import limit_threads
+from .lct import COLUMNS as LCT_COLUMNS
 from .lct import block_edges, ilct, lct
 
 __all__ = [
@@ -360,8 +361,12 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
                 Y[:, tr] = _warp_detrended(X[:, tr], factor, windows[g])
         for N, parts in by_window.items():
             plain = np.concatenate(parts)
-            Y[:, plain] = warp_curves(X[:, plain], factor, N)
+            for c0 in range(0, plain.size, LCT_COLUMNS):  # the columns the transform takes at a time (memory)
+                cs = plain[c0:c0 + LCT_COLUMNS]
+                Y[:, cs] = warp_curves(X[:, cs], factor, N)
+    del X  # the input's curves: not needed to decode (memory)
     quats, _ = decoder.decode_arrays(Y, translations=False)
+    del Y
 
     # Translations: the travelling joint as mean velocity + warped residual; other moving joints warped.
     trans = np.broadcast_to(motion.translations[0], (n_out,) + motion.translations.shape[1:]).copy()
