@@ -4,7 +4,7 @@ import pytest
 from mocycle.datasets import synthetic_walk
 from mocycle.errors import MocycleError
 from mocycle.keyframes import ONE_STEP, PoseSpace, project_one_step, spatial_layout, stress
-from mocycle.keyframes.projection import lamp_map, project_force, project_mds, rbfp_map
+from mocycle.keyframes.projection import lamp_map, orient_axes, project_force, project_mds, rbfp_map
 
 
 @pytest.fixture(scope="module")
@@ -78,3 +78,16 @@ def test_bad_names(space):
         spatial_layout(space, "rbfp", "uniform", 5, seed="rbfp")
     with pytest.raises(MocycleError, match="PoseSpace"):
         PoseSpace(np.zeros((5, 3, 4)))
+
+
+@pytest.mark.parametrize("n", [20, 80])   # np.linalg.eigh below 50 poses, scipy's eigsh above
+def test_mds_plane_does_not_depend_on_the_eigenvectors_signs(n):
+    """An eigenvector's sign is the LAPACK build's choice (numpy 1.26 and 2.x mirrored the project plane):
+    the MDS plane is oriented so each axis's entry of largest magnitude is positive."""
+    rng = np.random.default_rng(n)
+    P = rng.normal(size=(n, 3)) * [3.0, 1.0, 0.1]
+    D = np.linalg.norm(P[:, None] - P[None], axis=-1)
+    Y = project_mds(D)
+    top = Y[np.argmax(np.abs(Y), axis=0), [0, 1]]
+    assert (top > 0).all()
+    assert np.allclose(orient_axes(-Y), Y) and np.allclose(orient_axes(Y * [1, -1]), Y)

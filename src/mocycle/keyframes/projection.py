@@ -119,7 +119,19 @@ def project_mds(D: np.ndarray) -> np.ndarray:
     else:
         vals, vecs = eigsh(B, k=2, which="LA", v0=np.ones(n))
     order = np.argsort(vals)[::-1]
-    return vecs[:, order] * np.sqrt(np.maximum(vals[order], 0.0))
+    return orient_axes(vecs[:, order] * np.sqrt(np.maximum(vals[order], 0.0)))
+
+
+def orient_axes(Y: np.ndarray) -> np.ndarray:
+    """``Y`` ``(n, d)`` with each column's sign chosen so that its entry of largest magnitude is positive.
+
+    An eigenvector's sign is arbitrary: LAPACK builds (numpy 1.26's OpenBLAS against 2.x's) return the
+    same plane mirrored, so a projection is made deterministic here (as scikit-learn's ``svd_flip``)."""
+    Y = np.array(Y, dtype=np.float64)
+    if Y.size:
+        top = Y[np.argmax(np.abs(Y), axis=0), np.arange(Y.shape[1])]
+        Y *= np.where(top < 0, -1.0, 1.0)
+    return Y
 
 
 def project_isomap(D: np.ndarray, n_neighbors: int = 14) -> np.ndarray:
@@ -152,7 +164,7 @@ def project_lle(X: np.ndarray, n_neighbors: int = 15, random_state: int = 0) -> 
     except (ValueError, np.linalg.LinAlgError, RuntimeError):
         Y = LocallyLinearEmbedding(n_neighbors=k, n_components=2, eigen_solver="dense", reg=1e-2,
                                    random_state=random_state).fit_transform(X)
-    return _pad2(Y)
+    return orient_axes(_pad2(Y))
 
 
 def project_force(D: np.ndarray, iterations: int = 50, random_state: int = 0, tol: float = 1e-6) -> np.ndarray:
