@@ -78,7 +78,7 @@ def _wrap_near(angles: np.ndarray, ref: np.ndarray) -> np.ndarray:
     return angles - TWO_PI * np.round((angles - ref) / TWO_PI)
 
 
-def continuous_euler(quats: np.ndarray, order: str) -> np.ndarray:
+def continuous_euler(quats: np.ndarray, order: str, joints=None) -> np.ndarray:
     """Intrinsic Euler angles (radians) continuous in time.
 
     Parameters
@@ -86,6 +86,8 @@ def continuous_euler(quats: np.ndarray, order: str) -> np.ndarray:
     quats : ``(T, N, 4)`` quaternions ``(x, y, z, w)``: N joints sharing one order.
     order : intrinsic axis order as in BVH channels, e.g. ``"ZYX"``; 1 or 2
         letters for joints with fewer rotation channels.
+    joints : the N joints of ``quats`` (``(T, J, 4)``) to convert, read a block of frames at a time (the
+        same as ``quats[:, joints]`` without that copy); default all.
 
     Returns
     -------
@@ -94,7 +96,9 @@ def continuous_euler(quats: np.ndarray, order: str) -> np.ndarray:
     closest to the frame before.
     """
     quats = np.asarray(quats, dtype=np.float64)
-    T, N = quats.shape[:2]
+    sel = slice(None) if joints is None else np.asarray(joints, dtype=np.intp).reshape(-1)
+    T = quats.shape[0]
+    N = quats.shape[1] if joints is None else sel.size
     k = len(order)
     if k == 0:
         return np.zeros((T, N, 0))
@@ -105,7 +109,7 @@ def continuous_euler(quats: np.ndarray, order: str) -> np.ndarray:
         # continuity pass below then picks the split closest to the neighbours.
         warnings.simplefilter("ignore", UserWarning)
         for f0 in range(0, T, _BLOCK):  # in blocks of frames: scipy's temporaries stay small
-            block = quats[f0:f0 + _BLOCK]
+            block = quats[f0:f0 + _BLOCK, sel]
             a[f0:f0 + _BLOCK] = Rotation.from_quat(block.reshape(-1, 4)).as_euler(full).reshape(-1, N, 3)
     if k < 3:
         # Only the primary solution keeps the dropped angles at zero.
@@ -120,7 +124,8 @@ def continuous_euler(quats: np.ndarray, order: str) -> np.ndarray:
         start = int(np.argmax(jumps[:, cols].any(axis=1)))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)
-            aa = Rotation.from_quat(quats[:, cols].reshape(-1, 4)).as_euler(full).reshape(T, cols.size, 3)
+            picked = cols if joints is None else sel[cols]
+            aa = Rotation.from_quat(quats[:, picked].reshape(-1, 4)).as_euler(full).reshape(T, cols.size, 3)
         # The other solution of the same rotation.
         bb = aa.copy()
         bb[..., 0] += np.pi

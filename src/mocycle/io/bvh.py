@@ -524,8 +524,8 @@ def motion_channels(motion: Motion) -> np.ndarray:
     for order, items in by_order.items():
         joints = [j for j, _ in items]
         cols = [c for _, cs in items for c in cs]
-        angles = np.degrees(continuous_euler(motion.rotations[:, joints], order))
-        out[:, cols] = angles.reshape(T, -1)
+        angles = continuous_euler(motion.rotations, order, joints)  # no (T, N, 4) copy of the joints
+        out[:, cols] = np.degrees(angles, out=angles).reshape(T, -1)
     return out
 
 
@@ -544,7 +544,7 @@ def bvh_size(motion: Motion) -> int:
 
 
 #: Frames per piece of text :func:`bvh_chunks` yields.
-_ROWS_PER_CHUNK = 8192
+_ROWS_PER_CHUNK = 1024  # the text of 1024 rows of 69 channels: about 1 MB (a StringIO holds 4 bytes a character)
 
 
 def bvh_chunks(motion: Motion) -> Iterator[str]:

@@ -93,7 +93,8 @@ def edit_swing(motion: Motion, seg: Segmentation, joint: str | int, swing: int, 
         old = np.interp(new, [sw.start, new_end, limit], [sw.start, sw.end, limit]) if limit > new_end else \
             np.interp(new, [sw.start, new_end], [sw.start, sw.end])
         q[sw.start:limit + 1] = _resample(q, old)
-    return motion.replace(rotations=_fix_joint(motion, j, q))
+    # a new array, handed over (no second copy); the translations are shared
+    return motion.replace(rotations=_fix_joint(motion, j, q), copy=False)
 
 
 def _fix_joint(motion: Motion, j: int, q: np.ndarray) -> np.ndarray:

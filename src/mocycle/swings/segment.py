@@ -54,6 +54,8 @@ MINOR_JOINT_PATTERNS = (
     "*toe*", "*twist*", "*sharebone*", "*eye*", "*jaw*", "*tongue*", "*teeth*", "*facial*",
     "*breast*", "*end*", "*nub*",
 )
+#: frames per block where a whole take's angular velocities would otherwise be held at once
+SPEED_BLOCK = 8192
 
 
 # ---------------------------------------------------------------- records
@@ -318,7 +320,12 @@ def choose_joints(motion: Motion, joints: str | Iterable[str] | None = None, min
     major = [j for j, n in enumerate(skel.names) if not any(fnmatch.fnmatch(n.lower(), p) for p in pats)]
     if motion.n_frames < 2 or not major:
         return major
-    speed = np.linalg.norm(angular_velocity(motion.rotations[:, major], 1.0), axis=-1).mean(axis=0)
+    T = motion.n_frames
+    speeds = np.empty((T - 1, len(major)))
+    for f0 in range(0, T - 1, SPEED_BLOCK):  # blocks of frames (one frame of overlap): no (T, J, 4) temporaries
+        q = motion.rotations[f0:min(f0 + SPEED_BLOCK, T - 1) + 1, major]
+        speeds[f0:f0 + q.shape[0] - 1] = np.linalg.norm(angular_velocity(q, 1.0), axis=-1)
+    speed = speeds.mean(axis=0)
     top = float(speed.max())
     if top <= 1e-9:
         return []
@@ -545,10 +552,9 @@ def segment(motion: Motion, threshold: float = DEFAULT_THRESHOLD, joints: str | 
     chosen = choose_joints(motion, joints)
     swings: list[Swing] = []
     holds: list[Hold] = []
-    if T >= 3 and chosen:
-        omega = smooth_velocity(angular_velocity(motion.rotations[:, chosen], dt), n_win)  # (T-1, J', 3)
-    for k, j in enumerate(chosen if T >= 3 else []):
-        axes, speed = unit_axes(omega[:, k])
+    for j in chosen if T >= 3 else []:
+        omega = smooth_velocity(angular_velocity(motion.rotations[:, j], dt), n_win)  # (T-1, 3); joint by joint
+        axes, speed = unit_axes(omega)
         error = swing_error(axes, n_win)
         eligible = speed >= np.radians(still_deg_s)
         error = np.where(eligible, error, np.inf)
