@@ -22,13 +22,15 @@ SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual
 
 def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = SKATE_HEIGHT,
           up: np.ndarray | None = None, per_joint: bool = False,
-          positions: np.ndarray | None = None) -> float | dict[str, float]:
+          positions: np.ndarray | None = None, body: float | None = None) -> float | dict[str, float]:
     """The skate measure of the module docstring (units/s); ``per_joint=True``: a dict joint name -> value.
-    ``positions``: ``motion.world_positions(end_sites=True)`` when the caller has it (saves recomputing)."""
+    ``positions``: ``motion.world_positions(end_sites=True)`` when the caller has it (saves recomputing); with
+    ``body``, the body height in file units (e.g. ``Contacts.body`` of the same rig), any world positions
+    ``[frames, joints]`` holding the contact joints (a leg chain's, :func:`~mocycle.contacts.feet.chain_transforms`)."""
     if feet is None or isinstance(feet, str):
         feet = find_feet(motion.skeleton, feet)
     up = up_axis(motion) if up is None else np.asarray(up, dtype=np.float64)
-    H = height * body_height(motion, up, positions)
+    H = height * (body_height(motion, up, positions) if body is None else float(body))
     joints = [j for f in feet for j in f.contact_joints]
     if motion.n_frames < 2:
         return {motion.skeleton.names[j]: 0.0 for j in joints} if per_joint else 0.0

@@ -282,8 +282,10 @@ def _skate(motion: Motion, up: np.ndarray, positions: np.ndarray | None = None) 
         return float("nan")
 
 
-def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
+def loop_metrics(motion: Motion, cycle: Cycle, travelling: Motion | None = None) -> dict[str, float]:
     """Every metric of the module docstring for ``cycle`` extracted from ``motion``.
+
+    ``travelling``: ``cycle.repeat(2, root="motion")`` when the caller has it (the feet are measured on it).
 
     Returns
     -------
@@ -317,7 +319,7 @@ def loop_metrics(motion: Motion, cycle: Cycle) -> dict[str, float]:
     jerk = jerk_ratio([Y[a:b] for a, b in cycle.axis.regions], C, motion.frame_time)
     del Y  # (T, 9J): not held while the feet are measured
     seams = [seam_ratios(C), seam_ratios(root)]
-    travelling = cycle.repeat(2, root="motion")
+    travelling = cycle.repeat(2, root="motion") if travelling is None else travelling
     captured = motion[frames[0]:frames[-1] + 1]
     up = cycle.space.world_up
     # every joint's world positions once per motion: the feet, the body's height and the skate all read them

@@ -14,9 +14,12 @@ FOOT_JOINTS_HELP = ("Name the feet when the name patterns fail: ANKLE[:TOE],ANKL
                     "lfoot:ltoes,rfoot:rtoes).")
 
 
-def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=None):
+def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=None, before=None,
+               skate_before: float | None = None):
     """The cycle with its feet locked (or not), and what the JSON says about it.  ``reference``: the take (or
-    takes) the cycle was made from, whose swing clearance the locked feet keep."""
+    takes) the cycle was made from, whose swing clearance the locked feet keep.  ``before``: the cycle
+    repeated twice with its root motion, and ``skate_before`` its skate on the same feet, when the caller has
+    measured them (``loop_metrics`` does: its ``skate``)."""
     from ..contacts import find_feet, largest_leg_step, lock_cycle
 
     if mode == "auto":
@@ -35,9 +38,11 @@ def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=N
     cleaned, contacts = lock_cycle(cycle, foot_joints, reference=reference)
     facts["seconds"] = time.perf_counter() - t0
     facts["clearance"] = _clearance_facts(contacts, contacts.clearance, cycle.space.skeleton.names)
-    before, after = cycle.repeat(2, root="motion"), cleaned.repeat(2, root="motion")
+    before = cycle.repeat(2, root="motion") if before is None else before
+    after = cleaned.repeat(2, root="motion")
     names = cycle.space.skeleton.names
-    facts.update(contacts=contacts.to_dict(names, cycle.n_frames), skate_before=_skate(before, contacts),
+    facts.update(contacts=contacts.to_dict(names, cycle.n_frames),
+                 skate_before=_skate(before, contacts) if skate_before is None else float(skate_before),
                  skate_after=_skate(after, contacts),
                  largest_leg_step_before=largest_leg_step(before, contacts.feet),
                  largest_leg_step_after=largest_leg_step(after, contacts.feet))
@@ -45,10 +50,14 @@ def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=N
 
 
 def _skate(motion, contacts) -> float:
-    """The skate measure of ``motion`` on the feet and vertical of ``contacts``, from one forward kinematics."""
-    from ..contacts import skate
+    """The skate measure of ``motion`` on the feet and vertical of ``contacts``, from the forward kinematics of
+    the legs alone (its body height from some 50 frames of the whole body, as ``loop_metrics`` measures it)."""
+    from ..contacts import body_height, skate
+    from ..contacts.feet import chain_joints, chain_transforms
 
-    return skate(motion, contacts.feet, up=contacts.up, positions=motion.world_positions(end_sites=True))
+    joints = [j for f in contacts.feet for j in f.contact_joints]
+    W = chain_transforms(motion, chain_joints(motion, joints))[1]
+    return skate(motion, contacts.feet, up=contacts.up, positions=W, body=body_height(motion, contacts.up))
 
 
 def _clearance_facts(contacts, clearance, names) -> dict:

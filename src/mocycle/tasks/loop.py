@@ -120,18 +120,22 @@ def run(take, options: Options | None = None) -> Report:
             with rec.part("cycle"):
                 fitted = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
                                        time_axis_method=o.time_axis, which=k, phase=phase)
-            with rec.part("feet"):
-                frames = fitted.axis.frames()   # the swing clearance of the looped region of the take
-                cycle, feet_facts, contacts = clean_feet(fitted, o.feet, o.root, o.foot_joints,
-                                                         reference=motion[frames[0]:frames[-1] + 1])
-            with rec.part("cycle"):
-                result = cycle.repeat(o.cycles, root=o.root)
             with rec.part("metrics"):
                 # the metrics and checks judge the fitted cycle against the take (locking changes the legs on
                 # purpose); the feet block says what locking did
-                metrics = loop_metrics(motion, fitted)
+                travelling = fitted.repeat(2, root="motion")
+                metrics = loop_metrics(motion, fitted, travelling)
                 label = f"{label_of(take)} class {k}" if everything else label_of(take)
                 failed = check_loop(motion, fitted, metrics, force=o.force, label=label)
+            with rec.part("feet"):
+                frames = fitted.axis.frames()   # the swing clearance of the looped region of the take
+                # the fitted cycle's skate is the metrics' when the feet are the ones found by name
+                cycle, feet_facts, contacts = clean_feet(fitted, o.feet, o.root, o.foot_joints,
+                                                         reference=motion[frames[0]:frames[-1] + 1],
+                                                         before=travelling,
+                                                         skate_before=None if o.foot_joints else metrics["skate"])
+            with rec.part("cycle"):
+                result = cycle.repeat(o.cycles, root=o.root)
             index = next(i for i, c in enumerate(phase.classes) if c is cycle.periodic)
             loops.append({
                 "class": index,
