@@ -332,3 +332,44 @@ def test_a_low_frame_is_shifted_down_with_its_hold_only_near_the_contact():
     assert np.allclose(corr[8:20, [0, 2]], 0.0)               # held horizontally
     corr, _ = _own_holds(path, mask, [np.array([0.0, 1.5, 0.0])], up, low=3.0, near=10.0, n_extend=12)
     assert np.allclose(corr[8:20, 1], 0.5)                    # held higher than it came in: shifted up whole
+
+
+def _bent(motion, deg_per_unit):
+    """``motion`` with its root's path bent onto a circle (``deg_per_unit`` degrees of turn per unit of
+    travel) and the body turned with it: a turning walk whose planted feet stay nearly planted."""
+    from scipy.spatial.transform import Rotation
+
+    root = motion.translations[:, 0]
+    d = root[-1] - root[0]
+    f = np.array([d[0], 0.0, d[2]]) / np.hypot(d[0], d[2])
+    side = np.cross([0.0, 1.0, 0.0], f)
+    rel = root - root[0]
+    s, lat = rel @ f, rel @ side
+    k = np.radians(deg_per_unit)
+    phi = k * s
+    t = motion.translations.copy()
+    t[:, 0] = (root[0] + np.outer(np.sin(phi) / k - lat * np.sin(phi), f)
+               + np.outer((1 - np.cos(phi)) / k + lat * np.cos(phi), side) + np.outer(rel[:, 1], [0.0, 1.0, 0.0]))
+    q = motion.rotations.copy()
+    q[:, 0] = (Rotation.from_rotvec(np.outer(phi, [0.0, 1.0, 0.0])) * Rotation.from_quat(q[:, 0])).as_quat()
+    return Motion(motion.skeleton, q, t, motion.frame_time)
+
+
+@pytest.mark.parametrize("deg_per_unit", [0.0, 0.2])   # straight, and about 25 degrees per cycle
+def test_a_turning_loop_holds_each_foot_across_its_seam(deg_per_unit):
+    """Each repeat of a turning loop is the one before turned about its first frame: a contact across the
+    seam is held at one place seen from either side (the hips' follow shift turns with the loop and is 0 at
+    the first frame, so the repeats meet)."""
+    m = _planted_walk(n_frames=360, fps=60.0, noise_deg=0.3)[1]
+    if deg_per_unit:
+        m = _bent(m, deg_per_unit)
+    cycle = extract_cycle(m)
+    assert abs(np.degrees(cycle.drift[3]) - deg_per_unit * np.linalg.norm(cycle.drift[:3])) < 3.0
+    cleaned, con = lock_cycle(cycle)
+    W = cleaned.repeat(3, root="motion").world_positions()
+    crossing = 0
+    for c, j in enumerate(con.joints):
+        crossing += bool(con.mask[0, c] and con.mask[-1, c])
+        for s, e in ranges(np.tile(con.mask[:, c], 3)):
+            assert np.abs(W[s:e, j] - W[s, j]).max() < 1e-6 * np.linalg.norm(cycle.drift[:3])
+    assert crossing   # the test is about a contact over the seam

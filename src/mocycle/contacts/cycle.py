@@ -52,7 +52,8 @@ def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend:
     contacts = replace(contacts, clearance=np.broadcast_to(np.asarray(clearance, dtype=np.float64),
                                                            (len(contacts.joints),)).copy())
     locked = lock_feet(ext, contacts, blend=blend, reach=reach, period=N, frames=slice(N, 2 * N),
-                       clearance=clearance, transforms=(Rw, W))
+                       clearance=clearance, transforms=(Rw, W), turn=float(cycle.drift[3]),
+                       turn_axis=cycle.space.up)
     P, L = cycle.space.encode(locked)
     turn, move = cycle.drift[3], cycle.drift[:3]
     R = axis_rotations(cycle.space.up, np.array([turn]))[0]

@@ -56,6 +56,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
+from ..rotations import axis_rotations
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
 from .feet import chain_joints, chain_transforms
@@ -488,10 +489,17 @@ def _weights(contacts: Contacts, n_blend: int) -> np.ndarray:
     return np.stack([_hold_weights(m, n_blend) for m in contacts.mask.T], axis=1)
 
 
-def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | None) -> np.ndarray:
+def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | None,
+                turn: float = 0.0, turn_axis: np.ndarray | None = None) -> np.ndarray:
     """Horizontal world displacement ``(T, 3)`` of the root that cancels the hold-weighted mean horizontal
     velocity of the planted contact joints (the hips follow the planted foot, as in a real stance), less
-    its mean over a period (or the take) so the travel is kept."""
+    its mean over a period (or the take) so the travel is kept; centred on the take.
+
+    For a loop (``period``, the motion at least three periods long) the displacement is the middle period's,
+    repeated, and turned with the loop (``turn`` rad per period about ``turn_axis``, default the vertical):
+    the velocities are read in a frame turning with the loop and the displacement is turned back, so each
+    repeat's is the one before turned, as every other pose of a turning loop is, and a contact across the
+    seam is held at the same place seen from either side.  It is 0 at each period's first frame."""
     T = W.shape[0]
     if T < 2:
         return np.zeros((T, 3))
@@ -501,9 +509,24 @@ def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | N
     v = v - (v @ up)[..., None] * up
     ws = 0.5 * (w[1:] + w[:-1])
     u = -np.einsum("tc,tci->ti", ws, v) / np.maximum(ws.sum(axis=1), 1.0)[:, None]
-    u -= u[period:2 * period].mean(axis=0) if period and T >= 3 * period else u.mean(axis=0)
-    shift = np.vstack([np.zeros(3), np.cumsum(u, axis=0)])
-    return shift - shift.mean(axis=0)
+    if not (period and T >= 3 * period):
+        u -= u.mean(axis=0)
+        shift = np.vstack([np.zeros(3), np.cumsum(u, axis=0)])
+        return shift - shift.mean(axis=0)
+    axis = up if turn_axis is None else np.asarray(turn_axis, dtype=np.float64)
+    steps = np.arange(period, 2 * period)
+    u = u[steps]
+    if turn:   # each step's velocity in the loop's frame at the step's middle
+        u = np.einsum("tji,tj->ti", axis_rotations(axis, turn * (steps + 0.5) / period), u)
+    u -= u.mean(axis=0)
+    # (period, 3), 0 at each period's first frame: the loop's first frame keeps its place, and a turning
+    # loop turns about it (Cycle.repeat), so the repeats still meet
+    s = np.vstack([np.zeros(3), np.cumsum(u[:-1], axis=0)])
+    t = np.arange(T)
+    shift = s[t % period]
+    if turn:
+        shift = np.einsum("tij,tj->ti", axis_rotations(axis, turn * t / period), shift)
+    return shift
 
 
 def _descendants(motion: Motion, joint: int) -> np.ndarray:
@@ -526,7 +549,8 @@ def _move_travel(motion: Motion, trans: np.ndarray, Rw: np.ndarray, world: np.nd
 
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
               follow: bool = True, period: int | None = None, frames: slice | None = None,
-              clearance: float | np.ndarray | None = None, transforms: tuple | None = None) -> Motion:
+              clearance: float | np.ndarray | None = None, transforms: tuple | None = None,
+              turn: float = 0.0, turn_axis: np.ndarray | None = None) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
 
     ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
@@ -537,7 +561,9 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     height a swinging foot clears, one for all contact joints or ``(C,)`` one per joint of ``contacts``
     (0: no swing clearance; default: the motion's own, :func:`~mocycle.contacts.clearance.swing_clearance`);
     ``transforms``: ``chain_transforms(motion, chain_joints(motion, legs))`` when the caller has them (they are
-    changed in place).  Returns a new Motion with the same skeleton and
+    changed in place); ``turn``: with ``period``, the loop's turn per period (rad about ``turn_axis``, default
+    the vertical: each repeat is the one before turned, as :meth:`~mocycle.cycle.Cycle.repeat` makes them).
+    Returns a new Motion with the same skeleton and
     frame time.
     """
     if contacts.n_frames != motion.n_frames:
@@ -553,7 +579,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     Rw, W = chain_transforms(motion, chain) if transforms is None else transforms
     trans = motion.translations.copy()
     if follow:
-        shift = _root_shift(W, contacts, n_blend, period)
+        shift = _root_shift(W, contacts, n_blend, period, turn, turn_axis)
         if np.abs(shift).max() > 0:
             _move_travel(motion, trans, Rw, shift)
             W.add(below, shift)    # the travel joint and all below it move with it; no rotation changes
