@@ -31,7 +31,7 @@ from ..limits import check_frames
 from ..motion import ROTATION_CHANNELS, Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
-from ..rotations import axis_rotations
+from ..rotations import axis_rotations, continuous_quats, matrix_quats, vector_norms
 from ..threads import limit_threads
 from .differences import HALF, central_acceleration, central_velocity
 from .harmonic import MODELS, ROWS, HarmonicRegression, max_harmonics
@@ -162,13 +162,33 @@ class Cycle:
         count = _validate.integer("count", count, 1)
         check_frames(count * self.n_frames, self.space.skeleton.n_joints,
                      f"{count} cycles of {self.n_frames} frames")
-        P = np.tile(self.P, (count, 1))
+        return self.space.decode(np.tile(self.P, (count, 1)), self._repeat_L(count, root), self._rotations(count))
+
+    def _repeat_L(self, count: int, root: str) -> np.ndarray:
+        """``L (count * N, 4)`` of :meth:`repeat`."""
         if root == "inplace":
-            return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)), self._rotations(count))
+            return np.tile(self._inplace_L(), (count, 1))
         Ls = [self.L]
         for _ in range(count - 1):  # each repeat is the last one moved rigidly: a turning walk walks a circle
             Ls.append(self._next_repeat(Ls[-1]))
-        return self.space.decode(P, np.concatenate(Ls), self._rotations(count))
+        return np.concatenate(Ls)
+
+    def repeat_path(self, count: int, root: str = "inplace") -> np.ndarray:
+        """``space.path(repeat(count, root))`` ``(count * N, 4)``, the same numbers, from the travel joint alone:
+        its rotation decoded as :meth:`repeat` and the Motion it makes do (quaternions, signs made continuous,
+        normalised), no other joint's (a long view's ``(T, J, 3, 3)`` rotations and their quaternions are
+        never made)."""
+        _check_choice(root, ROOT_MODES, "root")
+        count = _validate.integer("count", count, 1)
+        space = self.space
+        L = self._repeat_L(count, root)
+        R = np.tile(self._rotations()[:, space.travel], (count, 1, 1))
+        R = space.heading_rotations(L) @ R
+        q = continuous_quats(matrix_quats(R[:, None]), inplace=True)  # decode
+        q /= vector_norms(q, keepdims=True)  # Motion's own normalisation
+        q = continuous_quats(q, inplace=True)[:, 0]
+        psi = space.heading(Rotation.from_quat(q).as_matrix())
+        return np.concatenate([L[:, :3], psi[:, None]], axis=1)
 
     def to_dict(self) -> dict:
         return {
