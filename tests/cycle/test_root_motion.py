@@ -96,3 +96,13 @@ def test_drifting_path_is_the_inverse_of_the_in_place_path():
 
     cycle = extract_cycle(synthetic_circle_walk(n_frames=300, turn_per_cycle_deg=60.0, noise_deg=0.5).motion)
     assert np.abs(drifting_L(cycle.space.up, cycle._inplace_L(), cycle.drift) - cycle.L).max() < 1e-9
+
+
+def test_repeat_path_is_the_path_of_the_repeated_cycle_bit_for_bit(straight):
+    """``Cycle.repeat_path`` (the review's long view reads it) decodes the travel joint alone: the numbers of
+    ``space.path(cycle.repeat(...))``, a turning walk's heading unwrapped over every repeat included."""
+    cycle = extract_cycle(_turning(straight, 30.0), phase=find_phase(straight.motion))
+    for root in ("inplace", "motion"):
+        for count in (1, 14):
+            np.testing.assert_array_equal(cycle.repeat_path(count, root),
+                                          cycle.space.path(cycle.repeat(count, root)))

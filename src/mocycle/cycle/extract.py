@@ -31,10 +31,10 @@ from ..limits import check_frames
 from ..motion import ROTATION_CHANNELS, Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
 from ..phase.period import circle_gmm_cdf
-from ..rotations import axis_rotations
+from ..rotations import axis_rotations, continuous_quats, matrix_quats, vector_norms
 from ..threads import limit_threads
 from .differences import HALF, central_acceleration, central_velocity
-from .harmonic import MODELS, HarmonicRegression, max_harmonics
+from .harmonic import MODELS, ROWS, HarmonicRegression, max_harmonics
 from .representation import CycleSpace
 from .seam import calmest_start
 from .timeaxis import TIME_AXES, TimeAxis, time_axis
@@ -162,13 +162,33 @@ class Cycle:
         count = _validate.integer("count", count, 1)
         check_frames(count * self.n_frames, self.space.skeleton.n_joints,
                      f"{count} cycles of {self.n_frames} frames")
-        P = np.tile(self.P, (count, 1))
+        return self.space.decode(np.tile(self.P, (count, 1)), self._repeat_L(count, root), self._rotations(count))
+
+    def _repeat_L(self, count: int, root: str) -> np.ndarray:
+        """``L (count * N, 4)`` of :meth:`repeat`."""
         if root == "inplace":
-            return self.space.decode(P, np.tile(self._inplace_L(), (count, 1)), self._rotations(count))
+            return np.tile(self._inplace_L(), (count, 1))
         Ls = [self.L]
         for _ in range(count - 1):  # each repeat is the last one moved rigidly: a turning walk walks a circle
             Ls.append(self._next_repeat(Ls[-1]))
-        return self.space.decode(P, np.concatenate(Ls), self._rotations(count))
+        return np.concatenate(Ls)
+
+    def repeat_path(self, count: int, root: str = "inplace") -> np.ndarray:
+        """``space.path(repeat(count, root))`` ``(count * N, 4)``, the same numbers, from the travel joint alone:
+        its rotation decoded as :meth:`repeat` and the Motion it makes do (quaternions, signs made continuous,
+        normalised), no other joint's (a long view's ``(T, J, 3, 3)`` rotations and their quaternions are
+        never made)."""
+        _check_choice(root, ROOT_MODES, "root")
+        count = _validate.integer("count", count, 1)
+        space = self.space
+        L = self._repeat_L(count, root)
+        R = np.tile(self._rotations()[:, space.travel], (count, 1, 1))
+        R = space.heading_rotations(L) @ R
+        q = continuous_quats(matrix_quats(R[:, None]), inplace=True)  # decode
+        q /= vector_norms(q, keepdims=True)  # Motion's own normalisation
+        q = continuous_quats(q, inplace=True)[:, 0]
+        psi = space.heading(Rotation.from_quat(q).as_matrix())
+        return np.concatenate([L[:, :3], psi[:, None]], axis=1)
 
     def to_dict(self) -> dict:
         return {
@@ -212,10 +232,30 @@ def _check_choice(value, choices, name):
 
 
 # ------------------------------------------------------------------ harmonic
+def _derivative_part(Y: np.ndarray, axis: TimeAxis, s: int, e: int, r0: int, r1: int):
+    """Velocities and accelerations per period (eq. 3.23-3.25) of region ``[s, e)``'s interior rows ``r0 .. r1-1``
+    (frames ``s + HALF + r0 ..``): ``(x, dY, ddY)``, each row read from the stencil's ``2 * HALF + 1`` frames."""
+    a, b = s + r0, s + r1 + 2 * HALF  # the frames the rows' stencils read
+    if axis.method in ("smooth", "line"):  # the local tempo, frames per period, follows the axis
+        rate = central_velocity(axis.x[a:b], 1.0)[:, 0]
+    else:                                  # the thesis: t = 1/N everywhere (eq. 3.25)
+        rate = np.full(r1 - r0, 1.0 / axis.period_frames)
+    dY = central_velocity(Y[a:b], 1.0)
+    dY /= rate[:, None]
+    ddY = central_acceleration(Y[a:b], 1.0)
+    ddY /= rate[:, None] ** 2
+    return axis.x[a + HALF:b - HALF], dY, ddY
+
+
+def _derivative_regions(axis: TimeAxis) -> list[tuple[int, int]]:
+    """The regions long enough for the central stencils."""
+    return [(s, e) for s, e in axis.regions if e - s >= 2 * HALF + 1]
+
+
 def _derivative_rows(Y: np.ndarray, axis: TimeAxis):
     """Velocities and accelerations per period (eq. 3.23-3.25) on the interior frames of every region (written
-    region by region into one array each, divided in place: no per-region parts joined afterwards)."""
-    regions = [(s, e) for s, e in axis.regions if e - s >= 2 * HALF + 1]
+    region by region into one array each: no per-region parts joined afterwards)."""
+    regions = _derivative_regions(axis)
     if not regions:
         return None, None, None
     n = sum(e - s - 2 * HALF for s, e in regions)
@@ -225,18 +265,29 @@ def _derivative_rows(Y: np.ndarray, axis: TimeAxis):
     r = 0
     for s, e in regions:
         m = e - s - 2 * HALF
-        x = axis.x[s:e]
-        if axis.method in ("smooth", "line"):  # the local tempo, frames per period, follows the axis
-            rate = central_velocity(x, 1.0)[:, 0]
-        else:                                  # the thesis: t = 1/N everywhere (eq. 3.25)
-            rate = np.full(m, 1.0 / axis.period_frames)
-        xs[r:r + m] = x[HALF:e - s - HALF]
-        dY[r:r + m] = central_velocity(Y[s:e], 1.0)
-        dY[r:r + m] /= rate[:, None]
-        ddY[r:r + m] = central_acceleration(Y[s:e], 1.0)
-        ddY[r:r + m] /= rate[:, None] ** 2
+        xs[r:r + m], dY[r:r + m], ddY[r:r + m] = _derivative_part(Y, axis, s, e, 0, m)
         r += m
     return xs, dY, ddY
+
+
+def _derivative_blocks(Y: np.ndarray, axis: TimeAxis, rows: int = ROWS):
+    """:func:`_derivative_rows` as :meth:`HarmonicRegression.fit_blocks` reads them: a function returning a new
+    iterator of ``(x, dY, ddY)`` blocks of at most ``rows`` rows, each made from its frames of ``Y`` when it
+    is read (a long take's ``(T, D)`` velocities and accelerations are never held whole).  Rows that fit in
+    one block are made once and kept for the fit's later passes."""
+    parts = [(s, e, r0, min(r0 + rows, e - s - 2 * HALF)) for s, e in _derivative_regions(axis)
+             for r0 in range(0, e - s - 2 * HALF, rows)]
+    if sum(r1 - r0 for _, _, r0, r1 in parts) <= rows:
+        kept = [_derivative_part(Y, axis, *part) for part in parts]
+        return lambda: iter(kept)
+    return lambda: (_derivative_part(Y, axis, *part) for part in parts)
+
+
+def _position_blocks(Y: np.ndarray, axis: TimeAxis, rows: int = ROWS):
+    """A function returning a new iterator of ``(x, Y)`` blocks over the axis' frames (views of ``Y``: the
+    frames are never copied)."""
+    return lambda: ((axis.x[r:min(r + rows, e)], Y[r:min(r + rows, e)]) for s, e in axis.regions
+                    for r in range(s, e, rows))
 
 
 def _rows(Y: np.ndarray, axis: TimeAxis, frames: np.ndarray) -> np.ndarray:
@@ -274,14 +325,19 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     N = int(round(axis.period_frames))
     K = _harmonics(n_harmonics, frames.size, N)
     x = axis.x[frames]
-    xd, dP, ddP = _derivative_rows(P, axis) if model != "M2" else (None, None, None)
-    _, dL, ddL = _derivative_rows(L, axis) if model != "M2" else (None, None, None)
-    if model != "M2" and (xd is None or xd.size < 2 * K):
+    if model != "M2" and sum(e - s - 2 * HALF for s, e in _derivative_regions(axis)) < max(2 * K, 1):
         raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the excited "
                            f"regions are too short: use --model M2 or fewer harmonics")
-    fit_p = HarmonicRegression(K, model).fit(x, _rows(P, axis, frames), xd, dP, ddP)
-    del dP, ddP  # (T, D) each: not held while L is fitted
-    fit_l = HarmonicRegression(K, model, linear=True).fit(x, _rows(L, axis, frames), xd, dL, ddL)
+    if model == "M1":  # the rows block by block: P's frames, velocities and accelerations are never held whole
+        fit_p = HarmonicRegression(K, model).fit_blocks(_position_blocks(P, axis), _derivative_blocks(P, axis))
+        fit_l = HarmonicRegression(K, model, linear=True).fit_blocks(_position_blocks(L, axis),
+                                                                     _derivative_blocks(L, axis))
+    else:
+        xd, dP, ddP = _derivative_rows(P, axis) if model != "M2" else (None, None, None)
+        _, dL, ddL = _derivative_rows(L, axis) if model != "M2" else (None, None, None)
+        fit_p = HarmonicRegression(K, model).fit(x, _rows(P, axis, frames), xd, dP, ddP)
+        del dP, ddP  # (T, D) each: not held while L is fitted
+        fit_l = HarmonicRegression(K, model, linear=True).fit(x, _rows(L, axis, frames), xd, dL, ddL)
     x0 = float(np.floor(x[0]))
     if calmest or (calmest is None and reference is not None):  # start at the calmest step, between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)

@@ -15,7 +15,10 @@ with ``x`` the time axis in periods.  Three ways to fit it (Tables A-B):
 
 Every DOF shares one design matrix, so M2 and M3 are one least-squares call
 with ``D`` right-hand sides and M1 is one batched solve of ``D`` normal
-equations of size ``2K+1`` (+1 with the linear term).
+equations of size ``2K+1`` (+1 with the linear term).  M1 reads its rows block
+by block (:meth:`HarmonicRegression.fit_blocks`): the cross products, the
+designs' QR factors and the residual sums are added up over blocks, so a long
+take's velocities and accelerations need never be held whole.
 """
 
 from __future__ import annotations
@@ -90,6 +93,50 @@ def _column_sq_sums(B: np.ndarray, coef: np.ndarray, Y: np.ndarray, rows: int = 
     return out
 
 
+#: rows of a block when :meth:`HarmonicRegression.fit` hands whole arrays to :meth:`~HarmonicRegression.fit_blocks`
+ROWS = 8192
+
+
+class _DesignSums:
+    """What M1 needs of one design ``B`` and its targets ``Y``, added up block by block of rows: ``BᵀB``
+    ``(p, p)``, ``BᵀY`` ``(p, D)``, the ``R`` of ``B``'s QR factorisation (``B = QR``: ``B``'s singular values
+    and right singular vectors are ``R``'s), which columns of ``B`` are not all zero, and the row count."""
+
+    def __init__(self):
+        self.BtB = self.BtY = self.R = self.nonzero = None
+        self.rows = 0
+
+    def add(self, B: np.ndarray, Y: np.ndarray) -> None:
+        BtB, BtY = B.T @ B, B.T @ Y
+        stacked = B if self.R is None else np.vstack([self.R, B])
+        self.R = np.linalg.qr(stacked, mode="r")
+        nonzero = np.abs(B).max(axis=0) > 0 if B.shape[0] else np.zeros(B.shape[1], dtype=bool)
+        if self.BtB is None:
+            self.BtB, self.BtY, self.nonzero = BtB, BtY, nonzero
+        else:
+            self.BtB += BtB
+            self.BtY += BtY
+            self.nonzero |= nonzero
+        self.rows += B.shape[0]
+
+    def least_squares(self) -> tuple[np.ndarray, np.ndarray]:
+        """The columns used and :func:`least_squares` ``(B[:, cols], Y)`` from the sums: ``cols`` are ``B``'s
+        columns that are not all zero (derivative designs lose the constant column); ``R[:, cols]``'s SVD
+        is ``B[:, cols]``'s (``U`` aside), with the same cut of small singular values, and
+        ``Uᵀ Y = S⁻¹ Vᵀ (BᵀY)``."""
+        cols = np.flatnonzero(self.nonzero)
+        _, S, Vt = np.linalg.svd(self.R[:, cols], full_matrices=False)
+        kept = S > np.finfo(np.float64).eps * max(self.rows, cols.size) * (S[0] if S.size else 0.0)
+        inv = np.where(kept, 1.0 / np.where(kept, S, 1.0), 0.0)
+        return cols, Vt.T @ ((inv ** 2)[:, None] * (Vt @ self.BtY[cols]))
+
+
+def _array_blocks(*arrays: np.ndarray, rows: int = ROWS):
+    """A function returning a new iterator of row blocks (views) of ``arrays``, which share their row count."""
+    n = arrays[0].shape[0]
+    return lambda: (tuple(a[r:r + rows] for a in arrays) for r in range(0, n, rows))
+
+
 class HarmonicRegression:
     """Harmonic regression of ``D`` curves on a shared time axis (scikit-learn style).
 
@@ -142,6 +189,8 @@ class HarmonicRegression:
         """Fit positions ``Y (M, D)`` at times ``x (M,)`` (periods); velocities ``dY`` and accelerations
         ``ddY`` ``(M', D)`` per period (and per period²) at times ``xd (M',)`` for M1 and M3."""
         x, Y, xd, dY, ddY = self._check(x, Y, xd, dY, ddY)
+        if self.model == "M1":
+            return self.fit_blocks(_array_blocks(x, Y), _array_blocks(xd, dY, ddY))
         P = harmonic_basis(x, self.n_harmonics, 0, self.linear)
         still = np.all(Y == Y[:1], axis=0)
         if still.any():
@@ -150,6 +199,83 @@ class HarmonicRegression:
             self._fit_all(P, xd, Y, dY, ddY)
         self.rmse_ = self._rmse(P, Y, xd, dY, ddY)
         return self
+
+    def fit_blocks(self, positions, derivatives=None) -> HarmonicRegression:
+        """:meth:`fit` on rows handed over block by block, so that no array of every row need be held (a long
+        take's velocities and accelerations are made a block at a time from its positions).
+
+        ``positions()``: a new iterator of ``(x, Y)`` blocks (``(B,)``, ``(B, D)``) each time it is called;
+        ``derivatives()`` (M1, M3): likewise of ``(xd, dY, ddY)`` blocks.  M1 reads them in three passes:
+        the designs' cross products and QR factors; the residuals of the separate ordinary fits (the group
+        variances, eq. 3.11-3.13); the residuals of the weighted fit (``rmse_``).  M2 and M3 join the blocks
+        and fit them as :meth:`fit` does."""
+        _validate.choice("model", self.model, MODELS)
+        if self.model != "M1":
+            x, Y = (np.concatenate(part) for part in zip(*positions(), strict=True))
+            if derivatives is None:
+                return self.fit(x, Y)
+            return self.fit(x, Y, *(np.concatenate(part) for part in zip(*derivatives(), strict=True)))
+        K = _validate.integer("n_harmonics", self.n_harmonics, 1)
+        if derivatives is None:
+            raise MocycleError(f"model {self.model} needs velocities and accelerations (xd, dY, ddY)")
+        lin, p = self.linear, 2 * K + 1 + int(self.linear)
+        pos, vel, acc = _DesignSums(), _DesignSums(), _DesignSums()
+        first, moving = None, None
+        for x, Y in positions():  # pass 1: cross products, QR factors, the columns that move
+            x, Y = np.asarray(x, dtype=np.float64).reshape(-1), np.asarray(Y, dtype=np.float64)
+            Y = Y[:, None] if Y.ndim == 1 else Y
+            if not x.size:
+                continue
+            if not (np.isfinite(x).all() and np.isfinite(Y).all()):
+                raise MocycleError("the time axis and the curves must be finite numbers")
+            if first is None:
+                first, moving = Y[0].copy(), np.zeros(Y.shape[1], dtype=bool)
+            moving |= (Y != first).any(axis=0)
+            pos.add(harmonic_basis(x, K, 0, lin), Y)
+        if pos.rows < p:
+            raise MocycleError(f"K = {K} harmonics need at least {p} frames; got {pos.rows} "
+                               f"(K <= {max_harmonics(pos.rows)})")
+        D = first.size
+        for xd, dY, ddY in derivatives():
+            if not xd.size:
+                continue
+            if dY.shape[1] != D or ddY.shape[1] != D:
+                raise MocycleError("velocities and accelerations must have the columns of Y")
+            vel.add(harmonic_basis(xd, K, 1, lin), dY)
+            acc.add(harmonic_basis(xd, K, 2, lin), ddY)
+        if vel.rows < 2 * K:
+            raise MocycleError(f"K = {K} harmonics need velocities on at least {2 * K} frames; got {vel.rows}")
+        self._fit_fgls(positions, derivatives, pos, vel, acc)
+        still = ~moving
+        if still.any():  # a joint that never moves: its constant exactly, the weights of a still curve, no error
+            self.coef_[:, still] = 0.0
+            self.coef_[0, still] = first[still]
+            self.alpha_[still], self.gamma_[still], self.sigma2_[:, still] = 0.0, 0.0, 0.0
+        # pass 3: the errors of the weighted fit (thesis eq. 4.1-4.3)
+        sp = self._sq_sums(positions, self.coef_)
+        sv, sa = self._sq_sums(derivatives, self.coef_, self.coef_)
+        self.rmse_ = np.sqrt([sp.sum() / pos.rows, (self.alpha_ * sv).sum() / vel.rows,
+                              (self.gamma_ * sa).sum() / acc.rows])
+        return self
+
+    def _sq_sums(self, blocks, coef, coef2=None, cols=None, cols2=None):
+        """Column sums of squared residuals ``(D,)`` over ``blocks()``: of the positions' design (``(x, Y)``
+        blocks, ``coef``) or, with ``coef2``, of the velocities' and the accelerations' (``(xd, dY, ddY)``
+        blocks; two sums).  ``cols``/``cols2``: only these columns of the design (and rows of ``coef``)."""
+        K, lin = self.n_harmonics, self.linear
+        first, second = 0.0, 0.0
+        for block in blocks():
+            x = block[0]
+            if not x.size:
+                continue
+            if coef2 is None:
+                B = harmonic_basis(x, K, 0, lin)
+                first = first + _column_sq_sums(B if cols is None else B[:, cols], coef, block[1])
+            else:
+                V, A = harmonic_basis(x, K, 1, lin), harmonic_basis(x, K, 2, lin)
+                first = first + _column_sq_sums(V if cols is None else V[:, cols], coef, block[1])
+                second = second + _column_sq_sums(A if cols2 is None else A[:, cols2], coef2, block[2])
+        return first if coef2 is None else (first, second)
 
     def _fit_all(self, P, xd, Y, dY, ddY) -> None:
         """``coef_``, ``alpha_``, ``gamma_``, ``sigma2_`` of every column of ``Y`` (design ``P`` of the positions)."""
@@ -160,12 +286,9 @@ class HarmonicRegression:
             self.sigma2_ = np.full((3, D), np.nan)
             return
         V, A = harmonic_basis(xd, K, 1, lin), harmonic_basis(xd, K, 2, lin)
-        if self.model == "M3":
-            self.alpha_, self.gamma_ = np.ones(D), np.ones(D)
-            self.sigma2_ = np.full((3, D), np.nan)
-            self.coef_ = np.linalg.lstsq(np.vstack([P, V, A]), np.vstack([Y, dY, ddY]), rcond=None)[0]
-        else:
-            self._fit_fgls(P, V, A, Y, dY, ddY)
+        self.alpha_, self.gamma_ = np.ones(D), np.ones(D)  # M3 (M1 is fitted by fit_blocks)
+        self.sigma2_ = np.full((3, D), np.nan)
+        self.coef_ = np.linalg.lstsq(np.vstack([P, V, A]), np.vstack([Y, dY, ddY]), rcond=None)[0]
 
     def _fit_moving(self, moving: np.ndarray, P, xd, Y, dY, ddY) -> None:
         """Fit the columns where ``moving`` ``(D,)`` is set; every other column of ``Y`` is one value on every
@@ -188,25 +311,22 @@ class HarmonicRegression:
             self.alpha_[moving], self.gamma_[moving] = sub.alpha_, sub.gamma_
             self.sigma2_[:, moving] = sub.sigma2_
 
-    def _fit_fgls(self, P, V, A, Y, dY, ddY) -> None:
-        """M1: group variances from separate OLS fits (eq. 3.11-3.13), then WLS (eq. 3.19), all DOFs at once."""
+    def _fit_fgls(self, positions, derivatives, pos: _DesignSums, vel: _DesignSums, acc: _DesignSums) -> None:
+        """M1: group variances from separate OLS fits (eq. 3.11-3.13), then WLS (eq. 3.19), all DOFs at once,
+        from the designs' sums of pass 1 and the OLS residuals of pass 2."""
         K = self.n_harmonics
-        M, Md = P.shape[0], V.shape[0]
-
-        def resid_var(B, T, dof):
-            cols = np.flatnonzero(np.abs(B).max(axis=0) > 0)  # derivative designs lose the constant column
-            beta = least_squares(B[:, cols], T)
-            return _column_sq_sums(B[:, cols], beta, T) / max(dof, 1)
-
-        s2p = resid_var(P, Y, M - 2 * K - 1 - int(self.linear))
-        s2v = resid_var(V, dY, Md - 2 * K)
-        s2a = resid_var(A, ddY, Md - 2 * K)
+        (cp, bp), (cv, bv), (ca, ba) = pos.least_squares(), vel.least_squares(), acc.least_squares()
+        sp = self._sq_sums(positions, bp, cols=cp)
+        sv, sa = self._sq_sums(derivatives, bv, ba, cols=cv, cols2=ca)
+        s2p = sp / max(pos.rows - 2 * K - 1 - int(self.linear), 1)
+        s2v = sv / max(vel.rows - 2 * K, 1)
+        s2a = sa / max(acc.rows - 2 * K, 1)
         tiny = np.finfo(np.float64).tiny
         self.alpha_ = np.clip(s2p / np.maximum(s2v, tiny), 0.0, WEIGHT_LIMIT)
         self.gamma_ = np.clip(s2p / np.maximum(s2a, tiny), 0.0, WEIGHT_LIMIT)
         self.sigma2_ = np.vstack([s2p, s2v, s2a])
-        PtP, VtV, AtA = P.T @ P, V.T @ V, A.T @ A
-        b = (P.T @ Y).T + self.alpha_[:, None] * (V.T @ dY).T + self.gamma_[:, None] * (A.T @ ddY).T  # (D, p)
+        PtP, VtV, AtA = pos.BtB, vel.BtB, acc.BtB
+        b = pos.BtY.T + self.alpha_[:, None] * vel.BtY.T + self.gamma_[:, None] * acc.BtY.T  # (D, p)
         # A tiny ridge keeps DOFs that never move (all-zero rows and columns but the constant) solvable.
         ridge = 1e-12 * np.trace(PtP) / PtP.shape[0] * np.eye(PtP.shape[0])
         # every DOF's normal matrix PtP + ridge + alpha VtV + gamma AtA as one product (D, 3) @ (3, p²)

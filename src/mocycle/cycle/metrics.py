@@ -110,6 +110,9 @@ def _rms(E: np.ndarray) -> float:
 
 #: Rows per block of the long metric passes (their (rows, D) temporaries stay a few MB).
 _ROWS = 8192
+#: Rows per block where the cycle's spline is read: a dozen (rows, D) temporaries a block (its knots' polynomials,
+#: the derivatives, the errors): 100 MB at 8192 rows of a 22-joint rig, more than the (T, 9J) features held
+_SPLINE_ROWS = 2048
 
 
 def regression_errors(Y: np.ndarray, C: np.ndarray, positions: np.ndarray, regions, frames: np.ndarray,
@@ -125,15 +128,15 @@ def regression_errors(Y: np.ndarray, C: np.ndarray, positions: np.ndarray, regio
     pos_of = np.full(Y.shape[0], np.nan)
     pos_of[frames] = positions
     sums, counts = [0.0, 0.0, 0.0], [0, 0, 0]
-    for b in range(0, frames.size, _ROWS):
-        e = spline(positions[b:b + _ROWS]) - Y[frames[b:b + _ROWS]]
+    for b in range(0, frames.size, _SPLINE_ROWS):
+        e = spline(positions[b:b + _SPLINE_ROWS]) - Y[frames[b:b + _SPLINE_ROWS]]
         sums[0] += float(np.einsum("ij,ij->", e, e))
         counts[0] += e.shape[0]
     for s, e in regions:
         if e - s < 2 * HALF + 1:
             continue
-        for r0 in range(s + HALF, e - HALF, _ROWS):  # output rows r0 .. r1-1 need Y[r0 - HALF : r1 + HALF]
-            r1 = min(r0 + _ROWS, e - HALF)
+        for r0 in range(s + HALF, e - HALF, _SPLINE_ROWS):  # output rows r0 .. r1-1 need Y[r0 - HALF : r1 + HALF]
+            r1 = min(r0 + _SPLINE_ROWS, e - HALF)
             p = pos_of[r0:r1]
             window = Y[r0 - HALF:r1 + HALF]
             first, second = spline.derivatives(p)

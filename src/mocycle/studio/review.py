@@ -58,9 +58,10 @@ def loop_view(report):
     index = np.empty(T)
     for start, stop, _ in segments:  # each region's passes counted from the first repeat
         index[start:stop] = u[start:stop] - N * np.floor(u[start:stop].min() / N)
-    view = cycle.repeat(int(np.floor(index.max() / N)) + 2, root=root)
-    Lv = space.path(view)
-    Pv = space.encode(view[: N + 1])[0]  # P repeats every cycle (the repeats differ in L only): one cycle read
+    # the repeated cycle's path from its travel joint alone (no (T, J) rotations of every joint decoded); P
+    # repeats every cycle (the repeats differ in L only): one cycle read
+    Lv = cycle.repeat_path(int(np.floor(index.max() / N)) + 2, root=root)
+    Pv = space.encode(cycle.repeat(2, root=root)[: N + 1])[0]
     i0 = np.floor(index).astype(int)
     a = (index - i0)[:, None]
     L = (1 - a) * Lv[i0] + a * Lv[i0 + 1]
