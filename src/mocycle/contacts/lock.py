@@ -515,18 +515,14 @@ def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | N
         return shift - shift.mean(axis=0)
     axis = up if turn_axis is None else np.asarray(turn_axis, dtype=np.float64)
     steps = np.arange(period, 2 * period)
-    u = u[steps]
-    if turn:   # each step's velocity in the loop's frame at the step's middle
-        u = np.einsum("tji,tj->ti", axis_rotations(axis, turn * (steps + 0.5) / period), u)
+    # each step's velocity in the loop's frame at the step's middle (the identity for a straight loop)
+    u = np.einsum("tji,tj->ti", axis_rotations(axis, turn * (steps + 0.5) / period), u[steps])
     u -= u.mean(axis=0)
     # (period, 3), 0 at each period's first frame: the loop's first frame keeps its place, and a turning
     # loop turns about it (Cycle.repeat), so the repeats still meet
     s = np.vstack([np.zeros(3), np.cumsum(u[:-1], axis=0)])
     t = np.arange(T)
-    shift = s[t % period]
-    if turn:
-        shift = np.einsum("tij,tj->ti", axis_rotations(axis, turn * t / period), shift)
-    return shift
+    return np.einsum("tij,tj->ti", axis_rotations(axis, turn * t / period), s[t % period])
 
 
 def _descendants(motion: Motion, joint: int) -> np.ndarray:
