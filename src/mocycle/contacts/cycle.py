@@ -25,7 +25,7 @@ from ..motion import Motion
 from ..rotations import axis_rotations
 from .clearance import swing_clearance
 from .detect import Contacts, detect_contacts
-from .feet import Foot, chain_joints, chain_transforms, find_feet
+from .feet import Foot, chain_joints, chain_transforms, find_feet, leg_joints
 from .lock import BLEND_SECONDS, REACH, lock_feet
 
 
@@ -43,8 +43,7 @@ def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend:
     detect_options.setdefault("up", cycle.space.world_up)   # the take's vertical (found once, by the fit)
     if feet is None or isinstance(feet, str):
         feet = find_feet(ext.skeleton, feet)
-    legs = sorted({j for f in feet for j in (f.hip, f.knee, f.ankle) + f.contact_joints})
-    Rw, W = chain_transforms(ext, chain_joints(ext, legs))   # once for detection and locking
+    Rw, W = chain_transforms(ext, chain_joints(ext, leg_joints(feet)))   # once for detection and locking
     contacts = detect_contacts(ext, feet, positions=W, **detect_options)
     if clearance is None:
         clearance = swing_clearance(ext if reference is None else reference, contacts.feet,

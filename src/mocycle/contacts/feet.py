@@ -235,6 +235,11 @@ def body_height(motion: Motion, up: np.ndarray | None = None, positions: np.ndar
     return float(np.ptp(pose @ up)) or 1.0
 
 
+def leg_joints(feet: Sequence[Foot]) -> list[int]:
+    """The hip, knee, ankle and toe of every foot, in skeleton order."""
+    return sorted({j for f in feet for j in (f.hip, f.knee, f.ankle) + f.contact_joints})
+
+
 def chain_joints(motion: Motion, joints) -> list[int]:
     """``joints``, the travel joint and all their ancestors, in skeleton order (parents first)."""
     parents = motion.skeleton.parents

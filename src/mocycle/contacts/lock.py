@@ -59,7 +59,7 @@ from ..motion import Motion
 from ..rotations import axis_rotations
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
-from .feet import chain_joints, chain_transforms
+from .feet import chain_joints, chain_transforms, leg_joints
 from .smooth import maximum, uniform
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
@@ -569,8 +569,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         clearance = swing_clearance(motion, contacts.feet, up=contacts.up, body=contacts.body)
     clearance = np.broadcast_to(np.asarray(clearance, dtype=np.float64), (len(contacts.joints),))
     skel = motion.skeleton
-    legs = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle) + f.contact_joints})
-    chain = chain_joints(motion, legs)
+    chain = chain_joints(motion, leg_joints(contacts.feet))
     below = _descendants(motion, motion.travel_joint)
     Rw, W = chain_transforms(motion, chain) if transforms is None else transforms
     trans = motion.translations.copy()

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..motion import Motion
-from .feet import Foot, body_height, find_feet, up_axis
+from .feet import Foot, body_height, find_feet, leg_joints, up_axis
 
 SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual absolute H
 
@@ -46,10 +46,6 @@ def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: f
     if per_joint:
         return {motion.skeleton.names[j]: float(v) for j, v in zip(joints, values, strict=True)}
     return float(values.mean())
-
-
-def leg_joints(feet: Sequence[Foot]) -> list[int]:
-    return sorted({j for f in feet for j in (f.hip, f.knee, f.ankle) + ((f.toe,) if f.toe is not None else ())})
 
 
 def largest_leg_step(motion: Motion, feet: Sequence[Foot] | None = None) -> float:
