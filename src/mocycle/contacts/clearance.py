@@ -40,7 +40,7 @@ def swing_clearance(motion: Motion | Sequence[Motion], feet: Sequence[Foot] | st
     several takes, e.g. the two takes of a blend, the mean of theirs).  0 for a joint that hardly swings.
     ``up``, ``body``: the vertical and the body height (file units) when the caller has them (the same rig's)."""
     from .detect import heights_and_speeds, local_floor
-    from .feet import chain_joints, chain_transforms
+    from .feet import chain_joints, chain_positions
 
     if not isinstance(motion, Motion):
         return np.mean([swing_clearance(m, feet, up=up, body=body, quantile=quantile) for m in motion], axis=0)
@@ -51,7 +51,7 @@ def swing_clearance(motion: Motion | Sequence[Motion], feet: Sequence[Foot] | st
     if motion.n_frames < 3:
         return np.zeros(len(joints))
     body = body_height(motion, up) if body is None else float(body)
-    W = chain_transforms(motion, chain_joints(motion, joints))[1]   # the feet and the travel joint only
+    W = chain_positions(motion, chain_joints(motion, joints))   # the feet and the travel joint only
     h, v, _ = heights_and_speeds(motion, joints, up, positions=W)
     h, v = h / body, v / body
     h = h - local_floor(h, motion.fps)

@@ -45,7 +45,7 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion
-from .feet import Foot, body_height, chain_joints, chain_transforms, find_feet, up_axis
+from .feet import Foot, body_height, chain_joints, chain_positions, find_feet, up_axis
 from .smooth import gaussian, minimum
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
@@ -231,7 +231,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
     body = body_height(motion, up)
     joints = tuple(j for f in feet for j in f.contact_joints)
     foot_of = tuple(i for i, f in enumerate(feet) for _ in f.contact_joints)
-    W = chain_transforms(motion, chain_joints(motion, joints))[1] if positions is None else positions  # legs only
+    W = chain_positions(motion, chain_joints(motion, joints)) if positions is None else positions  # legs only
     h, v, vu = heights_and_speeds(motion, joints, up, positions=W)
     h, v, vu = h / body, v / body, vu / body
     h = h - local_floor(h, motion.fps)

@@ -294,18 +294,44 @@ def chain_transforms(motion: Motion, chain: list[int]) -> tuple[ChainArray, Chai
     ``(..., 3)``) of the joints of ``chain`` (:class:`ChainArray`, NaN for the others): forward kinematics of
     the legs only, not of a 100-joint rig's fingers and face, held for the chain's joints only."""
     T = motion.n_frames
-    parents = motion.skeleton.parents
     Rw = ChainArray(T, chain, (3, 3))
     W = ChainArray(T, chain, (3,))
-    locals_ = Rotation.from_quat(motion.rotations[:, chain].reshape(-1, 4)).as_matrix().reshape(T, len(chain), 3, 3)
+    _chain_fk(motion, chain, slice(None), Rw, W)
+    return Rw, W
+
+
+#: frames per block of :func:`chain_positions` (its world rotations are held for one block only)
+POSITIONS_BLOCK = 16384
+
+
+def chain_positions(motion: Motion, chain: list[int]) -> ChainArray:
+    """The world positions of :func:`chain_transforms` alone, computed a block of frames at a time: for a long
+    take only the ``(T, len(chain), 3)`` positions are held, not the rotations (three times their size)."""
+    T = motion.n_frames
+    W = ChainArray(T, chain, (3,))
+    Rw = ChainArray(min(T, POSITIONS_BLOCK), chain, (3, 3))
+    for start in range(0, T, POSITIONS_BLOCK):
+        rows = slice(start, min(T, start + POSITIONS_BLOCK))
+        n = rows.stop - rows.start
+        if n < Rw.data.shape[0]:
+            Rw.data = Rw.data[:n]
+        block = ChainArray(0, chain, (3,))
+        block.data = W.data[rows]          # a view: the block's positions are written into W
+        _chain_fk(motion, chain, rows, Rw, block)
+    return W
+
+
+def _chain_fk(motion: Motion, chain: list[int], rows: slice, Rw: ChainArray, W: ChainArray) -> None:
+    """Forward kinematics of ``chain`` over the frames ``rows``, into ``Rw`` and ``W`` (of those frames'
+    length); each joint's local rotation matrices are made when it is reached, not all at once."""
+    parents = motion.skeleton.parents
     for i, j in enumerate(chain):
         p = int(parents[j])
-        local = locals_[:, i]
+        local = Rotation.from_quat(motion.rotations[rows, j]).as_matrix()
         if p < 0:
             Rw.data[:, i] = local
-            W.data[:, i] = motion.translations[:, j]
+            W.data[:, i] = motion.translations[rows, j]
         else:
             Rp = Rw[:, p]
-            Rw.data[:, i] = Rp @ local
-            W.data[:, i] = W[:, p] + (Rp @ motion.translations[:, j, :, None])[..., 0]
-    return Rw, W
+            np.matmul(Rp, local, out=Rw.data[:, i])
+            W.data[:, i] = W[:, p] + (Rp @ motion.translations[rows, j, :, None])[..., 0]

@@ -600,10 +600,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         g[free] = base + _soft_reach(base, g[free] - base, hips, R, zone, contacts.up)
     window = np.zeros(motion.n_frames, bool)
     window[frames if frames is not None else slice(None)] = True
-    legs3 = sorted({j for f in contacts.feet for j in (f.hip, f.knee, f.ankle)})
-    col = {j: i for i, j in enumerate(legs3)}
-    local = Rotation.from_quat(motion.rotations[:, legs3].reshape(-1, 4)).as_matrix().reshape(
-        motion.n_frames, len(legs3), 3, 3)
+    new_locals = []  # (frames, joint, local rotation matrices (n, 3, 3)): only what the legs' IK changes
     for foot, g, gt, ch in zip(contacts.feet, goals, toe_goals, changed, strict=True):
         t = np.flatnonzero((ch | lowered) & window)
         if t.size == 0:
@@ -620,30 +617,24 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
         hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
         Rp_hip = Rw[t, hp] if hp >= 0 else np.broadcast_to(np.eye(3), (t.size, 3, 3))
-        local[t, col[foot.hip]] = np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rw[t, foot.hip]
-        local[t, col[foot.knee]] = np.swapaxes(Rw[t, kp], 1, 2) @ R1 @ Rw[t, foot.knee]
         aim = np.broadcast_to(np.eye(3), (t.size, 3, 3))
         if gt is not None:
             aim = _swing(W[t, foot.toe] - A, gt[t] - G)
         new_parent = R2 @ R1 @ Rw[t, ap]
-        local[t, col[foot.ankle]] = np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle]
+        new_locals += [(t, foot.hip, np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rw[t, foot.hip]),
+                       (t, foot.knee, np.swapaxes(Rw[t, kp], 1, 2) @ R1 @ Rw[t, foot.knee]),
+                       (t, foot.ankle, np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle])]
     del W, Rw  # the chain's world positions and rotations: not needed for the quaternions (memory)
-    rotations = motion.rotations
+    row = np.arange(motion.n_frames)  # a frame's row in the output
     if frames is not None:
-        rotations, trans, local, lowered = rotations[frames], trans[frames], local[frames], lowered[frames]
-        changed = [ch[frames] for ch in changed]
-    T = rotations.shape[0]
-    quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(T, len(legs3), 4)
-    del local
-    # frames and joints not touched keep their exact quaternions
-    touched = np.zeros((T, len(legs3)), bool)
-    for foot, ch in zip(contacts.feet, changed, strict=True):
-        touched[np.ix_(ch | lowered, [col[foot.hip], col[foot.knee], col[foot.ankle]])] = True
-    old = rotations[:, legs3]
-    np.copyto(quats, old, where=~touched[..., None])
-    quats *= np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)  # the sign of the old
-    del old
-    rotations = rotations.copy()
-    rotations[:, legs3] = quats
-    del quats
+        row = np.full(motion.n_frames, -1)
+        row[frames] = np.arange(window.sum())
+        trans = trans[frames].copy()
+    rotations = motion.rotations[frames if frames is not None else slice(None)].copy()
+    for t, j, local in new_locals:  # frames and joints not touched keep their exact quaternions
+        quats = Rotation.from_matrix(local).as_quat()
+        old = rotations[row[t], j]
+        quats *= np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)  # the sign of the old
+        rotations[row[t], j] = quats
+    del new_locals
     return Motion(motion.skeleton, rotations, trans, motion.frame_time, copy=False)

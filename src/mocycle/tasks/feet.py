@@ -53,10 +53,10 @@ def _skate(motion, contacts) -> float:
     """The skate measure of ``motion`` on the feet and vertical of ``contacts``, from the forward kinematics of
     the legs alone (its body height from some 50 frames of the whole body, as ``loop_metrics`` measures it)."""
     from ..contacts import body_height, skate
-    from ..contacts.feet import chain_joints, chain_transforms
+    from ..contacts.feet import chain_joints, chain_positions
 
     joints = [j for f in contacts.feet for j in f.contact_joints]
-    W = chain_transforms(motion, chain_joints(motion, joints))[1]
+    W = chain_positions(motion, chain_joints(motion, joints))
     return skate(motion, contacts.feet, up=contacts.up, positions=W, body=body_height(motion, contacts.up))
 
 
