@@ -111,7 +111,8 @@ class PoseDecoder:
         """
         quats, trans = self.decode_arrays(X)
         tpl = self.template
-        return Motion(tpl.skeleton, quats, trans, tpl.frame_time if frame_time is None else frame_time)
+        return Motion(tpl.skeleton, quats, trans, tpl.frame_time if frame_time is None else frame_time,
+                      copy=False)  # decode_arrays made them: handed over, not copied
 
     def decode_arrays(self, X: np.ndarray, translations: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """What :meth:`decode` makes a motion of: quaternions ``(T, J, 4)`` (not yet normalised) and

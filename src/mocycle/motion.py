@@ -471,7 +471,7 @@ class Motion:
             rot[:, j] = Slerp(old_t, Rotation.from_quat(self.rotations[:, j]))(new_t).as_quat()
         flat = self.translations.reshape(self.n_frames, -1)
         trans = np.stack([np.interp(new_t, old_t, col) for col in flat.T], axis=1)
-        return Motion(self.skeleton, rot, trans.reshape(n_new, self.n_joints, 3), new_dt)
+        return Motion(self.skeleton, rot, trans.reshape(n_new, self.n_joints, 3), new_dt, copy=False)
 
     @classmethod
     def rest(cls, skeleton: Skeleton, n_frames: int = 1, frame_time: float = 1 / 30) -> Motion:

@@ -210,7 +210,7 @@ def resample_cycle(cycle: Motion, n_frames: int, shift: float = 0.0, frame_time:
         raise MocycleError(f"the shift must be a finite number of cycles; got {shift!r}")
     N = cycle.n_frames
     quats, trans = _circular_sample(cycle, (np.arange(n_frames) / n_frames + shift) * N)
-    return Motion(cycle.skeleton, quats, trans, frame_time or cycle.frame_time * N / n_frames)
+    return Motion(cycle.skeleton, quats, trans, frame_time or cycle.frame_time * N / n_frames, copy=False)
 
 
 # ----------------------------------------------------------- prepared inputs

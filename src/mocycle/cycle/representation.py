@@ -265,4 +265,4 @@ class CycleSpace:
         """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``;
         ``projected``: :meth:`project` of ``P`` when the caller has it."""
         quats = continuous_quats(matrix_quats(self.rotations(P, L, projected)))
-        return Motion(self.skeleton, quats, self.translations(P, L), self.frame_time)
+        return Motion(self.skeleton, quats, self.translations(P, L), self.frame_time, copy=False)

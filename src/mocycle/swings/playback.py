@@ -120,7 +120,7 @@ def playback(seg: Segmentation, profile: str = "hermite") -> Motion:
         else:
             for a in range(3):
                 trans[:, j, a] = np.interp(frames, kf, kv[:, a])
-    return Motion(seg.skeleton, quats, trans, seg.frame_time)
+    return Motion(seg.skeleton, quats, trans, seg.frame_time, copy=False)  # arrays made here: handed over
 
 
 def _euler_near(quats: np.ndarray, order: str, ref: np.ndarray) -> np.ndarray:
@@ -159,21 +159,32 @@ def euler_differences(original: Motion, other: Motion) -> np.ndarray:
     ``other``'s triples are the equivalent ones nearest the original's, so the
     difference measures the pose, not the choice of Euler solution.
     """
+    blocks = list(_euler_difference_blocks(original, other))
+    return np.concatenate(blocks, axis=0) if blocks[0].shape[1] else np.zeros((original.n_frames, 0))
+
+
+#: frames per block of :func:`_euler_difference_blocks`
+DIFFERENCE_BLOCK = 8192
+
+
+def _euler_difference_blocks(original: Motion, other: Motion):
+    """:func:`euler_differences` a block of :data:`DIFFERENCE_BLOCK` frames at a time (the same numbers): a
+    caller that reduces them holds no ``(T, R)`` array but the original's channels."""
     if not original.skeleton.same_as(other.skeleton) or original.n_frames != other.n_frames:
         raise MocycleError(f"motions differ in skeleton or length ({original!r} vs {other!r})")
     ref = motion_channels(original)
     T = original.n_frames
-    cols_all, diffs = [], []
-    for j, (rot_cols, order, _, _) in enumerate(_channel_layout(original.skeleton)):
-        if not rot_cols:
-            continue
-        r = np.radians(ref[:, rot_cols])[:, None, :]
-        mine = _euler_near(other.rotations[:, j:j + 1], order, r)
-        diffs.append(np.degrees(mine - r).reshape(T, -1))
-        cols_all += rot_cols
-    if not diffs:
-        return np.zeros((T, 0))
-    return np.concatenate(diffs, axis=1)
+    layout = [(j, rot_cols, order) for j, (rot_cols, order, _, _) in enumerate(_channel_layout(original.skeleton))
+              if rot_cols]
+    for f0 in range(0, T, DIFFERENCE_BLOCK):
+        rows = slice(f0, min(T, f0 + DIFFERENCE_BLOCK))
+        n = rows.stop - rows.start
+        diffs = []
+        for j, rot_cols, order in layout:
+            r = np.radians(ref[rows, rot_cols])[:, None, :]
+            mine = _euler_near(other.rotations[rows, j:j + 1], order, r)
+            diffs.append(np.degrees(mine - r).reshape(n, -1))
+        yield np.concatenate(diffs, axis=1) if diffs else np.zeros((n, 0))
 
 
 def segmentation_error(original: Motion, other: Motion) -> float:
@@ -193,14 +204,17 @@ def geodesic_errors(original: Motion, other: Motion) -> np.ndarray:
 def playback_errors(original: Motion, other: Motion) -> dict:
     """Segmentation Error (deg), the paper's per-angle figure (error / rotation DOFs), the RMS per angle,
     the mean geodesic error over joints and per joint (deg)."""
-    d = euler_differences(original, other)
-    n_dof = d.shape[1]
-    seg_err = float(np.linalg.norm(d, axis=1).mean()) if d.size else 0.0
+    norms, squares, n_dof = [], 0.0, 0
+    for d in _euler_difference_blocks(original, other):  # block by block: no (T, R) arrays
+        n_dof = d.shape[1]
+        norms.append(np.linalg.norm(d, axis=1))
+        squares += float(np.sum(d ** 2))
+    seg_err = float(np.concatenate(norms).mean()) if n_dof else 0.0
     geo = geodesic_errors(original, other)
     return dict(
         segmentation_error=seg_err,
         per_angle_error_deg=seg_err / n_dof if n_dof else 0.0,
-        rms_angle_error_deg=float(np.sqrt(np.mean(d**2))) if d.size else 0.0,
+        rms_angle_error_deg=float(np.sqrt(squares / (original.n_frames * n_dof))) if n_dof else 0.0,
         rotation_dofs=n_dof,
         geodesic_error_deg=float(geo.mean()),
         geodesic_error_by_joint_deg={n: float(g) for n, g in zip(original.skeleton.names, geo, strict=True)},
