@@ -112,3 +112,21 @@ def test_vectorised_playback_is_the_per_swing_definition():
         assert np.abs(np.abs(np.sum(got * one, axis=1)) - 1.0).max() < 1e-12
         checked += 1
     assert checked > walk.n_joints // 2
+
+
+def test_playback_errors_block_by_block_equal_those_of_the_whole_difference_array(monkeypatch):
+    import importlib
+
+    from mocycle.swings.playback import euler_differences
+
+    pb_module = importlib.import_module("mocycle.swings.playback")  # the module (the package exports a function)
+
+    walk = synthetic_walk(n_frames=300, fps=60, noise_deg=1.0, seed=5).motion
+    again = playback(segment(walk, threshold=0.4))
+    d = euler_differences(walk, again)
+    monkeypatch.setattr(pb_module, "DIFFERENCE_BLOCK", 70)  # five blocks, the last one short
+    np.testing.assert_array_equal(euler_differences(walk, again), d)
+    errs = playback_errors(walk, again)
+    assert errs["segmentation_error"] == pytest.approx(float(np.linalg.norm(d, axis=1).mean()), rel=1e-12)
+    assert errs["rms_angle_error_deg"] == pytest.approx(float(np.sqrt(np.mean(d ** 2))), rel=1e-12)
+    assert errs["rotation_dofs"] == d.shape[1] > 0
