@@ -447,7 +447,7 @@ def pose_matrix(
     centred = raw
     if normalize:
         mean = raw.mean(axis=0)
-        centred = raw - mean
+        centred = np.subtract(raw, mean, out=raw)  # in place: raw is not read again (a (T, D) array less)
         # raw.std(axis=0) from the centred rows numpy's _var makes anyway (the same operations, the same bits)
         std = np.sqrt(np.add.reduce(np.square(centred), axis=0) / raw.shape[0])
         scale = np.where(std > 1e-12 * (1.0 + np.abs(mean)), std, 1.0)

@@ -38,8 +38,8 @@ import numpy as np
 
 from ..errors import LoopRefused, MocycleWarning
 from ..motion import Motion
-from ..phase.period import autocorrelation_period
-from .extract import Cycle, loop_blocks, metric_features
+from ..phase.period import autocorrelation_period, autocorrelation_period_of_blocks
+from .extract import Cycle, MetricRows, loop_blocks
 from .metrics import template_error
 from .seam import seam_ratios
 
@@ -84,7 +84,7 @@ def _plain_cut_error(Y: np.ndarray, period: float, differences: dict | None = No
     for lag in lags:
         lag = int(lag)
         if lag not in differences:
-            differences[lag] = _lag_differences(Y, lag)
+            differences[lag] = Y.lag_differences(lag) if isinstance(Y, MetricRows) else _lag_differences(Y, lag)
         d = differences[lag]
         if d.size < 2 * h + 1:
             continue
@@ -125,14 +125,17 @@ def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = 
     region: the better of cuts near the cycle's period and near the region's own autocorrelation period
     (paper 004 eq. 1 on the pose features; independent of the phase).  ``reference`` changes nothing
     (:func:`~mocycle.cycle.extract.metric_features`); ``features``: the region's metric features when the
-    caller has them (its still columns may be left out: :func:`moving_columns`)."""
+    caller has them, an array or a :class:`~mocycle.cycle.extract.MetricRows` (its still columns may be left
+    out: :func:`moving_columns`); by default they are made block by block as they are read."""
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    Y = moving_columns(metric_features(motion, rows=slice(s, e)) if features is None else features)
+    Y = MetricRows(motion, slice(s, e)) if features is None else features
+    Y = Y.moving() if isinstance(Y, MetricRows) else moving_columns(Y)
     candidates = [cycle.period_frames]
     if Y.shape[0] >= 8:
         min_lag = max(2, int(round(MIN_PERIOD_S / motion.frame_time)))
         if min_lag <= Y.shape[0] // 2:
-            candidates.append(autocorrelation_period(Y, min_lag=min_lag))
+            candidates.append(autocorrelation_period_of_blocks(Y.column_blocks(), Y.shape[0], min_lag=min_lag)
+                              if isinstance(Y, MetricRows) else autocorrelation_period(Y, min_lag=min_lag))
     best = (float("nan"), float("nan"))
     differences: dict = {}
     for p in candidates:
@@ -153,20 +156,17 @@ def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> li
             f"the cycle ({cycle.n_frames} frames) is longer than the {fitted} frames it was fitted on: the take "
             f"holds {cycle.n_periods:.2f} periods, not one whole cycle"))
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    Y = metric_features(motion, rows=slice(s, e))  # the longest excited region
     if metrics is not None:
         tmpl = metrics["template_error"]
         seam = max(metrics["seam_pose_local"], metrics["seam_velocity_local"])
     else:
         C, root = loop_blocks(cycle)
-        tmpl = template_error(Y, C)[0]
+        tmpl = template_error(MetricRows(motion, slice(s, e)), C)[0]
         ratios = [seam_ratios(C), seam_ratios(root)]
         seam = max(max(r["pose_local"], r["velocity_local"]) for r in ratios)
-    Y = moving_columns(Y)  # the cut and the spread: still columns add nothing
+    Y = MetricRows(motion, slice(s, e)).moving()  # the longest excited region without its still columns
     cut, cut_period = best_cut_error(motion, cycle, features=Y)
-    mean = Y.mean(axis=0)
-    spread = float(np.sqrt(sum(float(((Y[r:r + 8192] - mean) ** 2).sum()) for r in range(0, Y.shape[0], 8192))
-                           / Y.shape[0]))
+    spread = Y.spread()
     del Y
     if np.isfinite(cut) and not tmpl <= max(MAX_FIT_RATIO * cut, FIT_FLOOR * spread):
         why = (f"the period found ({cycle.period_frames:.1f} frames) is probably wrong"

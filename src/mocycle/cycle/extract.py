@@ -39,6 +39,10 @@ from .representation import CycleSpace
 from .seam import calmest_start
 from .timeaxis import TIME_AXES, TimeAxis, time_axis
 
+#: Above this size (bytes) the M1 harmonic fit reads the pose rows ``P`` of :meth:`CycleSpace.encode` as it
+#: goes (:meth:`CycleSpace.encode_rows`: each of its three passes makes them again) instead of holding them.
+LAZY_P_BYTES = 1 << 26
+
 METHODS = ("harmonic", "centroid", "cut")
 ROOT_MODES = ("inplace", "motion")
 DEFAULT_HARMONICS = 20   # the thesis' K
@@ -484,6 +488,125 @@ def _rotation_joints(skeleton) -> list[int]:
     return [j for j, channels in enumerate(skeleton.channels) if any(c in ROTATION_CHANNELS for c in channels)]
 
 
+class MetricRows:
+    """``metric_features(motion, rows=region)[:, columns]`` made a block of rows (or of columns) at a time when
+    read, never held whole: a long take's ``(T, 9J)`` array (158 MB for 100k frames of 22 joints) was the
+    largest thing the loop metrics and checks held.
+
+    ``rows[a:b]`` and ``rows[index array]`` are those rows of the array ``(n, len(columns))``, the same numbers
+    (each block made as :func:`metric_features` makes its blocks, columns picked as ``array[:, columns]``
+    picks them); :meth:`region` is a block of frames, :meth:`select` and :meth:`moving` pick columns;
+    :meth:`column_blocks` feeds :func:`~mocycle.phase.period.autocorrelation_period_of_blocks`;
+    :meth:`lag_differences` gives the squared row distances ``lag`` rows apart from the quaternions
+    (``||R1 - R2||²/2 = 4 sin²(θ/2) = 4 (1 - (q1·q2)²)`` per moving joint, within 1e-15 of the largest of the
+    rows' own); :meth:`spread` the RMS distance of the rows from their mean row."""
+
+    BLOCK = 8192
+
+    def __init__(self, motion: Motion, region: slice = slice(None), columns: np.ndarray | None = None):
+        self.quats = motion.rotations[region]
+        self.joints = np.asarray(_rotation_joints(motion.skeleton), dtype=np.intp)
+        if self.joints.size == 0:
+            metric_features(motion, rows=region)  # raises: no features
+        self.every = columns is None
+        self.columns = np.arange(9 * self.joints.size) if columns is None else np.asarray(columns, dtype=np.intp)
+        self.shape = (self.quats.shape[0], int(self.columns.size))
+        self.ndim = 2
+
+    def _like(self, quats: np.ndarray, columns: np.ndarray | None) -> MetricRows:
+        out = object.__new__(MetricRows)
+        out.quats, out.joints, out.every = quats, self.joints, columns is None
+        out.columns = self.columns if columns is None else columns
+        out.shape, out.ndim = (quats.shape[0], int(out.columns.size)), 2
+        return out
+
+    def region(self, start: int, stop: int) -> MetricRows:
+        """Rows ``start:stop`` as another :class:`MetricRows` (nothing is made)."""
+        return self._like(self.quats[start:stop], None if self.every else self.columns)
+
+    def select(self, keep: np.ndarray) -> MetricRows:
+        """The columns where the boolean ``keep`` ``(n_columns,)`` is true."""
+        return self._like(self.quats, self.columns[np.asarray(keep, dtype=bool)])
+
+    def still(self) -> np.ndarray:
+        """``(n_columns,)`` True where a column holds one value on every row (``np.ptp(rows, axis=0) == 0``)."""
+        lo = hi = None
+        for r0 in range(0, self.shape[0], self.BLOCK):
+            raw = self._raw(self.quats[r0:r0 + self.BLOCK])
+            lo = raw.min(axis=0) if lo is None else np.minimum(lo, raw.min(axis=0))
+            hi = raw.max(axis=0) if hi is None else np.maximum(hi, raw.max(axis=0))
+        if lo is None:
+            return np.zeros(self.shape[1], dtype=bool)
+        return (hi - lo == 0)[self.columns]
+
+    def moving(self) -> MetricRows:
+        """Without the still columns (:func:`~mocycle.cycle.checks.moving_columns`); itself when all move."""
+        still = self.still()
+        return self if not still.any() else self.select(~still)
+
+    def _raw(self, quats: np.ndarray, joints: np.ndarray | None = None) -> np.ndarray:
+        """All 9 entries per joint (of ``joints``, default every rotation joint) of the frames ``quats``."""
+        block = np.take(quats, self.joints if joints is None else joints, axis=1)
+        out = Rotation.from_quat(block.reshape(-1, 4)).as_matrix().reshape(block.shape[0], -1)
+        out /= np.sqrt(2.0)
+        return out
+
+    def _pick(self, raw: np.ndarray) -> np.ndarray:
+        return raw if self.every else raw[:, self.columns]  # laid out as array[:, columns]: the same rounding
+
+    def __getitem__(self, key) -> np.ndarray:
+        if isinstance(key, slice):
+            if key.step not in (None, 1):
+                raise TypeError("MetricRows reads a slice of rows with step 1")
+            r0, r1, _ = key.indices(self.shape[0])
+            if r1 <= r0:
+                return np.empty((0, self.shape[1]))
+            blocks = [self._raw(self.quats[a:min(r1, a + self.BLOCK)]) for a in range(r0, r1, self.BLOCK)]
+            return self._pick(blocks[0] if len(blocks) == 1 else np.concatenate(blocks, axis=0))
+        index = np.asarray(key)
+        if index.ndim != 1 or index.dtype.kind not in "iu":
+            raise TypeError("MetricRows reads a slice of rows or a 1-D array of row indices")
+        blocks = [self._raw(np.take(self.quats, index[a:a + self.BLOCK], axis=0))
+                  for a in range(0, index.size, self.BLOCK)] or [np.empty((0, 9 * self.joints.size))]
+        return self._pick(blocks[0] if len(blocks) == 1 else np.concatenate(blocks, axis=0))
+
+    def column_blocks(self):
+        """The columns, :func:`~mocycle.phase.period.column_block_width` at a time, all rows each ``(n, d)``."""
+        from ..phase.period import column_block_width
+
+        M, width = self.shape[0], column_block_width(self.shape[0])
+        for c0 in range(0, self.shape[1], width):
+            cols = self.columns[c0:c0 + width]
+            ks = np.unique(cols // 9)  # the joints (positions in self.joints) these columns belong to
+            local = np.searchsorted(ks, cols // 9) * 9 + cols % 9
+            out = np.empty((M, cols.size))
+            for r0 in range(0, M, self.BLOCK):
+                out[r0:r0 + self.BLOCK] = self._raw(self.quats[r0:r0 + self.BLOCK], self.joints[ks])[:, local]
+            yield out
+
+    def lag_differences(self, lag: int) -> np.ndarray:
+        """``(n - lag,)`` squared distances between rows ``lag`` apart (see the class docstring)."""
+        M = self.shape[0]
+        d = np.empty(max(0, M - lag))
+        joints = self.joints[np.unique(self.columns // 9)]  # those with a column here: the others add nothing
+        every = np.array_equal(joints, np.arange(self.quats.shape[1]))
+        for r in range(0, M - lag, self.BLOCK):
+            r1 = min(r + self.BLOCK, M - lag)
+            a, b = self.quats[r:r1], self.quats[r + lag:r1 + lag]
+            if not every:
+                a, b = np.take(a, joints, axis=1), np.take(b, joints, axis=1)
+            cos = np.einsum("tjk,tjk->tj", a, b)  # cos(θ/2) per joint, up to sign
+            d[r:r1] = 4.0 * (joints.size - np.einsum("tj,tj->t", cos, cos))
+        return d
+
+    def spread(self) -> float:
+        """RMS distance of the rows from their mean row."""
+        M = self.shape[0]
+        mean = sum(self[r:r + self.BLOCK].sum(axis=0) for r in range(0, M, self.BLOCK)) / M
+        return float(np.sqrt(sum(float(((self[r:r + self.BLOCK] - mean) ** 2).sum())
+                                 for r in range(0, M, self.BLOCK)) / M))
+
+
 def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """What the seam of a cycle is judged on: its in-place rotations as :func:`metric_features` ``(N, 9J)``
     and the world path of its travel joint ``(N, 3)``.
@@ -597,7 +720,10 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
         warnings.warn(f"only {axis.n_periods:.2f} periods found (fewer than {FEW_PERIODS}); the cycle rests on "
                       f"little evidence", MocycleWarning, stacklevel=2)
     space = CycleSpace.fit(motion)
-    P, L = space.encode(motion)
+    if method == "harmonic" and model == "M1" and motion.n_frames * space.n_periodic * 8 > LAZY_P_BYTES:
+        P, L = space.encode_rows(motion)  # the fit reads P's rows block by block: made as read, never held
+    else:
+        P, L = space.encode(motion)
     # The path is fitted straightened (periodic plus a line) and turned back along the cycle's heading.
     Q = space.straighten(L, axis.period_frames)
     # The cut's wrap is its seam; the others have none, so they start at the calmest point.

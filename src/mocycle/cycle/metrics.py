@@ -44,7 +44,7 @@ from ..axes import vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion
 from .differences import FORWARD_3, HALF, central_acceleration, central_velocity, forward_jerk
-from .extract import Cycle, loop_blocks, metric_features
+from .extract import Cycle, MetricRows, loop_blocks
 from .seam import seam_ratios
 
 CONTACT_HEIGHT = 0.02  # of the body height
@@ -306,21 +306,20 @@ def loop_metrics(motion: Motion, cycle: Cycle, travelling: Motion | None = None)
     >>> metrics["template_error"] < 0.1, metrics["seam_pose"] <= 1.0
     (True, True)
     """
-    Y = metric_features(motion)
+    Y = MetricRows(motion)  # the (T, 9J) metric features, made block by block as they are read
     C, root = loop_blocks(cycle)
     # columns that hold one value in the take and in the cycle (joints that never move, the fixed entries of a
     # joint turning about one axis) add only rounding to every pose figure: left out (a 100-joint rig's fingers)
-    still = (np.ptp(Y, axis=0) == 0) & (np.ptp(C, axis=0) == 0)
+    still = Y.still() & (np.ptp(C, axis=0) == 0)
     if still.any() and not still.all():
-        Y, C = Y[:, ~still], C[:, ~still]
+        Y, C = Y.select(~still), C[:, ~still]
     frames = cycle.axis.frames()
     rate = cycle.n_frames / cycle.period_frames
     rmse_h, rmse_dh, rmse_ddh = regression_errors(Y, C, cycle.positions, cycle.axis.regions, frames,
                                                   motion.frame_time, rate)
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
-    tmpl, offset = template_error(Y[s:e], C)
-    jerk = jerk_ratio([Y[a:b] for a, b in cycle.axis.regions], C, motion.frame_time)
-    del Y  # (T, 9J): not held while the feet are measured
+    tmpl, offset = template_error(Y.region(s, e), C)
+    jerk = jerk_ratio([Y.region(a, b) for a, b in cycle.axis.regions], C, motion.frame_time)
     seams = [seam_ratios(C), seam_ratios(root)]
     travelling = cycle.repeat(2, root="motion") if travelling is None else travelling
     captured = motion[frames[0]:frames[-1] + 1]

@@ -103,23 +103,22 @@ class CycleSpace:
     # -- motion -> (P, L) -----------------------------------------------
     def encode(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
         """``P (T, n_periodic)`` and ``L (T, 4)`` of a motion with the space's skeleton."""
+        rows, L = self.encode_rows(motion)
+        # written block by block of frames straight into P: no (T, J, 3, 3) array or copy of it is held
+        P = np.empty(rows.shape)
+        for f0 in range(0, rows.shape[0], BLOCK_FRAMES):
+            rows.write(f0, min(rows.shape[0], f0 + BLOCK_FRAMES), P[f0:f0 + BLOCK_FRAMES])
+        return P, L
+
+    def encode_rows(self, motion: Motion) -> tuple[EncodedRows, np.ndarray]:
+        """:meth:`encode` with ``P`` left unmade: an :class:`EncodedRows` that makes the rows a caller reads
+        (``rows[a:b]``, the same numbers as ``P[a:b]``), for a reader of a long take that goes over them a block
+        at a time (the harmonic fit): its ``(T, 9J)`` array is never held."""
         if not motion.skeleton.same_as(self.skeleton):
             raise MocycleError("this motion's skeleton differs from the one the cycle space was made for")
-        T, J, travel = motion.n_frames, self.n_joints, self.travel
-        psi = self.heading(Rotation.from_quat(motion.rotations[:, travel]).as_matrix())
-        turn = np.swapaxes(axis_rotations(self.up, psi), 1, 2)  # (T, 3, 3): the heading taken out
-        # written block by block of frames straight into P: no (T, J, 3, 3) array or copy of it is held
-        P = np.empty((T, self.n_periodic))
-        rot = P[:, :9 * J].reshape(T, J, 3, 3)
-        for f0 in range(0, T, BLOCK_FRAMES):
-            f1 = min(T, f0 + BLOCK_FRAMES)
-            rot[f0:f1] = Rotation.from_quat(motion.rotations[f0:f1].reshape(-1, 4)).as_matrix().reshape(
-                f1 - f0, J, 3, 3)
-            rot[f0:f1, travel] = turn[f0:f1] @ rot[f0:f1, travel]
-        if self.moving:
-            P[:, 9 * J:] = motion.translations[:, list(self.moving)].reshape(T, -1)
-        L = np.concatenate([motion.translations[:, travel], psi[:, None]], axis=1)
-        return P, L
+        psi = self.heading(Rotation.from_quat(motion.rotations[:, self.travel]).as_matrix())
+        L = np.concatenate([motion.translations[:, self.travel], psi[:, None]], axis=1)
+        return EncodedRows(self, motion, psi), L
 
     def path(self, motion: Motion) -> np.ndarray:
         """``L (T, 4)`` of :meth:`encode` alone (the travel joint's translation and heading), without ``P``."""
@@ -266,3 +265,34 @@ class CycleSpace:
         ``projected``: :meth:`project` of ``P`` when the caller has it."""
         quats = continuous_quats(matrix_quats(self.rotations(P, L, projected)))
         return Motion(self.skeleton, quats, self.translations(P, L), self.frame_time, copy=False)
+
+
+class EncodedRows:
+    """The rows of :meth:`CycleSpace.encode`'s ``P`` made when read: ``rows[a:b]`` (a slice of frames) is
+    ``P[a:b]`` ``(b - a, n_periodic)``; ``shape`` is ``P``'s.  What the harmonic fit reads of a long take
+    instead of ``P`` (158 MB for 100k frames of 22 joints), a few times over."""
+
+    def __init__(self, space: CycleSpace, motion: Motion, psi: np.ndarray):
+        self.space, self.motion, self.psi = space, motion, psi
+        self.shape = (motion.n_frames, space.n_periodic)
+        self.ndim = 2
+
+    def __getitem__(self, key: slice) -> np.ndarray:
+        if not isinstance(key, slice) or key.step not in (None, 1):
+            raise TypeError("EncodedRows reads a slice of frames")
+        f0, f1, _ = key.indices(self.shape[0])
+        out = np.empty((max(0, f1 - f0), self.shape[1]))
+        for a in range(f0, f1, BLOCK_FRAMES):
+            self.write(a, min(f1, a + BLOCK_FRAMES), out[a - f0:a - f0 + BLOCK_FRAMES])
+        return out
+
+    def write(self, f0: int, f1: int, out: np.ndarray) -> None:
+        """Rows ``f0:f1`` of ``P`` into ``out`` ``(f1 - f0, n_periodic)``."""
+        space, motion, J, travel = self.space, self.motion, self.space.n_joints, self.space.travel
+        n = f1 - f0
+        rot = out[:, :9 * J].reshape(n, J, 3, 3)
+        rot[:] = Rotation.from_quat(motion.rotations[f0:f1].reshape(-1, 4)).as_matrix().reshape(n, J, 3, 3)
+        turn = np.swapaxes(axis_rotations(space.up, self.psi[f0:f1]), 1, 2)  # the heading taken out
+        rot[:, travel] = turn @ rot[:, travel]
+        if space.moving:
+            out[:, 9 * J:] = motion.translations[f0:f1, list(space.moving)].reshape(n, -1)

@@ -299,11 +299,35 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
     finite = np.flatnonzero(np.all(np.isfinite(A), axis=0))
     if finite.size == 0:
         return float("nan")
+    width = column_block_width(T)
+    blocks = (A[:, finite[c0:c0 + width]] for c0 in range(0, finite.size, width))
+    return _period_of_column_blocks(blocks, T, min_lag, max_lag, min_strength)
+
+
+def column_block_width(T: int) -> int:
+    """Columns per block of :func:`autocorrelation_period` on ``T`` frames (:data:`_BLOCK_VALUES`)."""
+    return max(_COLUMNS, _BLOCK_VALUES // T)
+
+
+def autocorrelation_period_of_blocks(blocks, T: int, min_lag: int = 2, max_lag: int | None = None,
+                                     min_strength: float = 0.1) -> float:
+    """:func:`autocorrelation_period` of a ``(T, D)`` array given as its blocks of columns ``(T, d)`` (finite
+    values), :func:`column_block_width` columns each: the same number (within the FFT's rounding, which
+    follows the blocks' memory layout) for a caller that makes the columns block by block instead of holding
+    them all (the loop checks' pose features of a long take)."""
+    if T < 4:
+        raise MocycleError(f"the autocorrelation period needs at least 4 frames; got {T}")
+    max_lag = T // 2 if max_lag is None else max_lag
+    if not 1 <= min_lag <= max_lag <= T - 2:
+        raise MocycleError(f"need 1 <= min_lag <= max_lag <= T - 2; got {min_lag}, {max_lag} with T = {T}")
+    return _period_of_column_blocks(blocks, T, min_lag, max_lag, min_strength)
+
+
+def _period_of_column_blocks(blocks, T: int, min_lag: int, max_lag: int, min_strength: float) -> float:
+    """The core of :func:`autocorrelation_period`: its windowed autocorrelation summed over blocks of columns."""
     window = periodic_hann(T)
     r = np.zeros(T)
-    width = max(_COLUMNS, _BLOCK_VALUES // T)
-    for c0 in range(0, finite.size, width):  # a block of columns at a time: no temporaries as large as A
-        B = A[:, finite[c0:c0 + width]]
+    for B in blocks:  # a block of columns at a time: no temporaries as large as the whole array
         B = B - B.mean(axis=0)
         B[:, np.ptp(B, axis=0) == 0.0] = 0.0  # exactly constant columns: remove the rounding left by centring
         r += circular_autocorrelation(B * window[:, None])  # sums over columns: blocks add up
