@@ -81,3 +81,17 @@ def test_pose_vectors_small_angle_distance():
     X = pose_vectors(np.concatenate([q, q2]), w)
     assert X.shape == (2, 36)
     assert np.linalg.norm(X[0] - X[1]) == pytest.approx(w[2] * 1e-3, rel=1e-3)
+
+
+def test_frame_errors_block_by_block_are_the_pose_distances_of_the_whole_take(monkeypatch):
+    import importlib
+
+    from mocycle.datasets import synthetic_walk
+
+    distance = importlib.import_module("mocycle.keyframes.distance")
+    a = synthetic_walk(n_frames=200, fps=60, noise_deg=0.0, seed=1).motion
+    b = synthetic_walk(n_frames=200, fps=60, noise_deg=3.0, seed=2).motion
+    whole = distance.pose_distance(a.rotations, b.rotations, distance.joint_weights(a.skeleton))
+    monkeypatch.setattr(distance, "ERROR_BLOCK", 48)  # five blocks, the last one short
+    np.testing.assert_array_equal(distance.frame_errors(a, b), whole)
+    assert whole.min() > 0
