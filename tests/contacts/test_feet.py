@@ -95,3 +95,16 @@ def test_leg_positions_block_by_block_are_the_forward_kinematics_of_the_whole_ta
     full = walk.world_positions()
     np.testing.assert_allclose(blocked.data, full[:, chain], atol=1e-9)
     np.testing.assert_allclose(Rw.data, walk.world_transforms()[0][:, chain], atol=1e-12)
+
+
+def test_the_floor_read_a_block_of_frames_at_a_time_is_the_lowest_foot_point(monkeypatch):
+    import importlib
+
+    from mocycle.contacts import floor_height, foot_points
+
+    plant = importlib.import_module("mocycle.contacts.plant")
+    walk = synthetic_walk(n_frames=300, fps=60, noise_deg=2.0, seed=4).motion
+    up = up_axis(walk)
+    lowest = float((walk.world_positions(end_sites=True)[:, foot_points(walk)] @ up).min())
+    monkeypatch.setattr(plant, "FLOOR_BLOCK", 70)  # five blocks, the last one short
+    assert floor_height(walk) == lowest

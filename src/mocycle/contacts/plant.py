@@ -35,8 +35,14 @@ def foot_points(motion: Motion, foot_joints: str | None = None) -> np.ndarray:
 def floor_height(motion: Motion, foot_joints: str | None = None, up: np.ndarray | None = None) -> float:
     """The ground of a take along ``up``: the lowest any foot point comes over the take (file units)."""
     up = up_axis(motion) if up is None else np.asarray(up, dtype=np.float64)
-    W = motion.world_positions(end_sites=True)[:, foot_points(motion, foot_joints)]
-    return float((W @ (up / np.linalg.norm(up))).min())
+    points, up = foot_points(motion, foot_joints), up / np.linalg.norm(up)
+    # a block of frames at a time: the forward kinematics of every joint of a long take are not held
+    return min(float((motion[f0:f0 + FLOOR_BLOCK].world_positions(end_sites=True)[:, points] @ up).min())
+               for f0 in range(0, motion.n_frames, FLOOR_BLOCK))
+
+
+#: frames per block of :func:`floor_height`
+FLOOR_BLOCK = 8192
 
 
 def plant_lowest_foot(motion: Motion, floor: float | None = None, foot_joints: str | None = None,
