@@ -1,7 +1,7 @@
 """Long fuzzing run of every reader, to run before releases (the suite's fuzz tests are the short version).
 
     python benchmarks/fuzz.py [--seconds 3600] [--readers bvh,asf,amc,mck,mosw,json] [--engine auto|atheris|random]
-                              [--rss-mb 2048] [--timeout 10] [--out DIR] [--data DIR]
+                              [--rss-mb 2048] [--timeout 10] [--max-frames 100000] [--out DIR] [--data DIR]
 
 Each reader runs in its own process under a memory limit (``RLIMIT_AS`` of ``--rss-mb``) and a time limit
 per input (``--timeout`` seconds).  A reader passes an input when it returns a result that goes on working
@@ -271,6 +271,8 @@ def parse_libfuzzer(text: str) -> dict:
 def run_reader(reader: str, engine: str, args) -> dict:
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src") + os.pathsep
            + os.environ.get("PYTHONPATH", ""), "MOCYCLE_FUZZ_DATA": str(args.data)}
+    if args.max_frames:  # the largest take a file may claim: one that fits the memory limit when played back
+        env["MOCYCLE_MAX_FRAMES"] = str(args.max_frames)
     cmd = [sys.executable, __file__, "--child", reader, "--engine", engine, "--seconds", str(args.seconds),
            "--rss-mb", str(args.rss_mb), "--timeout", str(args.timeout), "--out", str(args.out)]
     if engine == "random":
@@ -317,6 +319,11 @@ def main(argv=None) -> int:
     parser.add_argument("--engine", choices=("auto", "atheris", "random"), default="auto")
     parser.add_argument("--rss-mb", type=int, default=2048)
     parser.add_argument("--timeout", type=float, default=10.0, help="seconds per input")
+    parser.add_argument("--max-frames", type=int, default=100_000,
+                        help="MOCYCLE_MAX_FRAMES of the readers (0: as set): a compressed file (.mck, .mosw, swings "
+                             "JSON) may describe a long take in a few bytes, which is legitimate up to this limit; "
+                             "the default keeps the largest such take within --rss-mb, so that a run past the "
+                             "memory limit is an allocation the limit does not bound")
     parser.add_argument("--out", type=Path, default=Path(tempfile.gettempdir()) / "mocycle-fuzz")
     parser.add_argument("--data", type=Path, default=DEFAULT_DATA)
     parser.add_argument("--child", choices=READERS)
