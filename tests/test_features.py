@@ -145,3 +145,12 @@ def test_heading_root_features_do_not_depend_on_where_the_walker_faces(up):
     assert np.abs(Xc[:, -4:-1] - Xs[:, -4:-1]).max() < 0.05 * speed  # velocity in the heading frame
     Xv, _ = pose_matrix(circle, rep="expmap", root="velocity")      # world axes: they turn with the walker
     assert np.abs(Xv[:, -3:] - Xs[:, -4:-1]).max() > 0.5 * speed
+
+
+@pytest.mark.parametrize("shape", [(30000, 2), (30000, 5), (20001, 70), (9000, 909), (30000, 1), (500, 40)])
+def test_column_sums_of_squares_are_numpys_bits(shape, monkeypatch):
+    import mocycle.features as features_module
+
+    monkeypatch.setattr(features_module, "SQUARES_BLOCK", 4096)
+    X = np.random.default_rng(shape[1]).standard_normal(shape) * np.linspace(0.01, 100.0, shape[1])
+    np.testing.assert_array_equal(features_module.column_sums_of_squares(X), np.add.reduce(np.square(X), axis=0))

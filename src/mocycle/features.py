@@ -269,6 +269,29 @@ def _joints_by_order(skel, joints: Iterable[int]) -> dict[str, list[int]]:
     return groups
 
 
+#: rows per block of :func:`column_sums_of_squares`
+SQUARES_BLOCK = 8192
+
+
+def column_sums_of_squares(X: np.ndarray) -> np.ndarray:
+    """``np.add.reduce(np.square(X), axis=0)`` ``(D,)`` of ``X`` ``(T, D)`` without the ``(T, D)`` squares: a
+    block of rows at a time, each block's squared rows added on to the running sums in order.  numpy adds the
+    rows of a C-ordered array one after the other along axis 0, so these are the same bits; a single column
+    (which numpy sums pairwise) or a short or non-C-ordered array is summed at once."""
+    T, D = X.shape
+    if D < 2 or T <= SQUARES_BLOCK or not X.flags.c_contiguous:
+        return np.add.reduce(np.square(X), axis=0)
+    sums = np.add.reduce(np.square(X[:SQUARES_BLOCK]), axis=0)
+    rows = np.empty((SQUARES_BLOCK + 1, D))
+    for f0 in range(SQUARES_BLOCK, T, SQUARES_BLOCK):
+        block = X[f0:f0 + SQUARES_BLOCK]
+        n = block.shape[0]
+        rows[0] = sums  # the sums so far, then this block's rows: added in the same order as the whole array
+        np.square(block, out=rows[1:n + 1])
+        sums = np.add.reduce(rows[:n + 1], axis=0)
+    return sums
+
+
 def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
                   reference: np.ndarray, travel: int, frame: HeadingFrame | None = None) -> np.ndarray:
     T = motion.n_frames
@@ -449,7 +472,7 @@ def pose_matrix(
         mean = raw.mean(axis=0)
         centred = np.subtract(raw, mean, out=raw)  # in place: raw is not read again (a (T, D) array less)
         # raw.std(axis=0) from the centred rows numpy's _var makes anyway (the same operations, the same bits)
-        std = np.sqrt(np.add.reduce(np.square(centred), axis=0) / raw.shape[0])
+        std = np.sqrt(column_sums_of_squares(centred) / raw.shape[0])
         scale = np.where(std > 1e-12 * (1.0 + np.abs(mean)), std, 1.0)
     w = _joint_weights(motion, weights, chosen)
     scale = scale / w[owner_arr]

@@ -93,14 +93,15 @@ def phase_features(motion: Motion, *, joints: str | Iterable[str] | None = None,
     if pca:
         pca = _validate.integer("pca", pca, 1)
         n = min(pca, X.shape[1], X.shape[0])
-        X = principal_components(X, n)
+        X = principal_components(X, n, overwrite=True)  # X is this function's own (pose_matrix made it)
     if delay:
         X = delay_embed(X, int(delay))
     return X
 
 
-def principal_components(X: np.ndarray, n: int) -> np.ndarray:
-    """The scores ``(T, n)`` of ``X`` ``(T, D)`` on its first ``n`` principal components.
+def principal_components(X: np.ndarray, n: int, overwrite: bool = False) -> np.ndarray:
+    """The scores ``(T, n)`` of ``X`` ``(T, D)`` on its first ``n`` principal components (``overwrite``: ``X``
+    is the caller's to lose and is centred in place, the same numbers without a ``(T, D)`` copy).
 
     What scikit-learn's ``PCA(n_components=n, svd_solver="full").fit_transform(X)`` returns (centred, the sign
     of each component set by its largest coefficient), without importing scikit-learn, which takes longer than
@@ -113,7 +114,8 @@ def principal_components(X: np.ndarray, n: int) -> np.ndarray:
     """
     from scipy.linalg import eigh
 
-    Xc = X - X.mean(axis=0)
+    owned = overwrite and isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.writeable
+    Xc = np.subtract(X, X.mean(axis=0), out=X) if owned else X - X.mean(axis=0)
     if Xc.shape[0] < Xc.shape[1]:
         G = Xc @ Xc.T
         w, U = eigh(G, subset_by_index=[G.shape[0] - n, G.shape[0] - 1], driver="evr")
