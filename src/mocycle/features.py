@@ -297,6 +297,7 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
     T = motion.n_frames
     js = list(joints)
     parts = []
+    out = None  # the feature matrix, when a part is written straight into it
     tilt = None
     if root == "heading":
         tilt, psi = frame.tilt(motion)
@@ -313,7 +314,9 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
             parts.append(continuous_euler(rotations(group), order).reshape(T, -1))
     elif rep == "expmap":
         if js == list(range(motion.n_joints)):  # every joint: no (T, J, 4) copy; each joint's curve is its own
-            v = continuous_rotvec(motion.rotations)
+            # written straight into the feature matrix: no (T, 3J) part joined to the root's afterwards
+            out = np.empty((T, len(_columns(motion, rep, root, joints)[0])))
+            v = continuous_rotvec(motion.rotations, out=out[:, :3 * len(js)].reshape(T, len(js), 3))
             if tilt is not None:
                 v[:, travel] = continuous_rotvec(tilt[:, None])[:, 0]
         else:
@@ -339,6 +342,14 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
         else:
             v = np.zeros((1, 4))
         parts.append(v)
+    if out is not None:  # parts[0] is out's first columns already
+        c = parts[0].shape[1]
+        for part in parts[1:]:
+            out[:, c:c + part.shape[1]] = part
+            c += part.shape[1]
+        if c != out.shape[1]:  # pragma: no cover - _columns and the parts disagree
+            raise MocycleError(f"internal: {c} feature columns made, {out.shape[1]} named")
+        return out
     return np.concatenate(parts, axis=1) if parts else np.zeros((T, 0))
 
 

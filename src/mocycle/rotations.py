@@ -249,16 +249,19 @@ def quat_log(quats: np.ndarray) -> np.ndarray:
     return v * scale
 
 
-def continuous_rotvec(quats: np.ndarray) -> np.ndarray:
+def continuous_rotvec(quats: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """Rotation vectors continuous in time, even for joints that turn several full circles.
 
     ``quats``: ``(T, N, 4)``.  Each frame takes, among the equivalent vectors
     ``u·(θ + 2πk)``, the one closest to the frame before; frame 0 is canonical
-    (angle ≤ π).  Returns ``(T, N, 3)`` radians.
+    (angle ≤ π).  Returns ``(T, N, 3)`` radians (written into ``out`` when given, e.g. a view of the
+    caller's feature matrix).
     """
     q = np.asarray(quats, dtype=np.float64)
     T, N = q.shape[:2]
-    v = np.empty((T, N, 3))
+    v = np.empty((T, N, 3)) if out is None else out
+    if v.shape != (T, N, 3):
+        raise ValueError(f"out must have shape {(T, N, 3)}; got {v.shape}")
     turned = np.zeros(N, dtype=bool)  # joints whose angle passes π/2 somewhere
     sign = np.where(q[0, :, 3] < 0, -1.0, 1.0)  # frame 0 canonical
     # quat_log of the sign-continuous quaternions (continuous_quats) without making them: one sign and one

@@ -325,3 +325,19 @@ def test_circular_autocorrelation_is_the_same_at_fast_and_slow_fft_lengths():
         Y = rng.normal(size=(T, 3))
         direct = [sum(float(Y[:, d] @ np.roll(Y[:, d], -k)) for d in range(3)) for k in range(T)]
         assert np.allclose(circular_autocorrelation(Y), direct, rtol=0, atol=1e-9)
+
+
+def test_a_long_take_s_columns_four_at_a_time_give_the_same_period(monkeypatch):
+    import mocycle.phase.period as period_module
+
+    T = 70_000  # past _LONG_TAKE: 4 columns at a time instead of 16
+    t = np.arange(T)
+    rng = np.random.default_rng(5)
+    X = np.stack([np.sin(2 * np.pi * t / 97.3 + k) * (1 + k) for k in range(20)], axis=1)
+    X += 0.1 * rng.standard_normal(X.shape)
+    assert period_module.column_block_width(T) == 4
+    four = autocorrelation_period(X, min_lag=20, max_lag=400)
+    monkeypatch.setattr(period_module, "_LONG_TAKE", 1 << 30)
+    assert period_module.column_block_width(T) == 16
+    assert four == pytest.approx(autocorrelation_period(X, min_lag=20, max_lag=400), rel=1e-12)
+    assert four == pytest.approx(97.3, rel=1e-3)

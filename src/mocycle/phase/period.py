@@ -257,6 +257,10 @@ PEAK_TIE = 0.02
 #: not transformed 16 columns at a time, and a long take's temporaries stay small.
 _BLOCK_VALUES = 1 << 18
 _COLUMNS = 16
+#: From this many frames on, 4 columns at a time: a block's transforms (its padded spectrum is complex and
+#: twice the take long) were the largest arrays of ``find_phase`` on a million frames (640 MB at 16 columns).
+#: The sum over columns then rounds differently in its last bits; shorter takes are unchanged.
+_LONG_TAKE, _LONG_COLUMNS = 1 << 16, 4
 
 
 def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_strength: float = 0.1) -> float:
@@ -306,7 +310,7 @@ def autocorrelation_period(X, min_lag: int = 2, max_lag: int | None = None, min_
 
 def column_block_width(T: int) -> int:
     """Columns per block of :func:`autocorrelation_period` on ``T`` frames (:data:`_BLOCK_VALUES`)."""
-    return max(_COLUMNS, _BLOCK_VALUES // T)
+    return max(_COLUMNS if T < _LONG_TAKE else _LONG_COLUMNS, _BLOCK_VALUES // T)
 
 
 def autocorrelation_period_of_blocks(blocks, T: int, min_lag: int = 2, max_lag: int | None = None,
