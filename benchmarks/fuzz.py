@@ -2,6 +2,7 @@
 
     python benchmarks/fuzz.py [--seconds 3600] [--readers bvh,asf,amc,mck,mosw,json] [--engine auto|atheris|random]
                               [--rss-mb 2048] [--timeout 10] [--max-frames 100000] [--out DIR] [--data DIR]
+    python benchmarks/fuzz.py --replay DIR/json-oom-... [...]    # saved inputs, each in a fresh process
 
 Each reader runs in its own process under a memory limit (``RLIMIT_AS`` of ``--rss-mb``) and a time limit
 per input (``--timeout`` seconds).  A reader passes an input when it returns a result that goes on working
@@ -267,6 +268,64 @@ def parse_libfuzzer(text: str) -> dict:
     return stats
 
 
+# ---------------------------------------------------------------- replaying saved inputs
+def replay_one(reader: str, path: Path, rss_mb: int, timeout: float) -> dict:
+    """Run the saved input ``path`` through ``reader``'s target once in this process under ``rss_mb`` of
+    address space: outcome (accepted, refused, crash, hang, blow-up), seconds and peak MB."""
+    from mocycle.errors import MotionFileError
+
+    run = _targets()[reader][0]
+    _limit_memory(rss_mb)
+
+    def alarm(signum, frame):
+        raise Hang()
+
+    signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, timeout)
+    t0 = time.monotonic()
+    try:
+        run(path.read_bytes())
+        outcome = "accepted"
+    except MotionFileError as exc:
+        outcome = f"refused: {str(exc)[:100]}"
+    except Hang:
+        outcome = "hang"
+    except MemoryError:
+        outcome = "blow-up (MemoryError)"
+    except Exception as exc:  # noqa: BLE001 - what a crash is
+        outcome = f"crash: {signature(exc)}"
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+    return {"file": path.name, "outcome": outcome, "seconds": round(time.monotonic() - t0, 4),
+            "peak_mb": round(_peak_mb())}
+
+
+def replay(args) -> int:
+    """``--replay``: each file in a fresh process (a long fuzzing process's memory is not the input's)."""
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src") + os.pathsep
+           + os.environ.get("PYTHONPATH", "")}
+    if args.max_frames:
+        env["MOCYCLE_MAX_FRAMES"] = str(args.max_frames)
+    bad = False
+    for path in args.replay:
+        reader = path.name.split("-")[0]
+        if reader not in READERS:
+            print(f"{path}: the name does not start with a reader ({', '.join(READERS)})")
+            bad = True
+            continue
+        code = ("import json, sys; from pathlib import Path; sys.path.insert(0, sys.argv[1]); import fuzz; "
+                "print(json.dumps(fuzz.replay_one(sys.argv[2], Path(sys.argv[3]), int(sys.argv[4]), "
+                "float(sys.argv[5]))))")
+        proc = subprocess.run([sys.executable, "-c", code, str(Path(__file__).resolve().parent), reader, str(path),
+                               str(args.rss_mb), str(args.timeout)], capture_output=True, text=True, env=env)
+        lines = proc.stdout.strip().splitlines()
+        result = json.loads(lines[-1]) if proc.returncode == 0 and lines else \
+            {"file": path.name, "outcome": f"process ended with {proc.returncode}: {proc.stderr[-200:]}"}
+        bad |= not (result["outcome"] == "accepted" or result["outcome"].startswith("refused"))
+        print(json.dumps(result))
+    return 1 if bad else 0
+
+
 # ---------------------------------------------------------------- the parent
 def run_reader(reader: str, engine: str, args) -> dict:
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src") + os.pathsep
@@ -328,7 +387,12 @@ def main(argv=None) -> int:
     parser.add_argument("--data", type=Path, default=DEFAULT_DATA)
     parser.add_argument("--child", choices=READERS)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--replay", type=Path, nargs="+", metavar="FILE",
+                        help="run saved inputs (named READER-KIND-..., as --out keeps them) once each in a fresh "
+                             "process under the same limits, and print what each does there")
     args = parser.parse_args(argv)
+    if args.replay:
+        return replay(args)
     if args.child:
         if args.engine == "atheris":
             child_atheris(args.child, args.seconds, args.rss_mb, args.timeout, args.out, args.seed)
