@@ -302,12 +302,19 @@ def replay_one(reader: str, path: Path, rss_mb: int, timeout: float) -> dict:
             "peak_mb": round(_peak_mb())}
 
 
-def _replay_outcome(path: Path, args) -> str:
-    """What the saved input ``path`` does alone in a fresh process under ``args``' limits (:func:`replay_one`)."""
+def _child_env(args) -> dict:
+    """The environment of a child process: this checkout's ``src`` first, and the readers' frame limit (the
+    largest take a file may claim: one that fits the memory limit when played back)."""
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src") + os.pathsep
            + os.environ.get("PYTHONPATH", "")}
     if args.max_frames:
         env["MOCYCLE_MAX_FRAMES"] = str(args.max_frames)
+    return env
+
+
+def _replay_outcome(path: Path, args) -> str:
+    """What the saved input ``path`` does alone in a fresh process under ``args``' limits (:func:`replay_one`)."""
+    env = _child_env(args)
     code = ("import json, sys; from pathlib import Path; sys.path.insert(0, sys.argv[1]); import fuzz; "
             "print(json.dumps(fuzz.replay_one(sys.argv[2], Path(sys.argv[3]), int(sys.argv[4]), "
             "float(sys.argv[5]))))")
@@ -335,10 +342,7 @@ def replay(args) -> int:
 
 # ---------------------------------------------------------------- the parent
 def run_reader(reader: str, engine: str, args) -> dict:
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src") + os.pathsep
-           + os.environ.get("PYTHONPATH", ""), "MOCYCLE_FUZZ_DATA": str(args.data)}
-    if args.max_frames:  # the largest take a file may claim: one that fits the memory limit when played back
-        env["MOCYCLE_MAX_FRAMES"] = str(args.max_frames)
+    env = {**_child_env(args), "MOCYCLE_FUZZ_DATA": str(args.data)}
     cmd = [sys.executable, __file__, "--child", reader, "--engine", engine, "--seconds", str(args.seconds),
            "--rss-mb", str(args.rss_mb), "--timeout", str(args.timeout), "--out", str(args.out)]
     if engine == "random":

@@ -296,7 +296,7 @@ def chain_transforms(motion: Motion, chain: list[int]) -> tuple[ChainArray, Chai
     T = motion.n_frames
     Rw = ChainArray(T, chain, (3, 3))
     W = ChainArray(T, chain, (3,))
-    _chain_fk(motion, chain, slice(None), Rw, W)
+    _chain_fk(motion, chain, slice(None), Rw.data, W.data)
     return Rw, W
 
 
@@ -309,29 +309,26 @@ def chain_positions(motion: Motion, chain: list[int]) -> ChainArray:
     take only the ``(T, len(chain), 3)`` positions are held, not the rotations (three times their size)."""
     T = motion.n_frames
     W = ChainArray(T, chain, (3,))
-    Rw = ChainArray(min(T, POSITIONS_BLOCK), chain, (3, 3))
+    Rw = np.empty((min(T, POSITIONS_BLOCK), len(chain), 3, 3))  # one block's world rotations
     for start in range(0, T, POSITIONS_BLOCK):
         rows = slice(start, min(T, start + POSITIONS_BLOCK))
-        n = rows.stop - rows.start
-        if n < Rw.data.shape[0]:
-            Rw.data = Rw.data[:n]
-        block = ChainArray(0, chain, (3,))
-        block.data = W.data[rows]          # a view: the block's positions are written into W
-        _chain_fk(motion, chain, rows, Rw, block)
+        _chain_fk(motion, chain, rows, Rw[:rows.stop - rows.start], W.data[rows])
     return W
 
 
-def _chain_fk(motion: Motion, chain: list[int], rows: slice, Rw: ChainArray, W: ChainArray) -> None:
-    """Forward kinematics of ``chain`` over the frames ``rows``, into ``Rw`` and ``W`` (of those frames'
-    length); each joint's local rotation matrices are made when it is reached, not all at once."""
+def _chain_fk(motion: Motion, chain: list[int], rows: slice, Rw: np.ndarray, W: np.ndarray) -> None:
+    """Forward kinematics of ``chain`` over the frames ``rows``, into ``Rw`` ``(n, len(chain), 3, 3)`` and ``W``
+    ``(n, len(chain), 3)`` (columns in chain order); each joint's local rotation matrices are made when it is
+    reached, not all at once."""
     parents = motion.skeleton.parents
+    column = {int(j): i for i, j in enumerate(chain)}
     for i, j in enumerate(chain):
         p = int(parents[j])
         local = Rotation.from_quat(motion.rotations[rows, j]).as_matrix()
         if p < 0:
-            Rw.data[:, i] = local
-            W.data[:, i] = motion.translations[rows, j]
+            Rw[:, i] = local
+            W[:, i] = motion.translations[rows, j]
         else:
-            Rp = Rw[:, p]
-            np.matmul(Rp, local, out=Rw.data[:, i])
-            W.data[:, i] = W[:, p] + (Rp @ motion.translations[rows, j, :, None])[..., 0]
+            Rp = Rw[:, column[p]]
+            np.matmul(Rp, local, out=Rw[:, i])
+            W[:, i] = W[:, column[p]] + (Rp @ motion.translations[rows, j, :, None])[..., 0]
