@@ -3,6 +3,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from helpers import max_angle, random_motion, tiny_skeleton
+from mocycle.datasets import synthetic_walk
 from mocycle.errors import MocycleError
 from mocycle.motion import Motion, Skeleton, concatenate
 
@@ -99,3 +100,25 @@ def test_concatenate_checks_skeleton():
     other = Motion.rest(Skeleton(("x",), [-1], [[0, 0, 0]], ((),)), 3)
     with pytest.raises(MocycleError, match="skeleton"):
         concatenate([m, other])
+
+
+def test_a_motion_hands_its_own_arrays_over_and_copies_shared_ones():
+    walk = synthetic_walk(n_frames=60).motion
+    own = Motion(walk.skeleton, walk.rotations, walk.translations, walk.frame_time)  # arrays it alone holds
+    address = own.rotations.__array_interface__["data"][0], own.translations.__array_interface__["data"][0]
+    rotations, translations = own._hand_over()
+    assert (rotations.__array_interface__["data"][0], translations.__array_interface__["data"][0]) == address
+    assert rotations.flags.writeable and translations.flags.writeable
+    with pytest.raises(AttributeError):
+        own.translations  # noqa: B018 (emptied)
+
+    shared = Motion(walk.skeleton, walk.rotations, walk.translations, walk.frame_time)
+    view = shared[10:50]                                    # shares both arrays
+    moved = shared.replace(translations=shared.translations + 1.0)  # shares the rotations
+    before = view.rotations.copy(), view.translations.copy(), moved.rotations.copy()
+    rotations, translations = shared._hand_over()
+    rotations[:] = 0.0
+    translations[:] = 0.0
+    np.testing.assert_array_equal(view.rotations, before[0])
+    np.testing.assert_array_equal(view.translations, before[1])
+    np.testing.assert_array_equal(moved.rotations, before[2])

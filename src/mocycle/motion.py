@@ -19,6 +19,7 @@ from __future__ import annotations
 import fnmatch
 import functools
 import re
+import sys
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
@@ -428,6 +429,26 @@ class Motion:
         )
         args.update(changes)
         return Motion(**args, copy=copy)
+
+    def _hand_over(self) -> tuple[np.ndarray, np.ndarray]:
+        """The motion's ``rotations`` and ``translations``, writable, for a caller that makes the next motion
+        from them and holds the last reference to this one (a long take's edit without a copy of it).
+
+        The motion is emptied: any later use of it raises AttributeError.  An array that another object may
+        see (a view, a view's base or an array another motion shares, as :meth:`replace` and slices share
+        them) is copied instead, so handing over never changes what anyone else holds."""
+        out = []
+        probe = np.empty(0)  # an array only a local name holds: the count of a sole reference, measured alike
+        for name in ("rotations", "translations"):
+            array = getattr(self, name)
+            delattr(self, name)
+            # any other holder (a view holds its base) counts one more than the probe
+            if array.base is None and sys.getrefcount(array) <= sys.getrefcount(probe):
+                array.setflags(write=True)
+            else:
+                array = array.copy()
+            out.append(array)
+        return out[0], out[1]
 
     def __getitem__(self, index) -> Motion:
         """Frames by slice (``motion[10:200]``, ``motion[::2]``) or index array.

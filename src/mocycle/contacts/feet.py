@@ -316,6 +316,21 @@ def chain_positions(motion: Motion, chain: list[int]) -> ChainArray:
     return W
 
 
+def chain_rotation_blocks(motion: Motion, chain: list[int], block: int | None = None):
+    """The world rotations of :func:`chain_transforms` a block of frames at a time: yields ``(rows, Rw)``, the
+    frames (a slice) and their rotations ``(n, len(chain), 3, 3)`` (columns in chain order; one buffer,
+    reused: read a block before asking for the next); ``block``: frames per block (default POSITIONS_BLOCK)."""
+    T = motion.n_frames
+    block = POSITIONS_BLOCK if block is None else block
+    Rw = np.empty((min(T, block), len(chain), 3, 3))
+    W = np.empty((min(T, block), len(chain), 3))  # the positions, made on the way
+    for start in range(0, T, block):
+        rows = slice(start, min(T, start + block))
+        n = rows.stop - start
+        _chain_fk(motion, chain, rows, Rw[:n], W[:n])
+        yield rows, Rw[:n]
+
+
 def _chain_fk(motion: Motion, chain: list[int], rows: slice, Rw: np.ndarray, W: np.ndarray) -> None:
     """Forward kinematics of ``chain`` over the frames ``rows``, into ``Rw`` ``(n, len(chain), 3, 3)`` and ``W``
     ``(n, len(chain), 3)`` (columns in chain order); each joint's local rotation matrices are made when it is

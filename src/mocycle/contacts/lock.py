@@ -59,7 +59,7 @@ from ..motion import Motion
 from ..rotations import axis_rotations
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
-from .feet import chain_joints, chain_transforms, leg_joints
+from .feet import chain_joints, chain_positions, chain_rotation_blocks, leg_joints
 from .smooth import maximum, uniform
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
@@ -458,19 +458,34 @@ def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weight
     return np.where(delta > 1e-9 * contacts.body, delta, 0.0)  # no round-off tails: untouched frames stay exact
 
 
-def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
-    """Unit normals ``(T, 3)`` of the hip-knee-ankle plane, eased toward the leg's usual bend axis as the
-    knee straightens: ``thigh x shin`` (its length is the sine of the knee angle) plus ``STRAIGHT_KNEE`` times
-    the mean bend axis in the thigh's frame (weighted by the bend).  A nearly straight knee, whose own plane
-    is undefined or turns fast, so bends about its usual axis, and the normal never jumps."""
-    c = _cross(u1, u2)
-    local = np.einsum("tji,tj->ti", Rw_hip, c).sum(axis=0)
+def _bend_axis(hip_bends: np.ndarray, hip_thighs: np.ndarray) -> np.ndarray:
+    """The leg's usual bend axis ``(3,)`` in the thigh's frame: the mean of ``thigh x shin`` weighted by the bend,
+    from ``hip_bends`` ``(T, 3)``, each frame's ``thigh x shin`` in the hip's frame (``Rw_hipᵀ (u1 x u2)``),
+    and ``hip_thighs`` ``(T, 3)``, the thigh in the hip's frame (``Rw_hipᵀ u1``: a never-bent leg's axis is
+    across it)."""
+    local = hip_bends.sum(axis=0)
     if np.linalg.norm(local) < 1e-9:  # never bent: any axis across the leg
-        local = np.cross(np.einsum("tji,tj->ti", Rw_hip, u1).mean(axis=0), [0.0, 0.0, 1.0])
+        local = np.cross(hip_thighs.mean(axis=0), [0.0, 0.0, 1.0])
         if np.linalg.norm(local) < 1e-9:
             local = np.array([1.0, 0.0, 0.0])
-    local = local / np.linalg.norm(local)
-    return _normalize(c + STRAIGHT_KNEE * np.einsum("tij,j->ti", Rw_hip, local))
+    return local / np.linalg.norm(local)
+
+
+def _bend_normals(Rw_hip: np.ndarray, u1: np.ndarray, u2: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """Unit normals ``(T, 3)`` of the hip-knee-ankle plane, eased toward the leg's usual bend ``axis``
+    (:func:`_bend_axis`) as the knee straightens: ``thigh x shin`` (its length is the sine of the knee angle)
+    plus ``STRAIGHT_KNEE`` times the axis turned with the thigh.  A nearly straight knee, whose own plane is
+    undefined or turns fast, so bends about its usual axis, and the normal never jumps."""
+    return _normalize(_cross(u1, u2) + STRAIGHT_KNEE * np.einsum("tij,j->ti", Rw_hip, axis))
+
+
+def _thigh_shin(W, foot, t: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Hip, knee and ankle positions ``(n, 3)`` at the frames ``t``, the thigh and shin lengths ``(n,)`` and
+    unit directions ``(n, 3)``: ``H, K, A, l1, l2, u1, u2``."""
+    H, K, A = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle]
+    l1 = np.linalg.norm(K - H, axis=1)
+    l2 = np.linalg.norm(A - K, axis=1)
+    return H, K, A, l1, l2, (K - H) / l1[:, None], (A - K) / l2[:, None]
 
 
 def _knee_turn(u1: np.ndarray, u2: np.ndarray, n: np.ndarray, cos1: np.ndarray) -> np.ndarray:
@@ -535,18 +550,42 @@ def _descendants(motion: Motion, joint: int) -> np.ndarray:
     return below
 
 
-def _move_travel(motion: Motion, trans: np.ndarray, Rw: np.ndarray, world: np.ndarray) -> None:
-    """Move ``motion``'s travel joint by ``world`` ``(T, 3)`` (world frame) in its translations ``trans``
-    ``(T, J, 3)`` (in place)."""
-    travel = motion.travel_joint
-    parent = int(motion.skeleton.parents[travel])
-    trans[:, travel] += np.einsum("tji,tj->ti", Rw[:, parent], world) if parent >= 0 else world
+def _leg_ik(motion: Motion, foot, W, Rb: np.ndarray, column: dict, t: np.ndarray, rb: np.ndarray,
+            g: np.ndarray, gt: np.ndarray | None, axis: np.ndarray) -> list[tuple[np.ndarray, int, np.ndarray]]:
+    """Two-bone IK of one leg at the frames ``t`` (their rows ``rb`` in ``Rb``, the chain's world rotations
+    ``(n, len(chain), 3, 3)``, columns as ``column`` says): the ankle to its goal ``g[t]``, the foot turned to
+    its toe goal ``gt[t]``, the knee bent about ``axis`` when straight (:func:`_bend_normals`).
+    ``[(t, joint, new local quaternions (len(t), 4)), ...]`` for the hip, knee and ankle, each with the sign
+    of the old one."""
+    skel = motion.skeleton
+    H, K, A, l1, l2, u1, u2 = _thigh_shin(W, foot, t)
+    G = g[t]
+    n = _bend_normals(Rb[rb, column[foot.hip]], u1, u2, axis)
+    d = np.clip(np.linalg.norm(G - H, axis=1), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
+    cos1 = -np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0)  # thigh . shin wanted
+    R1 = Rotation.from_rotvec(n * _knee_turn(u1, u2, n, cos1)[:, None]).as_matrix()  # knee bend, world
+    A1 = K + np.einsum("tij,tj->ti", R1, A - K)
+    R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
+    hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
+    Rp_hip = Rb[rb, column[hp]] if hp >= 0 else np.broadcast_to(np.eye(3), (t.size, 3, 3))
+    aim = np.broadcast_to(np.eye(3), (t.size, 3, 3))
+    if gt is not None:
+        aim = _swing(W[t, foot.toe] - A, gt[t] - G)
+    new_parent = R2 @ R1 @ Rb[rb, column[ap]]
+    out = []
+    for j, local in ((foot.hip, np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rb[rb, column[foot.hip]]),
+                     (foot.knee, np.swapaxes(Rb[rb, column[kp]], 1, 2) @ R1 @ Rb[rb, column[foot.knee]]),
+                     (foot.ankle, np.swapaxes(new_parent, 1, 2) @ aim @ Rb[rb, column[foot.ankle]])):
+        quats = Rotation.from_matrix(local).as_quat()
+        quats *= np.where(np.sum(quats * motion.rotations[t, j], axis=-1, keepdims=True) < 0, -1.0, 1.0)
+        out.append((t, j, quats))
+    return out
 
 
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
               follow: bool = True, period: int | None = None, frames: slice | None = None,
               clearance: float | np.ndarray | None = None, transforms: tuple | None = None,
-              turn: float = 0.0, turn_axis: np.ndarray | None = None) -> Motion:
+              turn: float = 0.0, turn_axis: np.ndarray | None = None, hand_over: bool = False) -> Motion:
     """``motion`` with every contact of ``contacts`` held still (the method of the module docstring).
 
     ``blend``: seconds of cross-fade before and after each contact; ``reach``: fraction of a leg's length
@@ -557,10 +596,12 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     height a swinging foot clears, one for all contact joints or ``(C,)`` one per joint of ``contacts``
     (0: no swing clearance; default: the motion's own, :func:`~mocycle.contacts.clearance.swing_clearance`);
     ``transforms``: ``chain_transforms(motion, chain_joints(motion, legs))`` when the caller has them (they are
-    changed in place); ``turn``: with ``period``, the loop's turn per period (rad about ``turn_axis``, default
-    the vertical: each repeat is the one before turned, as :meth:`~mocycle.cycle.Cycle.repeat` makes them).
-    Returns a new Motion with the same skeleton and
-    frame time.
+    changed in place; without them the legs' world positions are held and their rotations made a block of
+    frames at a time); ``turn``: with ``period``, the loop's turn per period (rad about ``turn_axis``, default
+    the vertical: each repeat is the one before turned, as :meth:`~mocycle.cycle.Cycle.repeat` makes them);
+    ``hand_over``: the caller gives ``motion`` up, and the result is made from its arrays instead of copies
+    (:meth:`~mocycle.motion.Motion._hand_over`: ``motion`` is emptied; a long take is locked without a
+    second copy of it).  Returns a new Motion with the same skeleton and frame time.
     """
     if contacts.n_frames != motion.n_frames:
         raise ValueError(f"contacts cover {contacts.n_frames} frames, the motion {motion.n_frames}")
@@ -571,12 +612,12 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     skel = motion.skeleton
     chain = chain_joints(motion, leg_joints(contacts.feet))
     below = _descendants(motion, motion.travel_joint)
-    Rw, W = chain_transforms(motion, chain) if transforms is None else transforms
-    trans = motion.translations.copy()
+    W = chain_positions(motion, chain) if transforms is None else transforms[1]
+    moves = []  # (T, 3) world-frame moves of the travel joint (and all below it), in the order they are made
     if follow:
         shift = _root_shift(W, contacts, n_blend, period, turn, turn_axis)
         if np.abs(shift).max() > 0:
-            _move_travel(motion, trans, Rw, shift)
+            moves.append(shift)
             W.add(below, shift)    # the travel joint and all below it move with it; no rotation changes
     n_extend = int(round(EXTEND_SECONDS / motion.frame_time))
     n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
@@ -591,7 +632,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     lowered = delta > 0
     if lowered.any():  # every foot keeps its goal in the world: a swing foot does not dip with the root
         down = -np.outer(delta, contacts.up)
-        _move_travel(motion, trans, Rw, down)
+        moves.append(down)
         W.add(below, down)
     for foot, g, h in zip(contacts.feet, goals, held, strict=True):  # goals not held: within reach, softly
         free = ~h
@@ -600,41 +641,51 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         g[free] = base + _soft_reach(base, g[free] - base, hips, R, zone, contacts.up)
     window = np.zeros(motion.n_frames, bool)
     window[frames if frames is not None else slice(None)] = True
-    new_locals = []  # (frames, joint, local rotation matrices (n, 3, 3)): only what the legs' IK changes
-    for foot, g, gt, ch in zip(contacts.feet, goals, toe_goals, changed, strict=True):
-        t = np.flatnonzero((ch | lowered) & window)
-        if t.size == 0:
-            continue
-        H, K, A, G = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle], g[t]
-        l1 = np.linalg.norm(K - H, axis=1)
-        l2 = np.linalg.norm(A - K, axis=1)
-        u1, u2 = (K - H) / l1[:, None], (A - K) / l2[:, None]
-        n = _bend_normals(Rw[t, foot.hip], u1, u2)
-        d = np.clip(np.linalg.norm(G - H, axis=1), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
-        cos1 = -np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0)  # thigh . shin wanted
-        R1 = Rotation.from_rotvec(n * _knee_turn(u1, u2, n, cos1)[:, None]).as_matrix()  # knee bend, world
-        A1 = K + np.einsum("tij,tj->ti", R1, A - K)
-        R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
-        hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
-        Rp_hip = Rw[t, hp] if hp >= 0 else np.broadcast_to(np.eye(3), (t.size, 3, 3))
-        aim = np.broadcast_to(np.eye(3), (t.size, 3, 3))
-        if gt is not None:
-            aim = _swing(W[t, foot.toe] - A, gt[t] - G)
-        new_parent = R2 @ R1 @ Rw[t, ap]
-        new_locals += [(t, foot.hip, np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rw[t, foot.hip]),
-                       (t, foot.knee, np.swapaxes(Rw[t, kp], 1, 2) @ R1 @ Rw[t, foot.knee]),
-                       (t, foot.ankle, np.swapaxes(new_parent, 1, 2) @ aim @ Rw[t, foot.ankle])]
-    del W, Rw  # the chain's world positions and rotations: not needed for the quaternions (memory)
-    row = np.arange(motion.n_frames)  # a frame's row in the output
+    solved = [np.flatnonzero((ch | lowered) & window) for ch in changed]  # the frames each leg's IK changes
+    column = {j: i for i, j in enumerate(chain)}
+    travel = motion.travel_joint
+    parent = int(skel.parents[travel])
+    local_moves = [m if parent < 0 else np.empty_like(m) for m in moves]  # the moves in the parent's frame
+    new_quats = []  # (frames, joint, quaternions (n, 4)): only what the legs' IK changes
+    def blocks():  # the chain's world rotations (n, len(chain), 3, 3) of the frames ``rows``, a block at a time
+        if transforms is not None:
+            return [(slice(0, motion.n_frames), transforms[0].data)]
+        return chain_rotation_blocks(motion, chain)
+
+    # each leg's usual bend axis, from all its solved frames (the same sum as over one array: the rows first)
+    bends = [np.empty((t.size, 3)) for t in solved]
+    thighs = [np.empty((t.size, 3)) for t in solved]
+    for rows, Rb in blocks():
+        for foot, t, bend, thigh in zip(contacts.feet, solved, bends, thighs, strict=True):
+            i, k = np.searchsorted(t, rows.start), np.searchsorted(t, rows.stop)
+            if k > i:
+                _, _, _, _, _, u1, u2 = _thigh_shin(W, foot, t[i:k])
+                Rh = Rb[t[i:k] - rows.start, column[foot.hip]]
+                bend[i:k] = np.einsum("tji,tj->ti", Rh, _cross(u1, u2))
+                thigh[i:k] = np.einsum("tji,tj->ti", Rh, u1)
+    axes = [_bend_axis(bend, thigh) for bend, thigh in zip(bends, thighs, strict=True)]
+    del bends, thighs
+    for rows, Rb in blocks():
+        if parent >= 0:
+            for m, local in zip(moves, local_moves, strict=True):
+                local[rows] = np.einsum("tji,tj->ti", Rb[:, column[parent]], m[rows])
+        for foot, g, gt, t, axis in zip(contacts.feet, goals, toe_goals, solved, axes, strict=True):
+            t = t[np.searchsorted(t, rows.start):np.searchsorted(t, rows.stop)]
+            if t.size:
+                new_quats += _leg_ik(motion, foot, W, Rb, column, t, t - rows.start, g, gt, axis)
+    del W  # the chain's world positions and rotations: not needed for the quaternions (memory)
+    if hand_over:
+        rotations, trans = motion._hand_over()
+    else:
+        rotations, trans = motion.rotations.copy(), motion.translations.copy()
+    for local in local_moves:
+        trans[:, travel] += local
+    row = np.arange(len(window))  # a frame's row in the output
     if frames is not None:
-        row = np.full(motion.n_frames, -1)
+        row = np.full(len(window), -1)
         row[frames] = np.arange(window.sum())
-        trans = trans[frames].copy()
-    rotations = motion.rotations[frames if frames is not None else slice(None)].copy()
-    for t, j, local in new_locals:  # frames and joints not touched keep their exact quaternions
-        quats = Rotation.from_matrix(local).as_quat()
-        old = rotations[row[t], j]
-        quats *= np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)  # the sign of the old
+        trans, rotations = trans[frames].copy(), rotations[frames].copy()
+    for t, j, quats in new_quats:  # frames and joints not touched keep their exact quaternions
         rotations[row[t], j] = quats
-    del new_locals
-    return Motion(motion.skeleton, rotations, trans, motion.frame_time, copy=False)
+    del new_quats
+    return Motion(skel, rotations, trans, motion.frame_time, copy=False)

@@ -36,7 +36,8 @@ def run(source, options: Options | None = None) -> Report:
         motion = packed.decompress()
         with rec.part("feet"):
             # auto is keep: rebuilding the keyframes exactly is what decompress promises
-            motion, feet_facts = lock_motion(motion, options.feet, options.foot_joints, options.feet == "lock")
+            motion, feet_facts = lock_motion(motion, options.feet, options.foot_joints, options.feet == "lock",
+                                             hand_over=True)
         facts = {"frames": motion.n_frames, "keyframes": packed.n_keyframes, "scheme": packed.scheme,
                  "keyframes_exact": feet_facts["mode"] == "keep", "feet": feet_facts}
     return rec.report("decompress", facts, {"motion": motion}, packed)

@@ -77,9 +77,11 @@ def travels(motion) -> bool:
     return bool(np.linalg.norm(step - (step @ up) * up) > 0.5 * body_height(motion, up))
 
 
-def lock_motion(motion, mode: str, foot_joints: str | None, moves: bool):
+def lock_motion(motion, mode: str, foot_joints: str | None, moves: bool, hand_over: bool = False):
     """Any motion with its feet locked (``mode`` lock, or auto when ``moves`` and feet are found) and what the
-    JSON says about it: a thin wrapper over :func:`mocycle.contacts.detect_contacts` and ``lock_feet``."""
+    JSON says about it: a thin wrapper over :func:`mocycle.contacts.detect_contacts` and ``lock_feet``
+    (``hand_over``: the caller gives ``motion`` up to the locked one, which is made from its arrays; emptied
+    when the feet are locked)."""
     from ..contacts import detect_contacts, find_feet, largest_leg_step, lock_feet
     from ..contacts.clearance import swing_clearance
 
@@ -98,11 +100,13 @@ def lock_motion(motion, mode: str, foot_joints: str | None, moves: bool):
     t0 = time.perf_counter()
     contacts = detect_contacts(motion, foot_joints)
     clearance = swing_clearance(motion, contacts.feet, up=contacts.up, body=contacts.body)
-    locked = lock_feet(motion, contacts, clearance=clearance)
-    facts["seconds"] = time.perf_counter() - t0
-    facts["clearance"] = _clearance_facts(contacts, clearance, motion.skeleton.names)
-    facts.update(contacts=contacts.to_dict(motion.skeleton.names), skate_before=_skate(motion, contacts),
-                 skate_after=_skate(locked, contacts),
-                 largest_leg_step_before=largest_leg_step(motion, contacts.feet),
+    seconds = time.perf_counter() - t0
+    names = motion.skeleton.names
+    facts.update(skate_before=_skate(motion, contacts), largest_leg_step_before=largest_leg_step(motion, contacts.feet))
+    t0 = time.perf_counter()
+    locked = lock_feet(motion, contacts, clearance=clearance, hand_over=hand_over)
+    facts["seconds"] = seconds + time.perf_counter() - t0
+    facts["clearance"] = _clearance_facts(contacts, clearance, names)
+    facts.update(contacts=contacts.to_dict(names), skate_after=_skate(locked, contacts),
                  largest_leg_step_after=largest_leg_step(locked, contacts.feet))
     return locked, facts

@@ -46,7 +46,9 @@ def run(take, options: Options) -> Report:
         motion = load(take, options.amc_fps)
         result, report = stretch_motion(motion, options.factor, window=options.window_frames, force=options.force)
         with rec.part("feet"):
-            result, feet_facts = lock_motion(result, options.feet, options.foot_joints, travels(motion))
+            # the stretched take before locking is not kept: the locked one is made from its arrays (memory)
+            result, feet_facts = lock_motion(result, options.feet, options.foot_joints, travels(motion),
+                                             hand_over=True)
         facts = {**report.to_dict(), "fps": motion.fps,
                  "joints_per_group": {g: len(names) for g, names in report.groups.items()}, "feet": feet_facts}
     return rec.report("stretch", facts, {"stretched": result, "input": motion}, report)
