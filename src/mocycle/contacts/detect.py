@@ -169,12 +169,16 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
     h = P @ up
     h = h - h.min(axis=0)
     sigma = smooth / motion.frame_time
-    Ps = gaussian(P, sigma) if sigma >= 0.3 else P
     if motion.n_frames < 2:
         return h, np.zeros_like(h), np.zeros_like(h)
-    v = np.gradient(Ps, motion.frame_time, axis=0)
+    if sigma >= 0.3:
+        P = gaussian(P, sigma)
+    v = np.gradient(P, motion.frame_time, axis=0)
+    del P  # (T, C, 3) arrays held one or two at a time (memory)
     vu = v @ up
-    return h, np.linalg.norm(v - vu[..., None] * up, axis=-1), np.abs(vu)
+    for k in range(3):  # the horizontal velocity in place: v - vu up, axis by axis
+        v[..., k] -= vu * up[k]
+    return h, np.linalg.norm(v, axis=-1), np.abs(vu)
 
 
 def local_floor(h: np.ndarray, fps: float) -> np.ndarray:

@@ -663,7 +663,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
                 Rh = Rb[t[i:k] - rows.start, column[foot.hip]]
                 bend[i:k] = np.einsum("tji,tj->ti", Rh, _cross(u1, u2))
                 thigh[i:k] = np.einsum("tji,tj->ti", Rh, u1)
-    axes = [_bend_axis(bend, thigh) for bend, thigh in zip(bends, thighs, strict=True)]
+    axes = [_bend_axis(bend, thigh) if len(bend) else None for bend, thigh in zip(bends, thighs, strict=True)]
     del bends, thighs
     for rows, Rb in blocks():
         if parent >= 0:

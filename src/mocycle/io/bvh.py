@@ -510,23 +510,41 @@ def _motion(skel: Skeleton, quats: np.ndarray, trans: np.ndarray, frame_time: fl
         raise MotionFileError(f"cannot build a motion from this file: {exc}", path) from None
 
 
-def motion_channels(motion: Motion) -> np.ndarray:
-    """The BVH channel values ``(T, C)`` of ``motion`` in file order (degrees, continuous)."""
+def _channel_parts(motion: Motion) -> list[tuple[list[int], np.ndarray | tuple[int, list[int]]]]:
+    """The BVH channel values of ``motion`` in parts: ``(columns, values)``, the rotations of each Euler order
+    as degrees ``(T, len(columns))`` (continuous), the positions as ``(joint, axes)`` of its translations
+    (read when needed, not copied)."""
     skel = motion.skeleton
     T = motion.n_frames
-    out = np.empty((T, skel.n_channels))
+    parts: list[tuple[list[int], np.ndarray | tuple[int, list[int]]]] = []
     by_order: dict[str, list[tuple[int, list[int]]]] = {}
     for j, (rot_cols, order, pos_cols, pos_axes) in enumerate(_channel_layout(skel)):
         if rot_cols:
             by_order.setdefault(order, []).append((j, rot_cols))
         if pos_cols:
-            out[:, pos_cols] = motion.translations[:, j, pos_axes]
+            parts.append((pos_cols, (j, pos_axes)))
     for order, items in by_order.items():
         joints = [j for j, _ in items]
-        cols = [c for _, cs in items for c in cs]
         angles = continuous_euler(motion.rotations, order, joints)  # no (T, N, 4) copy of the joints
-        out[:, cols] = np.degrees(angles, out=angles).reshape(T, -1)
+        parts.append(([c for _, cs in items for c in cs], np.degrees(angles, out=angles).reshape(T, -1)))
+    return parts
+
+
+def _channel_rows(motion: Motion, parts, rows: slice) -> np.ndarray:
+    """The channel values ``(n, C)`` of the frames ``rows`` from :func:`_channel_parts`."""
+    out = np.empty((len(range(*rows.indices(motion.n_frames))), motion.skeleton.n_channels))
+    for cols, values in parts:
+        if isinstance(values, tuple):
+            j, axes = values
+            out[:, cols] = motion.translations[rows, j][:, axes]
+        else:
+            out[:, cols] = values[rows]
     return out
+
+
+def motion_channels(motion: Motion) -> np.ndarray:
+    """The BVH channel values ``(T, C)`` of ``motion`` in file order (degrees, continuous)."""
+    return _channel_rows(motion, _channel_parts(motion), slice(None))
 
 
 def _fmt(x: float) -> str:
@@ -581,12 +599,12 @@ def bvh_chunks(motion: Motion) -> Iterator[str]:
 
     out.write(f"MOTION\nFrames: {motion.n_frames}\nFrame Time: {motion.frame_time!r}\n")
     yield out.getvalue()
-    values = motion_channels(motion)
-    if not values.shape[1]:
+    if not motion.skeleton.n_channels:
         yield "\n" * motion.n_frames
         return
+    parts = _channel_parts(motion)  # the angles of the whole take (continuity), not a second (T, C) array
     for f0 in range(0, motion.n_frames, _ROWS_PER_CHUNK):
-        block = values[f0:f0 + _ROWS_PER_CHUNK]
+        block = _channel_rows(motion, parts, slice(f0, f0 + _ROWS_PER_CHUNK))
         # Write tiny values as 0 so files stay readable; keep 9 significant digits.
         block = np.where(np.abs(block) < 1e-9, 0.0, block)
         out = io.StringIO()
