@@ -34,13 +34,17 @@ def motion_info(motion: Motion) -> dict:
     """The facts of a take, JSON-ready (see :data:`LABELS`)."""
     import numpy as np
 
-    from ..io.bvh import motion_channels
+    from ..contacts.feet import chain_joints, chain_positions
+    from ..io.bvh import _channel_parts
 
     skel = motion.skeleton
     travel = motion.travel_joint
-    root = motion.world_positions()[:, travel]
+    root = chain_positions(motion, chain_joints(motion, []))[:, travel]  # the travel joint's chain only
     steps = np.linalg.norm(np.diff(root, axis=0), axis=1) if motion.n_frames > 1 else np.zeros(0)
-    values = motion_channels(motion)
+    ptp = {}  # channel column -> its range over the take (degrees), from the angles alone (no (T, C) array)
+    for cols, values in _channel_parts(motion):
+        if not isinstance(values, tuple):
+            ptp.update(zip(cols, np.ptp(values, axis=0).tolist(), strict=True))
     ranges: dict[str, dict[str, float]] = {}
     spread: dict[str, float] = {}
     col = 0
@@ -48,7 +52,7 @@ def motion_info(motion: Motion) -> dict:
         per = {}
         for c in skel.channels[j]:
             if c.endswith("rotation"):
-                per[c] = float(np.ptp(values[:, col]))
+                per[c] = float(ptp[col])
             col += 1
         if per:
             ranges[name] = per
