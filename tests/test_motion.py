@@ -122,3 +122,13 @@ def test_a_motion_hands_its_own_arrays_over_and_copies_shared_ones():
     np.testing.assert_array_equal(view.rotations, before[0])
     np.testing.assert_array_equal(view.translations, before[1])
     np.testing.assert_array_equal(moved.rotations, before[2])
+
+
+def test_one_joints_path_is_its_column_of_the_world_positions(monkeypatch):
+    import mocycle.motion as motion_module
+
+    walk = synthetic_walk(n_frames=150, noise_deg=2.0).motion
+    monkeypatch.setattr(motion_module, "_FK_BLOCK", 64)  # three blocks, the last one short
+    W = walk.world_positions()
+    for j in (0, walk.travel_joint, walk.n_joints - 1):
+        np.testing.assert_array_equal(walk.joint_path(j), W[:, j])

@@ -206,6 +206,25 @@ def _forward_kinematics(quats: np.ndarray, translations: np.ndarray, parents) ->
     return world_r, world_p
 
 
+def chain_forward_kinematics(motion: Motion, chain: list[int], rows: slice, Rw: np.ndarray, W: np.ndarray) -> None:
+    """Forward kinematics of ``chain`` (joints with all their ancestors, parents first) over the frames
+    ``rows``, into ``Rw`` ``(n, len(chain), 3, 3)`` and ``W`` ``(n, len(chain), 3)`` (columns in chain order); each
+    joint's local rotation matrices are made when it is reached, not all at once.  The same numbers as
+    :func:`_forward_kinematics`."""
+    parents = motion.skeleton.parents
+    column = {int(j): i for i, j in enumerate(chain)}
+    for i, j in enumerate(chain):
+        p = int(parents[j])
+        local = Rotation.from_quat(motion.rotations[rows, j]).as_matrix()
+        if p < 0:
+            Rw[:, i] = local
+            W[:, i] = motion.translations[rows, j]
+        else:
+            Rp = Rw[:, column[p]]
+            np.matmul(Rp, local, out=Rw[:, i])
+            W[:, i] = W[:, column[p]] + (Rp @ motion.translations[rows, j, :, None])[..., 0]
+
+
 def _check_translations(trans: np.ndarray) -> None:
     """Refuse translations with NaN or infinite values or beyond ±MAX_MAGNITUDE (two reductions: NaN propagates)."""
     if not trans.size:
@@ -402,6 +421,23 @@ class Motion:
             out[block, :J] = world_p
             for k, s in enumerate(ends):
                 out[block, J + k] = world_p[:, s.parent] + world_r[:, s.parent] @ np.asarray(s.offset)
+        return out
+
+    def joint_path(self, joint: int) -> np.ndarray:
+        """World positions ``(T, 3)`` of one joint (the same numbers as ``world_positions()[:, joint]``): forward
+        kinematics of its chain from the root only, a block of frames at a time."""
+        chain = [int(joint)]
+        while self.skeleton.parents[chain[-1]] >= 0:
+            chain.append(int(self.skeleton.parents[chain[-1]]))
+        chain.reverse()
+        T = self.n_frames
+        out = np.empty((T, 3))
+        Rw, W = np.empty((min(T, _FK_BLOCK), len(chain), 3, 3)), np.empty((min(T, _FK_BLOCK), len(chain), 3))
+        for f0 in range(0, T, _FK_BLOCK):
+            rows = slice(f0, min(T, f0 + _FK_BLOCK))
+            n = rows.stop - f0
+            chain_forward_kinematics(self, chain, rows, Rw[:n], W[:n])
+            out[rows] = W[:n, -1]
         return out
 
     # -- new motions -----------------------------------------------------

@@ -23,11 +23,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..axes import vertical_axis
 from ..errors import MocycleError
-from ..motion import Motion, Skeleton
+from ..motion import Motion, Skeleton, chain_forward_kinematics
 
 #: Glob patterns (case-insensitive) of ankle joints and toe joints.
 ANKLE_PATTERNS = ("*foot", "*foot_l", "*foot_r", "*foot.l", "*foot.r", "*ankle*", "?foot*", "foot*")
@@ -296,7 +295,7 @@ def chain_transforms(motion: Motion, chain: list[int]) -> tuple[ChainArray, Chai
     T = motion.n_frames
     Rw = ChainArray(T, chain, (3, 3))
     W = ChainArray(T, chain, (3,))
-    _chain_fk(motion, chain, slice(None), Rw.data, W.data)
+    chain_forward_kinematics(motion, chain, slice(None), Rw.data, W.data)
     return Rw, W
 
 
@@ -312,7 +311,7 @@ def chain_positions(motion: Motion, chain: list[int]) -> ChainArray:
     Rw = np.empty((min(T, POSITIONS_BLOCK), len(chain), 3, 3))  # one block's world rotations
     for start in range(0, T, POSITIONS_BLOCK):
         rows = slice(start, min(T, start + POSITIONS_BLOCK))
-        _chain_fk(motion, chain, rows, Rw[:rows.stop - rows.start], W.data[rows])
+        chain_forward_kinematics(motion, chain, rows, Rw[:rows.stop - rows.start], W.data[rows])
     return W
 
 
@@ -327,23 +326,5 @@ def chain_rotation_blocks(motion: Motion, chain: list[int], block: int | None = 
     for start in range(0, T, block):
         rows = slice(start, min(T, start + block))
         n = rows.stop - start
-        _chain_fk(motion, chain, rows, Rw[:n], W[:n])
+        chain_forward_kinematics(motion, chain, rows, Rw[:n], W[:n])
         yield rows, Rw[:n]
-
-
-def _chain_fk(motion: Motion, chain: list[int], rows: slice, Rw: np.ndarray, W: np.ndarray) -> None:
-    """Forward kinematics of ``chain`` over the frames ``rows``, into ``Rw`` ``(n, len(chain), 3, 3)`` and ``W``
-    ``(n, len(chain), 3)`` (columns in chain order); each joint's local rotation matrices are made when it is
-    reached, not all at once."""
-    parents = motion.skeleton.parents
-    column = {int(j): i for i, j in enumerate(chain)}
-    for i, j in enumerate(chain):
-        p = int(parents[j])
-        local = Rotation.from_quat(motion.rotations[rows, j]).as_matrix()
-        if p < 0:
-            Rw[:, i] = local
-            W[:, i] = motion.translations[rows, j]
-        else:
-            Rp = Rw[:, column[p]]
-            np.matmul(Rp, local, out=Rw[:, i])
-            W[:, i] = W[:, column[p]] + (Rp @ motion.translations[rows, j, :, None])[..., 0]

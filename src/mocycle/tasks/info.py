@@ -34,12 +34,11 @@ def motion_info(motion: Motion) -> dict:
     """The facts of a take, JSON-ready (see :data:`LABELS`)."""
     import numpy as np
 
-    from ..contacts.feet import chain_joints, chain_positions
     from ..io.bvh import _channel_parts
 
     skel = motion.skeleton
     travel = motion.travel_joint
-    root = chain_positions(motion, chain_joints(motion, []))[:, travel]  # the travel joint's chain only
+    root = motion.joint_path(travel)  # the travel joint's chain only, not every joint's positions
     steps = np.linalg.norm(np.diff(root, axis=0), axis=1) if motion.n_frames > 1 else np.zeros(0)
     ptp = {}  # channel column -> its range over the take (degrees), from the angles alone (no (T, C) array)
     for cols, values in _channel_parts(motion):
