@@ -4,6 +4,7 @@ from scipy.spatial.transform import Rotation
 
 from mocycle.rotations import (
     continuous_euler,
+    continuous_euler_blocks,
     continuous_quats,
     euler_to_quats,
     quat_exp,
@@ -143,3 +144,21 @@ def test_vector_norms_are_numpys_norms_bit_for_bit(k):
     assert np.isinf(vector_norms(np.array([[np.inf, 1.0, 0.0]]))[0])
     one = np.array([3.0, 4.0, 12.0])
     assert vector_norms(one) == np.linalg.norm(one) == 13.0 and vector_norms(one, keepdims=True).shape == (1,)
+
+
+@pytest.mark.parametrize("order", ["ZXY", "ZYX", "ZXZ", "ZX", "Y"])
+def test_continuous_euler_a_block_at_a_time_is_the_same(order):
+    # three joints: still, swinging through the places where the primary solution flips (from frame 150 on,
+    # so the frame-by-frame choice starts mid-take), and turning on a random walk
+    t = np.linspace(0, 1, 400)
+    swing = np.stack([np.sin(2 * np.pi * t) * 3.0, np.cos(2 * np.pi * t) * 1.2, t * 9.0], axis=1)
+    swing[:150] = swing[150]
+    walk = np.cumsum(np.random.default_rng(2).normal(scale=0.2, size=(400, 3)), axis=0)
+    q = np.stack([np.tile([0.0, 0, 0, 1], (400, 1)), Rotation.from_rotvec(swing).as_quat(),
+                  Rotation.from_rotvec(walk).as_quat()], axis=1)
+    q = continuous_quats(q)
+    whole = continuous_euler(q, order, [2, 0, 1])
+    for block in (1, 7, 150, 151, 400, 1000):
+        parts = list(continuous_euler_blocks(q, order, [2, 0, 1], block))
+        assert [rows.start for rows, _ in parts] == list(range(0, 400, block))
+        np.testing.assert_array_equal(np.concatenate([a for _, a in parts]), whole)

@@ -96,21 +96,12 @@ def continuous_euler(quats: np.ndarray, order: str, joints=None) -> np.ndarray:
     closest to the frame before.
     """
     quats = np.asarray(quats, dtype=np.float64)
-    sel = slice(None) if joints is None else np.asarray(joints, dtype=np.intp).reshape(-1)
-    T = quats.shape[0]
-    N = quats.shape[1] if joints is None else sel.size
-    k = len(order)
+    sel, T, N, k, full = _euler_setup(quats, order, joints)
     if k == 0:
         return np.zeros((T, N, 0))
-    full = _full_order(order)
     a = np.empty((T, N, 3))
-    with warnings.catch_warnings():
-        # At gimbal lock scipy warns and sets the third angle to 0; the
-        # continuity pass below then picks the split closest to the neighbours.
-        warnings.simplefilter("ignore", UserWarning)
-        for f0 in range(0, T, _BLOCK):  # in blocks of frames: scipy's temporaries stay small
-            block = quats[f0:f0 + _BLOCK, sel]
-            a[f0:f0 + _BLOCK] = Rotation.from_quat(block.reshape(-1, 4)).as_euler(full).reshape(-1, N, 3)
+    for f0 in range(0, T, _BLOCK):  # in blocks of frames: scipy's temporaries stay small
+        a[f0:f0 + _BLOCK] = _primary_euler(quats, slice(f0, f0 + _BLOCK), sel, full)
     if k < 3:
         # Only the primary solution keeps the dropped angles at zero.
         return _unwrap_frames(np.ascontiguousarray(a[..., :k]))
@@ -118,41 +109,116 @@ def continuous_euler(quats: np.ndarray, order: str, joints=None) -> np.ndarray:
     # Where the unwrapped primary solution still jumps, choose frame by frame.
     jumps = np.empty((max(T - 1, 0), N), dtype=bool)
     for f0 in range(0, T - 1, _BLOCK):
-        jumps[f0:f0 + _BLOCK] = np.abs(np.diff(out[f0:f0 + _BLOCK + 1], axis=0)).max(axis=2) > np.pi / 2
+        jumps[f0:f0 + _BLOCK] = _jumps(out[f0:f0 + _BLOCK + 1])
     cols = np.flatnonzero(jumps.any(axis=0))
     if cols.size:
         start = int(np.argmax(jumps[:, cols].any(axis=1)))
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)
-            picked = cols if joints is None else sel[cols]
-            aa = Rotation.from_quat(quats[:, picked].reshape(-1, 4)).as_euler(full).reshape(T, cols.size, 3)
-        # The other solution of the same rotation.
-        bb = aa.copy()
-        bb[..., 0] += np.pi
-        bb[..., 2] += np.pi
-        bb[..., 1] = -aa[..., 1] if full[0] == full[2] else np.pi - aa[..., 1]
-        prev = out[start, cols]
-        for t in range(start + 1, T):
-            ca = _wrap_near(aa[t], prev)
-            cb = _wrap_near(bb[t], prev)
-            use_b = np.sum((cb - prev) ** 2, axis=1) < np.sum((ca - prev) ** 2, axis=1)
-            prev = np.where(use_b[:, None], cb, ca)
-            out[t, cols] = prev
+        aa = _primary_euler(quats, slice(None), sel[cols] if joints is not None else cols, full)
+        _nearest_solutions(aa[start + 1:], out[start, cols], full, out, slice(start + 1, T), cols)
     return out
+
+
+def continuous_euler_blocks(quats: np.ndarray, order: str, joints=None, block: int | None = None):
+    """:func:`continuous_euler` a block of frames at a time: yields ``(rows, angles)``, the frames (a slice) and
+    their angles ``(n, N, len(order))``, the same numbers, without a ``(T, N, 3)`` array (a writer's rows).
+
+    Two passes over the quaternions: the first unwraps and finds where each joint's primary solution first
+    jumps, the second makes the angles again and chooses between the two solutions from there on."""
+    quats = np.asarray(quats, dtype=np.float64)
+    sel, T, N, k, full = _euler_setup(quats, order, joints)
+    block = _BLOCK if block is None else int(block)
+    blocks = [slice(f0, min(T, f0 + block)) for f0 in range(0, T, block)]
+    if k == 0:
+        yield from ((rows, np.zeros((rows.stop - rows.start, N, 0))) for rows in blocks)
+        return
+    state = None
+    if k < 3:
+        for rows in blocks:
+            a = np.ascontiguousarray(_primary_euler(quats, rows, sel, full)[..., :k])
+            state = _unwrap_step(a, state)
+            yield rows, a
+        return
+    first = np.full(N, T)  # each joint's first frame whose next frame jumps (T: none)
+    last = None
+    for rows in blocks:
+        a = _primary_euler(quats, rows, sel, full)
+        state = _unwrap_step(a, state)
+        jumps = _jumps(a if last is None else np.concatenate([last[None], a]))  # (pairs, N)
+        new = jumps.any(axis=0) & (first == T)
+        if new.any():
+            first[new] = (rows.start - (last is not None)) + np.argmax(jumps[:, new], axis=0)
+        last = a[-1].copy()
+    cols = np.flatnonzero(first < T)
+    start = int(first[cols].min()) if cols.size else T
+    state, prev = None, None
+    for rows in blocks:
+        a = _primary_euler(quats, rows, sel, full)
+        raw = a[:, cols].copy()  # the primary solutions of the joints that jump, before unwrapping
+        state = _unwrap_step(a, state)
+        if rows.start <= start < rows.stop:
+            prev = a[start - rows.start, cols]
+        if prev is not None:
+            t0 = max(start + 1, rows.start) - rows.start
+            prev = _nearest_solutions(raw[t0:], prev, full, a, slice(t0, None), cols)
+        yield rows, a
+
+
+def _euler_setup(quats: np.ndarray, order: str, joints):
+    """``(sel, T, N, k, full order)`` of :func:`continuous_euler`'s arguments."""
+    sel = slice(None) if joints is None else np.asarray(joints, dtype=np.intp).reshape(-1)
+    N = quats.shape[1] if joints is None else sel.size
+    return sel, quats.shape[0], N, len(order), _full_order(order)
+
+
+def _primary_euler(quats: np.ndarray, rows: slice, sel, full: str) -> np.ndarray:
+    """scipy's Euler angles ``(n, N, 3)`` (intrinsic ``full`` order) of ``quats[rows, sel]``.  At gimbal lock
+    scipy warns and sets the third angle to 0; the continuity pass then picks the split closest to the
+    neighbours."""
+    block = quats[rows, sel]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        return Rotation.from_quat(block.reshape(-1, 4)).as_euler(full).reshape(block.shape[:2] + (3,))
+
+
+def _jumps(angles: np.ndarray) -> np.ndarray:
+    """``(n - 1, N)``: where a joint's unwrapped angles ``(n, N, 3)`` jump by more than a quarter turn."""
+    return np.abs(np.diff(angles, axis=0)).max(axis=2) > np.pi / 2
+
+
+def _nearest_solutions(aa: np.ndarray, prev: np.ndarray, full: str, out: np.ndarray, rows: slice,
+                       cols: np.ndarray) -> np.ndarray:
+    """Frame by frame, the one of the two Euler solutions of the primary angles ``aa`` ``(n, C, 3)`` (any whole
+    turns) closest to the frame before, starting from ``prev`` ``(C, 3)``, written to ``out[rows, cols]``;
+    returns the last frame's."""
+    bb = aa.copy()  # the other solution of the same rotation
+    bb[..., 0] += np.pi
+    bb[..., 2] += np.pi
+    bb[..., 1] = -aa[..., 1] if full[0] == full[2] else np.pi - aa[..., 1]
+    out_rows = range(*rows.indices(out.shape[0]))
+    for t, row in enumerate(out_rows):
+        ca = _wrap_near(aa[t], prev)
+        cb = _wrap_near(bb[t], prev)
+        use_b = np.sum((cb - prev) ** 2, axis=1) < np.sum((ca - prev) ** 2, axis=1)
+        prev = np.where(use_b[:, None], cb, ca)
+        out[row, cols] = prev
+    return prev
 
 
 #: Frames per block of the long per-frame passes (their temporaries stay a few MB).
 _BLOCK = 8192
 
 
-def _unwrap_frames(p: np.ndarray) -> np.ndarray:
-    """``np.unwrap(p, axis=0)`` computed in place, block by block of frames (the same numbers)."""
-    carry = np.zeros(p.shape[1:])
-    last = p[0].copy()
-    for f0 in range(1, p.shape[0], _BLOCK):
-        block = p[f0:f0 + _BLOCK]
-        raw_last = block[-1].copy()
-        dd = np.diff(np.concatenate([last[None], block]), axis=0)
+def _unwrap_step(p: np.ndarray, state):
+    """Unwrap the frames ``p`` ``(n, ...)`` in place, going on from ``state`` (``None`` at the take's first
+    frame, which stays as it is); returns the state for the next frames.  Blocks of any length give
+    ``np.unwrap``'s numbers: the corrections are summed in frame order."""
+    if state is None:
+        last, carry, body = p[0].copy(), np.zeros(p.shape[1:]), p[1:]
+    else:
+        (last, carry), body = state, p
+    if body.shape[0]:
+        raw_last = body[-1].copy()
+        dd = np.diff(np.concatenate([last[None], body]), axis=0)
         ddmod = np.mod(dd + np.pi, TWO_PI) - np.pi
         ddmod[(ddmod == -np.pi) & (dd > 0)] = np.pi
         correct = ddmod - dd
@@ -160,8 +226,16 @@ def _unwrap_frames(p: np.ndarray) -> np.ndarray:
         correct[0] += carry  # the running sum goes on from the block before, in the same order
         np.cumsum(correct, axis=0, out=correct)
         carry = correct[-1].copy()
-        block += correct
+        body += correct
         last = raw_last
+    return last, carry
+
+
+def _unwrap_frames(p: np.ndarray) -> np.ndarray:
+    """``np.unwrap(p, axis=0)`` computed in place, block by block of frames (the same numbers)."""
+    state = None
+    for f0 in range(0, p.shape[0], _BLOCK):
+        state = _unwrap_step(p[f0:f0 + _BLOCK], state)
     return p
 
 

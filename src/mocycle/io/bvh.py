@@ -33,7 +33,7 @@ import numpy as np
 from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..limits import MAX_MAGNITUDE, check_frames, frame_time_problem
 from ..motion import POSITION_CHANNELS, ROTATION_CHANNELS, EndSite, Motion, Skeleton
-from ..rotations import continuous_euler, euler_quat_components
+from ..rotations import continuous_euler_blocks, euler_quat_components
 from .atomic import atomic_write
 
 _CHANNEL_NAMES = {c.lower(): c for c in ROTATION_CHANNELS + POSITION_CHANNELS}
@@ -510,41 +510,38 @@ def _motion(skel: Skeleton, quats: np.ndarray, trans: np.ndarray, frame_time: fl
         raise MotionFileError(f"cannot build a motion from this file: {exc}", path) from None
 
 
-def _channel_parts(motion: Motion) -> list[tuple[list[int], np.ndarray | tuple[int, list[int]]]]:
-    """The BVH channel values of ``motion`` in parts: ``(columns, values)``, the rotations of each Euler order
-    as degrees ``(T, len(columns))`` (continuous), the positions as ``(joint, axes)`` of its translations
-    (read when needed, not copied)."""
+def channel_blocks(motion: Motion, block: int = 8192) -> Iterator[tuple[slice, np.ndarray]]:
+    """The BVH channel values of ``motion`` in file order (degrees, continuous over the take) a block of
+    ``block`` frames at a time: yields ``(rows, values (n, C))``, holding no ``(T, C)`` or ``(T, N, 3)`` array
+    (each Euler order's angles come from :func:`~mocycle.rotations.continuous_euler_blocks`)."""
     skel = motion.skeleton
-    T = motion.n_frames
-    parts: list[tuple[list[int], np.ndarray | tuple[int, list[int]]]] = []
+    positions: list[tuple[list[int], int, list[int]]] = []
     by_order: dict[str, list[tuple[int, list[int]]]] = {}
     for j, (rot_cols, order, pos_cols, pos_axes) in enumerate(_channel_layout(skel)):
         if rot_cols:
             by_order.setdefault(order, []).append((j, rot_cols))
         if pos_cols:
-            parts.append((pos_cols, (j, pos_axes)))
-    for order, items in by_order.items():
-        joints = [j for j, _ in items]
-        angles = continuous_euler(motion.rotations, order, joints)  # no (T, N, 4) copy of the joints
-        parts.append(([c for _, cs in items for c in cs], np.degrees(angles, out=angles).reshape(T, -1)))
-    return parts
-
-
-def _channel_rows(motion: Motion, parts, rows: slice) -> np.ndarray:
-    """The channel values ``(n, C)`` of the frames ``rows`` from :func:`_channel_parts`."""
-    out = np.empty((len(range(*rows.indices(motion.n_frames))), motion.skeleton.n_channels))
-    for cols, values in parts:
-        if isinstance(values, tuple):
-            j, axes = values
+            positions.append((pos_cols, j, pos_axes))
+    angles = [([c for _, cs in items for c in cs],
+               continuous_euler_blocks(motion.rotations, order, [j for j, _ in items], block))
+              for order, items in by_order.items()]
+    for f0 in range(0, motion.n_frames, block):
+        rows = slice(f0, min(motion.n_frames, f0 + block))
+        out = np.empty((rows.stop - f0, skel.n_channels))
+        for cols, j, axes in positions:
             out[:, cols] = motion.translations[rows, j][:, axes]
-        else:
-            out[:, cols] = values[rows]
-    return out
+        for cols, blocks in angles:
+            _, a = next(blocks)
+            out[:, cols] = np.degrees(a, out=a).reshape(len(out), -1)
+        yield rows, out
 
 
 def motion_channels(motion: Motion) -> np.ndarray:
     """The BVH channel values ``(T, C)`` of ``motion`` in file order (degrees, continuous)."""
-    return _channel_rows(motion, _channel_parts(motion), slice(None))
+    out = np.empty((motion.n_frames, motion.skeleton.n_channels))
+    for rows, values in channel_blocks(motion):
+        out[rows] = values
+    return out
 
 
 def _fmt(x: float) -> str:
@@ -602,9 +599,7 @@ def bvh_chunks(motion: Motion) -> Iterator[str]:
     if not motion.skeleton.n_channels:
         yield "\n" * motion.n_frames
         return
-    parts = _channel_parts(motion)  # the angles of the whole take (continuity), not a second (T, C) array
-    for f0 in range(0, motion.n_frames, _ROWS_PER_CHUNK):
-        block = _channel_rows(motion, parts, slice(f0, f0 + _ROWS_PER_CHUNK))
+    for _, block in channel_blocks(motion, _ROWS_PER_CHUNK):  # a block of rows at a time, none held whole
         # Write tiny values as 0 so files stay readable; keep 9 significant digits.
         block = np.where(np.abs(block) < 1e-9, 0.0, block)
         out = io.StringIO()

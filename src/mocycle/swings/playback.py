@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from .. import _validate
 from ..errors import MocycleError
-from ..io.bvh import _channel_layout, _channel_parts, _channel_rows
+from ..io.bvh import _channel_layout, channel_blocks
 from ..motion import Motion
 from ..rotations import quat_angles, quat_exp, quat_multiply, slerp
 from .segment import Segmentation, swing_angles
@@ -169,17 +169,13 @@ DIFFERENCE_BLOCK = 8192
 
 def _euler_difference_blocks(original: Motion, other: Motion):
     """:func:`euler_differences` a block of :data:`DIFFERENCE_BLOCK` frames at a time (the same numbers): a
-    caller that reduces them holds no ``(T, R)`` array, only the original's angles."""
+    caller that reduces them holds no ``(T, R)`` array, nor the original's channels."""
     if not original.skeleton.same_as(other.skeleton) or original.n_frames != other.n_frames:
         raise MocycleError(f"motions differ in skeleton or length ({original!r} vs {other!r})")
-    parts = _channel_parts(original)  # the original's angles (continuous over the take), not its (T, C) channels
-    T = original.n_frames
     layout = [(j, rot_cols, order) for j, (rot_cols, order, _, _) in enumerate(_channel_layout(original.skeleton))
               if rot_cols]
-    for f0 in range(0, T, DIFFERENCE_BLOCK):
-        rows = slice(f0, min(T, f0 + DIFFERENCE_BLOCK))
+    for rows, ref in channel_blocks(original, DIFFERENCE_BLOCK):
         n = rows.stop - rows.start
-        ref = _channel_rows(original, parts, rows)
         diffs = []
         for j, rot_cols, order in layout:
             r = np.radians(ref[:, rot_cols])[:, None, :]

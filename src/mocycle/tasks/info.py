@@ -34,16 +34,18 @@ def motion_info(motion: Motion) -> dict:
     """The facts of a take, JSON-ready (see :data:`LABELS`)."""
     import numpy as np
 
-    from ..io.bvh import _channel_parts
+    from ..io.bvh import channel_blocks
 
     skel = motion.skeleton
     travel = motion.travel_joint
     root = motion.joint_path(travel)  # the travel joint's chain only, not every joint's positions
     steps = np.linalg.norm(np.diff(root, axis=0), axis=1) if motion.n_frames > 1 else np.zeros(0)
-    ptp = {}  # channel column -> its range over the take (degrees), from the angles alone (no (T, C) array)
-    for cols, values in _channel_parts(motion):
-        if not isinstance(values, tuple):
-            ptp.update(zip(cols, np.ptp(values, axis=0).tolist(), strict=True))
+    high = np.full(skel.n_channels, -np.inf)  # each channel's range over the take, a block of rows at a time
+    low = np.full(skel.n_channels, np.inf)
+    for _, values in channel_blocks(motion):
+        np.maximum(high, values.max(axis=0, initial=-np.inf), out=high)
+        np.minimum(low, values.min(axis=0, initial=np.inf), out=low)
+    ptp = high - low
     ranges: dict[str, dict[str, float]] = {}
     spread: dict[str, float] = {}
     col = 0
