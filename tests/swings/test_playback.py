@@ -8,6 +8,7 @@ from mocycle.datasets import synthetic_walk
 from mocycle.errors import MocycleError
 from mocycle.io import read
 from mocycle.motion import Motion
+from mocycle.rotations import quat_angles
 from mocycle.swings import geodesic_errors, playback, playback_errors, segment, segmentation_error
 
 
@@ -130,3 +131,5 @@ def test_playback_errors_block_by_block_equal_those_of_the_whole_difference_arra
     assert errs["segmentation_error"] == pytest.approx(float(np.linalg.norm(d, axis=1).mean()), rel=1e-12)
     assert errs["rms_angle_error_deg"] == pytest.approx(float(np.sqrt(np.mean(d ** 2))), rel=1e-12)
     assert errs["rotation_dofs"] == d.shape[1] > 0
+    whole = np.degrees(quat_angles(walk.rotations, again.rotations)).mean(axis=0)
+    np.testing.assert_array_equal(geodesic_errors(walk, again), whole)  # the same sums, block by block

@@ -195,7 +195,13 @@ def geodesic_errors(original: Motion, other: Motion) -> np.ndarray:
     """Mean geodesic angle (degrees) between the local rotations of each joint, ``(J,)``."""
     if not original.skeleton.same_as(other.skeleton) or original.n_frames != other.n_frames:
         raise MocycleError(f"motions differ in skeleton or length ({original!r} vs {other!r})")
-    return np.degrees(quat_angles(original.rotations, other.rotations)).mean(axis=0)
+    # a block of frames at a time (no (T, J, 4) product), the rows added in frame order as mean(axis=0) adds them
+    total = np.zeros((1, original.n_joints))
+    for f0 in range(0, original.n_frames, DIFFERENCE_BLOCK):
+        rows = slice(f0, f0 + DIFFERENCE_BLOCK)
+        angles = np.degrees(quat_angles(original.rotations[rows], other.rotations[rows]))
+        total = np.add.reduce(np.concatenate([total, angles]) if f0 else angles, axis=0, keepdims=True)
+    return total[0] / original.n_frames
 
 
 def playback_errors(original: Motion, other: Motion) -> dict:
