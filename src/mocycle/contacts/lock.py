@@ -582,6 +582,41 @@ def _leg_ik(motion: Motion, foot, W, Rb: np.ndarray, column: dict, t: np.ndarray
     return out
 
 
+def _bend_axes(feet, W, blocks, column: dict, solved: list[np.ndarray]) -> list[np.ndarray | None]:
+    """Each leg's usual bend axis (:func:`_bend_axis`) over all its ``solved`` frames, from the chain's world
+    rotations ``blocks`` (``(rows, (n, len(chain), 3, 3))``) a block at a time; the rows are kept and summed at
+    once, the same sum as over one array (``None``: a leg with no solved frame)."""
+    bends = [np.empty((t.size, 3)) for t in solved]
+    thighs = [np.empty((t.size, 3)) for t in solved]
+    for rows, Rb in blocks:
+        for foot, t, bend, thigh in zip(feet, solved, bends, thighs, strict=True):
+            i, k = np.searchsorted(t, rows.start), np.searchsorted(t, rows.stop)
+            if k > i:
+                _, _, _, _, _, u1, u2 = _thigh_shin(W, foot, t[i:k])
+                Rh = Rb[t[i:k] - rows.start, column[foot.hip]]
+                bend[i:k] = np.einsum("tji,tj->ti", Rh, _cross(u1, u2))
+                thigh[i:k] = np.einsum("tji,tj->ti", Rh, u1)
+    return [_bend_axis(bend, thigh) if len(bend) else None for bend, thigh in zip(bends, thighs, strict=True)]
+
+
+def _solve_legs(motion: Motion, feet, W, blocks, column: dict, solved, goals, toe_goals, axes, moves):
+    """The two-bone IK of every leg (:func:`_leg_ik`) at its ``solved`` frames and the travel joint's world
+    ``moves`` (``(T, 3)`` each) in its parent's frame, a block of the chain's world rotations at a time:
+    ``(new quaternions [(frames, joint, (n, 4)), ...], local moves [(T, 3), ...])``."""
+    parent = int(motion.skeleton.parents[motion.travel_joint])
+    local_moves = [m if parent < 0 else np.empty_like(m) for m in moves]
+    new_quats = []
+    for rows, Rb in blocks:
+        if parent >= 0:
+            for m, local in zip(moves, local_moves, strict=True):
+                local[rows] = np.einsum("tji,tj->ti", Rb[:, column[parent]], m[rows])
+        for foot, g, gt, t, axis in zip(feet, goals, toe_goals, solved, axes, strict=True):
+            t = t[np.searchsorted(t, rows.start):np.searchsorted(t, rows.stop)]
+            if t.size:
+                new_quats += _leg_ik(motion, foot, W, Rb, column, t, t - rows.start, g, gt, axis)
+    return new_quats, local_moves
+
+
 def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECONDS, reach: float = REACH,
               follow: bool = True, period: int | None = None, frames: slice | None = None,
               clearance: float | np.ndarray | None = None, transforms: tuple | None = None,
@@ -642,37 +677,17 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     window = np.zeros(motion.n_frames, bool)
     window[frames if frames is not None else slice(None)] = True
     solved = [np.flatnonzero((ch | lowered) & window) for ch in changed]  # the frames each leg's IK changes
-    column = {j: i for i, j in enumerate(chain)}
     travel = motion.travel_joint
-    parent = int(skel.parents[travel])
-    local_moves = [m if parent < 0 else np.empty_like(m) for m in moves]  # the moves in the parent's frame
-    new_quats = []  # (frames, joint, quaternions (n, 4)): only what the legs' IK changes
+
     def blocks():  # the chain's world rotations (n, len(chain), 3, 3) of the frames ``rows``, a block at a time
         if transforms is not None:
             return [(slice(0, motion.n_frames), transforms[0].data)]
         return chain_rotation_blocks(motion, chain)
 
-    # each leg's usual bend axis, from all its solved frames (the same sum as over one array: the rows first)
-    bends = [np.empty((t.size, 3)) for t in solved]
-    thighs = [np.empty((t.size, 3)) for t in solved]
-    for rows, Rb in blocks():
-        for foot, t, bend, thigh in zip(contacts.feet, solved, bends, thighs, strict=True):
-            i, k = np.searchsorted(t, rows.start), np.searchsorted(t, rows.stop)
-            if k > i:
-                _, _, _, _, _, u1, u2 = _thigh_shin(W, foot, t[i:k])
-                Rh = Rb[t[i:k] - rows.start, column[foot.hip]]
-                bend[i:k] = np.einsum("tji,tj->ti", Rh, _cross(u1, u2))
-                thigh[i:k] = np.einsum("tji,tj->ti", Rh, u1)
-    axes = [_bend_axis(bend, thigh) if len(bend) else None for bend, thigh in zip(bends, thighs, strict=True)]
-    del bends, thighs
-    for rows, Rb in blocks():
-        if parent >= 0:
-            for m, local in zip(moves, local_moves, strict=True):
-                local[rows] = np.einsum("tji,tj->ti", Rb[:, column[parent]], m[rows])
-        for foot, g, gt, t, axis in zip(contacts.feet, goals, toe_goals, solved, axes, strict=True):
-            t = t[np.searchsorted(t, rows.start):np.searchsorted(t, rows.stop)]
-            if t.size:
-                new_quats += _leg_ik(motion, foot, W, Rb, column, t, t - rows.start, g, gt, axis)
+    column = {j: i for i, j in enumerate(chain)}
+    axes = _bend_axes(contacts.feet, W, blocks(), column, solved)
+    new_quats, local_moves = _solve_legs(motion, contacts.feet, W, blocks(), column, solved, goals, toe_goals, axes,
+                                         moves)
     del W  # the chain's world positions and rotations: not needed for the quaternions (memory)
     if hand_over:
         rotations, trans = motion._hand_over()
