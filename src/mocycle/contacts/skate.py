@@ -38,7 +38,10 @@ def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: f
     h = P @ up
     h = h - h.min(axis=0)
     step = np.diff(P, axis=0)
-    step = step - (step @ up)[..., None] * up
+    del P  # (T, C, 3) arrays held one or two at a time (memory)
+    vu = step @ up
+    for k in range(3):  # the horizontal step in place: step - (step . up) up, axis by axis
+        step[..., k] -= vu * up[k]
     speed = np.linalg.norm(step, axis=-1) / motion.frame_time    # (T-1, C)
     hm = 0.5 * (h[1:] + h[:-1])
     w = np.where(hm < H, 2.0 - 2.0 ** (hm / H), 0.0)
