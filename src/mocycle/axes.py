@@ -106,10 +106,7 @@ def up_in_parent_frame(motion: Motion, joint: int, world_up: np.ndarray) -> np.n
 def _world_rotation(motion: Motion, joint: int) -> np.ndarray:
     """World rotation matrices ``(T, 3, 3)`` of one joint: the products of :meth:`Motion.world_transforms`
     along its chain from the root only (not every joint of a 100-joint rig)."""
-    chain = [joint]
-    while motion.skeleton.parents[chain[-1]] >= 0:
-        chain.append(int(motion.skeleton.parents[chain[-1]]))
-    chain.reverse()
+    chain = motion.skeleton.chain_to(joint)
     T = motion.n_frames
     local = Rotation.from_quat(motion.rotations[:, chain].reshape(-1, 4)).as_matrix().reshape(T, len(chain), 3, 3)
     world = local[:, 0]

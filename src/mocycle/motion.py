@@ -113,6 +113,13 @@ class Skeleton:
     def children(self, j: int) -> list[int]:
         return [int(c) for c in np.flatnonzero(self.parents == j)]
 
+    def chain_to(self, joint: int) -> list[int]:
+        """The joints from the root down to ``joint`` (root first, ``joint`` last)."""
+        chain = [int(joint)]
+        while self.parents[chain[-1]] >= 0:
+            chain.append(int(self.parents[chain[-1]]))
+        return chain[::-1]
+
     def euler_order(self, j: int) -> str:
         """Rotation axes of joint ``j`` in channel order, e.g. ``"ZYX"`` ('' for none)."""
         return "".join(c[0] for c in self.channels[j] if c in ROTATION_CHANNELS)
@@ -223,6 +230,20 @@ def chain_forward_kinematics(motion: Motion, chain: list[int], rows: slice, Rw: 
             Rp = Rw[:, column[p]]
             np.matmul(Rp, local, out=Rw[:, i])
             W[:, i] = W[:, column[p]] + (Rp @ motion.translations[rows, j, :, None])[..., 0]
+
+
+def chain_kinematics_blocks(motion: Motion, chain: list[int], block: int):
+    """:func:`chain_forward_kinematics` a block of ``block`` frames at a time: yields ``(rows, Rw, W)``, the
+    frames (a slice) and their world rotations ``(n, len(chain), 3, 3)`` and positions ``(n, len(chain), 3)``
+    (one pair of buffers, reused: read a block before asking for the next)."""
+    T = motion.n_frames
+    Rw = np.empty((min(T, block), len(chain), 3, 3))
+    W = np.empty((min(T, block), len(chain), 3))
+    for start in range(0, T, block):
+        rows = slice(start, min(T, start + block))
+        n = rows.stop - start
+        chain_forward_kinematics(motion, chain, rows, Rw[:n], W[:n])
+        yield rows, Rw[:n], W[:n]
 
 
 def _check_translations(trans: np.ndarray) -> None:
@@ -426,18 +447,9 @@ class Motion:
     def joint_path(self, joint: int) -> np.ndarray:
         """World positions ``(T, 3)`` of one joint (the same numbers as ``world_positions()[:, joint]``): forward
         kinematics of its chain from the root only, a block of frames at a time."""
-        chain = [int(joint)]
-        while self.skeleton.parents[chain[-1]] >= 0:
-            chain.append(int(self.skeleton.parents[chain[-1]]))
-        chain.reverse()
-        T = self.n_frames
-        out = np.empty((T, 3))
-        Rw, W = np.empty((min(T, _FK_BLOCK), len(chain), 3, 3)), np.empty((min(T, _FK_BLOCK), len(chain), 3))
-        for f0 in range(0, T, _FK_BLOCK):
-            rows = slice(f0, min(T, f0 + _FK_BLOCK))
-            n = rows.stop - f0
-            chain_forward_kinematics(self, chain, rows, Rw[:n], W[:n])
-            out[rows] = W[:n, -1]
+        out = np.empty((self.n_frames, 3))
+        for rows, _, W in chain_kinematics_blocks(self, self.skeleton.chain_to(joint), _FK_BLOCK):
+            out[rows] = W[:, -1]
         return out
 
     # -- new motions -----------------------------------------------------

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..axes import vertical_axis
 from ..errors import MocycleError
-from ..motion import Motion, Skeleton, chain_forward_kinematics
+from ..motion import Motion, Skeleton, chain_forward_kinematics, chain_kinematics_blocks
 
 #: Glob patterns (case-insensitive) of ankle joints and toe joints.
 ANKLE_PATTERNS = ("*foot", "*foot_l", "*foot_r", "*foot.l", "*foot.r", "*ankle*", "?foot*", "foot*")
@@ -306,12 +306,9 @@ POSITIONS_BLOCK = 16384
 def chain_positions(motion: Motion, chain: list[int]) -> ChainArray:
     """The world positions of :func:`chain_transforms` alone, computed a block of frames at a time: for a long
     take only the ``(T, len(chain), 3)`` positions are held, not the rotations (three times their size)."""
-    T = motion.n_frames
-    W = ChainArray(T, chain, (3,))
-    Rw = np.empty((min(T, POSITIONS_BLOCK), len(chain), 3, 3))  # one block's world rotations
-    for start in range(0, T, POSITIONS_BLOCK):
-        rows = slice(start, min(T, start + POSITIONS_BLOCK))
-        chain_forward_kinematics(motion, chain, rows, Rw[:rows.stop - rows.start], W.data[rows])
+    W = ChainArray(motion.n_frames, chain, (3,))
+    for rows, _, positions in chain_kinematics_blocks(motion, chain, POSITIONS_BLOCK):
+        W.data[rows] = positions
     return W
 
 
@@ -319,12 +316,5 @@ def chain_rotation_blocks(motion: Motion, chain: list[int], block: int | None = 
     """The world rotations of :func:`chain_transforms` a block of frames at a time: yields ``(rows, Rw)``, the
     frames (a slice) and their rotations ``(n, len(chain), 3, 3)`` (columns in chain order; one buffer,
     reused: read a block before asking for the next); ``block``: frames per block (default POSITIONS_BLOCK)."""
-    T = motion.n_frames
-    block = POSITIONS_BLOCK if block is None else block
-    Rw = np.empty((min(T, block), len(chain), 3, 3))
-    W = np.empty((min(T, block), len(chain), 3))  # the positions, made on the way
-    for start in range(0, T, block):
-        rows = slice(start, min(T, start + block))
-        n = rows.stop - start
-        chain_forward_kinematics(motion, chain, rows, Rw[:n], W[:n])
-        yield rows, Rw[:n]
+    for rows, Rw, _ in chain_kinematics_blocks(motion, chain, POSITIONS_BLOCK if block is None else block):
+        yield rows, Rw

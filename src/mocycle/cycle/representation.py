@@ -241,10 +241,7 @@ class CycleSpace:
         ``translations (N, J, 3)``: forward kinematics along its chain from the root only (the products of
         :meth:`Motion.world_positions <mocycle.motion.Motion.world_positions>` for that joint).
         ``travel_rotation`` ``(N, 3, 3)``: the travel joint's rotation, in place of ``rotations[:, travel]``."""
-        chain = [self.travel]
-        while self.skeleton.parents[chain[-1]] >= 0:
-            chain.append(int(self.skeleton.parents[chain[-1]]))
-        chain.reverse()
+        chain = self.skeleton.chain_to(self.travel)
 
         def local(j):
             return travel_rotation if j == self.travel and travel_rotation is not None else rotations[:, j]
