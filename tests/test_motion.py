@@ -105,10 +105,11 @@ def test_concatenate_checks_skeleton():
 def test_a_motion_hands_its_own_arrays_over_and_copies_shared_ones():
     walk = synthetic_walk(n_frames=60).motion
     own = Motion(walk.skeleton, walk.rotations, walk.translations, walk.frame_time)  # arrays it alone holds
-    address = own.rotations.__array_interface__["data"][0], own.translations.__array_interface__["data"][0]
-    rotations, translations = own._hand_over()
-    assert (rotations.__array_interface__["data"][0], translations.__array_interface__["data"][0]) == address
-    assert rotations.flags.writeable and translations.flags.writeable
+    address = own.rotations.__array_interface__["data"][0], own.root_positions.__array_interface__["data"][0]
+    rotations, static, tracks = own._hand_over()
+    assert list(tracks) == [0]
+    assert (rotations.__array_interface__["data"][0], tracks[0].__array_interface__["data"][0]) == address
+    assert rotations.flags.writeable and tracks[0].flags.writeable and static.flags.writeable
     with pytest.raises(AttributeError):
         own.translations  # noqa: B018 (emptied)
 
@@ -116,12 +117,43 @@ def test_a_motion_hands_its_own_arrays_over_and_copies_shared_ones():
     view = shared[10:50]                                    # shares both arrays
     moved = shared.replace(translations=shared.translations + 1.0)  # shares the rotations
     before = view.rotations.copy(), view.translations.copy(), moved.rotations.copy()
-    rotations, translations = shared._hand_over()
+    rotations, static, tracks = shared._hand_over()
     rotations[:] = 0.0
-    translations[:] = 0.0
+    static[:] = 0.0
+    tracks[0][:] = 0.0
     np.testing.assert_array_equal(view.rotations, before[0])
     np.testing.assert_array_equal(view.translations, before[1])
     np.testing.assert_array_equal(moved.rotations, before[2])
+
+
+def test_translations_are_stored_once_per_joint_that_stands_still():
+    walk = synthetic_walk(n_frames=80).motion
+    full = walk.translations.copy()
+    full[:, 5] += np.linspace(0.0, 1.0, 80)[:, None]  # a second joint that moves
+    m = Motion(walk.skeleton, walk.rotations, full, walk.frame_time)
+    assert m.tracked_joints == (0, 5)
+    np.testing.assert_array_equal(m.translations, full)
+    np.testing.assert_array_equal(m.translations_at(7), full[7])
+    np.testing.assert_array_equal(m.translations_at([3, 1, 3]), full[[3, 1, 3]])
+    np.testing.assert_array_equal(m.translations_at(slice(10, 60, 7)), full[10:60:7])
+    np.testing.assert_array_equal(m.joint_translations(2), full[:, 2])
+    assert not m.joint_translations(2).flags.writeable and not m.translations.flags.writeable
+    np.testing.assert_array_equal(m[20:30].translations, full[20:30])
+    np.testing.assert_array_equal(m[::3].translations, full[::3])
+    # a track replaces one joint's translations; the others are kept (shared)
+    moved = m.replace(tracks={3: full[:, 3] + 2.0})
+    assert moved.tracked_joints == (0, 3, 5) and moved.joint_translations(5) is m.joint_translations(5)
+    np.testing.assert_array_equal(moved.joint_translations(3), full[:, 3] + 2.0)
+    # (J, 3) translations: the same at every frame; joints that move in one part of a take move in the whole
+    still = m.replace(translations=full[0])
+    assert still.tracked_joints == () and still.travel_joint == 0
+    both = concatenate([still, m.replace(tracks={7: full[:, 7] + 0.5})])
+    np.testing.assert_array_equal(both.translations[80:, 7], full[:, 7] + 0.5)
+    np.testing.assert_array_equal(both.translations[:80], np.broadcast_to(full[0], (80,) + full.shape[1:]))
+    with pytest.raises(MocycleError, match=r"track of joint 3 must have shape \(80, 3\)"):
+        m.replace(tracks={3: full[:10, 3]})
+    with pytest.raises(MocycleError, match="NaN"):
+        Motion(walk.skeleton, walk.rotations, full[0], walk.frame_time, tracks={4: np.full((80, 3), np.nan)})
 
 
 def test_one_joints_path_is_its_column_of_the_world_positions(monkeypatch):

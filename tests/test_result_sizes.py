@@ -93,7 +93,8 @@ def test_phase_result_keeps_no_features_or_estimator(walk):
 def test_cycle_keeps_what_decoding_needs_not_the_input(walk, method):
     cycle = extract_cycle(walk, method=method)
     size = _assert_small(cycle)
-    assert size < 0.5 * len(pickle.dumps(walk))
+    assert size < 0.75 * len(pickle.dumps(walk))  # less than the input's rotations alone (a take stores no
+    # per-frame translations for joints that stand still)
     again = pickle.loads(pickle.dumps(cycle))
     assert np.allclose(again.motion("motion").world_positions(), cycle.motion("motion").world_positions())
     assert again.space.skeleton.same_as(walk.skeleton) and again.space.frame_time == walk.frame_time

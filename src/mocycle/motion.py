@@ -6,9 +6,11 @@ Conventions
 * Rotations are local (relative to the parent), stored as unit quaternions in
   scipy's scalar-last order ``(x, y, z, w)``, shape ``(T, J, 4)``, and kept
   sign-continuous in time (``q[t] . q[t-1] >= 0``).
-* Translations are local too, shape ``(T, J, 3)``: for a joint with position
-  channels they are the channel values (they *replace* the rest offset, as BVH
-  exporters write them); for every other joint they equal the rest offset.
+* Translations are local too, ``(T, J, 3)`` as :attr:`Motion.translations` shows them: for a joint with
+  position channels they are the channel values (they *replace* the rest offset, as BVH exporters write
+  them); for every other joint they equal the rest offset.  A motion stores them as one ``(J, 3)`` row of
+  constant translations and a ``(T, 3)`` *track* per joint whose translation changes (usually the root
+  alone): a long take costs its rotations, not three more floats per joint and frame.
   ``root_positions`` is ``translations[:, 0]``.
 * Lengths are in the file's units; angles inside mocycle are radians.
 * Objects are immutable in practice: every operation returns a new object.
@@ -223,13 +225,14 @@ def chain_forward_kinematics(motion: Motion, chain: list[int], rows: slice, Rw: 
     for i, j in enumerate(chain):
         p = int(parents[j])
         local = Rotation.from_quat(motion.rotations[rows, j]).as_matrix()
+        t = motion.joint_translations(j)[rows]
         if p < 0:
             Rw[:, i] = local
-            W[:, i] = motion.translations[rows, j]
+            W[:, i] = t
         else:
             Rp = Rw[:, column[p]]
             np.matmul(Rp, local, out=Rw[:, i])
-            W[:, i] = W[:, column[p]] + (Rp @ motion.translations[rows, j, :, None])[..., 0]
+            W[:, i] = W[:, column[p]] + (Rp @ np.ascontiguousarray(t)[..., None])[..., 0]
 
 
 def chain_kinematics_blocks(motion: Motion, chain: list[int], block: int):
@@ -258,6 +261,55 @@ def _check_translations(trans: np.ndarray) -> None:
         raise MocycleError(f"translations reach {reach:.3g}, beyond ±{MAX_MAGNITUDE:g}")
 
 
+def _float_array(values, copy: bool) -> np.ndarray:
+    """``values`` as float64: a copy, or (``copy=False``) the caller's array itself when it is one already."""
+    return np.array(values, dtype=np.float64, copy=True) if copy else np.asarray(values, dtype=np.float64)
+
+
+def split_translations(trans: np.ndarray) -> tuple[np.ndarray, dict[int, np.ndarray]]:
+    """A ``(T, J, 3)`` array of local translations as a motion stores them: the first frame's ``(J, 3)`` and
+    a ``(T, 3)`` track (a copy) for each joint whose translation changes at all (compared exactly)."""
+    static = np.array(trans[0], dtype=np.float64)
+    tracks = {}
+    for j in range(trans.shape[1]):
+        column = trans[:, j]
+        if not np.array_equal(column, np.broadcast_to(column[0], column.shape)):
+            tracks[j] = np.array(column, dtype=np.float64)
+    return static, tracks
+
+
+def _translation_parts(T: int, J: int, static, translations, root_positions, tracks, copy: bool):
+    """The checked ``(J, 3)`` constant translations and ``{joint: (T, 3)}`` tracks of a new motion: from
+    ``translations`` (``(T, J, 3)``, or ``(J, 3)`` for every frame, or ``None`` for ``static``), then
+    ``root_positions`` (the root's track) and ``tracks`` on top."""
+    track_of: dict[int, np.ndarray] = {}
+    if translations is not None:
+        trans = _float_array(translations, copy)
+        if trans.shape == (T, J, 3):
+            static, track_of = split_translations(trans)
+        elif trans.shape == (J, 3):
+            static = trans
+        else:
+            raise MocycleError(f"translations must have shape ({T}, {J}, 3) or ({J}, 3); got {trans.shape}")
+    if root_positions is not None:
+        tracks = {**(tracks or {}), 0: root_positions}
+    for j, track in (tracks or {}).items():
+        if not 0 <= int(j) < J:
+            raise MocycleError(f"a translation track for joint {j}, but the skeleton has {J} joints")
+        track = _float_array(track, copy)
+        if track.shape != (T, 3):
+            name = "root_positions" if root_positions is not None and int(j) == 0 else f"the track of joint {j}"
+            raise MocycleError(f"{name} must have shape ({T}, 3); got {track.shape}")
+        track_of[int(j)] = track
+    _check_translations(static)
+    for track in track_of.values():
+        _check_translations(track)
+        track.setflags(write=False)
+    static = np.array(static, dtype=np.float64)  # small: never a caller's array, frozen
+    static.setflags(write=False)
+    return static, dict(sorted(track_of.items()))
+
+
 class Motion:
     """A take: skeleton, local rotations, local translations and the exact frame time.
 
@@ -266,15 +318,16 @@ class Motion:
     skeleton : :class:`Skeleton` with ``J`` joints.
     rotations : ``(T, J, 4)`` unit quaternions ``(x, y, z, w)`` (normalised and
         made sign-continuous here), or a ``(T, J, 3, 3)`` array of matrices.
-    translations : ``(T, J, 3)`` local translations, or ``None`` for the rest
-        offsets at every frame.
+    translations : ``(T, J, 3)`` local translations, ``(J, 3)`` the same at every frame, or ``None`` for the
+        rest offsets at every frame.  Stored as constant translations and a track per joint that moves.
     frame_time : seconds per frame (> 0).
     root_positions : ``(T, 3)``; a shortcut that sets ``translations[:, 0]``.
-    copy : ``False`` hands the float64 ``rotations`` and ``translations`` arrays over to the motion, which then
+    tracks : ``{joint: (T, 3)}`` translations of the joints that move (over ``translations``).
+    copy : ``False`` hands the float64 ``rotations`` and track arrays over to the motion, which then
         normalises and freezes them in place instead of copying them (what the readers do: half the memory).
     """
 
-    __slots__ = ("skeleton", "rotations", "translations", "frame_time", "_travel", "_up", "_heading")
+    __slots__ = ("skeleton", "rotations", "_static", "_tracks", "frame_time", "_travel", "_up", "_heading")
 
     def __init__(
         self,
@@ -284,6 +337,7 @@ class Motion:
         frame_time: float = 1 / 30,
         root_positions: np.ndarray | None = None,
         *,
+        tracks: dict[int, np.ndarray] | None = None,
         copy: bool = True,
     ):
         J = skeleton.n_joints
@@ -305,48 +359,40 @@ class Motion:
                 raise MocycleError("rotations contain NaN, infinite or zero quaternions")
             np.divide(rot[f0:f0 + 4096], norms, out=out[f0:f0 + 4096])
         rot = continuous_quats(out, inplace=True)
-        if translations is None:
-            trans = np.broadcast_to(skeleton.offsets, (T, J, 3)).copy()
-        else:
-            trans = np.array(translations, dtype=np.float64, copy=True) if copy \
-                else np.asarray(translations, dtype=np.float64)
-            if trans.shape != (T, J, 3):
-                raise MocycleError(f"translations must have shape ({T}, {J}, 3); got {trans.shape}")
-        if root_positions is not None:
-            rp = np.asarray(root_positions, dtype=np.float64)
-            if rp.shape != (T, 3):
-                raise MocycleError(f"root_positions must have shape ({T}, 3); got {rp.shape}")
-            trans[:, 0] = rp
-        _check_translations(trans)
+        static, track_of = _translation_parts(T, J, skeleton.offsets, translations, root_positions, tracks, copy)
         frame_time = _validate.positive("frame_time", frame_time)
         if frame_time_problem(frame_time):
             raise MocycleError(frame_time_problem(frame_time))
         rot.setflags(write=False)
-        trans.setflags(write=False)
         self.skeleton = skeleton
         self.rotations = rot
-        self.translations = trans
+        self._static = static
+        self._tracks = track_of
         self.frame_time = frame_time
 
     @classmethod
-    def _adopt(cls, skeleton: Skeleton, rotations: np.ndarray, translations: np.ndarray,
+    def _adopt(cls, skeleton: Skeleton, rotations: np.ndarray, static: np.ndarray, tracks: dict[int, np.ndarray],
                frame_time: float) -> Motion:
         """A motion that takes the arrays as they are: for readers that made them and checked them as
-        ``__init__`` does (float64 unit, sign-continuous quaternions ``(T, J, 4)``, finite translations
-        ``(T, J, 3)`` within ±MAX_MAGNITUDE, a checked frame time).  Only the shapes are checked again; the
-        arrays are frozen, not copied."""
+        ``__init__`` does (float64 unit, sign-continuous quaternions ``(T, J, 4)``, finite ``(J, 3)`` constant
+        translations and ``{joint: (T, 3)}`` tracks, sorted by joint, within ±MAX_MAGNITUDE, a checked frame
+        time).  Only the shapes are checked again; the arrays are frozen, not copied."""
         J = skeleton.n_joints
         T = rotations.shape[0]
-        if T < 1 or rotations.shape != (T, J, 4) or translations.shape != (T, J, 3) \
-                or rotations.dtype != np.float64 or translations.dtype != np.float64:
-            raise MocycleError(f"rotations (T, {J}, 4) and translations (T, {J}, 3) of T >= 1 frames expected; "
-                               f"got {rotations.shape} and {translations.shape}")
+        if T < 1 or rotations.shape != (T, J, 4) or rotations.dtype != np.float64 or static.shape != (J, 3) \
+                or any(not 0 <= j < J or t.shape != (T, 3) or t.dtype != np.float64 for j, t in tracks.items()):
+            raise MocycleError(f"rotations (T, {J}, 4), translations ({J}, 3) and (T, 3) tracks of T >= 1 frames "
+                               f"expected; got {rotations.shape}, {static.shape} and "
+                               f"{[t.shape for t in tracks.values()]}")
         self = object.__new__(cls)
         rotations.setflags(write=False)
-        translations.setflags(write=False)
+        static.setflags(write=False)
+        for t in tracks.values():
+            t.setflags(write=False)
         self.skeleton = skeleton
         self.rotations = rotations
-        self.translations = translations
+        self._static = static
+        self._tracks = tracks
         self.frame_time = float(frame_time)
         return self
 
@@ -373,8 +419,44 @@ class Motion:
 
     @property
     def root_positions(self) -> np.ndarray:
-        """``(T, 3)`` root translation per frame."""
-        return self.translations[:, 0]
+        """``(T, 3)`` root translation per frame (read-only)."""
+        return self.joint_translations(0)
+
+    # -- translations ----------------------------------------------------
+    @property
+    def translations(self) -> np.ndarray:
+        """``(T, J, 3)`` local translations (read-only).  Made on each use from the constant translations and the
+        tracks (a view, if no joint moves): a long take's code asks :meth:`joint_translations` or
+        :meth:`translations_at` for what it needs instead."""
+        if not self._tracks:
+            return np.broadcast_to(self._static, (self.n_frames,) + self._static.shape)
+        out = self.translations_at(slice(None))
+        out.setflags(write=False)
+        return out
+
+    @property
+    def tracked_joints(self) -> tuple[int, ...]:
+        """The joints whose translations are stored per frame (in order): every joint whose translation changes
+        is one of them (a slice of a take may hold some that stand still in it)."""
+        return tuple(self._tracks)
+
+    def joint_translations(self, joint: int) -> np.ndarray:
+        """``(T, 3)`` local translations of one joint (read-only; a view, not a copy)."""
+        track = self._tracks.get(joint)
+        if track is not None:
+            return track
+        return np.broadcast_to(self._static[joint], (self.n_frames, 3))
+
+    def translations_at(self, index) -> np.ndarray:
+        """The local translations of the frames ``index`` (a new array): ``(J, 3)`` for a frame number,
+        ``(n, J, 3)`` for a slice or an array of frame numbers."""
+        rows = np.broadcast_to(np.int8(0), (self.n_frames,))[index]  # the selection's shape, nothing allocated
+        out = np.empty(np.shape(rows) + self._static.shape)
+        out[...] = self._static
+        for j, track in self._tracks.items():
+            out[..., j, :] = track[index]
+        return out
+
 
     @property
     def travel_joint(self) -> int:
@@ -386,8 +468,8 @@ class Motion:
         """
         known = getattr(self, "_travel", None)  # the arrays are read-only: found once per motion
         if known is None:
-            moving = np.ptp(self.translations, axis=0).max(axis=1) > 1e-9  # (J,)
-            known = self._travel = int(np.argmax(moving)) if moving.any() else 0
+            moving = [j for j, track in self._tracks.items() if np.ptp(track, axis=0).max() > 1e-9]
+            known = self._travel = moving[0] if moving else 0
         return known
 
     def __repr__(self) -> str:
@@ -437,7 +519,7 @@ class Motion:
         out = np.empty((T, J + len(ends), 3))
         for f0 in range(0, T, _FK_BLOCK):
             block = slice(f0, f0 + _FK_BLOCK)
-            world_r, world_p = _forward_kinematics(self.rotations[block], self.translations[block],
+            world_r, world_p = _forward_kinematics(self.rotations[block], self.translations_at(block),
                                                    self.skeleton.parents)
             out[block, :J] = world_p
             for k, s in enumerate(ends):
@@ -454,49 +536,56 @@ class Motion:
 
     # -- new motions -----------------------------------------------------
     def replace(self, *, copy: bool = True, **changes) -> Motion:
-        """A copy with some of ``skeleton``, ``rotations``, ``translations``, ``frame_time`` changed.
+        """A copy with some of ``skeleton``, ``rotations``, ``translations``, ``tracks``, ``frame_time`` changed.
 
-        Arrays not changed are shared (they are read-only), not copied.  ``copy=False``: the caller hands
-        the new arrays over (they are normalised in place and frozen, as ``Motion(..., copy=False)`` does)."""
+        ``translations`` (``(T, J, 3)`` or ``(J, 3)``) replaces every joint's; ``tracks`` (``{joint: (T, 3)}``)
+        replaces some joints' over the others.  Arrays not changed are shared (they are read-only), not copied.
+        ``copy=False``: the caller hands the new arrays over (they are normalised in place and frozen, as
+        ``Motion(..., copy=False)`` does)."""
+        unknown = set(changes) - {"skeleton", "rotations", "translations", "tracks", "frame_time"}
+        if unknown:
+            raise TypeError(f"replace() got unexpected changes: {', '.join(sorted(unknown))}")
+        kept = {} if "translations" in changes else dict(self._tracks)  # checked already: shared, not copied
+        given = changes.get("tracks") or {}
         if "skeleton" not in changes and "rotations" not in changes:  # the checked rotations are kept as they are
             frame_time = _validate.positive("frame_time", changes.get("frame_time", self.frame_time))
             if frame_time_problem(frame_time):
                 raise MocycleError(frame_time_problem(frame_time))
-            trans = changes.get("translations", self.translations)
-            if trans is not self.translations:
-                trans = np.array(trans, dtype=np.float64, copy=True) if copy else np.asarray(trans, dtype=np.float64)
-                if trans.shape != self.translations.shape:
-                    raise MocycleError(f"translations must have shape {self.translations.shape}; got {trans.shape}")
-                _check_translations(trans)
-            return Motion._adopt(self.skeleton, self.rotations, trans, frame_time)
-        args = dict(
-            skeleton=self.skeleton,
-            rotations=self.rotations,
-            translations=self.translations,
-            frame_time=self.frame_time,
-        )
-        args.update(changes)
-        return Motion(**args, copy=copy)
+            static = self._static
+            if "translations" in changes or given:
+                static, new = _translation_parts(self.n_frames, self.n_joints, static, changes.get("translations"),
+                                                 None, given, copy)
+                kept = dict(sorted({**kept, **new}.items()))
+            return Motion._adopt(self.skeleton, self.rotations, static, kept, frame_time)
+        return Motion(changes.get("skeleton", self.skeleton), changes.get("rotations", self.rotations),
+                      changes.get("translations", self._static), changes.get("frame_time", self.frame_time),
+                      tracks={**kept, **given}, copy=copy)
 
-    def _hand_over(self) -> tuple[np.ndarray, np.ndarray]:
-        """The motion's ``rotations`` and ``translations``, writable, for a caller that makes the next motion
-        from them and holds the last reference to this one (a long take's edit without a copy of it).
+    def _hand_over(self) -> tuple[np.ndarray, np.ndarray, dict[int, np.ndarray]]:
+        """The motion's ``rotations``, constant translations ``(J, 3)`` and tracks, writable, for a caller that
+        makes the next motion from them and holds the last reference to this one (a long take's edit without a
+        copy of it).
 
         The motion is emptied: any later use of it raises AttributeError.  An array that another object may
         see (a view, a view's base or an array another motion shares, as :meth:`replace` and slices share
         them) is copied instead, so handing over never changes what anyone else holds."""
-        out = []
         probe = np.empty(0)  # an array only a local name holds: the count of a sole reference, measured alike
-        for name in ("rotations", "translations"):
-            array = getattr(self, name)
-            delattr(self, name)
+        static, tracks = self._static.copy(), self._tracks  # each motion has its own dict of tracks
+        arrays = [self.rotations]
+        del self.rotations, self._static, self._tracks
+        joints = list(tracks)
+        arrays += [tracks.pop(j) for j in joints]
+        out = []
+        for _ in range(len(arrays)):
+            array = arrays.pop(0)
             # any other holder (a view holds its base) counts one more than the probe
             if array.base is None and sys.getrefcount(array) <= sys.getrefcount(probe):
                 array.setflags(write=True)
             else:
                 array = array.copy()
             out.append(array)
-        return out[0], out[1]
+            del array
+        return out[0], static, dict(zip(joints, out[1:]))
 
     def __getitem__(self, index) -> Motion:
         """Frames by slice (``motion[10:200]``, ``motion[::2]``) or index array.
@@ -508,9 +597,10 @@ class Motion:
         rot = self.rotations[index]
         if rot.shape[0] == 0:
             raise MocycleError(f"frame selection {index!r} is empty (motion has {self.n_frames} frames)")
+        tracks = {j: track[index] for j, track in self._tracks.items()}
         if isinstance(index, slice) and step == 1:  # unit, continuous and checked already
-            return Motion._adopt(self.skeleton, rot, self.translations[index], self.frame_time)
-        return Motion(self.skeleton, rot, self.translations[index], self.frame_time * step)
+            return Motion._adopt(self.skeleton, rot, self._static, tracks, self.frame_time)
+        return Motion(self.skeleton, rot, self._static, self.frame_time * step, tracks=tracks, copy=False)
 
     def slice(self, start: int = 0, stop: int | None = None) -> Motion:
         """Frames ``start`` (inclusive) to ``stop`` (exclusive); negative indices count from the end."""
@@ -538,9 +628,9 @@ class Motion:
         rot = np.empty((n_new, self.n_joints, 4))
         for j in range(self.n_joints):
             rot[:, j] = Slerp(old_t, Rotation.from_quat(self.rotations[:, j]))(new_t).as_quat()
-        flat = self.translations.reshape(self.n_frames, -1)
-        trans = np.stack([np.interp(new_t, old_t, col) for col in flat.T], axis=1)
-        return Motion(self.skeleton, rot, trans.reshape(n_new, self.n_joints, 3), new_dt, copy=False)
+        tracks = {j: np.stack([np.interp(new_t, old_t, col) for col in track.T], axis=1)
+                  for j, track in self._tracks.items()}
+        return Motion(self.skeleton, rot, self._static, new_dt, tracks=tracks, copy=False)
 
     @classmethod
     def rest(cls, skeleton: Skeleton, n_frames: int = 1, frame_time: float = 1 / 30) -> Motion:
@@ -558,9 +648,14 @@ def concatenate(motions: Sequence[Motion]) -> Motion:
             raise MocycleError("cannot concatenate motions with different skeletons")
         if not np.isclose(m.frame_time, first.frame_time):
             raise MocycleError("cannot concatenate motions with different frame times")
+    static = first.translations_at(0)
+    moving = {j for m in motions for j in m.tracked_joints}
+    moving |= {j for m in motions for j in np.flatnonzero((m.translations_at(0) != static).any(axis=1)).tolist()}
     return Motion(
         first.skeleton,
         np.concatenate([m.rotations for m in motions]),
-        np.concatenate([m.translations for m in motions]),
+        static,
         first.frame_time,
+        tracks={j: np.concatenate([m.joint_translations(j) for m in motions]) for j in sorted(moving)},
+        copy=False,
     )

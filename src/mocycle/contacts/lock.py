@@ -689,18 +689,25 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     new_quats, local_moves = _solve_legs(motion, contacts.feet, W, blocks(), column, solved, goals, toe_goals, axes,
                                          moves)
     del W  # the chain's world positions and rotations: not needed for the quaternions (memory)
+    T, frame_time = motion.n_frames, motion.frame_time
     if hand_over:
-        rotations, trans = motion._hand_over()
-    else:
-        rotations, trans = motion.rotations.copy(), motion.translations.copy()
-    for local in local_moves:
-        trans[:, travel] += local
+        rotations, static, tracks = motion._hand_over()
+    else:  # the input's tracks are shared (read-only), the travel joint's copied when it moves
+        rotations, static = motion.rotations.copy(), motion.translations_at(0)
+        tracks = {j: motion.joint_translations(j) for j in motion.tracked_joints}
+    if local_moves:
+        path = tracks.get(travel, np.broadcast_to(static[travel], (T, 3)))
+        path = path if path.flags.writeable else path.copy()
+        for local in local_moves:
+            path += local
+        tracks[travel] = path
     row = np.arange(len(window))  # a frame's row in the output
     if frames is not None:
         row = np.full(len(window), -1)
         row[frames] = np.arange(window.sum())
-        trans, rotations = trans[frames].copy(), rotations[frames].copy()
+        rotations = rotations[frames].copy()
+        tracks = {j: track[frames].copy() for j, track in tracks.items()}
     for t, j, quats in new_quats:  # frames and joints not touched keep their exact quaternions
         rotations[row[t], j] = quats
     del new_quats
-    return Motion(skel, rotations, trans, motion.frame_time, copy=False)
+    return Motion(skel, rotations, static, frame_time, tracks=tracks, copy=False)

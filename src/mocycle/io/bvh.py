@@ -54,9 +54,9 @@ def read_bvh(path: str | os.PathLike) -> Motion:
     except OSError as exc:
         raise MotionFileError(f"cannot read file ({exc.strerror or exc})", p) from None
     skel, frames, frame_time, values = fast
-    quats, trans = _arrays_from_channels(skel, values)
+    quats, static, tracks = _arrays_from_channels(skel, values)
     del values, fast  # the channel array goes before the motion is made: lower peak memory
-    return _motion(skel, quats, trans, frame_time, p)
+    return _motion(skel, quats, static, tracks, frame_time, p)
 
 
 def _read_plain(p: Path):
@@ -402,13 +402,13 @@ def _parse_header(lines: list[str], path) -> tuple[Skeleton, int | None, float, 
 
 
 def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float, path=None) -> Motion:
-    quats, trans = _arrays_from_channels(skel, values)
-    return _motion(skel, quats, trans, frame_time, path)
+    return _motion(skel, *_arrays_from_channels(skel, values), frame_time, path)
 
 
-def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Local unit, sign-continuous quaternions ``(T, J, 4)`` and translations ``(T, J, 3)`` from the checked
-    channel values ``(T, C)`` (finite, within ``MAX_MAGNITUDE``).
+def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
+    """Local unit, sign-continuous quaternions ``(T, J, 4)``, constant translations ``(J, 3)`` and the
+    ``{joint: (T, 3)}`` tracks of the joints whose position channels change, from the checked channel values
+    ``(T, C)`` (finite, within ``MAX_MAGNITUDE``).
 
     One pass over the frames, :data:`BLOCK_FRAMES` at a time, so every temporary is a block (and stays in
     cache): Euler angles to quaternion components (:func:`~mocycle.rotations.euler_quat_components`),
@@ -418,20 +418,21 @@ def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarra
     """
     T, J = values.shape[0], skel.n_joints
     quats = np.empty((T, J, 4))
-    trans = np.empty((T, J, 3))
-    trans[...] = skel.offsets
+    static = np.array(skel.offsets, dtype=np.float64)
+    tracks = {}
     by_order: dict[str, list[tuple[int, list[int]]]] = {}
     still = []
-    columns, targets = [], []  # position channels and their places in trans.reshape(T, 3 * J)
     for j, (rot_cols, order, pos_cols, pos_axes) in enumerate(_channel_layout(skel)):
         if rot_cols:
             by_order.setdefault(order, []).append((j, rot_cols))
         else:
             still.append(j)
-        columns += pos_cols
-        targets += [3 * j + a for a in pos_axes]
-    if columns:
-        trans.reshape(T, 3 * J)[:, targets] = values[:, columns]
+        if pos_cols:  # the channel values replace the offset; a joint whose values never change is not tracked
+            static[j, pos_axes] = values[0, pos_cols]
+            if any(not np.array_equal(values[:, c], np.broadcast_to(values[0, c], (T,))) for c in pos_cols):
+                tracks[j] = np.empty((T, 3))
+                tracks[j][...] = static[j]
+                tracks[j][:, pos_axes] = values[:, pos_cols]
     quats[:, still] = (0.0, 0.0, 0.0, 1.0)
     groups = []
     for order, items in by_order.items():
@@ -459,7 +460,7 @@ def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarra
                 np.divide(comp[m], norm, out=out[..., m])
             if not isinstance(joints, slice):  # joints of this order interleaved with others'
                 quats[f0:f1, joints] = out
-    return quats, trans
+    return quats, static, tracks
 
 
 def _norms(comp: list[np.ndarray]) -> np.ndarray:
@@ -501,11 +502,11 @@ def _flip_signs(comp: list[np.ndarray], carry):
     return 1.0 - 2.0 * flips, carry
 
 
-def _motion(skel: Skeleton, quats: np.ndarray, trans: np.ndarray, frame_time: float, path) -> Motion:
-    """The motion, owning ``quats`` and ``trans`` as :func:`_arrays_from_channels` made them (frozen, not
-    copied or checked again: the values were checked when read)."""
+def _motion(skel: Skeleton, quats: np.ndarray, static: np.ndarray, tracks: dict, frame_time: float, path) -> Motion:
+    """The motion, owning the arrays :func:`_arrays_from_channels` made (frozen, not copied or checked again:
+    the values were checked when read)."""
     try:
-        return Motion._adopt(skel, quats, trans, frame_time)
+        return Motion._adopt(skel, quats, static, tracks, frame_time)
     except MocycleError as exc:
         raise MotionFileError(f"cannot build a motion from this file: {exc}", path) from None
 
@@ -529,7 +530,7 @@ def channel_blocks(motion: Motion, block: int = 8192) -> Iterator[tuple[slice, n
         rows = slice(f0, min(motion.n_frames, f0 + block))
         out = np.empty((rows.stop - f0, skel.n_channels))
         for cols, j, axes in positions:
-            out[:, cols] = motion.translations[rows, j][:, axes]
+            out[:, cols] = motion.joint_translations(j)[rows][:, axes]
         for cols, blocks in angles:
             _, a = next(blocks)
             out[:, cols] = np.degrees(a, out=a).reshape(len(out), -1)
