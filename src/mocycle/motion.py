@@ -585,7 +585,7 @@ class Motion:
                 array = array.copy()
             out.append(array)
             del array
-        return out[0], static, dict(zip(joints, out[1:]))
+        return out[0], static, dict(zip(joints, out[1:], strict=True))
 
     def __getitem__(self, index) -> Motion:
         """Frames by slice (``motion[10:200]``, ``motion[::2]``) or index array.
