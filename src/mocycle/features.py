@@ -109,14 +109,15 @@ class PoseDecoder:
         Non-feature parts come from the template frame by frame when T matches,
         otherwise from its mean pose (rotations) and first frame (root).
         """
-        quats, trans = self.decode_arrays(X)
+        quats, (static, tracks) = self.decode_arrays(X)
         tpl = self.template
-        return Motion(tpl.skeleton, quats, trans, tpl.frame_time if frame_time is None else frame_time,
-                      copy=False)  # decode_arrays made them: handed over, not copied
+        return Motion(tpl.skeleton, quats, static, tpl.frame_time if frame_time is None else frame_time,
+                      tracks=tracks, copy=False)  # decode_arrays made them: handed over, not copied
 
-    def decode_arrays(self, X: np.ndarray, translations: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """What :meth:`decode` makes a motion of: quaternions ``(T, J, 4)`` (not yet normalised) and
-        translations ``(T, J, 3)`` (``None`` with ``translations=False``, for a caller that has its own)."""
+    def decode_arrays(self, X: np.ndarray, translations: bool = True) -> tuple[np.ndarray, tuple | None]:
+        """What :meth:`decode` makes a motion of: quaternions ``(T, J, 4)`` (not yet normalised) and the
+        translations as a motion stores them, constant ``(J, 3)`` and ``{joint: (T, 3)}`` tracks (``None`` with
+        ``translations=False``, for a caller that has its own)."""
         X = np.asarray(X, dtype=np.float64)
         if X.ndim != 2 or X.shape[1] != self.n_features:
             raise MocycleError(f"X must have shape (T, {self.n_features}); got {X.shape}")
@@ -133,16 +134,14 @@ class PoseDecoder:
         kept = np.setdiff1d(np.arange(J), self.joints)  # joints whose rotations are not columns
         if same_length:
             quats = tpl.rotations.copy()
-            trans = tpl.translations.copy() if translations else None
+            static, tracks = tpl.translations_at(0), {j: tpl.joint_translations(j) for j in tpl.tracked_joints}
         else:
             quats = np.empty((T, J, 4))
             if kept.size:
                 quats[:, kept] = mean_rotations(tpl.rotations[:, kept])
-            if translations:
-                trans = np.broadcast_to(tpl.translations.mean(axis=0), (T, J, 3)).copy()
-                trans[:, self.travel] = tpl.translations[0, self.travel]
-            else:
-                trans = None
+            static = np.stack([tpl.joint_translations(j).mean(axis=0) for j in range(J)])  # the mean pose
+            static[self.travel] = tpl.joint_translations(self.travel)[0]
+            tracks = {}
         col = 0
         skel = tpl.skeleton
         if self.root == "heading":  # the travel joint's columns hold its tilt: start from the template's
@@ -169,21 +168,20 @@ class PoseDecoder:
                 else:
                     quats[rows, js] = matrix_quats(nearest_rotations(block.reshape(-1, n, 3, 3)))
             col += width * n
-        if self.root == "keep" and trans is not None:
-            trans[:, self.travel] = raw(col, col + 3)
-        elif self.root == "velocity" and trans is not None:
+        start = tpl.joint_translations(self.travel)[0]
+        if self.root == "keep" and translations:
+            tracks[self.travel] = raw(col, col + 3)
+        elif self.root == "velocity" and translations:
             v = raw(col, col + 3)
-            start = tpl.translations[0, self.travel]
-            trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
+            tracks[self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
         elif self.root == "heading":
             _, psi = self.frame.tilt(tpl[:1])
             psi = psi[0] + np.concatenate([[0.0], np.cumsum(raw(col + 3, col + 4, slice(1, None))[:, 0])])
             quats[:, self.travel] = self.frame.turn(quats[:, self.travel], psi)
-            if trans is not None:
+            if translations:
                 v = self.frame.to_world(raw(col, col + 3, slice(1, None)), 0.5 * (psi[1:] + psi[:-1]))
-                start = tpl.translations[0, self.travel]
-                trans[:, self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v, axis=0)])
-        return quats, trans
+                tracks[self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v, axis=0)])
+        return quats, (static, tracks) if translations else None
 
 
 @dataclass(frozen=True, eq=False)
@@ -329,15 +327,15 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
     else:
         parts.append(Rotation.from_quat(rotations(js).reshape(-1, 4)).as_matrix().reshape(T, -1))
     if root == "keep":
-        parts.append(motion.translations[:, travel])
+        parts.append(motion.joint_translations(travel))
     elif root == "velocity":
-        p = motion.translations[:, travel]
+        p = motion.joint_translations(travel)
         v = np.diff(p, axis=0) if T > 1 else np.zeros((1, 3))
         parts.append(np.concatenate([v[:1], v]) if T > 1 else v)
     elif root == "heading":
         if T > 1:
             mid = 0.5 * (psi[1:] + psi[:-1])
-            v = np.c_[frame.to_local(np.diff(motion.translations[:, travel], axis=0), mid), np.diff(psi)]
+            v = np.c_[frame.to_local(np.diff(motion.joint_translations(travel), axis=0), mid), np.diff(psi)]
             v = np.concatenate([v[:1], v])
         else:
             v = np.zeros((1, 4))

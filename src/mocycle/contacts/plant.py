@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import MocycleError
-from ..motion import Motion
+from ..motion import Motion, chain_kinematics_blocks
 from .feet import find_feet, up_axis
 
 
@@ -72,10 +72,7 @@ def plant_lowest_foot(motion: Motion, floor: float | None = None, foot_joints: s
     shift += np.outer(floor - heights[rows, low], up)  # vertical: it touches the floor
     travel = motion.travel_joint
     parent = int(motion.skeleton.parents[travel])
-    trans = motion.translations.copy()
-    if parent < 0:
-        trans[:, travel] += shift
-    else:
-        Rw, _ = motion.world_transforms()
-        trans[:, travel] += np.einsum("tba,tb->ta", Rw[:, parent], shift)  # world shift in the parent's frame
-    return motion.replace(translations=trans)
+    if parent >= 0:  # the world shift in the parent's frame
+        for rows, Rw, _ in chain_kinematics_blocks(motion, motion.skeleton.chain_to(parent), 4096):
+            shift[rows] = np.einsum("tba,tb->ta", Rw[:, -1], shift[rows])
+    return motion.replace(tracks={travel: motion.joint_translations(travel) + shift}, copy=False)

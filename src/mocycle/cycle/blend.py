@@ -191,7 +191,7 @@ def _circular_sample(motion: Motion, positions: np.ndarray) -> tuple[np.ndarray,
     q1 = Rotation.from_quat(motion.rotations[i1].reshape(-1, 4))
     step = (q0.inv() * q1).as_rotvec() * np.repeat(f, J)[:, None]   # slerp: the shortest arc, a fraction f
     quats = (q0 * Rotation.from_rotvec(step)).as_quat().reshape(pos.size, J, 4)
-    trans = (1 - f)[:, None, None] * motion.translations[i0] + f[:, None, None] * motion.translations[i1]
+    trans = (1 - f)[:, None, None] * motion.translations_at(i0) + f[:, None, None] * motion.translations_at(i1)
     return quats, trans
 
 
@@ -228,7 +228,8 @@ class _Loop:
 
 
 def _on(skeleton: Skeleton, motion: Motion) -> Motion:
-    return Motion(skeleton, motion.rotations, motion.translations, motion.frame_time)
+    return Motion(skeleton, motion.rotations, motion.translations_at(0), motion.frame_time,
+                  tracks={j: motion.joint_translations(j) for j in motion.tracked_joints})
 
 
 def _prepare(cycle: Cycle, space: CycleSpace, reference: _Loop | None) -> _Loop:

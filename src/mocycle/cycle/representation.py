@@ -77,10 +77,10 @@ class CycleSpace:
         e1, e2 = horizontal_basis(up)
         mean_rot = motion.rotation(travel).mean().as_matrix()
         forward = mean_rot.T @ e1
-        moved = np.ptp(motion.translations, axis=0).max(axis=1) > 1e-9
-        moving = tuple(int(j) for j in np.flatnonzero(moved) if j != travel)
+        moving = tuple(j for j in motion.tracked_joints
+                       if j != travel and np.ptp(motion.joint_translations(j), axis=0).max() > 1e-9)
         return cls(skeleton=motion.skeleton, frame_time=motion.frame_time,
-                   static_translations=motion.translations[0].copy(), travel=travel, world_up=up_world, up=up,
+                   static_translations=motion.translations_at(0), travel=travel, world_up=up_world, up=up,
                    e1=e1, e2=e2, forward=forward, moving=moving)
 
     # -- sizes ----------------------------------------------------------
@@ -117,7 +117,7 @@ class CycleSpace:
         if not motion.skeleton.same_as(self.skeleton):
             raise MocycleError("this motion's skeleton differs from the one the cycle space was made for")
         psi = self.heading(Rotation.from_quat(motion.rotations[:, self.travel]).as_matrix())
-        L = np.concatenate([motion.translations[:, self.travel], psi[:, None]], axis=1)
+        L = np.concatenate([motion.joint_translations(self.travel), psi[:, None]], axis=1)
         return EncodedRows(self, motion, psi), L
 
     def path(self, motion: Motion) -> np.ndarray:
@@ -125,7 +125,7 @@ class CycleSpace:
         if not motion.skeleton.same_as(self.skeleton):
             raise MocycleError("this motion's skeleton differs from the one the cycle space was made for")
         psi = self.heading(Rotation.from_quat(motion.rotations[:, self.travel]).as_matrix())
-        return np.concatenate([motion.translations[:, self.travel], psi[:, None]], axis=1)
+        return np.concatenate([motion.joint_translations(self.travel), psi[:, None]], axis=1)
 
     # -- straight and curved paths ---------------------------------------
     def _turned(self, V: np.ndarray, angles: np.ndarray) -> np.ndarray:
@@ -292,4 +292,5 @@ class EncodedRows:
         turn = np.swapaxes(axis_rotations(space.up, self.psi[f0:f1]), 1, 2)  # the heading taken out
         rot[:, travel] = turn @ rot[:, travel]
         if space.moving:
-            out[:, 9 * J:] = motion.translations[f0:f1, list(space.moving)].reshape(n, -1)
+            for k, j in enumerate(space.moving):
+                out[:, 9 * J + 3 * k:9 * J + 3 * k + 3] = motion.joint_translations(j)[f0:f1]

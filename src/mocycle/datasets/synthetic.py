@@ -682,9 +682,7 @@ def to_z_up(motion: Motion) -> Motion:
     W = Rotation.from_euler("x", 90.0, degrees=True)
     q = motion.rotations.copy()
     q[:, 0] = (W * Rotation.from_quat(q[:, 0])).as_quat()
-    t = motion.translations.copy()
-    t[:, 0] = W.apply(t[:, 0])
-    return Motion(motion.skeleton, q, t, motion.frame_time)
+    return motion.replace(rotations=q, tracks={0: W.apply(np.array(motion.root_positions))})
 
 
 def synthetic_circle_walk(n_frames: int = 600, fps: float = 60.0, period_s: float = 1.0,

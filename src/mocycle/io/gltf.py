@@ -322,7 +322,7 @@ def write_gltf(motion: Motion, path: str | os.PathLike, *, clip: Clip | None = N
     tol = 1e-7 * max(frame.body_size * frame.scale, 1e-9)
     trans32: dict[int, np.ndarray] = {}
     for j in range(J):
-        tj = frame.point(motion.translations[:, j]) if j == 0 else motion.translations[:, j] * frame.scale
+        tj = frame.point(motion.joint_translations(j)) if j == 0 else motion.joint_translations(j) * frame.scale
         if np.abs(tj - rest_t[j]).max() > tol:
             trans32[j] = tj.astype(np.float32)
     moves = list(trans32)

@@ -107,9 +107,9 @@ class Compressed:
         >>> again.n_frames, bool(np.allclose(again.rotations[packed.key_idx], walk.rotations[packed.key_idx]))
         (300, True)
         """
-        trans = np.broadcast_to(self.static, (self.n_frames,) + self.static.shape).copy()
-        trans[:, self.track_joints] = self.track
-        return Motion(self.skeleton, self.rotations(), trans, self.frame_time, copy=False)  # arrays made here
+        tracks = {int(j): self.track[:, k] for k, j in enumerate(self.track_joints)}  # views: held here anyway
+        return Motion(self.skeleton, self.rotations(), self.static, self.frame_time, tracks=tracks,
+                      copy=False)  # the rotations were made here
 
     # ------------------------------------------------------------ bytes
     def to_bytes(self) -> bytes:
@@ -354,12 +354,15 @@ def compress(motion: Motion, ratio: float | str | None = "auto", count: int | No
     else:
         key = select_keyframes(select, space, k, random_state=random_state)
     key = check_keys(key, n)
-    moving = np.flatnonzero(np.ptp(motion.translations, axis=0).max(axis=1) > 0)
-    track = motion.translations[:, moving].astype(np.float32).astype(np.float64)
-    track[key] = motion.translations[key][:, moving]
+    moving = np.array([j for j in motion.tracked_joints if np.ptp(motion.joint_translations(j), axis=0).max() > 0],
+                      dtype=np.int64)
+    track = np.empty((n, len(moving), 3))
+    for k, j in enumerate(moving):
+        track[:, k] = motion.joint_translations(j).astype(np.float32)
+        track[key, k] = motion.joint_translations(j)[key]
     return Compressed(skeleton=motion.skeleton, frame_time=motion.frame_time, n_frames=n, key_idx=key,
                       key_quats=motion.rotations[key].copy(), scheme=scheme, select=select,
                       projection=projection if scheme == "spatial" else None,
                       seed=seed if scheme == "spatial" and projection in ("rbfp", "lamp") else None,
                       optimized=bool(optimize and scheme == "spatial"), points=points, track_joints=moving,
-                      track=track, static=motion.translations[0].copy())
+                      track=track, static=motion.translations_at(0))

@@ -57,8 +57,7 @@ def author_motion(take: Motion, key_idx, markers, trajectory) -> Motion:
         raise MocycleError(f"need one 2-D marker per keyframe ({len(idx)}, 2); got {L.shape}")
     traj = np.asarray(trajectory, dtype=np.float64).reshape(-1, 2)
     q, _ = BackProjection(L, take.rotations[idx])(traj)
-    trans = np.broadcast_to(take.translations[0], (len(traj), take.n_joints, 3))
-    return Motion(take.skeleton, q, trans, take.frame_time)
+    return Motion(take.skeleton, q, take.translations_at(0), take.frame_time)  # no joint moves: (J, 3)
 
 
 def relayout(space: PoseSpace, key_idx, markers, optimize: bool = True,

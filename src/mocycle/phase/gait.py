@@ -102,9 +102,10 @@ def _fixed_offsets(motion: Motion, joints: list[int]) -> dict[int, np.ndarray]:
     """The local translation ``(3, 1)`` of each joint of the chain of ``joints`` that has the same one in every
     frame (a bone offset: turned as one vector, not one per frame)."""
     chain = _chain(motion, joints)
-    t = motion.translations[:, chain]  # one pass over the frames' rows for the whole chain
-    same = (t == t[0]).all(axis=(0, 2))
-    return {j: t[0, k][:, None].copy() for k, j in enumerate(chain) if same[k]}
+    moving = set(motion.tracked_joints)
+    moving = {j for j in moving if not (motion.joint_translations(j) == motion.joint_translations(j)[0]).all()}
+    first = motion.translations_at(0)
+    return {j: first[j][:, None].copy() for j in chain if j not in moving}
 
 
 def _world_chain(motion: Motion, joints: list[int], frames: slice = slice(None),
@@ -121,10 +122,10 @@ def _world_chain(motion: Motion, joints: list[int], frames: slice = slice(None),
         p = int(parents[j])
         q = np.ascontiguousarray(motion.rotations[frames, j].T)  # one gather, then contiguous components
         if p < 0:
-            Q[j], P[j] = q, np.ascontiguousarray(motion.translations[frames, j].T)
+            Q[j], P[j] = q, np.ascontiguousarray(motion.joint_translations(j)[frames].T)
         else:
             Q[j] = _multiply(Q[p], q)
-            offset = fixed[j] if j in fixed else np.ascontiguousarray(motion.translations[frames, j].T)
+            offset = fixed[j] if j in fixed else np.ascontiguousarray(motion.joint_translations(j)[frames].T)
             P[j] = _rotate(Q[p], offset, add=P[p])
     return Q, P
 

@@ -88,5 +88,5 @@ def plane_payload(motion, plane: dict, facts: dict) -> bytes:
     header = {**skeleton_header(motion), "keyframes": key.tolist(), "projection": facts.get("projection"),
               "select": facts.get("select"), "stress": facts.get("stress_optimized", facts.get("stress")),
               "optimized": plane.get("optimized") is not None}
-    return pack(header, {"points": points, "key_rotations": rot, "rest": motion.translations[0],
+    return pack(header, {"points": points, "key_rotations": rot, "rest": motion.translations_at(0),
                          "sites": sites})

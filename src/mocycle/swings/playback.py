@@ -111,16 +111,15 @@ def playback(seg: Segmentation, profile: str = "hermite") -> Motion:
         rows = slice(np.searchsorted(owner, a), np.searchsorted(owner, b))
         quats[:, j] = _play_joint(seg, j, swings[a:b], (owner[rows] - a, frames[rows], q[rows]),
                                   holds[hold_bounds[j]:hold_bounds[j + 1]])
-    trans = np.empty((T, J, 3))
+    static = np.array(seg.skeleton.offsets, dtype=np.float64)
+    tracks = {}
     frames = np.arange(T)
-    for j in range(J):
-        kf, kv = seg.translation_keys.get(j, (np.array([0]), seg.skeleton.offsets[j][None, :]))
+    for j, (kf, kv) in seg.translation_keys.items():
         if len(kf) == 1:
-            trans[:, j] = kv[0]
+            static[j] = kv[0]
         else:
-            for a in range(3):
-                trans[:, j, a] = np.interp(frames, kf, kv[:, a])
-    return Motion(seg.skeleton, quats, trans, seg.frame_time, copy=False)  # arrays made here: handed over
+            tracks[j] = np.stack([np.interp(frames, kf, kv[:, a]) for a in range(3)], axis=1)
+    return Motion(seg.skeleton, quats, static, seg.frame_time, tracks=tracks, copy=False)  # arrays made here
 
 
 def _euler_near(quats: np.ndarray, order: str, ref: np.ndarray) -> np.ndarray:

@@ -568,7 +568,7 @@ def segment(motion: Motion, threshold: float = DEFAULT_THRESHOLD, joints: str | 
     if translation_tol is None:
         height = float(np.ptp(Motion.rest(skel).world_positions(end_sites=True)[0], axis=0).max())
         translation_tol = 1e-3 * max(height, 1e-9)
-    keys = {j: translation_track(motion.translations[:, j], translation_tol) for j in range(skel.n_joints)}
+    keys = {j: translation_track(motion.joint_translations(j), translation_tol) for j in range(skel.n_joints)}
     return Segmentation(skeleton=skel, n_frames=T, frame_time=dt, joints=list(chosen), swings=swings, holds=holds,
                         translation_keys=keys, threshold=threshold, window_s=window_s,
                         params=dict(min_swing_frames=min_len, still_deg_s=float(still_deg_s),

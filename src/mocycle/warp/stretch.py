@@ -369,16 +369,16 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
     del Y
 
     # Translations: the travelling joint as mean velocity + warped residual; other moving joints warped.
-    trans = np.broadcast_to(motion.translations[0], (n_out,) + motion.translations.shape[1:]).copy()
     travel = motion.travel_joint if travel is None else travel
-    P = motion.translations
-    moving = np.ptp(P, axis=0).max(axis=1) > 1e-9 * (1.0 + np.abs(P).max(axis=(0, 2)))  # (J,)
-    for j in sorted(set(np.flatnonzero(moving).tolist()) | {travel}):
+    tracks = {}
+    for j in sorted(set(motion.tracked_joints) | {travel}):
+        P = motion.joint_translations(j)
         if j == travel:
-            trans[:, j] = _warp_detrended(P[:, j], factor, windows[group_of[j]])
-        else:
-            trans[:, j] = warp_curves(P[:, j], factor, windows[group_of[j]])
-    new = Motion(skel, quats, trans, motion.frame_time, copy=False)  # the arrays were made here
+            tracks[j] = _warp_detrended(P, factor, windows[group_of[j]])
+        elif np.ptp(P, axis=0).max() > 1e-9 * (1.0 + np.abs(P).max()):
+            tracks[j] = warp_curves(P, factor, windows[group_of[j]])
+    new = Motion(skel, quats, motion.translations_at(0), motion.frame_time, tracks=tracks,
+                 copy=False)  # the arrays were made here
 
     report = StretchReport(
         factor=factor,
@@ -465,11 +465,10 @@ class _Placer:
     def place(self, m: Motion) -> Motion:
         R = self._R()
         q = m.rotations.copy()
-        t = m.translations.copy()
         j = self.travel
         q[:, j] = quat_multiply(axis_angle_quats(self.space.up, np.array([self.angle]))[0], q[:, j])
-        t[:, j] = (t[:, j] - self.anchor) @ R.T + self.anchor + self.offset
-        return m.replace(rotations=q, translations=t)
+        path = (m.joint_translations(j) - self.anchor) @ R.T + self.anchor + self.offset
+        return m.replace(rotations=q, tracks={j: path}, copy=False)
 
     def heading(self, quat: np.ndarray) -> float:
         return float(self.space.heading(Rotation.from_quat(quat[None]).as_matrix())[0])
@@ -479,8 +478,8 @@ class _Placer:
         j = self.travel
         turn = self.heading(placed_last.rotations[0, j]) - self.heading(captured_last.rotations[0, j])
         self.angle = float(np.angle(np.exp(1j * turn)))
-        self.anchor = captured_last.translations[0, j].copy()
-        self.offset = placed_last.translations[0, j] - self.anchor
+        self.anchor = captured_last.joint_translations(j)[0].copy()
+        self.offset = placed_last.joint_translations(j)[0] - self.anchor
 
 
 def _fade(warped: Motion, target: Motion, at_start: bool, n: int) -> Motion:
@@ -492,14 +491,16 @@ def _fade(warped: Motion, target: Motion, at_start: bool, n: int) -> Motion:
     k = 0 if at_start else warped.n_frames - 1
     d = quat_multiply(target.rotations[0], quat_conj(warped.rotations[k]))
     diff = quat_log(d * np.where(d[:, 3:4] < 0, -1.0, 1.0))  # rotation vectors, angle <= π
-    dt = target.translations[0] - warped.translations[k]
+    dt = target.translations_at(0) - warped.translations_at(k)
     w = _smooth(n) if at_start else _smooth(n)[::-1]
     rows = np.arange(n) if at_start else np.arange(warped.n_frames - n, warped.n_frames)
     q = warped.rotations.copy()
-    t = warped.translations.copy()
     q[rows] = quat_multiply(quat_exp(w[:, None, None] * diff[None]), q[rows])
-    t[rows] += w[:, None, None] * dt[None]
-    return warped.replace(rotations=q, translations=t)
+    tracks = {}
+    for j in np.flatnonzero(dt.any(axis=1)):  # the joints whose translations differ at the join
+        tracks[j] = np.array(warped.joint_translations(j))
+        tracks[j][rows] += w[:, None] * dt[j]
+    return warped.replace(rotations=q, tracks=tracks, copy=False)
 
 
 @limit_threads
