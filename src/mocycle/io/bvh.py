@@ -605,7 +605,9 @@ def bvh_chunks(motion: Motion) -> Iterator[str]:
         block = np.where(np.abs(block) < 1e-9, 0.0, block)
         out = io.StringIO()
         np.savetxt(out, block, fmt="%.9g", delimiter=" ")
-        yield out.getvalue()
+        text = out.getvalue()
+        out.close()  # savetxt's writer holds the buffer in a reference cycle: freed now, not at the next gc
+        yield text
 
 
 def write_bvh(motion: Motion, path: str | os.PathLike) -> Path:
