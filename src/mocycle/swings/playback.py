@@ -100,16 +100,13 @@ def playback(seg: Segmentation, profile: str = "hermite") -> Motion:
     _validate.choice("profile", profile, PROFILES)
     T, J = seg.n_frames, seg.skeleton.n_joints
     swings = sorted(seg.swings, key=lambda s: (s.joint, s.start))  # as swings_of, all joints at once
-    owner, frames, q = _swing_table(swings, seg.frame_time, profile)
-    joint_of = np.array([s.joint for s in swings], dtype=int)
-    bounds = np.searchsorted(joint_of, np.arange(J + 1))
+    bounds = np.searchsorted(np.array([s.joint for s in swings], dtype=int), np.arange(J + 1))
     holds = sorted(seg.holds, key=lambda h: (h.joint, h.start))  # as holds_of, all joints at once
     hold_bounds = np.searchsorted(np.array([h.joint for h in holds], dtype=int), np.arange(J + 1))
     quats = np.empty((T, J, 4))
-    for j in range(J):
-        a, b = bounds[j], bounds[j + 1]
-        rows = slice(np.searchsorted(owner, a), np.searchsorted(owner, b))
-        quats[:, j] = _play_joint(seg, j, swings[a:b], (owner[rows] - a, frames[rows], q[rows]),
+    for j in range(J):  # one joint's swing table at a time: its rows are a joint's frames, not the take's
+        mine = swings[bounds[j]:bounds[j + 1]]
+        quats[:, j] = _play_joint(seg, j, mine, _swing_table(mine, seg.frame_time, profile),
                                   holds[hold_bounds[j]:hold_bounds[j + 1]])
     static = np.array(seg.skeleton.offsets, dtype=np.float64)
     tracks = {}
