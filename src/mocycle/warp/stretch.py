@@ -277,10 +277,18 @@ class StretchReport:
         }
 
 
+#: Columns per block of :func:`_line_fit` and the trend test (its least-squares solver copies the columns it is given)
+LINE_COLUMNS = 16
+
+
 def _line_fit(Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Least-squares line per column of ``Y`` (``(T, D)``): ``(intercept (D,), slope per frame (D,))``."""
+    """Least-squares line per column of ``Y`` (``(T, D)``): ``(intercept (D,), slope per frame (D,))``, a block
+    of :data:`LINE_COLUMNS` columns at a time (each column's line is its own: no ``(T, D)`` copy is made)."""
     t = np.arange(Y.shape[0], dtype=np.float64)
-    slope, intercept = np.polyfit(t, Y, 1)
+    slope, intercept = np.empty(Y.shape[1]), np.empty(Y.shape[1])
+    for c0 in range(0, Y.shape[1], LINE_COLUMNS):
+        cs = slice(c0, c0 + LINE_COLUMNS)
+        slope[cs], intercept[cs] = np.polyfit(t, Y[:, cs], 1)
     return intercept, slope
 
 
@@ -347,7 +355,11 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
     if X.shape[1]:
         a, v = _line_fit(X)
         rise = np.abs(v) * (T - 1)
-        resid_ptp = np.ptp(X - (a + v * np.arange(T)[:, None]), axis=0)
+        t = np.arange(T)[:, None]
+        resid_ptp = np.empty(X.shape[1])
+        for c0 in range(0, X.shape[1], LINE_COLUMNS):  # the residuals a block of columns at a time (memory)
+            cs = slice(c0, c0 + LINE_COLUMNS)
+            resid_ptp[cs] = np.ptp(X[:, cs] - (a[cs] + v[cs] * t), axis=0)
         trend = rise > TREND_DOMINATED * np.maximum(resid_ptp, 1e-12)
         trend_cols = [int(i) for i in np.flatnonzero(trend)]
         by_window: dict[int, list[np.ndarray]] = {}  # groups with the same window warp in one transform
