@@ -146,6 +146,16 @@ class SwingIndex:
         return hits[:top]
 
 
+def check_index_options(folder: str | os.PathLike, window_s: float) -> Path:
+    """The folder :func:`build_index` would read, checked with its window (before any take is read)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise MocycleError(f"{folder}: not a folder of takes")
+    if not 0 < window_s <= MAX_WINDOW_S:
+        raise MocycleError(f"the window must be a number of seconds in (0, {MAX_WINDOW_S:g}]; got {window_s}")
+    return folder
+
+
 @limit_threads
 def build_index(folder: str | os.PathLike, pattern: str = "*.bvh", threshold: float = DEFAULT_THRESHOLD,
                 joints: str | None = None, rate_hz: float = 30.0, window_s: float = 1.0) -> SwingIndex:
@@ -153,11 +163,7 @@ def build_index(folder: str | os.PathLike, pattern: str = "*.bvh", threshold: fl
 
     Files that cannot be read are skipped with a warning (listed in ``skipped``).
     """
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise MocycleError(f"{folder}: not a folder of takes")
-    if not 0 < window_s <= MAX_WINDOW_S:
-        raise MocycleError(f"the window must be a number of seconds in (0, {MAX_WINDOW_S:g}]; got {window_s}")
+    folder = check_index_options(folder, window_s)
     paths, sigs, skipped = [], [], []
     for p in sorted(folder.glob(pattern)):
         try:

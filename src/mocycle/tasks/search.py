@@ -27,14 +27,18 @@ class Options(_Options):
 
 def run(query, folder: str | os.PathLike, options: Options | None = None) -> Report:
     """Index the takes of ``folder`` and rank them against ``query`` (a Motion or a motion file)."""
-    from ..swings import build_index
+    from ..swings import SwingIndex, build_index
+    from ..swings.search import check_index_options
 
     o = options or Options()
     with Recorder() as rec:
-        motion = load(query, o.amc_fps)
+        check_index_options(folder, o.window_s)
+        # the query's signature first, with the index's settings: its take is let go before the folder is read
+        signature = SwingIndex([], [], threshold=o.threshold, window_s=o.window_s).signature_of(
+            load(query, o.amc_fps))
         index = build_index(folder, pattern=o.pattern, threshold=o.threshold, window_s=o.window_s)
         exclude = None if is_motion(query) else Path(query)
-        hits = index.query(motion, top=o.top, exclude=exclude)
+        hits = index.query(signature, top=o.top, exclude=exclude)
         facts = {"query": label_of(query), "indexed": len(index),
                  "results": [{"rank": k + 1, "path": str(h.path), "score": h.score, "offset_s": h.offset_s}
                              for k, h in enumerate(hits)]}
