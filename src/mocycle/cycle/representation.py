@@ -225,14 +225,21 @@ class CycleSpace:
         on the travel joint (in its parent's frame)."""
         return axis_rotations(self.up, L[:, 3])
 
+    def tracks(self, P: np.ndarray, L: np.ndarray) -> dict[int, np.ndarray]:
+        """The local translations ``{joint: (N, 3)}`` of the joints that move (the travel joint's from ``L``)
+        that :meth:`decode` puts in its motion; every other joint keeps ``static_translations``."""
+        P, L = self._check(P, L)
+        c0 = 9 * self.n_joints
+        tracks = {j: P[:, c0 + 3 * k:c0 + 3 * k + 3].copy() for k, j in enumerate(self.moving)}
+        tracks[self.travel] = L[:, :3].copy()
+        return dict(sorted(tracks.items()))
+
     def translations(self, P: np.ndarray, L: np.ndarray) -> np.ndarray:
         """The local translations ``(N, J, 3)`` that :meth:`decode` puts in its motion."""
-        P, L = self._check(P, L)
-        N, J = P.shape[0], self.n_joints
-        trans = np.broadcast_to(self.static_translations, (N, J, 3)).copy()
-        if self.moving:
-            trans[:, list(self.moving)] = P[:, 9 * J:].reshape(N, len(self.moving), 3)
-        trans[:, self.travel] = L[:, :3]
+        tracks = self.tracks(P, L)
+        trans = np.broadcast_to(self.static_translations, (len(L),) + self.static_translations.shape).copy()
+        for j, track in tracks.items():
+            trans[:, j] = track
         return trans
 
     def travel_path(self, rotations: np.ndarray, translations: np.ndarray,
@@ -252,16 +259,18 @@ class CycleSpace:
             world_r = world_r @ local(j)
         return world_p
 
-    def decode_rows(self, P: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The local quaternions ``(B, J, 4)`` (not yet made sign-continuous) and translations ``(B, J, 3)``
-        of rows ``P (B, n_periodic)``, ``L (B, 4)``: :meth:`decode` a block of frames at a time."""
-        return matrix_quats(self.rotations(P, L)), self.translations(P, L)
+    def decode_rows(self, P: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, dict[int, np.ndarray]]:
+        """The local quaternions ``(B, J, 4)`` (not yet made sign-continuous) and translation tracks
+        (:meth:`tracks`) of rows ``P (B, n_periodic)``, ``L (B, 4)``: :meth:`decode` a block of frames at a
+        time."""
+        return matrix_quats(self.rotations(P, L)), self.tracks(P, L)
 
     def decode(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray | None = None) -> Motion:
         """A Motion on the space's skeleton and frame time from ``P (N, n_periodic)``, ``L (N, 4)``;
         ``projected``: :meth:`project` of ``P`` when the caller has it."""
         quats = continuous_quats(matrix_quats(self.rotations(P, L, projected)))
-        return Motion(self.skeleton, quats, self.translations(P, L), self.frame_time, copy=False)
+        return Motion(self.skeleton, quats, self.static_translations, self.frame_time, tracks=self.tracks(P, L),
+                      copy=False)
 
 
 class EncodedRows:

@@ -81,9 +81,12 @@ def loop_view(report):
     facts = {"loop_frame": np.round(np.mod(u, N), 3).tolist(), "segments": [list(s) for s in segments],
              "cycle_frames": N, "root": root}
     # the rows of P are interpolated and decoded a block of frames at a time: no (T, 9J) array is held
-    quats, trans = np.empty((T, space.n_joints, 4)), np.empty((T, space.n_joints, 3))
+    quats, tracks = np.empty((T, space.n_joints, 4)), {}
     for f0 in range(0, T, BLOCK_FRAMES):
         f1 = min(T, f0 + BLOCK_FRAMES)
         i, w = i0[f0:f1] % N, a[f0:f1]
-        quats[f0:f1], trans[f0:f1] = space.decode_rows((1 - w) * Pv[i] + w * Pv[i + 1], L[f0:f1])
-    return Motion(space.skeleton, continuous_quats(quats, inplace=True), trans, space.frame_time, copy=False), facts
+        quats[f0:f1], rows = space.decode_rows((1 - w) * Pv[i] + w * Pv[i + 1], L[f0:f1])
+        for j, track in rows.items():
+            tracks.setdefault(j, np.empty((T, 3)))[f0:f1] = track
+    return Motion(space.skeleton, continuous_quats(quats, inplace=True), space.static_translations, space.frame_time,
+                  tracks=tracks, copy=False), facts
