@@ -95,3 +95,20 @@ def test_frame_errors_block_by_block_are_the_pose_distances_of_the_whole_take(mo
     monkeypatch.setattr(distance, "ERROR_BLOCK", 48)  # five blocks, the last one short
     np.testing.assert_array_equal(distance.frame_errors(a, b), whole)
     assert whole.min() > 0
+
+
+def test_project_refuses_a_take_too_long_for_all_pairs_before_any_work(monkeypatch):
+    import mocycle.keyframes as keyframes
+    from mocycle import tasks
+    from mocycle.keyframes.distance import MAX_PAIRWISE_FRAMES
+    from mocycle.motion import Motion, Skeleton
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("the poses were projected before the take's length was checked")
+
+    monkeypatch.setattr(keyframes, "PoseSpace", no_work)
+    skeleton = Skeleton(("root", "tip"), [-1, 0], [[0, 0, 0], [0, 1, 0]], (("Xposition", "Yposition", "Zposition",
+                        "Zrotation", "Xrotation", "Yrotation"), ("Zrotation", "Xrotation", "Yrotation")))
+    take = Motion.rest(skeleton, MAX_PAIRWISE_FRAMES + 1)
+    with pytest.raises(MocycleError, match=f"at most {MAX_PAIRWISE_FRAMES} frames; got {MAX_PAIRWISE_FRAMES + 1}"):
+        tasks.project.run(take)

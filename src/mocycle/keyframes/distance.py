@@ -78,6 +78,13 @@ def moving_joints(quats: np.ndarray, tol: float = 1e-9) -> np.ndarray:
     return np.flatnonzero(dev > tol)
 
 
+def check_pairwise_frames(n_frames: int) -> None:
+    """Refuse more than :data:`MAX_PAIRWISE_FRAMES` frames for all-pairs pose distances (before any work)."""
+    if n_frames > MAX_PAIRWISE_FRAMES:
+        raise MocycleError(f"all-pairs pose distances need at most {MAX_PAIRWISE_FRAMES} frames; got "
+                           f"{n_frames} (resample or cut the take first)")
+
+
 def pose_distance_matrix(quats: np.ndarray, weights: np.ndarray, other: np.ndarray | None = None) -> np.ndarray:
     """All-pairs eq. 3.2 distances: ``(T, T)`` for ``quats`` ``(T, J, 4)``, or ``(T, M)`` against ``other``.
 
@@ -86,9 +93,7 @@ def pose_distance_matrix(quats: np.ndarray, weights: np.ndarray, other: np.ndarr
     """
     q = np.asarray(quats, dtype=np.float64)
     o = q if other is None else np.asarray(other, dtype=np.float64)
-    if max(q.shape[0], o.shape[0]) > MAX_PAIRWISE_FRAMES:
-        raise MocycleError(f"all-pairs pose distances need at most {MAX_PAIRWISE_FRAMES} frames; got "
-                           f"{max(q.shape[0], o.shape[0])} (resample or cut the take first)")
+    check_pairwise_frames(max(q.shape[0], o.shape[0]))
     w = np.asarray(weights, dtype=np.float64)
     joints = moving_joints(np.concatenate([q, o]) if other is not None else q)
     D = np.zeros((q.shape[0], o.shape[0]))

@@ -29,10 +29,12 @@ def run(take, options: Options | None = None) -> Report:
     """Project every pose to 2-D and pick keyframes; ``result`` holds the arrays
     (``points`` (T, 2), ``keyframes`` (K,), ``optimized`` (T, 2) or None) for plots."""
     from ..keyframes import PoseSpace, keyframe_count, optimize_projection, spatial_layout, stress
+    from ..keyframes.distance import check_pairwise_frames
 
     o = options or Options()
     with Recorder() as rec:
         motion = load(take, o.amc_fps)
+        check_pairwise_frames(motion.n_frames)  # the stress needs every pair: refused before any work
         space = PoseSpace(motion)
         k = keyframe_count(motion.n_frames, ratio=o.ratio)
         key, points = spatial_layout(space, o.projection, o.select, k, seed=o.seed_projection)
