@@ -154,6 +154,12 @@ def test_translations_are_stored_once_per_joint_that_stands_still():
         m.replace(tracks={3: full[:10, 3]})
     with pytest.raises(MocycleError, match="NaN"):
         Motion(walk.skeleton, walk.rotations, full[0], walk.frame_time, tracks={4: np.full((80, 3), np.nan)})
+    with pytest.raises(MocycleError, match="track for joint 'hips'"):
+        Motion(walk.skeleton, walk.rotations, full[0], walk.frame_time, tracks={"hips": full[:, 0]})
+    with pytest.raises(MocycleError, match="track for joint 22"):
+        m.replace(tracks={22: full[:, 0]})
+    with pytest.raises(MocycleError, match=r"translations must have shape \(80, 22, 3\) or \(22, 3\)"):
+        Motion(walk.skeleton, walk.rotations, full[:, :3], walk.frame_time)
 
 
 def test_one_joints_path_is_its_column_of_the_world_positions(monkeypatch):

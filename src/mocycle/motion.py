@@ -266,7 +266,7 @@ def _float_array(values, copy: bool) -> np.ndarray:
     return np.array(values, dtype=np.float64, copy=True) if copy else np.asarray(values, dtype=np.float64)
 
 
-def split_translations(trans: np.ndarray) -> tuple[np.ndarray, dict[int, np.ndarray]]:
+def _split_translations(trans: np.ndarray) -> tuple[np.ndarray, dict[int, np.ndarray]]:
     """A ``(T, J, 3)`` array of local translations as a motion stores them: the first frame's ``(J, 3)`` and
     a ``(T, 3)`` track (a copy) for each joint whose translation changes at all (compared exactly)."""
     static = np.array(trans[0], dtype=np.float64)
@@ -284,28 +284,30 @@ def _translation_parts(T: int, J: int, static, translations, root_positions, tra
     ``root_positions`` (the root's track) and ``tracks`` on top."""
     track_of: dict[int, np.ndarray] = {}
     if translations is not None:
-        trans = _float_array(translations, copy)
+        trans = np.asarray(translations, dtype=np.float64)  # the tracks are copied from it: no copy first
         if trans.shape == (T, J, 3):
-            static, track_of = split_translations(trans)
-        elif trans.shape == (J, 3):
-            static = trans
-        else:
+            static, track_of = _split_translations(trans)
+        elif trans.shape != (J, 3):
             raise MocycleError(f"translations must have shape ({T}, {J}, 3) or ({J}, 3); got {trans.shape}")
+        else:
+            static = trans
+    static = np.array(static, dtype=np.float64)  # small: never a caller's array, frozen
+    if static.shape != (J, 3):
+        raise MocycleError(f"constant translations must have shape ({J}, 3); got {static.shape}")
     if root_positions is not None:
         tracks = {**(tracks or {}), 0: root_positions}
     for j, track in (tracks or {}).items():
-        if not 0 <= int(j) < J:
-            raise MocycleError(f"a translation track for joint {j}, but the skeleton has {J} joints")
+        if isinstance(j, bool) or not isinstance(j, (int, np.integer)) or not 0 <= j < J:
+            raise MocycleError(f"a translation track for joint {j!r}, but the skeleton's joints are 0 to {J - 1}")
         track = _float_array(track, copy)
         if track.shape != (T, 3):
-            name = "root_positions" if root_positions is not None and int(j) == 0 else f"the track of joint {j}"
+            name = "root_positions" if root_positions is not None and j == 0 else f"the track of joint {j}"
             raise MocycleError(f"{name} must have shape ({T}, 3); got {track.shape}")
         track_of[int(j)] = track
     _check_translations(static)
     for track in track_of.values():
         _check_translations(track)
         track.setflags(write=False)
-    static = np.array(static, dtype=np.float64)  # small: never a caller's array, frozen
     static.setflags(write=False)
     return static, dict(sorted(track_of.items()))
 
