@@ -4,6 +4,7 @@ from scipy.spatial.transform import Rotation
 
 from conftest import shared_path
 from helpers import tiny_skeleton
+from mocycle.datasets import synthetic_walk
 from mocycle.errors import MocycleError
 from mocycle.io import read
 from mocycle.motion import Motion
@@ -96,3 +97,19 @@ def test_real_bandai_arm_swing_smaller():
     before = Rotation.from_quat(m.rotations[sw.end, j]) * Rotation.from_quat(m.rotations[sw.start, j]).inv()
     after = Rotation.from_quat(out.rotations[sw.end, j]) * Rotation.from_quat(out.rotations[sw.start, j]).inv()
     assert after.magnitude() < 0.75 * before.magnitude()
+
+
+def test_an_edit_made_from_the_handed_over_take_is_the_same_edit():
+    walk = synthetic_walk(n_frames=240, fps=60).motion
+    seg = segment(walk, threshold=0.4)
+    joint = seg.swings[0].name
+    def own():  # a motion whose arrays it alone holds
+        return Motion(walk.skeleton, walk.rotations, walk.translations, walk.frame_time)
+
+    kept = edit_swing(own(), seg, joint, 0, angle_scale=1.3)
+    given = own()
+    handed = edit_swing(given, seg, joint, 0, angle_scale=1.3, hand_over=True)
+    np.testing.assert_array_equal(handed.rotations, kept.rotations)
+    np.testing.assert_array_equal(handed.translations, kept.translations)
+    with pytest.raises(AttributeError):
+        given.rotations  # noqa: B018 (emptied)

@@ -37,12 +37,15 @@ def _resample(q: np.ndarray, times: np.ndarray) -> np.ndarray:
 
 
 def edit_swing(motion: Motion, seg: Segmentation, joint: str | int, swing: int, angle_scale: float = 1.0,
-               duration_scale: float = 1.0) -> Motion:
+               duration_scale: float = 1.0, *, hand_over: bool = False) -> Motion:
     """The motion with swing ``swing`` (0-based, in time order) of ``joint`` edited.
 
     ``seg`` is the segmentation of ``motion``.  ``angle_scale`` (0-10) scales
     the angle the swing turns through; ``duration_scale`` (> 0) its length in
     frames, limited by the room up to the joint's next swing (the error says how far it can go).
+    ``hand_over``: the caller gives ``motion`` up, and the edited take is made from its arrays
+    (:meth:`~mocycle.motion.Motion._hand_over`: ``motion`` is emptied once the edit is checked; a long take is
+    edited without a second copy of it).
     """
     if seg.n_frames != motion.n_frames or not seg.skeleton.same_as(motion.skeleton):
         raise MocycleError("the segmentation is not of this motion (frames or skeleton differ)")
@@ -93,6 +96,11 @@ def edit_swing(motion: Motion, seg: Segmentation, joint: str | int, swing: int, 
         old = np.interp(new, [sw.start, new_end, limit], [sw.start, sw.end, limit]) if limit > new_end else \
             np.interp(new, [sw.start, new_end], [sw.start, sw.end])
         q[sw.start:limit + 1] = _resample(q, old)
+    if hand_over:
+        skeleton, frame_time = motion.skeleton, motion.frame_time
+        rotations, static, tracks = motion._hand_over()
+        rotations[:, j] = q
+        return Motion(skeleton, rotations, static, frame_time, tracks=tracks, copy=False)
     # a new array, handed over (no second copy); the translations are shared
     return motion.replace(rotations=_fix_joint(motion, j, q), copy=False)
 

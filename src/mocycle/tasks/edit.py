@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from . import fields
 from .options import Integer, Real, Text, option
 from .options import Options as _Options
-from .report import Recorder, Report, load
+from .report import Recorder, Report, is_motion, load
 
 LABELS = {"joint": ("joint", ""), "swing": ("swing (0-based)", ""), "start": ("first frame", ""),
           "end": ("last frame", ""), "angle_deg": ("angle turned", "deg"), "angle_scale": ("angle ×", ""),
@@ -42,7 +42,7 @@ def run(take, options: Options) -> Report:
             names = sorted({*(motion.skeleton.names[k] for k in seg.joints), o.joint})
             seg = segment(motion, threshold=o.threshold, joints=names)
         edited = edit_swing(motion, seg, o.joint, o.swing, angle_scale=o.angle_scale,
-                            duration_scale=o.duration_scale)
+                            duration_scale=o.duration_scale, hand_over=not is_motion(take))  # a file: ours
         sw = seg.swings_of(o.joint)[o.swing]
         facts = {"joint": o.joint, "swing": o.swing, "start": sw.start, "end": sw.end,
                  "angle_deg": math.degrees(abs(sw.end_angle - sw.start_angle)), "angle_scale": o.angle_scale,
