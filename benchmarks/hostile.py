@@ -159,7 +159,7 @@ def main(argv=None) -> int:
             r = run(folder, command)
             bad |= r["traceback"] or bool(r["tmp_left"])
             if args.markdown:
-                print(f"| {family} | `mocycle {command.replace('{d}/', '')}` | {r['code']} | "
+                print(f"| {family} | `mocycle {command.replace('{d}/', '').replace('{d}', '.')}` | {r['code']} | "
                       f"{r['message'][:150].replace('|', '/')} | {r['seconds']:.1f} | {r['peak_mb']} |")
             else:
                 flags = (", TRACEBACK" if r["traceback"] else "") + (f", left {r['tmp_left']}" if r["tmp_left"] else "")

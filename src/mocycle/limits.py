@@ -1,13 +1,13 @@
 """Size limits: absurd input or options are refused before they ask for absurd memory.
 
-A motion of ``T`` frames and ``J`` joints holds ``56·T·J`` bytes (quaternions and
-translations, float64).  Readers check every count against the bytes the file
+A motion of ``T`` frames and ``J`` joints holds about ``32·T·J`` bytes (float64
+quaternions; translations once per joint that stands still, ``24·T`` bytes per joint that moves).  Readers check every count against the bytes the file
 really holds; sizes that a file only *claims* (a ``Frames:`` count with no
 channels, a swings file's frame count) and sizes asked for by options
 (``--fps``, ``--cycles``, ``--factor``) are checked here against
 
 * ``MOCYCLE_MAX_FRAMES`` frames (default 2,000,000: 4.6 hours at 120 fps), and
-* ``MOCYCLE_MAX_FRAMES × 50`` joint-frames (default 100,000,000: about 5.2 GiB
+* ``MOCYCLE_MAX_FRAMES × 50`` joint-frames (default 100,000,000: about 3 GiB
   as a motion).
 
 Set the environment variable ``MOCYCLE_MAX_FRAMES`` to raise (or lower) both.
@@ -22,7 +22,7 @@ from .errors import MocycleError, MotionFileError
 ENV_MAX_FRAMES = "MOCYCLE_MAX_FRAMES"
 DEFAULT_MAX_FRAMES = 2_000_000
 JOINTS_BUDGET = 50  # joint-frames allowed = max_frames() * JOINTS_BUDGET
-BYTES_PER_JOINT_FRAME = 56  # a Motion: 4 + 3 float64 per joint and frame
+BYTES_PER_JOINT_FRAME = 32  # a Motion: 4 float64 per joint and frame (the translations of joints that move aside)
 
 
 def max_frames() -> int:
