@@ -2,8 +2,9 @@
 
 A motion of ``T`` frames and ``J`` joints holds about ``32·T·J`` bytes (float64
 quaternions; translations once per joint that stands still, ``24·T`` bytes per joint
-that moves).  Readers check every count against the bytes the file really holds; sizes that a file only *claims* (a ``Frames:`` count with no
-channels, a swings file's frame count) and sizes asked for by options
+that moves).  Readers check every count against the bytes the file really holds;
+sizes that a file only *claims* (a ``Frames:`` count with no channels, a swings
+file's frame count) and sizes asked for by options
 (``--fps``, ``--cycles``, ``--factor``) are checked here against
 
 * ``MOCYCLE_MAX_FRAMES`` frames (default 2,000,000: 4.6 hours at 120 fps), and
