@@ -131,7 +131,10 @@ def test_translations_are_stored_once_per_joint_that_stands_still():
     full = walk.translations.copy()
     full[:, 5] += np.linspace(0.0, 1.0, 80)[:, None]  # a second joint that moves
     m = Motion(walk.skeleton, walk.rotations, full, walk.frame_time)
-    assert m.tracked_joints == (0, 5)
+    assert m.tracked_joints == (0, 5) and list(m.tracks) == [0, 5] and m.moving_joints() == [0, 5]
+    still_track = m.replace(tracks={7: np.broadcast_to(full[0, 7], (80, 3))})  # tracked, but it stands still
+    assert still_track.tracked_joints == (0, 5, 7) and still_track.moving_joints() == [0, 5]
+    assert m.moving_joints(tol=2.0) == [0]  # joint 5 moves by 1.0
     np.testing.assert_array_equal(m.translations, full)
     np.testing.assert_array_equal(m.translations_at(7), full[7])
     np.testing.assert_array_equal(m.translations_at([3, 1, 3]), full[[3, 1, 3]])

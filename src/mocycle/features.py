@@ -134,7 +134,7 @@ class PoseDecoder:
         kept = np.setdiff1d(np.arange(J), self.joints)  # joints whose rotations are not columns
         if same_length:
             quats = tpl.rotations.copy()
-            static, tracks = tpl.translations_at(0), {j: tpl.joint_translations(j) for j in tpl.tracked_joints}
+            static, tracks = tpl.translations_at(0), tpl.tracks
         else:
             quats = np.empty((T, J, 4))
             if kept.size:

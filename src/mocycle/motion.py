@@ -442,6 +442,16 @@ class Motion:
         is one of them (a slice of a take may hold some that stand still in it)."""
         return tuple(self._tracks)
 
+    @property
+    def tracks(self) -> dict[int, np.ndarray]:
+        """``{joint: (T, 3)}``: the stored translations of :attr:`tracked_joints` (read-only; a new dict)."""
+        return dict(self._tracks)
+
+    def moving_joints(self, tol: float = 0.0) -> list[int]:
+        """The joints whose local translation changes by more than ``tol`` (file units, peak to peak along an
+        axis) over the take, in order."""
+        return [j for j, track in self._tracks.items() if np.ptp(track, axis=0).max() > tol]
+
     def joint_translations(self, joint: int) -> np.ndarray:
         """``(T, 3)`` local translations of one joint (read-only; a view, not a copy)."""
         track = self._tracks.get(joint)
@@ -470,7 +480,7 @@ class Motion:
         """
         known = getattr(self, "_travel", None)  # the arrays are read-only: found once per motion
         if known is None:
-            moving = [j for j, track in self._tracks.items() if np.ptp(track, axis=0).max() > 1e-9]
+            moving = self.moving_joints(1e-9)
             known = self._travel = moving[0] if moving else 0
         return known
 

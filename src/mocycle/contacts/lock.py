@@ -694,7 +694,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         rotations, static, tracks = motion._hand_over()
     else:  # the input's tracks are shared (read-only), the travel joint's copied when it moves
         rotations, static = motion.rotations.copy(), motion.translations_at(0)
-        tracks = {j: motion.joint_translations(j) for j in motion.tracked_joints}
+        tracks = motion.tracks
     if local_moves:
         path = tracks.get(travel, np.broadcast_to(static[travel], (T, 3)))
         path = path if path.flags.writeable else path.copy()

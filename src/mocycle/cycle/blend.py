@@ -229,7 +229,7 @@ class _Loop:
 
 def _on(skeleton: Skeleton, motion: Motion) -> Motion:
     return Motion(skeleton, motion.rotations, motion.translations_at(0), motion.frame_time,
-                  tracks={j: motion.joint_translations(j) for j in motion.tracked_joints})
+                  tracks=motion.tracks)
 
 
 def _prepare(cycle: Cycle, space: CycleSpace, reference: _Loop | None) -> _Loop:

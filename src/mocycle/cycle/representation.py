@@ -77,8 +77,7 @@ class CycleSpace:
         e1, e2 = horizontal_basis(up)
         mean_rot = motion.rotation(travel).mean().as_matrix()
         forward = mean_rot.T @ e1
-        moving = tuple(j for j in motion.tracked_joints
-                       if j != travel and np.ptp(motion.joint_translations(j), axis=0).max() > 1e-9)
+        moving = tuple(j for j in motion.moving_joints(1e-9) if j != travel)
         return cls(skeleton=motion.skeleton, frame_time=motion.frame_time,
                    static_translations=motion.translations_at(0), travel=travel, world_up=up_world, up=up,
                    e1=e1, e2=e2, forward=forward, moving=moving)

@@ -354,8 +354,7 @@ def compress(motion: Motion, ratio: float | str | None = "auto", count: int | No
     else:
         key = select_keyframes(select, space, k, random_state=random_state)
     key = check_keys(key, n)
-    moving = np.array([j for j in motion.tracked_joints if np.ptp(motion.joint_translations(j), axis=0).max() > 0],
-                      dtype=np.int64)
+    moving = np.array(motion.moving_joints(), dtype=np.int64)
     track = np.empty((n, len(moving), 3))
     for k, j in enumerate(moving):
         track[:, k] = motion.joint_translations(j).astype(np.float32)

@@ -102,8 +102,7 @@ def _fixed_offsets(motion: Motion, joints: list[int]) -> dict[int, np.ndarray]:
     """The local translation ``(3, 1)`` of each joint of the chain of ``joints`` that has the same one in every
     frame (a bone offset: turned as one vector, not one per frame)."""
     chain = _chain(motion, joints)
-    moving = set(motion.tracked_joints)
-    moving = {j for j in moving if not (motion.joint_translations(j) == motion.joint_translations(j)[0]).all()}
+    moving = set(motion.moving_joints())
     first = motion.translations_at(0)
     return {j: first[j][:, None].copy() for j in chain if j not in moving}
 
