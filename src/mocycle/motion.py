@@ -469,7 +469,6 @@ class Motion:
             out[..., j, :] = track[index]
         return out
 
-
     @property
     def travel_joint(self) -> int:
         """Index of the joint whose translation carries the travel: the first joint

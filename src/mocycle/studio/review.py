@@ -87,6 +87,8 @@ def loop_view(report):
         i, w = i0[f0:f1] % N, a[f0:f1]
         quats[f0:f1], rows = space.decode_rows((1 - w) * Pv[i] + w * Pv[i + 1], L[f0:f1])
         for j, track in rows.items():
-            tracks.setdefault(j, np.empty((T, 3)))[f0:f1] = track
+            if j not in tracks:  # the same joints in every block: each track is made once
+                tracks[j] = np.empty((T, 3))
+            tracks[j][f0:f1] = track
     return Motion(space.skeleton, continuous_quats(quats, inplace=True), space.static_translations, space.frame_time,
                   tracks=tracks, copy=False), facts
