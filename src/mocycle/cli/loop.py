@@ -6,9 +6,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from .. import tasks
-from ..errors import MocycleError
+from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 from ..tasks.loop import METRIC_LABELS
 from .common import (
     CLOSING_FRAME,
@@ -44,7 +45,7 @@ def loop(
     joints: Annotated[str | None, flag(O, "joints")] = default(O, "joints"),
     cycles: Annotated[int, flag(O, "cycles")] = default(O, "cycles"),
     classes: Annotated[str, flag(O, "classes")] = default(O, "classes"),
-    which: Annotated[str | None, flag(O, "which")] = default(O, "which"),
+    which: Annotated[str | None, flag(O, "which", "--class")] = default(O, "which"),
     pca: Annotated[str, flag(O, "pca")] = default(O, "pca"),
     delay: Annotated[int, flag(O, "delay")] = default(O, "delay"),
     min_periods: Annotated[float, flag(O, "min_periods")] = default(O, "min_periods"),
@@ -79,44 +80,69 @@ def loop(
                 joints=joints, cycles=cycles, classes=classes, which=which, pca=pca, delay=delay,
                 min_periods=min_periods, time_axis=time_axis, amc_fps=amc_fps, force=force, feet=feet,
                 foot_joints=foot_joints)
-    report = tasks.loop.run(path, options)
+    try:
+        report = tasks.loop.run(path, options)
+    except (NoPeriodicMotion, LoopRefused) as exc:
+        if as_json and getattr(exc, "facts", None) is not None:  # the same shape, status and reason: exit 3
+            print_json({"file": str(path), **exc.facts})
+        raise
     everything = options.which == "all"
-    roles = [f"loop.class{f['class']}" for f in report.facts["loops"]] if everything else ["loop"]
+    loops = report.facts["loops"]
+    roles = [f["role"] for f in loops]
     if feet_plot is not None and any(report.extras[r]["contacts"] is None for r in roles):
         # refused before any file is written
         raise MocycleError("--feet-plot needs locked feet (--feet lock, or auto with --root motion)")
     print_warnings(report)
-    loops = report.facts["loops"] if everything else [report.facts]
     cycles_made = report.result if everything else [report.result]
     shown = []
     for facts, cycle in zip(loops, cycles_made, strict=True):  # every cycle was made and checked before writing
-        k = facts["class"]
-        target = output.with_suffix(f".class{k}{output.suffix}") if everything else output
-        role = f"loop.class{k}" if everything else "loop"
+        role = facts["role"]
+        tag = role.split(".", 1)[1] if "." in role else None
+        if tag and facts.get("part") is not None:
+            tag = f"{tag}-{facts['kind'].replace(' ', '-')}"
+        target = output.with_suffix(f".{tag}{output.suffix}") if tag else output
         written = write_motion(report, role, target, gltf_scale, gltf_up, closing_frame)
         closing = report.motions[role].n_frames != written.n_frames
         images = []
         if feet_plot is not None:
-            extra = report.extras[f"loop.class{k}" if everything else "loop"]
-            images.append(feet_plot.with_suffix(f".class{k}.png") if everything else feet_plot)
-            _plot_feet(extra["fitted"], cycle, extra["contacts"], images[-1], f"{path.name}: feet locked")
+            images.append(feet_plot.with_suffix(f".{tag}.png") if tag else feet_plot)
+            _plot_feet(report.extras[role]["fitted"], cycle, report.extras[role]["contacts"], images[-1],
+                       f"{path.name}: feet locked")
         if plot is not None:
             from ..viz import plot_loop
 
-            images.append(plot.with_suffix(f".class{k}.png") if everything else plot)
+            images.append(plot.with_suffix(f".{tag}.png") if tag else plot)
             plot_loop(report.motions["input"], cycle, images[-1],
                       title=f"{path.name}: {method}{' ' + model if method == 'harmonic' else ''}")
-        facts = {**facts, "frames_out": written.n_frames, "closing_frame": closing}
-        shown.append(({"file": str(path), "output": str(target), **facts, "seconds": report.seconds,
+        facts.update(output=str(target), frames_out=written.n_frames, closing_frame=closing)
+        shown.append(({"file": str(path), **facts, "seconds": report.seconds,
                        "metrics_seconds": report.timings_s["metrics"]}, images))
     if as_json:
-        print_json({"file": str(path), "loops": [f for f, _ in shown]} if everything else shown[0][0])
+        top = {k: v for k, v in report.facts.items() if k not in shown[0][0]}
+        print_json({**shown[0][0], **top, "loops": [f for f, _ in shown]})
         return
+    _print_parts(path, report.facts)
     for facts, images in shown:
         _print_loop(facts)
         for image in images:
-            out.print(f"wrote {image}", soft_wrap=True)
+            out.print(f"wrote {escape(str(image))}", soft_wrap=True)
     out.print(timing_line(report))
+
+
+def _print_parts(path: Path, facts: dict) -> None:
+    """The take's parts, one line each, and which one was looped and why."""
+    parts = facts["parts"]
+    if len(parts) > 1:
+        out.print(f"[bold]{escape(str(path))}[/]: {len(parts)} parts")
+        for k, p in enumerate(parts):
+            a, b = p["frames"]
+            what = (f"{p['n_periods']:.1f} cycles of {p['period_frames']:.1f} frames"
+                    if p["loop"] and p["period_frames"] else escape(p["reason"]))
+            out.print(f"  part {k}: frames {a}-{b}, {p['kind']}: {what}", soft_wrap=True)
+    out.print(escape(facts["reason"]), soft_wrap=True)
+    for d in facts["not_looped"]:
+        if str(d["reason"]).startswith("refused"):
+            out.print(f"  part {d['part']} ({d['kind']}) not looped: {escape(d['reason'])}", soft_wrap=True)
 
 
 def _plot_feet(fitted, cycle, contacts, image: Path, title: str) -> None:
@@ -135,8 +161,10 @@ def _print_loop(facts: dict) -> None:
     from rich.table import Table
 
     kind = facts["method"] + (f" {facts['model']}, K = {facts['harmonics']}" if facts["method"] == "harmonic" else "")
-    out.print(f"[bold]{facts['file']}[/]: {facts['frames_in']} frames at {facts['fps']:.6g} fps")
-    out.print(f"  class {facts['class']}: {facts['n_periods']:.2f} periods of {facts['period_frames']:.2f} frames "
+    where = f"part {facts['part']} ({facts['kind']}, frames {facts['frames'][0]}-{facts['frames'][1]})" \
+        if facts.get("part") is not None else f"class {facts['class']}"
+    out.print(f"[bold]{escape(facts['file'])}[/]: {facts['frames_in']} frames at {facts['fps']:.6g} fps")
+    out.print(f"  {where}: {facts['n_periods']:.2f} periods of {facts['period_frames']:.2f} frames "
               f"(time axis: {facts['time_axis']}, {facts['excited_regions']} excited region(s): "
               + ", ".join(f"{s}-{e}" for s, e in facts["excitation"]) + f"; joints used: {facts['joints_used']})")
     out.print(f"  period: {facts['period_reason']}", soft_wrap=True)

@@ -332,20 +332,33 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     if model != "M2" and sum(e - s - 2 * HALF for s, e in _derivative_regions(axis)) < max(2 * K, 1):
         raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the excited "
                            f"regions are too short: use --model M2 or fewer harmonics")
+    # On a part of under SHORT_PERIODS periods a linear term fitted beside the harmonics trades off against
+    # them (a turn that speeds up and slows down came out 40 % too fast): there the drift per period is the
+    # path's change between its ends, and the harmonics fit what is left.
+    drift = end_drift(L, axis) if axis.n_periods < SHORT_PERIODS else None
+    if drift is not None:
+        L = L - np.outer(np.nan_to_num(axis.x), drift)
+    linear = drift is None
     if model == "M1":  # the rows block by block: P's frames, velocities and accelerations are never held whole
         fit_p = HarmonicRegression(K, model).fit_blocks(_position_blocks(P, axis), _derivative_blocks(P, axis))
-        fit_l = HarmonicRegression(K, model, linear=True).fit_blocks(_position_blocks(L, axis),
-                                                                     _derivative_blocks(L, axis))
+        fit_l = HarmonicRegression(K, model, linear=linear).fit_blocks(_position_blocks(L, axis),
+                                                                       _derivative_blocks(L, axis))
     else:
         xd, dP, ddP = _derivative_rows(P, axis) if model != "M2" else (None, None, None)
         _, dL, ddL = _derivative_rows(L, axis) if model != "M2" else (None, None, None)
         fit_p = HarmonicRegression(K, model).fit(x, _rows(P, axis, frames), xd, dP, ddP)
         del dP, ddP  # (T, D) each: not held while L is fitted
-        fit_l = HarmonicRegression(K, model, linear=True).fit(x, _rows(L, axis, frames), xd, dL, ddL)
+        fit_l = HarmonicRegression(K, model, linear=linear).fit(x, _rows(L, axis, frames), xd, dL, ddL)
+    if drift is None:
+        drift = fit_l.drift_
+
+    def path(at):
+        return fit_l.predict(at) if linear else fit_l.predict(at) + np.outer(at, drift)
+
     x0 = float(np.floor(x[0]))
     if calmest or (calmest is None and reference is not None):  # start at the calmest step, between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
-        trial = Cycle(space=space, P=fit_p.predict(fine), L=fit_l.predict(fine), drift=fit_l.drift_,
+        trial = Cycle(space=space, P=fit_p.predict(fine), L=path(fine), drift=drift,
                       method="harmonic", model=model, n_harmonics=K, axis=axis, positions=np.zeros(0),
                       periodic=periodic)
         start = calmest_start(*loop_blocks(trial), stride=SUBFRAMES)
@@ -357,10 +370,27 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     else:
         P, projected = fit_p.predict(x0 + np.arange(N) / N), None
     xs = x0 + np.arange(N) / N
-    cycle = Cycle(space=space, P=P, L=fit_l.predict(xs), drift=fit_l.drift_, method="harmonic", model=model,
+    cycle = Cycle(space=space, P=P, L=path(xs), drift=drift, method="harmonic", model=model,
                   n_harmonics=K, axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic, regression=fit_p)
     cycle._projected = projected
     return cycle
+
+
+#: Fewer periods than this: the path's drift is measured between its ends, not fitted (:func:`end_drift`).
+SHORT_PERIODS = 3.0
+
+
+def end_drift(L: np.ndarray, axis: TimeAxis) -> np.ndarray:
+    """``(D,)`` change per period of the curves ``L (T, D)`` along ``axis`` between the ends of its longest
+    region: the means of the first and last tenth of a period (at least a frame) against their times."""
+    s, e = max(axis.regions, key=lambda r: r[1] - r[0])
+    h = max(1, int(round(0.1 * axis.period_frames)))
+    h = min(h, max(1, (e - s) // 4))
+    L = np.asarray(L, dtype=np.float64)
+    dx = float(axis.x[e - h:e].mean() - axis.x[s:s + h].mean())
+    if not dx > 0:
+        return np.zeros(L.shape[1])
+    return (L[e - h:e].mean(axis=0) - L[s:s + h].mean(axis=0)) / dx
 
 
 # ------------------------------------------------------------------ centroid

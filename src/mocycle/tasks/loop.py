@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..errors import OptionError
+from ..errors import LoopRefused, NoPeriodicMotion, OptionError
 from . import fields
 from .options import Choice, Flag, Integer, option
 from .options import Options as _Options
@@ -75,9 +75,11 @@ class Options(_Options):
     joints: str | None = fields.phase_joints()
     cycles: int = fields.cycles(1, "Repeat the cycle this many times in the output.")
     classes: int | str = fields.classes()
-    which: int | str | None = fields.which("Which periodic motion to loop (0-based; default: the one covering most "
-                                           "frames), or 'all': one file per periodic motion, OUT.class0.bvh, "
-                                           "OUT.class1.bvh, ...", words=("all",))
+    which: int | str | None = option(None, "Which part of the take to loop (0-based, as listed; default: the steady part "
+                                           "with the most cycles), or 'all': one file per part that loops, named "
+                                           "OUT.part<k>-<kind>.bvh (kind: walk-straight, walk-turning-left, run-..., "
+                                           "arms, periodic). --class is the old name.",
+                                     Integer(0, words={"all": "all"}, optional=True), flag="--part")
     pca: int | str | None = fields.pca()
     delay: int = fields.delay()
     min_periods: float = fields.min_periods()
@@ -91,17 +93,27 @@ class Options(_Options):
     foot_joints: str | None = fields.foot_joints()
 
 
-def run(take, options: Options | None = None) -> Report:
-    """Extract one seamless cycle; ``motions["loop"]`` is it repeated ``cycles`` times with the chosen root.
+#: A loop's cycle more than this share off the stride period (the landings of each foot) is not written.
+STRIDE_AGREEMENT = 0.06
+#: A loop's turn per cycle more than max(TURN_SLACK_DEG, TURN_SLACK_SHARE x the take's) off the take's is not written.
+TURN_SLACK_DEG, TURN_SLACK_SHARE = 10.0, 0.25
 
-    With ``which="all"``: one loop per periodic motion, ``motions["loop.class<k>"]``, and ``facts["loops"]``
-    holds the figures of each (every cycle is made and checked before the report is returned).
-    Raises :class:`~mocycle.errors.NoPeriodicMotion` when the take holds no periodic motion and
-    :class:`~mocycle.errors.LoopRefused` when a cycle fails a loop check (``force``: a warning instead).
+
+def run(take, options: Options | None = None) -> Report:
+    """Cut the take into steady activities (:func:`~mocycle.activities.segment_activities`) and loop them.
+
+    ``motions["loop"]`` is the chosen part's cycle repeated ``cycles`` times with the chosen root; with
+    ``which="all"`` every part that loops gets ``motions["loop.part<k>"]`` (``k``: the part's index in
+    ``facts["parts"]``).  ``facts``: ``status``, ``reason`` (plain words), ``loops`` (each loop's figures:
+    ``part``, ``kind``, ``frames``, period, speed, turn per cycle, metrics, checks, feet), ``not_looped`` (the
+    parts that were not, each with its reason), ``parts`` (every part of the take) and, at the top level, the
+    figures of the first loop (what ``loop`` printed before parts existed).
+    Raises :class:`~mocycle.errors.NoPeriodicMotion` when no part of the take repeats and
+    :class:`~mocycle.errors.LoopRefused` when every cycle made fails a loop check (``force``: a warning
+    instead); both carry ``facts`` with the same shape (``status`` ``no-periodic-motion`` or ``refused``).
     """
-    from ..cycle import cycle_phase, extract_cycle, loop_metrics
-    from ..cycle.checks import check_loop
-    from .feet import clean_feet
+    from ..activities import segment_activities
+    from ..cycle import cycle_phase
 
     o = options or Options()
     everything = o.which == "all"
@@ -109,53 +121,286 @@ def run(take, options: Options | None = None) -> Report:
         motion = load(take, o.amc_fps)
         start, stop = parse_range(o.frame_range, motion.n_frames)
         motion = motion[start:stop]
+        label = label_of(take)
         with rec.part("cycle"):
-            phase = cycle_phase(motion, phase_step=o.step, joints=o.joints, classes=o.classes, pca=o.pca,
-                                delay=o.delay, min_periods=o.min_periods)
-        targets = list(range(len(phase.classes))) if everything else [o.which]
-        if everything and not targets:
-            targets = [None]  # extract_cycle says why there is nothing to loop
-        loops, motions, cycles, extras = [], {}, [], {}
-        for k in targets:
+            acts = segment_activities(motion, min_periods=o.min_periods) if o.joints is None and o.step == 1 \
+                else None
+        parts = acts.parts if acts is not None else []
+        loopable = [k for k, p in enumerate(parts) if p.loop]
+        whole = acts is None or _one_activity(acts)
+        if isinstance(o.which, int) and not whole and o.which >= len(parts):
+            raise OptionError("which", f"the take has {len(parts)} part(s) (0 to {len(parts) - 1}); got {o.which}")
+        jobs = []  # (part index or None, motion to loop, offset, PhaseResult, class index or None, Activity or None)
+        if whole:
+            part = parts[loopable[0]] if acts is not None and loopable else None
             with rec.part("cycle"):
-                fitted = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
-                                       time_axis_method=o.time_axis, which=k, phase=phase)
-            with rec.part("metrics"):
-                # the metrics and checks judge the fitted cycle against the take (locking changes the legs on
-                # purpose); the feet block says what locking did
-                travelling = fitted.repeat(2, root="motion")
-                metrics = loop_metrics(motion, fitted, travelling)
-                label = f"{label_of(take)} class {k}" if everything else label_of(take)
-                failed = check_loop(motion, fitted, metrics, force=o.force, label=label)
-            with rec.part("feet"):
-                frames = fitted.axis.frames()   # the swing clearance of the looped region of the take
-                # the fitted cycle's skate is the metrics' when the feet are the ones found by name
-                cycle, feet_facts, contacts = clean_feet(fitted, o.feet, o.root, o.foot_joints,
-                                                         reference=motion[frames[0]:frames[-1] + 1],
-                                                         before=travelling,
-                                                         skate_before=None if o.foot_joints else metrics["skate"])
-            with rec.part("cycle"):
-                result = cycle.repeat(o.cycles, root=o.root)
-            index = next(i for i, c in enumerate(phase.classes) if c is cycle.periodic)
-            loops.append({
-                "class": index,
-                "frames_in": motion.n_frames,
-                "frames_out": result.n_frames,
-                "fps": motion.fps,
-                **cycle.to_dict(),
-                "excitation": [[int(s), int(e)] for s, e in cycle.axis.regions],
-                "model": o.model if o.method == "harmonic" else None,
-                "root": o.root,
-                "cycles": o.cycles,
-                "metrics": metrics,
-                "failed_checks": [f.to_dict() for f in failed],
-                "feet": feet_facts,
-                "excited_regions": len(cycle.periodic.excitation),
-            })
-            role = f"loop.class{index}" if everything else "loop"
+                try:
+                    phase = cycle_phase(motion, phase_step=o.step, joints=o.joints, classes=o.classes, pca=o.pca,
+                                        delay=o.delay, min_periods=o.min_periods)
+                except NoPeriodicMotion as exc:
+                    raise _no_loop(exc, acts, start) from None
+            if everything and part is None:
+                ks = list(range(len(phase.classes))) or [None]
+            else:
+                ks = [o.which if isinstance(o.which, int) else None]
+            for k in ks:
+                if part is not None and phase.classes and k is None and _off_strides(phase, part):
+                    # the cohomology's period disagrees with the landings: the part's stride phase decides
+                    jobs.append((loopable[0], motion[part.start:part.stop], part.start,
+                                 _part_phase(part, phase), None, part))
+                else:
+                    jobs.append((None if part is None else loopable[0], motion, 0, phase, k, part))
+        else:
+            if isinstance(o.which, int):
+                chosen = [o.which] if parts[o.which].loop else []
+            else:
+                # by default the part with the most cycles first; the next ones only if it is refused
+                chosen = sorted(loopable, key=lambda k: -parts[k].n_periods)
+            for k in chosen:
+                p = parts[k]
+                jobs.append((k, motion[p.start:p.stop], p.start, _part_phase(p), None, p))
+        loops, not_looped, motions, cycles, extras, refusals = [], [], {}, [], {}, []
+        for index, piece, offset, phase, k, part in jobs:
+            try:
+                facts, result, extra, cycle = _loop_one(piece, phase, k, o, label, offset, part, rec)
+            except NoPeriodicMotion as exc:
+                if whole:
+                    raise _no_loop(exc, acts, start) from None
+                not_looped.append({"part": index, "kind": part.kind,
+                                   "frames": [start + part.start, start + part.stop], "reason": str(exc)})
+                continue
+            except LoopRefused as exc:
+                refusals.append(exc)
+                if part is not None:
+                    not_looped.append({"part": index, "kind": part.kind,
+                                       "frames": [start + part.start, start + part.stop], "reason": f"refused: {exc}"})
+                continue
+            facts["part"] = index
+            facts["frames"] = [f + start for f in facts["frames"]]
+            facts["excitation"] = [[a + start, b + start] for a, b in facts["excitation"]]
+            role = _role(index, k, everything)
+            facts["role"] = role
+            loops.append(facts)
             motions[role] = result
-            extras[role] = {"fitted": fitted, "contacts": contacts}
+            extras[role] = extra
             cycles.append(cycle)
+            if not everything:
+                break
+        for k, p in enumerate(parts):
+            if not p.loop:
+                not_looped.append({"part": k, "kind": p.kind, "frames": [start + p.start, start + p.stop],
+                                   "reason": p.reason})
+        not_looped.sort(key=lambda d: (d["frames"] or [0])[0])
+        if not loops:
+            if refusals:
+                exc = refusals[0] if len(refusals) == 1 else \
+                    LoopRefused("; ".join(map(str, refusals)), [f for r in refusals for f in r.failed])
+                exc.facts = _facts("refused", str(exc), [], not_looped, acts, start)
+                raise exc
+            reason = nothing_to_loop(acts)
+            exc = NoPeriodicMotion(reason)
+            exc.facts = _facts("no-periodic-motion", reason, [], not_looped, acts, start)
+            raise exc
     motions["input"] = motion
-    facts = {"loops": loops} if everything else loops[0]
+    facts = _facts("ok", _chosen_reason(loops, parts, everything), loops, not_looped, acts, start)
     return rec.report("loop", facts, motions, cycles if everything else cycles[0], extras)
+
+
+def _role(index, k, everything) -> str:
+    if not everything:
+        return "loop"
+    return f"loop.part{index}" if index is not None else f"loop.class{k or 0}"
+
+
+def _one_activity(acts) -> bool:
+    """Whether the take is looped whole, its phase found on all of it (as before parts existed): the rig's
+    feet were not found; or it does one thing (one part to loop, the rest under a tenth of its frames); or no
+    foot ever lands in a gait and nothing was found to repeat (the cohomology of the whole take has the last
+    word: a run whose contacts were missed)."""
+    if not acts.feet:
+        return True
+    loopable = acts.loopable()
+    if not loopable:
+        return not any(p.gait or p.kind == "transition" for p in acts.parts)
+    rest = acts.n_frames - sum(p.n_frames for p in loopable)
+    return len(loopable) == 1 and loopable[0].gait and rest < 0.1 * acts.n_frames
+
+
+def _off_strides(phase, part) -> bool:
+    """Whether the main periodic motion found on the whole take is more than :data:`STRIDE_AGREEMENT` off
+    the stride period of the take's one gait part."""
+    from ..cycle.extract import choose_periodic
+
+    period = choose_periodic(phase).period_frames
+    return part.periodic is not None and abs(period / part.period_frames - 1) > STRIDE_AGREEMENT
+
+
+def _no_loop(exc, acts, offset):
+    """``exc`` (nothing periodic found on the whole take) in plain words, with the technical why in the JSON."""
+    reason = nothing_to_loop(acts) if acts is not None and acts.parts else "no repeating motion found in the take"
+    out = NoPeriodicMotion(reason)
+    out.facts = _facts("no-periodic-motion", reason, [], [], acts, offset)
+    out.facts["detail"] = str(exc)
+    return out
+
+
+def _part_phase(part, found=None):
+    """The PhaseResult of one part's frames: its stride phase (gait) or the phase found on its limbs;
+    ``found``: the phase found on the whole take whose period the strides overrule (named in the reason)."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from ..cycle.extract import choose_periodic
+    from ..phase.analysis import PhaseResult
+
+    pm = part.periodic
+    if found is not None:
+        other = choose_periodic(found)
+        pm = replace(pm, period_candidates={**other.period_candidates, "strides": pm.period_frames},
+                     period_reason=(f"the strides: the {other.period_source}'s period on the whole take "
+                                    f"({other.period_frames:.2f} frames) is more than {STRIDE_AGREEMENT:.0%} off "
+                                    f"the landings' ({pm.period_frames:.2f})"))
+    return PhaseResult(classes=[pm], barcode=np.zeros((0, 2)), reason=pm.period_reason,
+                       autocorrelation_period_frames=float("nan"), n_frames=part.n_frames,
+                       frame_time=pm.frame_time, joints_used=pm.joints_used)
+
+
+def nothing_to_loop(acts) -> str:
+    """Why nothing in the take loops, in plain words."""
+    if acts is None or not acts.parts:
+        return "no repeating motion found in the take"
+    kinds = sorted({p.kind for p in acts.parts})
+    if kinds == ["standing"]:
+        return "no repeating motion: the actor stands still"
+    if set(kinds) <= {"gesture", "standing"}:
+        return "no repeating motion: the take does one gesture, it does not repeat"
+    short = [p for p in acts.parts if p.gait]
+    if short:
+        longest = max(short, key=lambda p: p.n_frames)
+        return (f"no part repeats long enough to loop: the longest steady part ({longest.reason.split(':')[0]}) "
+                f"holds {longest.n_periods:.1f} strides")
+    return "no repeating motion: " + "; ".join(p.reason for p in acts.parts)
+
+
+def _chosen_reason(loops, parts, everything) -> str:
+    if everything or not parts:
+        return f"{len(loops)} loop(s)"
+    f = loops[0]
+    if f["part"] is None:
+        return "the take does one thing: it is looped as a whole"
+    others = sum(1 for p in parts if p.loop) - 1
+    return (f"looped part {f['part']} ({f['kind']}, frames {f['frames'][0]}-{f['frames'][1]}): the steady part with "
+            f"the most cycles" + (f"; {others} other part(s) can loop too (--part all writes every one)"
+                                  if others > 0 else ""))
+
+
+def _facts(status, reason, loops, not_looped, acts, offset) -> dict:
+    parts = []
+    for p in acts.parts if acts is not None else []:
+        d = p.to_dict()
+        d["frames"] = [d["frames"][0] + offset, d["frames"][1] + offset]
+        d["landings"] = {k: [f + offset for f in v] for k, v in d["landings"].items()}
+        parts.append(d)
+    first = dict(loops[0]) if loops else {}
+    return {**first, "status": status, "reason": reason, "loops": loops, "not_looped": not_looped,
+            "parts": parts}
+
+
+def _loop_one(motion, phase, k, o, label, offset, part, rec):
+    """One loop: the cycle of ``motion`` (a part of the take starting at take frame ``offset``), its metrics,
+    checks and feet.  Returns ``(facts, repeated cycle, extras, cycle)``; raises LoopRefused."""
+    from ..cycle import extract_cycle, loop_metrics
+    from ..cycle.checks import check_loop
+    from .feet import clean_feet
+
+    with rec.part("cycle"):
+        fitted = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
+                               time_axis_method=o.time_axis, which=k, phase=phase)
+    with rec.part("metrics"):
+        # the metrics and checks judge the fitted cycle against the take (locking changes the legs on
+        # purpose); the feet block says what locking did
+        travelling = fitted.repeat(2, root="motion")
+        metrics = loop_metrics(motion, fitted, travelling)
+        name = f"{label} part {part.kind}" if part is not None and offset else label
+        extra_checks = _activity_checks(motion, fitted, part, offset)
+        failed = check_loop(motion, fitted, metrics, force=o.force, label=name, extra=extra_checks)
+    with rec.part("feet"):
+        frames = fitted.axis.frames()   # the swing clearance of the looped region of the take
+        # the fitted cycle's skate is the metrics' when the feet are the ones found by name
+        cycle, feet_facts, contacts = clean_feet(fitted, o.feet, o.root, o.foot_joints,
+                                                 reference=motion[frames[0]:frames[-1] + 1],
+                                                 before=travelling,
+                                                 skate_before=None if o.foot_joints else metrics["skate"])
+    with rec.part("cycle"):
+        result = cycle.repeat(o.cycles, root=o.root)
+    index = next(i for i, c in enumerate(phase.classes) if c is cycle.periodic)
+    regions = [[int(s) + offset, int(e) + offset] for s, e in cycle.axis.regions]
+    looped = [regions[0][0], regions[-1][1]]
+    facts = {
+        "class": index,
+        "kind": part.kind if part is not None else "periodic",
+        "frames": looped,
+        "frames_in": motion.n_frames,
+        "frames_out": result.n_frames,
+        "fps": motion.fps,
+        **cycle.to_dict(),
+        "speed": _speed(cycle),
+        "excitation": regions,
+        "model": o.model if o.method == "harmonic" else None,
+        "root": o.root,
+        "cycles": o.cycles,
+        "metrics": metrics,
+        "failed_checks": [f.to_dict() for f in failed],
+        "feet": feet_facts,
+        "excited_regions": len(cycle.periodic.excitation),
+    }
+    return facts, result, {"fitted": fitted, "contacts": contacts}, cycle
+
+
+def _speed(cycle) -> float:
+    """Units per second of the loop's travel (horizontal distance per cycle over the cycle's time)."""
+    import numpy as np
+
+    move = np.asarray(cycle.to_dict()["travel_per_cycle"], dtype=np.float64)
+    up = np.asarray(cycle.space.world_up, dtype=np.float64)
+    flat = move - (move @ up) * up
+    return float(np.linalg.norm(flat) / (cycle.period_frames * cycle.space.frame_time))
+
+
+def _activity_checks(motion, cycle, part, offset) -> list:
+    """The checks a loop of a part must pass beside :func:`~mocycle.cycle.checks.loop_checks`: its cycle
+    agrees with the stride period of the landings in the frames it loops, and it turns as the take does
+    there (the hips' heading)."""
+    import numpy as np
+
+    from ..activities import find_landings, heading_degrees
+    from ..cycle.checks import FailedCheck
+
+    failed = []
+    s, e = cycle.axis.regions[0][0], cycle.axis.regions[-1][1]
+    landings = find_landings(motion)
+    if landings is not None:
+        strides = []
+        for f in range(len(landings.sides)):
+            fr = landings.frames[(landings.foot == f) & (landings.frames >= s) & (landings.frames <= e)]
+            strides.extend(np.diff(fr).tolist())
+        legs_move = part is None or part.gait
+        if strides and legs_move:
+            stride = float(np.median(strides))
+            off = cycle.period_frames / stride - 1.0
+            if abs(off) > STRIDE_AGREEMENT:
+                failed.append(FailedCheck(
+                    "stride", float(abs(off)), STRIDE_AGREEMENT,
+                    f"the cycle ({cycle.period_frames:.1f} frames) is {abs(off):.0%} off the strides (each foot "
+                    f"lands every {stride:.1f} frames here)"))
+    heading = heading_degrees(motion)
+    take_turn = float(heading[e - 1] - heading[s]) / max(e - 1 - s, 1) * cycle.period_frames
+    loop_turn = float(cycle.to_dict()["turn_per_cycle_deg"])
+    slack = max(TURN_SLACK_DEG, TURN_SLACK_SHARE * abs(take_turn))
+    if abs(loop_turn - take_turn) > slack:
+        failed.append(FailedCheck(
+            "turn", float(abs(loop_turn - take_turn)), float(slack),
+            f"the loop turns {loop_turn:.0f} degrees per cycle where the take turns {take_turn:.0f} over the frames "
+            f"it loops"))
+    return failed
