@@ -75,6 +75,8 @@ class Activity:
     loop: bool = False
     reason: str = ""
     landings: dict[str, list[int]] = field(default_factory=dict)
+    #: whether the legs stand over the part (known for the parts without gait)
+    legs_still: bool = True
     #: the phase of the part's frames (frame ``start`` first), a PeriodicMotion, once known
     periodic: object = field(default=None, repr=False)
 
@@ -184,6 +186,17 @@ def _gait_chains(landings: Landings, fps: float) -> list[np.ndarray]:
     return [np.asarray(c, dtype=np.intp) for c in chains if len(c) >= 3]
 
 
+def stride_periods(landings: Landings, fps: float, start: int = 0, stop: int | None = None) -> list[int]:
+    """The strides (frames from a foot's landing to its next, the other foot landing once between, each step
+    of plausible length) whose landings lie in frames ``start .. stop``."""
+    out = []
+    for chain in _gait_chains(landings, fps):
+        f = landings.frames[chain]
+        f = f[(f >= start) & (f <= (stop if stop is not None else f.max()))]
+        out.extend(int(f[k + 2] - f[k]) for k in range(f.size - 2))
+    return out
+
+
 # ------------------------------------------------------------------------------------------- segmentation
 def heading_degrees(motion: Motion) -> np.ndarray:
     """The hips' (travel joint's) heading ``(T,)`` in degrees, unwrapped, positive turning left about up."""
@@ -259,6 +272,9 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2, contacts=Non
     body = _body_height(motion)
     parts: list[Activity] = []
     for chain in _gait_chains(landings, fps):
+        a, b = int(landings.frames[chain[0]]), int(landings.frames[chain[-1]])
+        if _legs_still(motion.skeleton, _rotation_spread(motion[a:b + 1])):
+            continue  # contacts that flicker while the legs stand are no steps
         strides = _stride_figures(chain, landings, heading, path, fps)
         kinds = _step_kinds(strides, body)
         f = landings.frames[chain]
@@ -350,15 +366,16 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
         return [Activity(start=start, stop=stop, kind="standing", limbs="none",
                          reason="the actor stands: nothing moves enough to loop")]
     found = _periodic_in(piece, spread, min_periods)
+    still = _legs_still(piece.skeleton, spread)
     if found is None:
-        return [Activity(start=start, stop=stop, kind="gesture", limbs="none",
+        return [Activity(start=start, stop=stop, kind="gesture", limbs="none", legs_still=still,
                          reason="no repeating motion: the body moves once, it does not repeat")]
     limbs, kind, pm, (s, e) = found
     out = []
     if s > 0:
         out.extend(_lead(motion, start, start + s, "before"))
     out.append(Activity(start=start + s, stop=start + e, kind=kind, limbs=limbs, period_frames=pm.period_frames,
-                        loop=True, periodic=pm,
+                        loop=True, periodic=pm, legs_still=still,
                         reason=f"{kind}: {pm.n_periods:.1f} periods of {pm.period_frames:.1f} frames"))
     if e < n:
         out.extend(_lead(motion, start + e, stop, "after"))
@@ -390,6 +407,15 @@ def _moving_arm_joints(skeleton, spread: np.ndarray) -> list[str]:
     if top < STILL_DEG:
         return []
     return [skeleton.names[j] for j in arms if spread[j] >= MOVING_SHARE * top]
+
+
+def _legs_still(skeleton, spread: np.ndarray) -> bool:
+    """Whether the legs stand: no leg joint's rotation spreads more than twice :data:`STILL_DEG`."""
+    try:
+        legs = skeleton.select("legs")
+    except MocycleError:
+        return True
+    return not legs or float(spread[legs].max()) < 2 * STILL_DEG
 
 
 def _repeating_region(piece: Motion, joints, min_periods: float) -> tuple[int, int, float] | None:
@@ -437,13 +463,15 @@ def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float):
     from .phase import find_phase
     from .phase.analysis import PERIOD_AGREEMENT
 
-    moving = _moving_arm_joints(piece.skeleton, spread)
+    moving = _moving_arm_joints(piece.skeleton, spread) if _legs_still(piece.skeleton, spread) else []
     tries = [(moving, "arms")] if moving else []
     tries.append((None, "periodic"))
     for joints, kind in tries:
         region = _repeating_region(piece, joints, min_periods)
         if region is None:
-            continue
+            if joints is not None:
+                continue
+            region = (0, piece.n_frames, float("nan"))  # the whole body: the cohomology finds where it repeats
         s, e, acf = region
         sub = piece[s:e]
         limbs = ",".join(joints) if joints else "all"
@@ -452,11 +480,13 @@ def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float):
             classes = result.classes
         except (NoPeriodicMotion, MocycleError):
             classes = []
-        agree = [c for c in classes if abs(c.period_frames / acf - 1) <= 2 * PERIOD_AGREEMENT]
+        agree = [c for c in classes if not np.isfinite(acf) or abs(c.period_frames / acf - 1) <= 2 * PERIOD_AGREEMENT]
         if agree:
             pm = max(agree, key=lambda c: len(c.frames()))
             a, b = pm.excitation[0][0], pm.excitation[-1][1]
             return limbs, kind, _rebased(pm, a, b), (s + a, s + b)
+        if not np.isfinite(acf):
+            continue
         x = np.arange(e - s, dtype=np.float64) / acf
         why = (f"the autocorrelation of the {'moving arm joints' if joints else 'body'}' velocities: "
                f"{acf:.2f} frames" + (f" (the cohomology's {', '.join(f'{c.period_frames:.2f}' for c in classes)} "

@@ -43,8 +43,12 @@ def test_no_periodic_motion_exits_3_and_writes_nothing(tmp_path):
     out = tmp_path / "cycle.bvh"
     result = runner.invoke(app, ["loop", str(src), "-o", str(out)])
     assert result.exit_code == 3
-    assert "no periodic motion found: " in result.stderr and "H1 bar" in result.stderr
+    assert "no repeating motion: the actor stands still" in result.stderr  # plain words on the terminal
     assert not out.exists()
+    as_json = runner.invoke(app, ["loop", str(src), "-o", str(out), "--json"])
+    facts = json.loads(as_json.stdout)  # a refused take prints its JSON too: status, reason, the technical why
+    assert as_json.exit_code == 3 and facts["status"] == "no-periodic-motion" and facts["loops"] == []
+    assert "H1 bar" in facts["detail"] and facts["parts"][0]["kind"] == "standing"
 
 
 def test_bad_options_exit_2_with_one_message(tmp_path):

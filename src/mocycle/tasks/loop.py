@@ -75,11 +75,11 @@ class Options(_Options):
     joints: str | None = fields.phase_joints()
     cycles: int = fields.cycles(1, "Repeat the cycle this many times in the output.")
     classes: int | str = fields.classes()
-    which: int | str | None = option(None, "Which part of the take to loop (0-based, as listed; default: the steady part "
-                                           "with the most cycles), or 'all': one file per part that loops, named "
-                                           "OUT.part<k>-<kind>.bvh (kind: walk-straight, walk-turning-left, run-..., "
-                                           "arms, periodic). --class is the old name.",
-                                     Integer(0, words={"all": "all"}, optional=True), flag="--part")
+    which: int | str | None = option(
+        None, "Which part of the take to loop (0-based, as listed; default: the steady part with the most cycles), or "
+              "'all': one file per part that loops, named OUT.part<k>-<kind>.bvh (kind: walk-straight, "
+              "walk-turning-left, run-..., arms, periodic). --class is the old name.",
+        Integer(0, words={"all": "all"}, optional=True), flag="--part")
     pca: int | str | None = fields.pca()
     delay: int = fields.delay()
     min_periods: float = fields.min_periods()
@@ -127,12 +127,13 @@ def run(take, options: Options | None = None) -> Report:
                 else None
         parts = acts.parts if acts is not None else []
         loopable = [k for k, p in enumerate(parts) if p.loop]
-        whole = acts is None or _one_activity(acts)
+        plan = _plan(acts)
+        whole = plan != "parts"
         if isinstance(o.which, int) and not whole and o.which >= len(parts):
             raise OptionError("which", f"the take has {len(parts)} part(s) (0 to {len(parts) - 1}); got {o.which}")
         jobs = []  # (part index or None, motion to loop, offset, PhaseResult, class index or None, Activity or None)
         if whole:
-            part = parts[loopable[0]] if acts is not None and loopable else None
+            part = parts[loopable[0]] if plan == "single" else None
             with rec.part("cycle"):
                 try:
                     phase = cycle_phase(motion, phase_step=o.step, joints=o.joints, classes=o.classes, pca=o.pca,
@@ -186,7 +187,7 @@ def run(take, options: Options | None = None) -> Report:
             cycles.append(cycle)
             if not everything:
                 break
-        for k, p in enumerate(parts):
+        for k, p in enumerate(parts if plan != "whole" else []):  # looped whole: the parts are only shown
             if not p.loop:
                 not_looped.append({"part": k, "kind": p.kind, "frames": [start + p.start, start + p.stop],
                                    "reason": p.reason})
@@ -212,18 +213,20 @@ def _role(index, k, everything) -> str:
     return f"loop.part{index}" if index is not None else f"loop.class{k or 0}"
 
 
-def _one_activity(acts) -> bool:
-    """Whether the take is looped whole, its phase found on all of it (as before parts existed): the rig's
-    feet were not found; or it does one thing (one part to loop, the rest under a tenth of its frames); or no
-    foot ever lands in a gait and nothing was found to repeat (the cohomology of the whole take has the last
-    word: a run whose contacts were missed)."""
-    if not acts.feet:
-        return True
+def _plan(acts) -> str:
+    """How the take is looped: ``"parts"`` (each steady part on its own), ``"single"`` (it does one thing: one
+    gait part to loop, the rest under a tenth of its frames; looped whole, its phase found on all of it and
+    checked against the strides) or ``"whole"`` (as before parts existed: the rig's feet were not found, or
+    the parts do not account for the take (the legs move where no foot lands in a gait: contacts were
+    missed, and the cohomology of the whole take, which finds several periodic motions and their regions,
+    has the last word), or nothing in it loops)."""
+    if acts is None or not acts.feet:
+        return "whole"
     loopable = acts.loopable()
-    if not loopable:
-        return not any(p.gait or p.kind == "transition" for p in acts.parts)
+    if not loopable or any(not p.gait and not p.legs_still for p in acts.parts):
+        return "whole"
     rest = acts.n_frames - sum(p.n_frames for p in loopable)
-    return len(loopable) == 1 and loopable[0].gait and rest < 0.1 * acts.n_frames
+    return "single" if len(loopable) == 1 and loopable[0].gait and rest < 0.1 * acts.n_frames else "parts"
 
 
 def _off_strides(phase, part) -> bool:
@@ -374,19 +377,18 @@ def _activity_checks(motion, cycle, part, offset) -> list:
     there (the hips' heading)."""
     import numpy as np
 
-    from ..activities import find_landings, heading_degrees
+    from ..activities import find_landings, heading_degrees, stride_periods
     from ..cycle.checks import FailedCheck
 
     failed = []
     s, e = cycle.axis.regions[0][0], cycle.axis.regions[-1][1]
     landings = find_landings(motion)
     if landings is not None:
-        strides = []
-        for f in range(len(landings.sides)):
-            fr = landings.frames[(landings.foot == f) & (landings.frames >= s) & (landings.frames <= e)]
-            strides.extend(np.diff(fr).tolist())
-        legs_move = part is None or part.gait
-        if strides and legs_move:
+        strides = stride_periods(landings, motion.fps, s, e)
+        # one stride measured from contacts that come and go (a gliding foot) is no ruler; a gait part's
+        # strides are (its phase was made from them)
+        enough = len(strides) >= 2 if part is None or not part.gait else bool(strides)
+        if enough and (part is None or part.gait):
             stride = float(np.median(strides))
             off = cycle.period_frames / stride - 1.0
             if abs(off) > STRIDE_AGREEMENT:
