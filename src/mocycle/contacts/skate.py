@@ -44,7 +44,9 @@ def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: f
         step[..., k] -= vu * up[k]
     speed = np.linalg.norm(step, axis=-1) / motion.frame_time    # (T-1, C)
     hm = 0.5 * (h[1:] + h[:-1])
-    w = np.where(hm < H, 2.0 - 2.0 ** (hm / H), 0.0)
+    # the exponent clipped at 1 (where the weight is 0 anyway): a foot far above a tiny body height (a still
+    # take, a rig whose body height comes out near 0) overflowed 2**(h/H) and printed a numpy warning
+    w = np.where(hm < H, 2.0 - 2.0 ** np.minimum(hm / H, 1.0), 0.0) if H > 0 else np.zeros_like(hm)
     values = (w * speed).mean(axis=0)
     if per_joint:
         return {motion.skeleton.names[j]: float(v) for j, v in zip(joints, values, strict=True)}

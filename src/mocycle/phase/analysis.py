@@ -473,8 +473,12 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
     for subset, label in _subsets(motion, joints):
         X = phase_features(motion, joints=subset, pca=pca, delay=delay, rep=rep, root=root, normalize=normalize,
                            weights=weights)
-        estimator = CohomologyFit(n_landmarks=n_landmarks, scale=scale, n_classes=classes,
-                                        min_cycles=float(min_periods)).fit(X)
+        try:
+            estimator = CohomologyFit(n_landmarks=n_landmarks, scale=scale, n_classes=classes,
+                                      min_cycles=float(min_periods)).fit(X)
+        except MocycleError as exc:  # e.g. no prime lifts the class to Z: the next joint selection may do
+            tries.append((label, f"the analysis failed ({exc})"))
+            continue
         found = _separate(_distinct([_periodic_motion(estimator.coords_[:, k], c, motion.frame_time,
                                                       motion.n_frames) for k, c in enumerate(estimator.classes_)]), X)
         acf = autocorrelation_period(X, min_lag=min_lag)
@@ -495,6 +499,8 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
         if checked and not doubt:
             kept = (checked, X, estimator, label, acf)
             break
+    if kept is None:  # every joint selection failed: no periodic motion to be found (exit 3, not a crash)
+        raise NoPeriodicMotion("no periodic motion found: " + "; ".join(f"{k}: {r}" for k, r in tries))
     checked, X, estimator, label, acf = kept
     if len(tries) == 1:
         reason = tries[0][1]
