@@ -13,12 +13,14 @@ The ruler does not use mocycle's phase, cycle or contacts code: only ``mocycle.r
 ``Motion.world_positions()``, the skeleton's names and parents, numpy and scipy.
 
 * feet: the two leg end joints (the joints lowest below the upper legs, found from the joints named
-  foot/toe/ankle or else the lowest leaves); the vertical is the axis along which the mean pose is
-  tallest, pointing from the feet to the hips; a foot's height is taken above its own 5th percentile.
+  foot/toe/ankle or else the lowest leaves); the vertical is the axis along which the body spreads most
+  (median over frames), pointing from the feet to the hips; a foot's height is taken above its own 5th
+  percentile over the surrounding 2 s (the floor drifts in some captures).
 * landings: starts of the runs (at least 0.06 s, gaps under 0.1 s closed) where a foot is low (under 3 %
   of the body height) and slow (horizontal speed under the larger of 15 % of the body height per second
   and 35 % of that foot's 95th percentile speed: the synthetic feet slide in stance); the stride period
-  over a frame range is the median interval between successive landings of the same foot there.
+  over a frame range is the median interval between successive landings (contact starts after at
+  least 0.15 s off the floor) of the same foot there.
 * heading: the horizontal direction perpendicular to the left-to-right upper-leg vector, unwrapped, in
   degrees; a range's turn rate is a line fit; a loop's turn per cycle is the mean of ``h[k + N] - h[k]``
   over its first cycle of ``N`` frames (the pelvis' own swing cancels).
@@ -50,7 +52,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.ndimage import binary_closing, binary_opening, gaussian_filter1d
+from scipy.ndimage import binary_closing, binary_opening, gaussian_filter1d, percentile_filter
 
 import mocycle
 from mocycle.datasets import (
@@ -214,7 +216,8 @@ class Body:
         v = sign * P[..., axis]                            # (T, J) height
         h1, h2 = (axis + 1) % 3, (axis + 2) % 3            # (h1, h2, up) right-handed
         height = float(spread(body)[axis])
-        feet = [v[:, e] - np.percentile(v[:, e], 5) for e in ends]
+        win = max(3, int(round(2.0 * motion.fps)))     # the floor under a foot: its 5th percentile over 2 s
+        feet = [v[:, e] - percentile_filter(v[:, e], 5, size=win, mode="nearest") for e in ends]
         feet_xy = [P[:, e][:, [h1, h2]] for e in ends]
         d = P[:, up_r] - P[:, up_l]                        # left -> right (or its opposite: a constant 180)
         fwd1 = sign * (-d[:, h2])                          # up x d in the (h1, h2) plane
@@ -267,8 +270,18 @@ class Body:
         return c
 
     def landings(self, i: int) -> np.ndarray:
+        """Frames where foot ``i`` lands: contact starts after at least 0.15 s off the floor (at the take's
+        start, 0.15 s in which the foot rises 4 % of the body height: a contact starting a few frames
+        into the take may be no landing at all)."""
         c = self.contact(i)
-        return np.nonzero(c[1:] & ~c[:-1])[0] + 1
+        starts = np.flatnonzero(c[1:] & ~c[:-1]) + 1
+        ends = np.flatnonzero(c[:-1] & ~c[1:]) + 1           # first frame off the floor
+        keep = []
+        for f in starts:
+            lift = ends[ends < f][-1] if np.any(ends < f) else 0
+            if f - lift >= 0.15 * self.fps and (lift > 0 or self.feet[i][:f].max() >= 0.04 * self.height):
+                keep.append(f)
+        return np.array(keep, dtype=np.int64)
 
     def stride_period(self, a: int, b: int) -> tuple[float, str]:
         """Median same-foot landing interval (frames) over ``[a, b)`` (widened by 15 % each side when
