@@ -1,6 +1,7 @@
 """Built-in demo data and test ground truth (synthetic takes with exact phase)."""
 
 from .synthetic import (
+    STEADY_KINDS,
     SyntheticTake,
     humanoid_skeleton,
     synthetic_circle_walk,
@@ -11,10 +12,14 @@ from .synthetic import (
     synthetic_still,
     synthetic_walk,
     synthetic_walk_then_run,
+    synthetic_walk_then_wave,
+    synthetic_walk_turn_walk,
+    synthetic_wave,
     to_z_up,
 )
 
 __all__ = [
+    "STEADY_KINDS",
     "SyntheticTake",
     "humanoid_skeleton",
     "synthetic_circle_walk",
@@ -25,5 +30,8 @@ __all__ = [
     "synthetic_still",
     "synthetic_walk",
     "synthetic_walk_then_run",
+    "synthetic_walk_then_wave",
+    "synthetic_walk_turn_walk",
+    "synthetic_wave",
     "to_z_up",
 ]

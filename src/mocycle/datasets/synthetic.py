@@ -28,6 +28,7 @@ from ..motion import EndSite, Motion, Skeleton
 from ..rotations import euler_to_quats
 
 __all__ = [
+    "STEADY_KINDS",
     "SyntheticTake",
     "humanoid_skeleton",
     "synthetic_gesture",
@@ -38,6 +39,9 @@ __all__ = [
     "synthetic_still",
     "synthetic_walk",
     "synthetic_walk_then_run",
+    "synthetic_walk_then_wave",
+    "synthetic_walk_turn_walk",
+    "synthetic_wave",
     "to_z_up",
 ]
 
@@ -81,6 +85,9 @@ _END_SITES = (
 _NAMES = tuple(j[0] for j in _JOINTS)
 _IX = {n: i for i, n in enumerate(_NAMES)}
 _AXIS = {"X": 0, "Y": 1, "Z": 2}
+#: Segment labels of steady periodic activities (see :attr:`SyntheticTake.steady_parts`).
+STEADY_KINDS = frozenset({"walk", "run", "symmetric walk", "straight", "turning left", "turning right",
+                          "wave"})
 #: Standing height of the Hips joint in the rest pose (cm); toes then touch y = 0.
 STAND_HEIGHT = 97.0
 
@@ -119,6 +126,9 @@ class SyntheticTake:
     description : one line saying how the take was made.
     euler_deg : ``(T, J, 3)`` the rotation channel values in degrees, in each
         joint's own channel order (what a BVH file of this take should hold).
+    heading_deg : ``(T,)`` the body's facing about the world vertical in degrees, from
+        the skeleton's forward axis (+Z), positive towards its left (+X, a left turn);
+        ``None`` for takes that do not say.
     """
 
     motion: Motion
@@ -128,6 +138,7 @@ class SyntheticTake:
     segments: list[tuple[str, int, int]]
     description: str
     euler_deg: np.ndarray | None = None
+    heading_deg: np.ndarray | None = None
 
     @property
     def n_frames(self) -> int:
@@ -136,6 +147,12 @@ class SyntheticTake:
     @property
     def fps(self) -> float:
         return self.motion.fps
+
+    @property
+    def steady_parts(self) -> list[tuple[str, int, int]]:
+        """The ``segments`` that hold a steady periodic activity (a gait, turning or not, or a wave);
+        transitions, raises, holds and one-off gestures left out."""
+        return [seg for seg in self.segments if seg[0] in STEADY_KINDS]
 
 
 # -- gait design --------------------------------------------------------------
@@ -455,7 +472,7 @@ def _gait_take(style: _Style, n_frames, fps, period_s, noise_deg, drift, speed_c
     desc = (f"synthetic {style.name}: {n_frames} frames at {fps:g} fps, period {period_s:g} s, "
             f"speed change {speed_change:+g}, noise {noise_deg:g} deg, drift {drift:g}, "
             f"phase0 {phase0:g}, seed {seed}")
-    return SyntheticTake(motion, phase, u, period, [(style.name, 0, n_frames)], desc, chan)
+    return SyntheticTake(motion, phase, u, period, [(style.name, 0, n_frames)], desc, chan, heading)
 
 
 # -- public generators ----------------------------------------------------------
@@ -716,7 +733,7 @@ def synthetic_circle_walk(n_frames: int = 600, fps: float = 60.0, period_s: floa
         motion = to_z_up(motion)
     desc = (f"synthetic {style.name} along a circle: {n_frames} frames at {fps:g} fps, period {period_s:g} s, "
             f"turn {turn_per_cycle_deg:g} deg per cycle, noise {noise_deg:g} deg, {up.upper()} up, seed {seed}")
-    return SyntheticTake(motion, phase, u, period, [(style.name, 0, n_frames)], desc, chan)
+    return SyntheticTake(motion, phase, u, period, [(style.name, 0, n_frames)], desc, chan, heading)
 
 
 def synthetic_half_cycle_trap(n_frames: int = 600, fps: float = 60.0, period_s: float = 1.0,
@@ -732,3 +749,245 @@ def synthetic_half_cycle_trap(n_frames: int = 600, fps: float = 60.0, period_s: 
     style = replace(_WALK, name="symmetric walk", pelvis_rot=0.0, pelvis_list=0.0, trunk_rot=0.0, sway=0.0,
                     symmetric=True)
     return _gait_take(style, n_frames, fps, period_s, noise_deg, 0.0, 0.0, 0.0, seed)
+
+
+# -- takes that change what they do (issue 28) ----------------------------------
+
+
+def _turn_profile(s: np.ndarray, taper: float = 0.25) -> np.ndarray:
+    """Fraction of the turn done at ``s`` in [0, 1] of the turning part (0 before, 1 after).
+
+    The heading rate is a plateau with raised-cosine tapers over the first and last ``taper`` of the part,
+    so the heading and its rate are smooth (no kink where the turn starts or ends).
+    """
+    s = np.clip(s, 0.0, 1.0)
+    r = taper
+
+    def rise(x: np.ndarray) -> np.ndarray:  # integral of the taper, x in [0, r]
+        return 0.5 * (x - r / np.pi * np.sin(np.pi * x / r))
+
+    area = 1.0 - r
+    f = np.where(s < r, rise(np.minimum(s, r)), 0.5 * r + (s - r))
+    f = np.where(s > 1.0 - r, area - rise(np.minimum(1.0 - s, r)), f)
+    return f / area
+
+
+def synthetic_walk_turn_walk(n_before_s: float = 4.0, turn_deg: float = 90.0, turn_strides: float = 2.0,
+                             n_after_s: float = 4.0, fps: float = 60.0, period_s: float = 1.0,
+                             noise_deg: float = 1.0, seed: int = 0) -> SyntheticTake:
+    """A walk that goes straight, turns ``turn_deg`` degrees within ``turn_strides`` strides, and goes straight on.
+
+    ``n_before_s`` / ``n_after_s``: seconds of straight walking before and after the turn; ``turn_deg``:
+    the turn in degrees, positive to the left, negative to the right; ``turn_strides``: the turn's length in
+    cycles (one cycle = a left and a right step = ``period_s`` seconds).  The gait is
+    :func:`synthetic_walk`'s (140 cm per cycle) at a constant period; the body and its path turn together
+    (as in :func:`synthetic_circle_walk`), the heading rate a plateau with smooth (raised-cosine) ends.
+    ``noise_deg``: Gaussian noise on every rotation channel (degrees).
+
+    Truth: ``heading_deg`` ``(T,)`` per frame (0 before the turn, ``turn_deg`` after); ``period_frames``
+    ``period_s * fps`` on every frame; ``segments`` ``[("straight", 0, b), ("turning left", b, c),
+    ("straight", c, T)]`` (``"turning right"`` for a negative turn; frames ``[b, c)`` are those where the
+    heading changes).
+    """
+    fps = _validate.positive("fps", fps)
+    period_s = _validate.positive("period_s", period_s)
+    for name, v in (("n_before_s", n_before_s), ("n_after_s", n_after_s)):
+        if not np.isfinite(v) or v < 0:
+            raise MocycleError(f"{name} must be >= 0 seconds; got {v!r}")
+    if not np.isfinite(turn_deg):
+        raise MocycleError(f"turn_deg must be a finite number; got {turn_deg!r}")
+    _validate.positive("turn_strides", turn_strides)
+    if not np.isfinite(noise_deg) or noise_deg < 0:
+        raise MocycleError(f"noise_deg must be >= 0; got {noise_deg!r}")
+    b = int(round(n_before_s * fps))
+    c = b + max(2, int(round(turn_strides * period_s * fps)))
+    T, _ = _check(c + int(round(n_after_s * fps)), fps)
+    u, phase, period = _phase_truth(T, fps, float(period_s), 0.0, 0.0)
+    k = np.arange(T, dtype=np.float64)
+    heading = float(turn_deg) * _turn_profile((k - b + 0.5) / (c - b))
+    skel = humanoid_skeleton()
+    chan = _channels(skel, _gait_angles(_WALK, u))
+    _turn_root(skel, chan, heading)
+    if noise_deg > 0:
+        chan += _rng(seed).normal(0.0, noise_deg, size=chan.shape)
+    motion = Motion(skel, _quats_from_channels(skel, chan), None, 1.0 / fps,
+                    root_positions=_gait_root(_WALK, u, heading))
+    turning = "straight" if turn_deg == 0 else ("turning left" if turn_deg > 0 else "turning right")
+    segments = [("straight", 0, b), (turning, b, c), ("straight", c, T)]
+    segments = [s for s in segments if s[2] > s[1]]
+    desc = (f"synthetic walk, turn {turn_deg:+g} deg in {turn_strides:g} strides, walk: {T} frames at {fps:g} fps "
+            f"(straight {b}, turning {c - b}, straight {T - c}), period {period_s:g} s, noise {noise_deg:g} deg, "
+            f"seed {seed}")
+    return SyntheticTake(motion, phase, u, period, segments, desc, chan, heading)
+
+
+_HANDS = {"left": ("Left",), "right": ("Right",), "both": ("Left", "Right")}
+
+
+def _stand_angles(n: int, fps: float, lift: dict[str, np.ndarray], wave: dict[str, np.ndarray]
+                  ) -> np.ndarray:
+    """Standing angles ``(n, J, 3)`` (degrees, by axis x, y, z): legs straight, a slow sway in the trunk.
+
+    ``lift[side]`` ``(n,)`` in [0, 1] raises that arm from hanging (0) to the waving pose (1): upper arm out
+    to the side 25 degrees above the horizontal and a little forward, forearm 80 degrees up (the hand a
+    little outward); ``wave[side]`` ``(n,)``
+    is the forearm's swing about the waving pose in degrees (in the body's frontal plane).
+    """
+    a = np.zeros((n, len(_NAMES), 3))
+    t = np.arange(n) / fps
+    # small sway: the trunk and head move slowly, at periods unrelated to the wave; the legs and root stand
+    a[:, _IX["Spine"], 2] = 1.2 * np.sin(2 * np.pi * t / 3.7)
+    a[:, _IX["Spine1"], 0] = 1.0 + 0.8 * np.sin(2 * np.pi * t / 5.3 + 1.0)
+    a[:, _IX["Head"], 0] = 1.5 * np.sin(2 * np.pi * t / 4.1 + 2.0)
+    for side, sign in (("Left", 1.0), ("Right", -1.0)):
+        up = lift.get(side, np.zeros(n))
+        sw = wave.get(side, np.zeros(n))
+        a[:, _IX[f"{side}UpLeg"], 2] = sign * 2.0        # feet a little apart
+        a[:, _IX[f"{side}Foot"], 2] = -sign * 2.0
+        a[:, _IX[f"{side}Arm"], 2] = sign * (-75.0 + 100.0 * up)
+        a[:, _IX[f"{side}Arm"], 1] = -sign * 20.0 * up   # a little forward
+        a[:, _IX[f"{side}ForeArm"], 1] = -sign * 15.0 * (1.0 - up)
+        a[:, _IX[f"{side}ForeArm"], 2] = sign * (55.0 * up + sw)  # forearm 80 deg up, hand outward
+        a[:, _IX[f"{side}Hand"], 2] = sign * 0.4 * sw
+    return a
+
+
+def synthetic_wave(n_frames: int = 360, fps: float = 60.0, hand: str = "right", wave_period_s: float = 0.6,
+                   n_waves: float | None = None, raise_s: float = 0.5, noise_deg: float = 0.5,
+                   seed: int = 0) -> SyntheticTake:
+    """A hand wave with standing legs: one arm (or both) raised and waving, the legs and root still.
+
+    ``hand``: ``"right"``, ``"left"`` or ``"both"`` (both wave in mirror image).  The waving arm's upper arm
+    is held out to the side, its forearm up, swinging 25 degrees either way in the frontal plane every
+    ``wave_period_s`` seconds (elbow angle, hand height and the hand's side-to-side position all repeat at
+    that period).  ``raise_s`` seconds (0 for none) raise the arm from hanging before the waving and lower
+    it after (a one-off lead-in and lead-out); the swing fades in and out over a quarter wave then.
+    ``n_waves``: number of waves (then the rest of the take stands still, split before and after); ``None``
+    waves for all the frames the raise and lower leave.  The trunk and head sway slowly (periods 3.7-5.3
+    s); the root stays at :data:`STAND_HEIGHT` (toes on the floor).  ``noise_deg``: Gaussian noise on every
+    rotation channel (degrees).
+
+    Truth: ``segments`` ``("stand", ...)``, ``("raise", ...)``, ``("wave", a, b)``, ``("lower", ...)``,
+    ``("stand", ...)`` (empty ones left out); ``phase``/``unwrapped_phase`` count waves from frame ``a``
+    (NaN outside the waving); ``period_frames`` ``wave_period_s * fps`` in the waving, NaN elsewhere;
+    ``heading_deg`` zeros.
+    """
+    n_frames, fps = _check(n_frames, fps)
+    if hand not in _HANDS:
+        raise MocycleError(f"hand must be 'left', 'right' or 'both'; got {hand!r}")
+    wave_period_s = _validate.positive("wave_period_s", wave_period_s)
+    if not np.isfinite(raise_s) or raise_s < 0:
+        raise MocycleError(f"raise_s must be >= 0 seconds; got {raise_s!r}")
+    if not np.isfinite(noise_deg) or noise_deg < 0:
+        raise MocycleError(f"noise_deg must be >= 0; got {noise_deg!r}")
+    n_raise = int(round(raise_s * fps))
+    p = wave_period_s * fps
+    room = n_frames - 2 * n_raise
+    if n_waves is None:
+        n_wave = room
+    else:
+        _validate.positive("n_waves", n_waves)
+        n_wave = int(round(n_waves * p))
+    if n_wave < 2 or n_wave > room:
+        raise MocycleError(f"a wave of {n_wave} frames does not fit in {n_frames} frames with {n_raise}-frame "
+                           f"raise and lower (or is under 2 frames)")
+    s0 = (room - n_wave) // 2
+    a, b = s0 + n_raise, s0 + n_raise + n_wave
+    e = b + n_raise
+    k = np.arange(n_frames, dtype=np.float64)
+    if n_raise:
+        lift = _smoothstep(np.minimum((k - s0 + 0.5) / n_raise, (e - k - 0.5) / n_raise))
+        fade = _smoothstep(np.minimum((k - a + 0.5) / (0.25 * p), (b - k - 0.5) / (0.25 * p)))
+    else:
+        lift = ((k >= a) & (k < b)).astype(float)
+        fade = lift.copy()
+    u = (k - a) / p
+    swing = 25.0 * fade * np.sin(2.0 * np.pi * u)
+    sides = _HANDS[hand]
+    ang = _stand_angles(n_frames, fps, {s: lift for s in sides}, {s: swing for s in sides})
+    chan = _channels(humanoid_skeleton(), ang)
+    if noise_deg > 0:
+        chan += _rng(seed).normal(0.0, noise_deg, size=chan.shape)
+    skel = humanoid_skeleton()
+    root = np.tile([0.0, STAND_HEIGHT, 0.0], (n_frames, 1))
+    waving = (k >= a) & (k < b)
+    unwrapped = np.where(waving, u, np.nan)
+    phase = np.where(waving, unwrapped - np.floor(np.where(waving, unwrapped, 0.0)), np.nan)
+    period = np.where(waving, p, np.nan)
+    segments = [("stand", 0, s0), ("raise", s0, a), ("wave", a, b), ("lower", b, e), ("stand", e, n_frames)]
+    segments = [seg for seg in segments if seg[2] > seg[1]]
+    desc = (f"synthetic wave ({hand} hand{'s' if hand == 'both' else ''}): {n_frames} frames at {fps:g} fps, "
+            f"wave period {wave_period_s:g} s, {n_wave / p:.2f} waves in frames [{a}, {b}), raise {n_raise} "
+            f"frames, noise {noise_deg:g} deg, seed {seed}")
+    return SyntheticTake(Motion(skel, _quats_from_channels(skel, chan), None, 1.0 / fps, root_positions=root),
+                         phase, unwrapped, period, segments, desc, chan, np.zeros(n_frames))
+
+
+def synthetic_walk_then_wave(walk_s: float = 4.0, stop_s: float = 0.8, wave_s: float = 4.0, fps: float = 60.0,
+                             period_s: float = 1.0, hand: str = "right", wave_period_s: float = 0.6,
+                             noise_deg: float = 0.5, seed: int = 0) -> SyntheticTake:
+    """A walk that stops and then waves with standing legs, in one take.
+
+    ``walk_s`` seconds of :func:`synthetic_walk` (cycle ``period_s``), then ``stop_s`` seconds in which the
+    walk's pose is slerped to the standing pose and the root's horizontal speed eases to zero (its height
+    keeping a foot on the floor), then ``wave_s`` seconds of :func:`synthetic_wave` (``hand``,
+    ``wave_period_s``, 0.5 s raise and lower) where the walk stopped.  ``noise_deg``: Gaussian noise on
+    every rotation channel (degrees).
+
+    Truth: ``segments`` ``[("walk", 0, n_walk), ("transition", ...), ("raise", ...), ("wave", a, b),
+    ("lower", ...)]``; :attr:`SyntheticTake.steady_parts` gives the two parts to loop (walk and wave).
+    ``period_frames``: the walk's period in the walk, the wave's in the waving, NaN elsewhere;
+    ``unwrapped_phase`` counts cycles in the walk and waves (from 0) in the waving; ``heading_deg`` zeros.
+    """
+    fps = _validate.positive("fps", fps)
+    for name, v in (("walk_s", walk_s), ("stop_s", stop_s), ("wave_s", wave_s)):
+        _validate.positive(name, v)
+    if not np.isfinite(noise_deg) or noise_deg < 0:
+        raise MocycleError(f"noise_deg must be >= 0; got {noise_deg!r}")
+    n_walk, n_stop, n_wave = (max(1, int(round(v * fps))) for v in (walk_s, stop_s, wave_s))
+    walk = synthetic_walk(n_walk + n_stop, fps, period_s=period_s)
+    wave = synthetic_wave(n_wave, fps, hand=hand, wave_period_s=wave_period_s, raise_s=0.5, noise_deg=0.0)
+    skel = walk.motion.skeleton
+    J = skel.n_joints
+    T, _ = _check(n_walk + n_stop + n_wave, fps)
+    k = np.arange(T)
+    w = _smoothstep((k - n_walk + 0.5) / n_stop)                 # 0 walking, 1 standing
+    q_clean = np.concatenate([walk.motion.rotations[:n_walk],
+                              np.repeat(wave.motion.rotations[:1], n_stop, axis=0),
+                              wave.motion.rotations])
+    chan = np.concatenate([walk.euler_deg[:n_walk], np.repeat(wave.euler_deg[:1], n_stop, axis=0),
+                           wave.euler_deg])
+    inside = np.arange(n_walk, n_walk + n_stop)
+    r0 = Rotation.from_quat(walk.motion.rotations[inside].reshape(-1, 4))
+    r1 = Rotation.from_quat(np.repeat(wave.motion.rotations[:1], n_stop, axis=0).reshape(-1, 4))
+    ww = np.repeat(w[inside], J)[:, None]
+    q_clean[inside] = (r0 * Rotation.from_rotvec(ww * (r0.inv() * r1).as_rotvec())).as_quat().reshape(-1, J, 4)
+    for j in range(J):
+        chan[inside, j] = Rotation.from_quat(q_clean[inside, j]).as_euler(skel.euler_order(j), degrees=True)
+    if noise_deg > 0:
+        chan = chan + _rng(seed).normal(0.0, noise_deg, size=chan.shape)
+        q = _quats_from_channels(skel, chan)
+    else:
+        q = q_clean
+    p0 = walk.motion.root_positions
+    v = np.diff(p0, axis=0) * (1.0 - w[1:n_walk + n_stop, None])
+    root = np.empty((T, 3))
+    root[:n_walk + n_stop] = np.concatenate([p0[:1], p0[:1] + np.cumsum(v, axis=0)])
+    root[n_walk + n_stop:] = root[n_walk + n_stop - 1]
+    after = np.arange(n_walk, T)
+    floor = _floor_height(skel, q_clean[after])
+    lift = p0[n_walk:, 1] - _floor_height(skel, walk.motion.rotations[n_walk:])
+    lift = np.concatenate([lift, np.zeros(n_wave)])
+    root[after, 1] = floor + (1.0 - w[after]) * lift
+    root[:n_walk, 1] = p0[:n_walk, 1]
+    off = n_walk + n_stop
+    period = np.concatenate([walk.period_frames[:n_walk], np.full(n_stop, np.nan), wave.period_frames])
+    unwrapped = np.concatenate([walk.unwrapped_phase[:n_walk], np.full(n_stop, np.nan), wave.unwrapped_phase])
+    phase = np.concatenate([walk.phase[:n_walk], np.full(n_stop, np.nan), wave.phase])
+    segments = [("walk", 0, n_walk), ("transition", n_walk, off)]
+    segments += [(lab, a + off, b + off) for lab, a, b in wave.segments]
+    desc = (f"synthetic walk then wave ({hand}): walk {n_walk}, stop {n_stop}, wave {n_wave} frames at "
+            f"{fps:g} fps, walk period {period_s:g} s, wave period {wave_period_s:g} s, noise {noise_deg:g} deg, "
+            f"seed {seed}")
+    return SyntheticTake(Motion(skel, q, None, 1.0 / fps, root_positions=root), phase, unwrapped, period,
+                         segments, desc, chan, np.zeros(T))
