@@ -145,33 +145,57 @@ class Landings:
     down: np.ndarray
 
 
-def find_landings(motion: Motion, contacts=None) -> Landings | None:
-    """The landings of ``motion``'s feet (``None`` when the rig's feet are not found by name)."""
-    from .contacts import detect_contacts, find_feet
+#: A foot is lifted above this height over its floor (body heights), and has landed below LAND_HEIGHT.
+LIFT_HEIGHT, LAND_HEIGHT = 0.04, 0.02
 
-    if contacts is None:
-        try:
-            feet = find_feet(motion.skeleton)
-        except MocycleError:
-            return None
-        contacts = detect_contacts(motion, feet)
+
+def find_landings(motion: Motion) -> Landings | None:
+    """The landings of ``motion``'s feet (``None`` when the rig's feet are not found by name).
+
+    A landing is where a foot that was lifted (its lower contact joint, ankle or toe, more than
+    :data:`LIFT_HEIGHT` of the body height above its floor) comes down (under :data:`LAND_HEIGHT`).  Heights
+    only, no speeds: a foot that glides on the floor (a retargeted or synthetic take, a fitted loop) still
+    lands where it comes down, and feet that stay down while the legs sway make no landing.  The floor of
+    each joint is its lowest level nearby (:func:`~mocycle.contacts.detect.local_floor`)."""
+    from .contacts import body_height, find_feet, up_axis
+    from .contacts.detect import heights_and_speeds, local_floor
+    from .contacts.feet import chain_joints, chain_positions
+
+    try:
+        feet = find_feet(motion.skeleton)
+    except MocycleError:
+        return None
+    up = up_axis(motion)
+    joints = [j for f in feet for j in f.contact_joints]
+    W = chain_positions(motion, chain_joints(motion, joints))
+    body = body_height(motion, up)
+    h, _, _ = heights_and_speeds(motion, joints, up, positions=W)
+    h = h / body
+    h = h - local_floor(h, motion.fps)
     frames, foot = [], []
     down = np.zeros(motion.n_frames, dtype=np.int8)
-    for f in range(len(contacts.feet)):
-        mask = contacts.foot_mask(f)
-        down += mask
-        for s, _ in contacts.foot_ranges(f):
-            if s > 0:  # a contact under way at frame 0 did not land in the take
-                frames.append(s)
+    col = 0
+    for f, ft in enumerate(feet):
+        n = len(ft.contact_joints)
+        low = h[:, col:col + n].min(axis=1)
+        col += n
+        down += low < LAND_HEIGHT
+        lifted = False
+        for t, v in enumerate(low.tolist()):
+            if v > LIFT_HEIGHT:
+                lifted = True
+            elif lifted and v < LAND_HEIGHT:
+                frames.append(t)
                 foot.append(f)
+                lifted = False
     order = np.argsort(frames, kind="stable")
     return Landings(np.asarray(frames, dtype=np.intp)[order], np.asarray(foot, dtype=np.intp)[order],
-                    tuple(f.side for f in contacts.feet), down)
+                    tuple(f.side for f in feet), down)
 
 
-def _gait_chains(landings: Landings, fps: float) -> list[np.ndarray]:
-    """Runs of landing indices that alternate feet with steps of plausible length (at least 3 landings: one
-    whole stride)."""
+def _gait_chains(landings: Landings, fps: float, least: int = 3) -> list[np.ndarray]:
+    """Runs of landing indices that alternate feet with steps of plausible length (at least ``least``
+    landings; 3: one whole stride)."""
     lo, hi = MIN_STEP_S * fps, MAX_STEP_S * fps
     chains, run = [], [0] if landings.frames.size else []
     for i in range(1, landings.frames.size):
@@ -183,7 +207,7 @@ def _gait_chains(landings: Landings, fps: float) -> list[np.ndarray]:
             run = [i]
     if run:
         chains.append(run)
-    return [np.asarray(c, dtype=np.intp) for c in chains if len(c) >= 3]
+    return [np.asarray(c, dtype=np.intp) for c in chains if len(c) >= least]
 
 
 def stride_periods(landings: Landings, fps: float, start: int = 0, stop: int | None = None) -> list[int]:
@@ -248,11 +272,11 @@ def _step_kinds(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
     return kinds
 
 
-def segment_activities(motion: Motion, *, min_periods: float = 1.2, contacts=None) -> Activities:
+def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activities:
     """Cut ``motion`` into steady parts (module notes); ``min_periods``: cycles a part needs to be looped.
 
     Without feet found by name the whole take is one part of kind ``"periodic"`` on every joint (the phase
-    decides).  ``contacts``: :func:`~mocycle.contacts.detect_contacts` of the motion, when known.
+    decides).
 
     Examples
     --------
@@ -262,7 +286,7 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2, contacts=Non
     [('walk straight', 0, 300, 60)]
     """
     T, fps = motion.n_frames, motion.fps
-    landings = find_landings(motion, contacts)
+    landings = find_landings(motion)
     if landings is None:
         whole = Activity(start=0, stop=T, kind="periodic", limbs="all", loop=True,
                          reason="the rig's feet were not found by name: the whole take is one part")
@@ -271,10 +295,15 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2, contacts=Non
     path = _horizontal_path(motion)
     body = _body_height(motion)
     parts: list[Activity] = []
-    for chain in _gait_chains(landings, fps):
+    for chain in _gait_chains(landings, fps, least=2):
         a, b = int(landings.frames[chain[0]]), int(landings.frames[chain[-1]])
         if _legs_still(motion.skeleton, _rotation_spread(motion[a:b + 1])):
             continue  # contacts that flicker while the legs stand are no steps
+        if chain.size == 2:  # one step: a take (or a part) of little more than a stride
+            short = _one_step_part(motion, chain, landings, heading, path, body)
+            if short is not None:
+                parts.append(short)
+            continue
         strides = _stride_figures(chain, landings, heading, path, fps)
         kinds = _step_kinds(strides, body)
         f = landings.frames[chain]
@@ -292,8 +321,13 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2, contacts=Non
     parts = _fill(motion, parts, landings, min_periods)
     for p in parts:
         if p.gait:
-            p.loop = p.n_periods >= min_periods
-            if p.loop:
+            p.loop = bool(p.n_periods >= min_periods)
+            if p.loop and sum(map(len, p.landings.values())) < 3:  # one step: the legs' self-similarity
+                x = (np.arange(p.start, p.stop) - p.start) / p.period_frames
+                p.periodic = line_periodic(x, p.period_frames, motion.frame_time, "legs self-similarity", "legs",
+                                           f"the legs' self-similarity: the take holds one step, its legs are "
+                                           f"most alike {p.period_frames:.2f} frames apart")
+            elif p.loop:
                 x, period = stride_phase(p, landings.frames, landings.foot, p.start, p.stop)
                 p.periodic = line_periodic(x, period, motion.frame_time, "strides", "legs",
                                            f"the strides: landings of each foot {period:.2f} frames apart "
@@ -318,6 +352,61 @@ def _gait_part(kind, f, chain, i, j, landings, strides, heading, path, fps) -> A
     return Activity(start=a, stop=b, kind=kind, limbs="legs", period_frames=period,
                     speed=float(np.linalg.norm(path[b] - path[a])) * fps / max(b - a, 1),
                     turn_deg=float(heading[b] - heading[a]), landings=own)
+
+
+def _one_step_part(motion: Motion, chain, landings: Landings, heading, path, body) -> Activity | None:
+    """A gait part from one step (two landings, one of each foot): its period from the legs' self-similarity
+    near twice the step (:func:`short_period`), its phase a line at that period; ``None`` when the legs do
+    not repeat there."""
+    fps = motion.fps
+    a, b = (int(x) for x in landings.frames[chain])
+    reach = b - a
+    lo, hi = max(0, a - 2 * reach), min(motion.n_frames, b + 2 * reach)
+    period, unlike = short_period(motion, 2.0 * reach, lo, hi)
+    if not np.isfinite(period):
+        return None
+    speed = float(np.linalg.norm(path[hi - 1] - path[lo])) * fps / max(hi - 1 - lo, 1)
+    turn = float(heading[hi - 1] - heading[lo])
+    per_stride = turn / (hi - 1 - lo) * period
+    way = "straight" if abs(per_stride) <= TURN_DEG else ("turning left" if per_stride > 0 else "turning right")
+    gait = "run" if speed > RUN_SPEED * body else "walk"
+    own = {}
+    for k in chain:
+        own.setdefault(landings.sides[landings.foot[k]], []).append(int(landings.frames[k]))
+    return Activity(start=a, stop=b, kind=f"{gait} {way}", limbs="legs", period_frames=period, speed=speed,
+                    turn_deg=turn, landings=own,
+                    periodic=None, reason=f"one step: the period from the legs' self-similarity ({unlike:.2f})")
+
+
+def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[float, float]:
+    """The period (frames) of the legs over frames ``start .. stop-1`` of little more than a cycle: the lag within
+    ``[0.75, 1.33]`` of ``guess`` at which the legs' rotations are most like themselves
+    (mean squared difference over the frames both ends cover, over twice the total variance; at least a
+    sixth of a period of overlap), refined by a parabola.  ``(NaN, value)`` when the best lag is not alike
+    (over a half) or no lag fits.  Returns ``(period, unlikeness)``."""
+    from .features import pose_matrix
+
+    try:
+        X, _ = pose_matrix(motion[start:stop], rep="expmap", root="drop", joints="legs", normalize=False,
+                           weights=None)
+    except MocycleError:
+        return float("nan"), float("nan")
+    T = X.shape[0]
+    var = float(X.var(axis=0).sum())
+    lags = np.arange(max(2, int(np.floor(0.75 * guess))), int(np.ceil(1.33 * guess)) + 1)
+    lags = lags[T - lags >= np.maximum(4, lags / 6.0)]
+    if lags.size < 3 or not var > 0:
+        return float("nan"), float("nan")
+    d = np.array([float(((X[lag:] - X[:-lag]) ** 2).sum(axis=1).mean()) / (2.0 * var) for lag in lags])
+    i = int(np.argmin(d))
+    best = float(lags[i])
+    if 0 < i < d.size - 1:
+        den = d[i - 1] - 2 * d[i] + d[i + 1]
+        if den > 0:
+            best += 0.5 * (d[i - 1] - d[i + 1]) / den
+    if not d[i] < 0.5:
+        return float("nan"), float(d[i])
+    return best, float(d[i])
 
 
 def _reach(parts: list[Activity], landings: Landings, T: int) -> None:

@@ -125,7 +125,7 @@ def test_blend_refuses_a_take_whose_cycle_is_not_a_loop(walk, wrong_phase, monke
 def test_a_non_periodic_take_is_refused(tmp_path):
     src = write(synthetic_nonperiodic(n_frames=400, seed=2).motion, tmp_path / "wander.bvh")
     result = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "c.bvh")])
-    assert result.exit_code == 3 and "no periodic motion" in result.output
+    assert result.exit_code == 3 and "no repeating motion" in result.output
 
 
 def test_shared_walk_passes_every_check():

@@ -155,8 +155,9 @@ def run(take, options: Options | None = None) -> Report:
             if isinstance(o.which, int):
                 chosen = [o.which] if parts[o.which].loop else []
             else:
-                # by default the part with the most cycles first; the next ones only if it is refused
-                chosen = sorted(loopable, key=lambda k: -parts[k].n_periods)
+                # all: in frame order; by default the part with the most cycles first, the next ones only if it
+                # is refused
+                chosen = loopable if everything else sorted(loopable, key=lambda k: -parts[k].n_periods)
             for k in chosen:
                 p = parts[k]
                 jobs.append((k, motion[p.start:p.stop], p.start, _part_phase(p), None, p))
@@ -270,20 +271,20 @@ def _part_phase(part, found=None):
 
 
 def nothing_to_loop(acts) -> str:
-    """Why nothing in the take loops, in plain words."""
+    """Why nothing in the take loops, in plain words (the technical why goes in the JSON's ``detail``)."""
     if acts is None or not acts.parts:
         return "no repeating motion found in the take"
-    kinds = sorted({p.kind for p in acts.parts})
-    if kinds == ["standing"]:
+    kinds = {p.kind for p in acts.parts}
+    if kinds == {"standing"}:
         return "no repeating motion: the actor stands still"
-    if set(kinds) <= {"gesture", "standing"}:
+    gait = [p for p in acts.parts if p.gait or p.landings]
+    if gait and not any(p.loop for p in acts.parts):
+        longest = max(gait, key=lambda p: p.n_periods if p.n_periods == p.n_periods else 0.0)
+        return (f"no steady part repeats long enough to loop: the longest ({longest.kind or 'steps'}, frames "
+                f"{longest.start}-{longest.stop}) holds {longest.n_periods:.1f} strides")
+    if kinds <= {"gesture", "standing", "transition"}:
         return "no repeating motion: the take does one gesture, it does not repeat"
-    short = [p for p in acts.parts if p.gait]
-    if short:
-        longest = max(short, key=lambda p: p.n_frames)
-        return (f"no part repeats long enough to loop: the longest steady part ({longest.reason.split(':')[0]}) "
-                f"holds {longest.n_periods:.1f} strides")
-    return "no repeating motion: " + "; ".join(p.reason for p in acts.parts)
+    return "no repeating motion found: the body moves, but nothing in it repeats"
 
 
 def _chosen_reason(loops, parts, everything) -> str:
