@@ -139,18 +139,21 @@ def run(take, options: Options | None = None) -> Report:
                     phase = cycle_phase(motion, phase_step=o.step, joints=o.joints, classes=o.classes, pca=o.pca,
                                         delay=o.delay, min_periods=o.min_periods)
                 except NoPeriodicMotion as exc:
-                    raise _no_loop(exc, acts, start) from None
-            if everything and part is None:
-                ks = list(range(len(phase.classes))) or [None]
+                    if part is None:
+                        raise _no_loop(exc, acts, start) from None
+                    phase = None  # a take of little more than a stride: its strides' phase decides
+            if part is not None and (phase is None or not phase.classes):
+                jobs.append((loopable[0], motion[part.start:part.stop], part.start, _part_phase(part), None, part))
+            elif part is not None and not isinstance(o.which, int) and _off_strides(phase, part):
+                # the cohomology's period disagrees with the landings: the part's stride phase decides
+                jobs.append((loopable[0], motion[part.start:part.stop], part.start, _part_phase(part, phase), None,
+                             part))
+            elif part is not None:
+                jobs.append((loopable[0], motion, 0, phase, o.which if isinstance(o.which, int) else None, part))
             else:
-                ks = [o.which if isinstance(o.which, int) else None]
-            for k in ks:
-                if part is not None and phase.classes and k is None and _off_strides(phase, part):
-                    # the cohomology's period disagrees with the landings: the part's stride phase decides
-                    jobs.append((loopable[0], motion[part.start:part.stop], part.start,
-                                 _part_phase(part, phase), None, part))
-                else:
-                    jobs.append((None if part is None else loopable[0], motion, 0, phase, k, part))
+                ks = list(range(len(phase.classes))) or [None] if everything else \
+                    [o.which if isinstance(o.which, int) else None]
+                jobs.extend((None, motion, 0, phase, k, None) for k in ks)
         else:
             if isinstance(o.which, int):
                 chosen = [o.which] if parts[o.which].loop else []
