@@ -45,7 +45,7 @@ def loop(
     joints: Annotated[str | None, flag(O, "joints")] = default(O, "joints"),
     cycles: Annotated[int, flag(O, "cycles")] = default(O, "cycles"),
     classes: Annotated[str, flag(O, "classes")] = default(O, "classes"),
-    which: Annotated[str | None, flag(O, "which", "--class")] = default(O, "which"),
+    which: Annotated[str | None, flag(O, "which", "--parts", "--class")] = default(O, "which"),
     pca: Annotated[str, flag(O, "pca")] = default(O, "pca"),
     delay: Annotated[int, flag(O, "delay")] = default(O, "delay"),
     min_periods: Annotated[float, flag(O, "min_periods")] = default(O, "min_periods"),

@@ -1,0 +1,167 @@
+"""Takes that change what they do (issue 28): steady parts, one loop per part, never an average.
+
+Every take here is generated (``mocycle.datasets``) with its truth: the parts' frames, the heading per frame
+and the period.  The loops are judged against that truth, not against the figures the code prints.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from mocycle import tasks
+from mocycle.activities import segment_activities, short_period
+from mocycle.cli import app
+from mocycle.datasets import (
+    synthetic_gesture,
+    synthetic_still,
+    synthetic_walk,
+    synthetic_walk_then_wave,
+    synthetic_walk_turn_walk,
+    synthetic_wave,
+)
+from mocycle.errors import MocycleError, NoPeriodicMotion
+from mocycle.io import read, write
+
+runner = CliRunner()
+
+
+def _loops(take, tmp_path, *extra):
+    src = write(take.motion, tmp_path / "take.bvh")
+    result = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "loop.bvh"), "--part", "all", "--root",
+                                 "motion", "--json", *extra])
+    return result, json.loads(result.stdout)
+
+
+def _overlap(a, b) -> int:
+    return max(0, min(a[1], b[1]) - max(a[0], b[0]))
+
+
+@pytest.mark.parametrize("turn_deg, fps", [(90.0, 60.0), (-90.0, 30.0)])
+def test_a_walk_that_turns_mid_take_gives_a_straight_a_turning_and_a_straight_loop(tmp_path, turn_deg, fps):
+    take = synthetic_walk_turn_walk(turn_deg=turn_deg, fps=fps, seed=4)
+    result, facts = _loops(take, tmp_path)
+    assert result.exit_code == 0, result.output
+    way = "left" if turn_deg > 0 else "right"
+    assert [loop["kind"] for loop in facts["loops"]] == ["walk straight", f"walk turning {way}", "walk straight"]
+    (_, b, c) = [s for s in take.segments if s[0].startswith("turning")][0]
+    period = float(np.nanmedian(take.period_frames))
+    for loop in facts["loops"]:
+        frames = loop["frames"]
+        assert abs(loop["period_frames"] / period - 1) < 0.08
+        # never an average: a loop's frames lie in one truth segment, bar the blur of half a stride at a border
+        inside = max(_overlap(frames, (s, e)) for _, s, e in take.segments)
+        assert frames[1] - frames[0] - inside <= 0.5 * period
+        # it turns per cycle as the take does over the frames it loops
+        h = take.heading_deg
+        take_turn = (h[frames[1] - 1] - h[frames[0]]) / (frames[1] - 1 - frames[0]) * loop["period_frames"]
+        assert abs(loop["turn_per_cycle_deg"] - take_turn) <= max(10.0, 0.25 * abs(take_turn))
+        written = read(loop["output"])
+        assert written.n_frames == loop["cycles"] * loop["cycle_frames"]
+    turning = facts["loops"][1]
+    assert _overlap(turning["frames"], (b, c)) >= 0.75 * (c - b)
+    assert abs(turning["turn_per_cycle_deg"]) > 20 and np.sign(turning["turn_per_cycle_deg"]) == np.sign(turn_deg)
+    assert "walk-turning" in turning["output"]
+
+
+def test_the_default_loop_is_one_part_and_says_which_and_why(tmp_path):
+    take = synthetic_walk_turn_walk(turn_deg=90.0, seed=5)
+    src = write(take.motion, tmp_path / "take.bvh")
+    result = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "loop.bvh"), "--json"])
+    assert result.exit_code == 0, result.output
+    facts = json.loads(result.stdout)
+    assert facts["status"] == "ok" and len(facts["loops"]) == 1 and (tmp_path / "loop.bvh").exists()
+    chosen = facts["loops"][0]
+    assert "the steady part with the most cycles" in facts["reason"] and chosen["part"] is not None
+    assert chosen["period_frames"] == facts["period_frames"]  # the old flat figures are the chosen loop's
+    assert [p["kind"] for p in facts["parts"]] == ["walk straight", "walk turning left", "walk straight"]
+    most = max(p["n_periods"] for p in facts["parts"])
+    assert facts["parts"][chosen["part"]]["n_periods"] == most
+
+
+@pytest.mark.parametrize("hand", ["right", "both"])
+def test_a_wave_with_standing_legs_is_looped_at_the_arms_period(tmp_path, hand):
+    take = synthetic_wave(hand=hand, seed=2)
+    result, facts = _loops(take, tmp_path)
+    assert result.exit_code == 0, result.output
+    [loop] = facts["loops"]
+    assert loop["kind"] == "arms" and abs(loop["period_frames"] / np.nanmedian(take.period_frames) - 1) < 0.08
+    assert all(p["kind"] in ("arms", "gesture") for p in facts["parts"])
+
+
+def test_a_walk_followed_by_a_wave_gives_two_parts(tmp_path):
+    take = synthetic_walk_then_wave(seed=3)
+    acts = segment_activities(take.motion)
+    kinds = [p.kind for p in acts.loopable()]
+    assert kinds == ["walk straight", "arms"]
+    result, facts = _loops(take, tmp_path)
+    assert result.exit_code == 0 and [loop["kind"] for loop in facts["loops"]] == ["walk straight", "arms"]
+
+
+def test_a_take_of_one_and_a_third_periods_is_found_and_looped(tmp_path):
+    take = synthetic_walk(n_frames=80, fps=60.0, period_s=1.0, noise_deg=1.0, seed=7)
+    result, facts = _loops(take, tmp_path)
+    assert result.exit_code == 0, result.output
+    [loop] = facts["loops"]
+    assert abs(loop["period_frames"] / 60.0 - 1) < 0.08 and loop["kind"] == "walk straight"
+    # the period estimator for a short take: the legs' self-similarity near twice the step
+    period, unlike = short_period(take.motion, 2 * 30.0, 0, 80)
+    assert abs(period / 60.0 - 1) < 0.05 and unlike < 0.5
+
+
+@pytest.mark.parametrize("make, words", [(lambda: synthetic_still(noise_deg=0.5), "stands still"),
+                                         (lambda: synthetic_gesture(), "one gesture")])
+def test_gestures_and_standing_are_never_looped_and_say_why_in_plain_words(tmp_path, make, words):
+    result, facts = _loops(make(), tmp_path)
+    assert result.exit_code == 3 and facts["status"] == "no-periodic-motion" and facts["loops"] == []
+    assert words in facts["reason"] and words in result.stderr
+    assert not list(tmp_path.glob("loop*.bvh"))
+
+
+def test_no_prime_lifting_the_class_falls_back_to_the_next_joints(monkeypatch):
+    """The lift of the cocycle to Z can fail on a capture (a 30 fps run); the legs, then the arms are tried."""
+    from mocycle.phase import analysis, find_phase
+
+    real_fit = analysis.CohomologyFit.fit
+    calls = []
+
+    def failing_first(self, X):
+        calls.append(X.shape)
+        if len(calls) == 1:
+            raise MocycleError("could not lift the cohomology class to integer coefficients with any prime tried")
+        return real_fit(self, X)
+
+    monkeypatch.setattr(analysis.CohomologyFit, "fit", failing_first)
+    walk = synthetic_walk(n_frames=300, fps=30.0, period_s=1.0, noise_deg=1.0, seed=1).motion
+    result = find_phase(walk)
+    assert result.joints_used == "legs" and result.classes and "could not lift" in result.reason
+    monkeypatch.setattr(analysis.CohomologyFit, "fit", lambda self, X: (_ for _ in ()).throw(
+        MocycleError("could not lift the cohomology class to integer coefficients with any prime tried")))
+    with pytest.raises(NoPeriodicMotion, match="could not lift"):
+        find_phase(walk)
+
+
+def test_a_loop_off_the_strides_or_the_takes_turn_is_refused():
+    """The stride and turn checks: a cycle fitted at a wrong period (a phase that runs 30 % slow) fails both."""
+    from mocycle.activities import line_periodic
+    from mocycle.cycle import extract_cycle
+    from mocycle.phase.analysis import PhaseResult
+    from mocycle.tasks.loop import _activity_checks
+
+    take = synthetic_walk_turn_walk(turn_deg=90.0, seed=6)
+    motion = take.motion
+    (_, b, c) = [s for s in take.segments if s[0].startswith("turning")][0]
+    piece = motion[b:c]
+    wrong = 1.3 * float(np.nanmedian(take.period_frames))
+    pm = line_periodic(np.arange(piece.n_frames) / wrong, wrong, motion.frame_time, "test", "legs", "a wrong period")
+    phase = PhaseResult(classes=[pm], barcode=np.zeros((0, 2)), reason="", autocorrelation_period_frames=np.nan,
+                        n_frames=piece.n_frames, frame_time=motion.frame_time)
+    cycle = extract_cycle(piece, phase=phase)
+    failed = {f.name for f in _activity_checks(piece, cycle, None, b)}
+    assert "stride" in failed
+    right = [p for p in segment_activities(motion).parts if p.kind == "walk turning left"][0]
+    good = extract_cycle(motion[right.start:right.stop], phase=tasks.loop._part_phase(right))
+    assert _activity_checks(motion[right.start:right.stop], good, right, right.start) == []
