@@ -37,6 +37,10 @@ from .motion import Motion
 
 #: A step (landing to the other foot's landing) lasts at least / at most this long, seconds.
 MIN_STEP_S, MAX_STEP_S = 0.15, 1.2
+#: Two consecutive steps of a gait differ in length by at most this factor (a limp stays under it).
+STEP_RATIO = 1.6
+#: The legs of a gait part are like themselves one stride later: unlikeness (repetition distance) under this.
+UNLIKE = 0.5
 #: A stride turning by more than this many degrees is a turning stride.
 TURN_DEG = 15.0
 #: Consecutive strides whose periods differ by more than this share are different activities.
@@ -200,7 +204,9 @@ def _gait_chains(landings: Landings, fps: float, least: int = 3) -> list[np.ndar
     chains, run = [], [0] if landings.frames.size else []
     for i in range(1, landings.frames.size):
         step = landings.frames[i] - landings.frames[i - 1]
-        if landings.foot[i] != landings.foot[i - 1] and lo <= step <= hi:
+        before = landings.frames[i - 1] - landings.frames[run[-2]] if len(run) >= 2 else step
+        if landings.foot[i] != landings.foot[i - 1] and lo <= step <= hi and \
+                1 / STEP_RATIO <= step / before <= STEP_RATIO:
             run.append(i)
         else:
             chains.append(run)
@@ -316,6 +322,8 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activitie
             # steps i .. j-1: landings f[i] .. f[j]
             parts.append(_gait_part(kinds[i][0], f, chain, i, j, landings, strides, heading, path, fps))
             i = j
+    # steps that land in turn but whose legs do not repeat a stride later (a wander, a stumble) are no gait
+    parts = [p for p in parts if not legs_repeat(motion, p.start, p.stop, p.period_frames) >= UNLIKE]
     parts.sort(key=lambda p: p.start)
     _reach(parts, landings, T)
     parts = _fill(motion, parts, landings, min_periods)
@@ -378,33 +386,59 @@ def _one_step_part(motion: Motion, chain, landings: Landings, heading, path, bod
                     periodic=None, reason=f"one step: the period from the legs' self-similarity ({unlike:.2f})")
 
 
-def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[float, float]:
-    """The period (frames) of the legs over frames ``start .. stop-1`` of little more than a cycle: the lag within
-    ``[0.75, 1.33]`` of ``guess`` at which the legs' rotations are most like themselves
-    (mean squared difference over the frames both ends cover, over twice the total variance; at least a
-    sixth of a period of overlap), refined by a parabola.  ``(NaN, value)`` when the best lag is not alike
-    (over a half) or no lag fits.  Returns ``(period, unlikeness)``."""
+def _leg_features(motion: Motion, start: int, stop: int) -> np.ndarray | None:
+    """The legs' rotation vectors ``(stop - start, D)`` (no root, not normalised), ``None`` without legs."""
     from .features import pose_matrix
 
     try:
         X, _ = pose_matrix(motion[start:stop], rep="expmap", root="drop", joints="legs", normalize=False,
                            weights=None)
     except MocycleError:
+        return None
+    return X
+
+
+def _unlike(X: np.ndarray, lag: int) -> float:
+    """Mean squared difference of the rows of ``X`` ``lag`` apart over twice its total variance: about 0 where
+    the motion repeats at that lag, about 1 or more where it does not."""
+    var = float(X.var(axis=0).sum())
+    if not var > 0 or not 0 < lag < X.shape[0]:
+        return float("nan")
+    return float(((X[lag:] - X[:-lag]) ** 2).sum(axis=1).mean()) / (2.0 * var)
+
+
+def legs_repeat(motion: Motion, start: int, stop: int, period: float) -> float:
+    """How unlike the legs are to themselves one ``period`` later over frames ``start .. stop-1`` (see
+    :func:`_unlike`; NaN when it cannot be told)."""
+    X = _leg_features(motion, start, stop)
+    lag = int(round(period)) if np.isfinite(period) else 0
+    return float("nan") if X is None else _unlike(X, lag)
+
+
+def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[float, float]:
+    """The period (frames) of the legs over frames ``start .. stop-1`` of little more than a cycle: the lag within
+    ``[0.75, 1.33]`` of ``guess`` at which the legs' rotations are most like themselves
+    (:func:`_unlike` over the frames both ends cover, at least a sixth of a period of overlap), refined by a
+    parabola.  ``(NaN, value)`` when the best lag is not alike (:data:`UNLIKE` or more) or no lag fits.
+    Returns ``(period, unlikeness)``."""
+    X = _leg_features(motion, start, stop)
+    if X is None:
         return float("nan"), float("nan")
     T = X.shape[0]
-    var = float(X.var(axis=0).sum())
     lags = np.arange(max(2, int(np.floor(0.75 * guess))), int(np.ceil(1.33 * guess)) + 1)
     lags = lags[T - lags >= np.maximum(4, lags / 6.0)]
-    if lags.size < 3 or not var > 0:
+    if lags.size < 3:
         return float("nan"), float("nan")
-    d = np.array([float(((X[lag:] - X[:-lag]) ** 2).sum(axis=1).mean()) / (2.0 * var) for lag in lags])
+    d = np.array([_unlike(X, int(lag)) for lag in lags])
+    if not np.isfinite(d).all():
+        return float("nan"), float("nan")
     i = int(np.argmin(d))
     best = float(lags[i])
     if 0 < i < d.size - 1:
         den = d[i - 1] - 2 * d[i] + d[i + 1]
         if den > 0:
             best += 0.5 * (d[i - 1] - d[i + 1]) / den
-    if not d[i] < 0.5:
+    if not d[i] < UNLIKE:
         return float("nan"), float(d[i])
     return best, float(d[i])
 

@@ -1,5 +1,6 @@
 """Loop checks (issue 11, item 4): a cycle that is not a loop is refused, exit 3, ``--force`` writes it."""
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -103,10 +104,15 @@ def test_loop_cli_refuses_with_exit_3_and_force_writes(tmp_path, walk, wrong_pha
     src = write(walk, tmp_path / "walk.bvh")
     monkeypatch.setattr(extract_module, "find_phase", lambda *a, **k: wrong_phase)
     out = tmp_path / "cycle.bvh"
-    result = runner.invoke(app, ["loop", str(src), "-o", str(out)])
+    # by default the walk's strides overrule the phase's period (issue 28): a loop at the strides' period
+    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--json"])
+    assert result.exit_code == 0 and json.loads(result.stdout)["period_source"] == "strides"
+    out.unlink()
+    # the phase on the legs, as asked: that phase is looped or refused, not overruled
+    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--joints", "legs"])
     assert result.exit_code == 3
     assert "not a loop" in result.output and "plain cut" in result.output and not out.exists()
-    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--force", "--json"])
+    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--force", "--json", "--joints", "legs"])
     assert result.exit_code == 0 and out.exists()
     assert "warning:" in result.output and "--force" in result.output
     tr = runner.invoke(app, ["transition", str(src), str(src), "-o", str(tmp_path / "t.bvh")])

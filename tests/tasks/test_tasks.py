@@ -54,7 +54,7 @@ def test_schema_gives_allowed_values_and_ranges():
     s = tasks.schema(tasks.loop.Options)["properties"]
     assert s["method"]["enum"] == ["harmonic", "centroid", "cut"] and s["method"]["default"] == "harmonic"
     assert s["cycles"] == {**s["cycles"], "type": "integer", "minimum": 1}
-    assert s["which"]["x-flag"] == "--class" and s["time_axis"]["x-flag"] == "--time"
+    assert s["which"]["x-flag"] == "--part" and s["time_axis"]["x-flag"] == "--time"
     assert {"type": "string", "enum": ["auto"]} in s["harmonics"]["anyOf"]
     edit = tasks.schema(tasks.edit.Options)
     assert edit["required"] == ["joint", "swing"]

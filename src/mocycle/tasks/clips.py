@@ -76,10 +76,11 @@ def clip_of(report, role: str, name: str, closing_frame: bool = False) -> Clip:
 
 
 def _loop_facts(facts: Mapping, role: str) -> Mapping:
-    if "loops" not in facts:
+    """The figures of the loop written as ``role`` (``loop``, ``loop.part<k>``, ``loop.class<k>``)."""
+    loops = facts.get("loops")
+    if not loops:
         return facts
-    k = int(role.rsplit("class", 1)[1])
-    return next(f for f in facts["loops"] if f["class"] == k)
+    return next((f for f in loops if f.get("role") == role), loops[0])
 
 
 def _seam(facts: Mapping) -> dict:
