@@ -17,7 +17,7 @@ import typer
 from .. import tasks
 from ..errors import MocycleError
 from ..tasks.options import MISSING, Flag, flag_of
-from .common import EXIT_USAGE, app, err, friendly, out, print_json
+from .common import EXIT_USAGE, app, err, escape, friendly, out, print_json
 
 #: the commands batch runs (the ones that take one file)
 BATCH_COMMANDS = ("info", "phase", "loop", "swings", "compress", "stretch")
@@ -88,7 +88,7 @@ def batch(
     try:
         command, inputs, options = parse_command_line(args)
     except click.UsageError as exc:
-        err.print(f"[bold red]error:[/] {exc.format_message()}", markup=True, soft_wrap=True)
+        err.print(f"[bold red]error:[/] {escape(exc.format_message())}", markup=True, soft_wrap=True)
         raise typer.Exit(EXIT_USAGE) from None
     if not inputs:
         raise MocycleError(f"batch {command}: no INPUTS (files, folders or glob patterns)")
@@ -107,4 +107,4 @@ def batch(
     if run["engine"]:
         out.print(f"  {run['workers']} worker(s) at {run['scheduler']}; {run['wall_seconds']:.2f} s wall, "
                   f"{run['task_seconds']:.2f} s in the tasks", soft_wrap=True)
-    out.print(f"wrote {Path(outdir) / 'results.csv'} and results.json", soft_wrap=True)
+    out.print(f"wrote {escape(Path(outdir) / 'results.csv')} and results.json", soft_wrap=True)
