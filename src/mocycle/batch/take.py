@@ -209,10 +209,14 @@ def _remove_stale(job: Job, take: Take, keep: set[str]) -> None:
         old = json.loads(job.record_path(take).read_text(encoding="utf-8"))
         if not _same_take(old, take):
             return
-        for check in old.get("output_checks", []):
-            tail = check["tail"]
-            path = _output_of(job, take, tail)
-            if tail not in keep and "/" not in tail and job.outdir in path.resolve().parents:
+        if "output_checks" in old:
+            stale = [_output_of(job, take, c["tail"]) for c in old["output_checks"]
+                     if c["tail"] not in keep and "/" not in c["tail"]]
+        else:  # a record of an older mocycle: its outputs by their names relative to the output folder
+            kept = {_output_of(job, take, tail) for tail in keep}
+            stale = [job.outdir / name for name in old.get("outputs", []) if job.outdir / name not in kept]
+        for path in stale:
+            if job.outdir in path.resolve().parents:
                 path.unlink(missing_ok=True)
     except (OSError, ValueError, AttributeError, TypeError, KeyError):
         pass
