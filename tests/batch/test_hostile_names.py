@@ -298,3 +298,13 @@ def test_a_record_names_its_outputs_by_tail_so_any_take_name_resumes(tmp_path, w
     assert [c["tail"] for c in row["output_checks"]] == [".mosw"]
     assert fresh_record(job, take) is not None
     assert isinstance(take, Take) and COMMANDS["swings"].suffix == ".mosw"
+
+
+def test_an_input_folder_inside_the_output_folder_is_searched_whole(tmp_path, walk_text):
+    """``-o .`` from the folder that holds the input folder: the takes are found (before: "no .bvh or .amc files
+    in this folder", as everything under the output folder was left out)."""
+    folder = _takes(tmp_path / "in", walk_text, "walk.bvh")
+    assert [t.rel.as_posix() for t in find_takes([folder], tmp_path)] == ["walk.bvh"]
+    (folder / "out").mkdir()
+    (folder / "out" / "old.bvh").write_text("an earlier output")  # outputs inside the input tree: left out
+    assert [t.rel.as_posix() for t in find_takes([folder], folder / "out")] == ["walk.bvh"]

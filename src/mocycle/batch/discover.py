@@ -144,6 +144,12 @@ def _abs(p) -> Path:
     return Path(os.path.abspath(p))
 
 
+def _below(outdir: Path | None, root: Path) -> Path | None:
+    """The output folder to leave out when searching ``root``: only when it lies inside ``root`` (outputs
+    written into the input tree); an input folder inside the output folder (``-o .``) is searched whole."""
+    return outdir if outdir is not None and outdir != root and root in outdir.parents else None
+
+
 def _inside(p: Path, folder: Path | None) -> bool:
     return folder is not None and (p == folder or folder in p.parents)
 
@@ -152,7 +158,8 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
     """The takes named by ``inputs`` (files, folders, glob patterns), sorted by their relative path.
 
     A folder is searched recursively for ``.bvh`` and ``.amc`` files (hidden files and anything under
-    ``outdir`` are left out, so outputs written into the input tree are never read back as inputs). The
+    ``outdir``, when it lies inside the folder, are left out, so outputs written into the input tree are never
+    read back as inputs; an input folder inside ``outdir`` is searched whole). The
     relative path of a take is taken from the common folder of the inputs' roots (a folder is its own root,
     a file's root is its folder, a pattern's root is its folder before the first wildcard).
 
@@ -170,7 +177,7 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
         p = Path(item)
         if p.is_dir():
             root = _abs(p)
-            files, problems = _walk(root, skip)
+            files, problems = _walk(root, _below(skip, root))
             if not files and not problems:
                 raise MocycleError(f"{item}: no .bvh or .amc files in this folder")
         elif p.exists():
@@ -184,7 +191,7 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
             root = _abs(_root_of_pattern(item))
             matched = [_abs(f) for f in sorted(glob.glob(item, recursive=True))]
             matched = [f for f in matched if f.suffix.lower() in TAKE_SUFFIXES and not f.name.startswith(".")
-                       and not _inside(f, skip) and not f.is_dir()]
+                       and not _inside(f, _below(skip, root)) and not f.is_dir()]
             files, problems = [], []
             for f in matched:
                 why = problem_of(f)
