@@ -173,3 +173,22 @@ def test_one_joints_path_is_its_column_of_the_world_positions(monkeypatch):
     W = walk.world_positions()
     for j in (0, walk.travel_joint, walk.n_joints - 1):
         np.testing.assert_array_equal(walk.joint_path(j), W[:, j])
+
+
+def test_the_body_root_is_where_the_skeleton_branches():
+    """A take where no joint moves (one frame, a still pose) takes the body's root as its travel joint, not a
+    static joint above it (Bandai's joint_Root at the room's origin)."""
+    walk = synthetic_walk(n_frames=2).motion
+    sk = walk.skeleton
+    assert sk.body_root() == 0 and len(sk.children(0)) > 1  # the Hips branch
+    rooted = Skeleton(("joint_Root", "extra", *sk.names), [-1, 0, *(sk.parents + 2)],
+                      np.vstack([[0, 0, 0], [0, 0, 0], sk.offsets]),
+                      [("Xposition", "Yposition", "Zposition"), ("Zrotation", "Xrotation", "Yrotation"), *sk.channels])
+    assert rooted.body_root() == 2
+    chain = Skeleton(("a", "b", "c"), [-1, 0, 1], np.zeros((3, 3)), [("Zrotation", "Xrotation", "Yrotation")] * 3)
+    assert chain.body_root() == 0  # no branch: the root
+    q = np.concatenate([np.tile([0, 0, 0, 1.0], (1, 2, 1)), walk.rotations[:1]], axis=1)
+    t = np.concatenate([np.zeros((1, 2, 3)), walk.translations[:1]], axis=1)
+    t[:, 2] += [400.0, 0, 0]
+    one = Motion(rooted, q, t, walk.frame_time)
+    assert one.moving_joints(1e-9) == [] and one.travel_joint == 2

@@ -115,6 +115,17 @@ class Skeleton:
     def children(self, j: int) -> list[int]:
         return [int(c) for c in np.flatnonzero(self.parents == j)]
 
+    def body_root(self) -> int:
+        """The joint where the body branches: down from the root while a joint has exactly one child joint (a
+        static ``joint_Root`` above ``Hips``), to the first with two or more (legs and spine); the root itself
+        when it branches or when no joint does (a single chain)."""
+        j = 0
+        while True:
+            kids = self.children(j)
+            if len(kids) != 1:
+                return j if len(kids) > 1 else 0
+            j = kids[0]
+
     def chain_to(self, joint: int) -> list[int]:
         """The joints from the root down to ``joint`` (root first, ``joint`` last)."""
         chain = [int(joint)]
@@ -472,15 +483,19 @@ class Motion:
     @property
     def travel_joint(self) -> int:
         """Index of the joint whose translation carries the travel: the first joint
-        (parents first) whose local translation changes over the take, else 0.
+        (parents first) whose local translation changes over the take; in a take where
+        none changes (one frame, a still pose) the body's root (:meth:`Skeleton.body_root`).
 
         Usually the root; in files such as the Bandai Namco set the root is a
         static ``joint_Root`` and ``Hips`` carries the motion in its position channels.
+        A one-frame take cannot show which joint moves: taking the file's root there
+        would put ``joint_Root``, at the room's origin metres away, into the body (its
+        size, its vertical: a one-frame Bandai take was 457 units tall and lay on -Z).
         """
         known = getattr(self, "_travel", None)  # the arrays are read-only: found once per motion
         if known is None:
             moving = self.moving_joints(1e-9)
-            known = self._travel = moving[0] if moving else 0
+            known = self._travel = moving[0] if moving else self.skeleton.body_root()
         return known
 
     def __repr__(self) -> str:

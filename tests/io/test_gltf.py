@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -145,6 +146,16 @@ def test_units_and_axes(tmp_path):
     t[:, 1] += [400.0, 0, 0]
     far = Motion(rooted, q, t, walk.frame_time)
     assert gltf_frame(far).body_size == pytest.approx(gltf_frame(walk).body_size)
+    # one or two frames cannot show which joint travels: the body's root (the Hips, where the skeleton
+    # branches) is taken, not the static joint_Root 4 m away (the one-frame take was 457 units tall, lying on -Z)
+    for n in (1, 2):
+        few = far[:n]
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", mocycle.MocycleWarning)  # no "the body is ... units tall"
+            frame = gltf_frame(few)
+        assert few.travel_joint == 1 and frame.unit == "cm" and frame.up.tolist() == [0.0, 1.0, 0.0]
+        assert frame.body_size == pytest.approx(gltf_frame(walk[:n]).body_size)
+        assert 150 < frame.body_size < 200
     # the node positions the file holds are in metres, Y up: the hips stand about 1 m high
     js = run_js(write_gltf(to_z_up(walk), tmp_path / "z.glb"), [0.0])
     assert 0.7 < js["positions"][0]["0"][1] < 1.2

@@ -3,8 +3,10 @@ path its outputs take under the output folder (the input tree, mirrored)."""
 
 from __future__ import annotations
 
+import errno
 import glob
 import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,10 +25,15 @@ class Take:
     source : the motion file (absolute path).
     rel : its path relative to the common folder of the inputs; the outputs go to ``OUTDIR / rel`` with their
         own suffix, so the output tree mirrors the input tree.
+    problem : why a path found in an input folder (or matched by a pattern) cannot be read as a take: a broken
+        symbolic link, a link loop, a folder or file that cannot be read, not a regular file. ``None`` for a
+        take to run. Such a path is not sent to the workers; it gets a row with status ``error`` and this
+        message, so every path found is in the results.
     """
 
     source: Path
     rel: Path
+    problem: str | None = None
 
     def output(self, outdir: Path, suffix: str) -> Path:
         """``OUTDIR/rel`` with ``suffix`` instead of the take's own (``a/walk.amc`` -> ``OUT/a/walk.bvh``)."""
@@ -42,6 +49,79 @@ class Take:
 
 def _is_take(p: Path) -> bool:
     return p.is_file() and p.suffix.lower() in TAKE_SUFFIXES and not p.name.startswith(".")
+
+
+def _why(exc: OSError) -> str:
+    return exc.strerror or type(exc).__name__
+
+
+def problem_of(p: Path) -> str | None:
+    """Why the path ``p`` (named like a take) cannot be read as one, or ``None`` when it can."""
+    try:
+        st = p.stat()
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            return "a symbolic link loop"
+        if p.is_symlink():
+            try:
+                return f"a broken symbolic link (to {os.readlink(p)})"
+            except OSError:
+                return "a broken symbolic link"
+        return f"cannot read the file ({_why(exc)})"
+    if stat.S_ISDIR(st.st_mode):
+        return None  # a folder named like a take is searched like any folder
+    if not stat.S_ISREG(st.st_mode):
+        return "not a regular file (a device, pipe or socket)"
+    if not os.access(p, os.R_OK):
+        return "cannot read the file (Permission denied)"
+    return None
+
+
+def _walk(root: Path, skip: Path | None) -> tuple[list[Path], list[tuple[Path, str]]]:
+    """The takes under the folder ``root`` (recursively, links to folders followed, hidden entries and
+    ``skip`` left out) and the paths found there that cannot be read: (path, why).
+
+    Every path is looked at once: a folder that cannot be listed, a folder link that leads back into its own
+    ancestors (a loop), a broken or looping link named like a take, a take that is no regular file or cannot
+    be read are returned with the reason, never dropped in silence. No recursion (a deep tree cannot exhaust
+    the stack)."""
+    files: list[Path] = []
+    problems: list[tuple[Path, str]] = []
+    stack: list[tuple[Path, tuple]] = [(root, ())]
+    while stack:
+        folder, ancestors = stack.pop()
+        try:
+            st = folder.stat()
+            ident = (st.st_dev, st.st_ino)
+            if ident in ancestors:
+                problems.append((folder, "a symbolic link loop (it leads back to a folder above it)"))
+                continue
+            with os.scandir(folder) as it:
+                entries = sorted(it, key=lambda e: e.name)
+        except OSError as exc:
+            problems.append((folder, f"cannot read the folder ({_why(exc)})"))
+            continue
+        below = []
+        for entry in entries:
+            if entry.name.startswith("."):
+                continue
+            p = folder / entry.name
+            if _inside(p, skip):
+                continue
+            try:
+                is_dir = entry.is_dir()  # follows links
+            except OSError:
+                is_dir = False
+            if is_dir:
+                below.append(p)
+            elif p.suffix.lower() in TAKE_SUFFIXES:
+                why = problem_of(p)
+                if why is None:
+                    files.append(p)
+                else:
+                    problems.append((p, why))
+        stack += [(p, (*ancestors, ident)) for p in reversed(below)]
+    return files, problems
 
 
 def _magic(text: str) -> bool:
@@ -64,6 +144,12 @@ def _abs(p) -> Path:
     return Path(os.path.abspath(p))
 
 
+def _below(outdir: Path | None, root: Path) -> Path | None:
+    """The output folder to leave out when searching ``root``: only when it lies inside ``root`` (outputs
+    written into the input tree); an input folder inside the output folder (``-o .``) is searched whole."""
+    return outdir if outdir is not None and outdir != root and root in outdir.parents else None
+
+
 def _inside(p: Path, folder: Path | None) -> bool:
     return folder is not None and (p == folder or folder in p.parents)
 
@@ -72,7 +158,8 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
     """The takes named by ``inputs`` (files, folders, glob patterns), sorted by their relative path.
 
     A folder is searched recursively for ``.bvh`` and ``.amc`` files (hidden files and anything under
-    ``outdir`` are left out, so outputs written into the input tree are never read back as inputs). The
+    ``outdir``, when it lies inside the folder, are left out, so outputs written into the input tree are never
+    read back as inputs; an input folder inside ``outdir`` is searched whole). The
     relative path of a take is taken from the common folder of the inputs' roots (a folder is its own root,
     a file's root is its folder, a pattern's root is its folder before the first wildcard).
 
@@ -85,35 +172,49 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
     if not inputs:
         raise MocycleError("no inputs: name files, folders or glob patterns")
     skip = _abs(outdir) if outdir is not None else None
-    found: list[tuple[Path, Path]] = []  # (file, root)
+    found: list[tuple[Path, Path, str | None]] = []  # (file, root, problem)
     for item in map(str, inputs):
         p = Path(item)
         if p.is_dir():
             root = _abs(p)
-            files = [f for f in sorted(root.rglob("*")) if _is_take(f) and not _inside(f, skip)
-                     and not any(part.startswith(".") for part in f.relative_to(root).parts)]
-            if not files:
+            files, problems = _walk(root, _below(skip, root))
+            if not files and not problems:
                 raise MocycleError(f"{item}: no .bvh or .amc files in this folder")
         elif p.exists():
             if p.suffix.lower() not in TAKE_SUFFIXES:
                 raise MocycleError(f"{item}: not a take; batch reads {' and '.join(TAKE_SUFFIXES)} files")
-            root, files = _abs(p).parent, [_abs(p)]
+            why = problem_of(_abs(p))
+            if why is not None:
+                raise MocycleError(f"{item}: {why}")
+            root, files, problems = _abs(p).parent, [_abs(p)], []
         elif _magic(item):
             root = _abs(_root_of_pattern(item))
-            files = [_abs(f) for f in sorted(glob.glob(item, recursive=True))]
-            files = [f for f in files if _is_take(f) and not _inside(f, skip)]
-            if not files:
+            matched = [_abs(f) for f in sorted(glob.glob(item, recursive=True))]
+            matched = [f for f in matched if f.suffix.lower() in TAKE_SUFFIXES and not f.name.startswith(".")
+                       and not _inside(f, _below(skip, root)) and not f.is_dir()]
+            files, problems = [], []
+            for f in matched:
+                why = problem_of(f)
+                if why is None:
+                    files.append(f)
+                else:
+                    problems.append((f, why))
+            if not files and not problems:
                 raise MocycleError(f"{item}: the pattern matches no .bvh or .amc file")
+        elif os.path.islink(item):
+            raise MocycleError(f"{item}: {problem_of(Path(item))}")
         else:
             raise MocycleError(f"{item}: no such file or folder")
-        found += [(f, root) for f in files]
-    base = Path(os.path.commonpath([str(root) for _, root in found]))
+        found += [(f, root, None) for f in files] + [(f, root, why) for f, why in problems]
+    base = Path(os.path.commonpath([str(root) for _, root, _ in found]))
     takes = {}
-    for f, _ in found:  # the same path named twice is one take; links of other names are takes of their own
-        takes.setdefault(f, Take(source=f, rel=f.relative_to(base)))
+    for f, _, why in found:  # the same path named twice is one take; links of other names are takes of their own
+        takes.setdefault(f, Take(source=f, rel=f.relative_to(base), problem=why))
     out = sorted(takes.values(), key=lambda t: str(t.rel))
     stems: dict[Path, Take] = {}
     for t in out:
+        if t.problem is not None:
+            continue
         stem = t.rel.with_suffix("")
         if stem in stems:
             raise MocycleError(f"{stems[stem].source} and {t.source} would write the same outputs "

@@ -21,11 +21,12 @@ from distributed.diagnostics.plugin import WorkerPlugin
 from distributed.scheduler import KilledWorker
 
 from ..errors import MocycleError
+from ..text import printable
 from . import forkserver
 from .commands import COMMANDS
 from .discover import Take
 from .forkserver import ONE_THREAD_ENV
-from .take import Job, message_of, process
+from .take import Job, base_row, message_of, process
 
 __all__ = ["ONE_THREAD_ENV", "OneBlasThread", "default_workers", "largest_first", "run_takes"]
 
@@ -141,6 +142,4 @@ def _run(job: Job, takes: list[Take], on_row, scheduler: str | None, workers: in
 
 def lost_row(job: Job, take: Take, message: str) -> dict:
     """The row of a take no worker could finish (status ``error``)."""
-    return {"file": str(take.source), "rel": str(take.rel), "status": "error", "message": message, "figures": {},
-            "seconds": None, "wall_seconds": None, "outputs": [], "warnings": [], "facts": None, "worker": None,
-            "options_hash": job.options_hash, "record": None}
+    return {**base_row(job, take), "status": "error", "message": printable(message), "record": None}

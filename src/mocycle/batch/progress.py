@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import time
 
+from ..text import printable
+
 __all__ = ["BarProgress", "LineProgress", "progress_for"]
 
 
@@ -29,16 +31,19 @@ class LineProgress:
     def __exit__(self, *exc):
         return False
 
-    def advance(self, row: dict) -> None:
+    def advance(self, row: dict, ran: bool = True) -> None:
+        """Count ``row``; ``ran``: it was run now (a path that could not be read as a take was not, and does
+        not count in the rate)."""
         self.done += 1
-        self.run += 1
+        self.run += ran
         self.failed += row["status"] != "ok"
         rate = self.run / max(time.perf_counter() - self.t0, 1e-9)
         what = row["status"] + (f": {row['message']}" if row["message"] else "")
         figures = _figures_text(row) if row["status"] == "ok" else ""
-        self.console.print(f"[{self.done}/{self.total}] {row['rel']}: {what}" + (f" ({figures})" if figures else "")
-                           + f"; not ok {self.failed}, {rate:.2f} takes/s", markup=False, highlight=False,
-                           soft_wrap=True)
+        rate_text = f", {rate:.2f} takes/s" if self.run else ""
+        self.console.print(printable(f"[{self.done}/{self.total}] {row['rel']}: {what}")
+                           + (f" ({figures})" if figures else "") + f"; not ok {self.failed}{rate_text}",
+                           markup=False, highlight=False, soft_wrap=True)
 
 
 class BarProgress:
@@ -61,9 +66,9 @@ class BarProgress:
     def __exit__(self, *exc):
         return self.progress.__exit__(*exc)
 
-    def advance(self, row: dict) -> None:
+    def advance(self, row: dict, ran: bool = True) -> None:
         self.failed += row["status"] != "ok"
-        self.run += 1
+        self.run += ran
         rate = self.run / max(time.perf_counter() - self.t0, 1e-9)
         self.progress.update(self.task, advance=1, failed=self.failed, rate=f"{rate:.2f}")
 

@@ -9,6 +9,7 @@ from collections import Counter
 from pathlib import Path
 
 from ..io.atomic import atomic_write
+from ..text import json_text, printable
 from .commands import COMMANDS
 
 __all__ = ["CSV_HEAD", "summary", "write_results"]
@@ -19,13 +20,15 @@ CSV_TAIL = ("seconds", "outputs", "warnings", "resumed")
 
 
 def _cell(value) -> str:
+    """A CSV cell as printable text (:func:`mocycle.text.printable`: control characters and bytes that are not
+    UTF-8 as ``\\xNN``), so the file is valid UTF-8 and safe to show in a terminal."""
     if value is None:
         return ""
     if isinstance(value, float):
         return f"{value:.6g}"
     if isinstance(value, (list, tuple)):
-        return " ".join(map(str, value))
-    return str(value)
+        return " ".join(map(printable, value))
+    return printable(value)
 
 
 def csv_text(command: str, rows: list[dict]) -> str:
@@ -36,8 +39,9 @@ def csv_text(command: str, rows: list[dict]) -> str:
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow([*CSV_HEAD, *figures, *CSV_TAIL])
     for r in rows:
-        writer.writerow([r["file"], r["status"], r["message"], *(_cell(r["figures"].get(k)) for k in figures),
-                         _cell(r["seconds"]), _cell(r["outputs"]), "; ".join(r["warnings"]),
+        writer.writerow([_cell(r["file"]), r["status"], _cell(r["message"]),
+                         *(_cell(r["figures"].get(k)) for k in figures),
+                         _cell(r["seconds"]), _cell(r["outputs"]), _cell("; ".join(r["warnings"])),
                          "yes" if r.get("resumed") else ""])
     return buffer.getvalue()
 
@@ -52,8 +56,6 @@ def summary(rows: list[dict]) -> dict:
 
 def write_results(outdir: Path, command: str, options: dict, rows: list[dict], run: dict) -> tuple[Path, Path]:
     """Write both files atomically; ``run``: how the batch ran (engine, workers, wall seconds)."""
-    from ..cli.common import json_text
-
     data = {"command": command, "options": options, "summary": summary(rows), "run": run, "takes": rows}
     return (atomic_write(outdir / "results.csv", csv_text(command, rows)),
             atomic_write(outdir / "results.json", json_text(data, indent=1)))

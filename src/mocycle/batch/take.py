@@ -19,10 +19,12 @@ from pathlib import Path
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 from ..tasks.options import Options
+from ..text import json_text, path_hex, printable
 from .commands import COMMANDS, motion_targets
 from .discover import Take
 
-__all__ = ["STATUSES", "Job", "fresh_record", "process", "status_of"]
+__all__ = ["STATUSES", "Job", "base_row", "fresh_record", "problem_row", "process", "row_key", "status_of",
+           "take_key"]
 
 STATUSES = ("ok", "no-periodic-motion", "refused", "error")
 
@@ -91,8 +93,7 @@ def process(job: Job, take: Take) -> dict:
 
     t0 = time.perf_counter()
     command = COMMANDS[job.command]
-    row = {"file": str(take.source), "rel": str(take.rel), "status": "ok", "message": "", "figures": {},
-           "seconds": None, "wall_seconds": None, "outputs": [], "warnings": [], "facts": None}
+    row = base_row(job, take)
     written: list[Path] = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -106,22 +107,75 @@ def process(job: Job, take: Take) -> dict:
             else:
                 _write_outputs(job, command, take, report, write, written)
         except Exception as exc:  # one bad take never stops the batch: its row says what happened
-            row["status"], row["message"] = status_of(exc), message_of(exc)
+            row["status"], row["message"] = status_of(exc), printable(message_of(exc))
             for path in written:  # a take that failed part-way leaves none of its outputs
                 path.unlink(missing_ok=True)
             written = []
     row["warnings"] += [str(w.message) for w in caught if not issubclass(w.category, DeprecationWarning)
                         and str(w.message) not in row["warnings"]]
-    row["outputs"] = [p.relative_to(job.outdir).as_posix() for p in written]
+    row["outputs"] = [printable(p.relative_to(job.outdir).as_posix()) for p in written]
+    row["output_checks"] = [_check_of(take, p) for p in written]
     record = job.record_path(take)
-    _remove_stale(job.outdir, record, set(row["outputs"]))
+    _remove_stale(job, take, {c["tail"] for c in row["output_checks"]})
     row["wall_seconds"] = time.perf_counter() - t0
     row["worker"] = _worker_name()
-    row["options_hash"] = job.options_hash
-    row["record"] = record.relative_to(job.outdir).as_posix()
     record.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write(record, json_text(row))
+    atomic_write(record, json_text(row, indent=1))
     return row
+
+
+def base_row(job: Job, take: Take) -> dict:
+    """The row of a take before it runs. ``file`` and ``rel`` are the paths as printable text
+    (:func:`mocycle.text.printable`: a byte that is not UTF-8 as ``\\xNN``, control characters escaped); when
+    that differs from the real name (a name that is not UTF-8), ``file_hex`` holds the path's bytes in hex."""
+    row = {"file": printable(take.source), "rel": printable(take.rel.as_posix()), "status": "ok", "message": "",
+           "figures": {}, "seconds": None, "wall_seconds": None, "outputs": [], "warnings": [], "facts": None,
+           "worker": None, "options_hash": job.options_hash,
+           "record": printable(job.record_path(take).relative_to(job.outdir).as_posix())}
+    if path_hex(take.source) is not None:
+        row["file_hex"] = path_hex(take.source)
+    return row
+
+
+def row_key(row: dict) -> tuple:
+    """What tells the rows of two takes apart (the printable name and, for a name that is not UTF-8, its
+    bytes)."""
+    return row["file"], row.get("file_hex")
+
+
+def take_key(take: Take) -> tuple:
+    """:func:`row_key` of the take's row."""
+    return printable(take.source), path_hex(take.source)
+
+
+def problem_row(job: Job, take: Take) -> dict:
+    """The row of a path that cannot be read as a take (:attr:`Take.problem`): status ``error``, no record."""
+    return {**base_row(job, take), "status": "error", "message": printable(take.problem), "record": None}
+
+
+def _tail(take: Take, path: Path) -> str:
+    """What an output's name adds to the take's stem (``walk.class1.bvh`` -> ``.class1.bvh``); always text
+    mocycle made (a role and a suffix), so a record can name its outputs whatever the take's name."""
+    stem = take.rel.with_suffix("").name
+    assert path.name.startswith(stem), (path, stem)
+    return path.name[len(stem):]
+
+
+def _output_of(job: Job, take: Take, tail: str) -> Path:
+    return job.outdir / take.rel.parent / (take.rel.with_suffix("").name + tail)
+
+
+def _digest(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _check_of(take: Take, path: Path) -> dict:
+    """An output as its record lists it: its name after the take's stem, its size and its SHA-256."""
+    return {"tail": _tail(take, path), "bytes": path.stat().st_size, "sha256": _digest(path)}
 
 
 def _figures(command, facts) -> dict:
@@ -147,40 +201,58 @@ def _write_outputs(job: Job, command, take: Take, report, write, written: list[P
     written.append(write(report.result, target))  # a Compressed take (.mck) or a Segmentation (.mosw / .json)
 
 
-def _remove_stale(outdir: Path, record: Path, keep: set[str]) -> None:
-    """Remove the outputs the previous record of this take lists (relative to ``outdir``) that this run did not
-    write; nothing outside ``outdir``."""
+def _remove_stale(job: Job, take: Take, keep: set[str]) -> None:
+    """Remove the outputs the previous record of this take lists that this run did not write (``keep``: the
+    tails of the ones it wrote); only when that record is this take's own (same file), nothing outside
+    ``outdir``."""
     try:
-        old = json.loads(record.read_text(encoding="utf-8"))
-        for name in old.get("outputs", []):
-            path = (outdir / name).resolve()
-            if name not in keep and outdir in path.parents:
+        old = json.loads(job.record_path(take).read_text(encoding="utf-8"))
+        if not _same_take(old, take):
+            return
+        if "output_checks" in old:
+            stale = [_output_of(job, take, c["tail"]) for c in old["output_checks"]
+                     if c["tail"] not in keep and "/" not in c["tail"]]
+        else:  # a record of an older mocycle: its outputs by their names relative to the output folder
+            kept = {_output_of(job, take, tail) for tail in keep}
+            stale = [job.outdir / name for name in old.get("outputs", []) if job.outdir / name not in kept]
+        for path in stale:
+            if job.outdir in path.resolve().parents:
                 path.unlink(missing_ok=True)
-    except (OSError, ValueError, AttributeError):
+    except (OSError, ValueError, AttributeError, TypeError, KeyError):
         pass
 
 
-def fresh_record(job: Job, take: Take) -> dict | None:
-    """The record of an earlier run of this take that ``--resume`` may keep, else ``None``.
+def _same_take(record: dict, take: Take) -> bool:
+    return (record.get("file"), record.get("file_hex")) == (printable(take.source), path_hex(take.source))
 
-    Kept when the record was made with the same options hash, its status is not ``error`` (errors are tried
-    again), every output it lists exists, and the record and outputs are newer than the take's input files.
+
+def fresh_record(job: Job, take: Take) -> dict | None:
+    """The record of an earlier run of this take that ``--resume`` may keep, else ``None`` (the take runs again).
+
+    Kept when the record is this take's (the same input file, the same relative path and record name), was
+    made with the same options hash, its status is not ``error`` (errors are tried again), every output it
+    lists exists with the size and SHA-256 the record holds, and the record and outputs are newer than the
+    take's input files. A record of an older mocycle without the outputs' sizes and hashes is not kept.
     """
     record = job.record_path(take)
     try:
         row = json.loads(record.read_text(encoding="utf-8"))
-        if row.get("options_hash") != job.options_hash or row.get("status") not in STATUSES[:3]:
+        expected = base_row(job, take)
+        if (row.get("options_hash") != job.options_hash or row.get("status") not in STATUSES[:3]
+                or not _same_take(row, take) or row.get("rel") != expected["rel"]
+                or row.get("record") != expected["record"]):
             return None
-        made = [record] + [job.outdir / p for p in row.get("outputs", [])]
+        checks = row.get("output_checks")
+        if not isinstance(checks, list) or len(checks) != len(row.get("outputs", [])):
+            return None
+        made = [record]
+        for check in checks:
+            path = _output_of(job, take, check["tail"])
+            if "/" in check["tail"] or path.stat().st_size != check["bytes"] or _digest(path) != check["sha256"]:
+                return None
+            made.append(path)
         oldest_output = min(p.stat().st_mtime for p in made)
         newest_input = max(p.stat().st_mtime for p in take.inputs())
-    except (OSError, ValueError, AttributeError, TypeError):
+    except (OSError, ValueError, AttributeError, TypeError, KeyError):
         return None
     return row if oldest_output >= newest_input else None
-
-
-def json_text(data) -> str:
-    """Strict JSON (non-finite numbers as null, and it says which), as the CLI's ``--json`` writes it."""
-    from ..cli.common import json_text
-
-    return json_text(data, indent=1)

@@ -17,7 +17,7 @@ import typer
 from .. import tasks
 from ..errors import MocycleError
 from ..tasks.options import MISSING, Flag, flag_of
-from .common import EXIT_USAGE, app, err, friendly, out, print_json
+from .common import EXIT_USAGE, app, err, escape, friendly, out, print_json
 
 #: the commands batch runs (the ones that take one file)
 BATCH_COMMANDS = ("info", "phase", "loop", "swings", "compress", "stretch")
@@ -61,14 +61,16 @@ def batch(
              "INPUTS are .bvh/.amc files, folders "
              "(searched recursively) or glob patterns; then any flag of 'mocycle COMMAND' that sets an option "
              "of the task (e.g. --harmonics 5, --root motion, --factor 2).")],
-    outdir: Annotated[Path, typer.Option("--output", "-o", help="The output folder: the outputs mirror the input "
+    outdir: Annotated[Path, typer.Option("--output", "-o", help="The output folder (made when missing; checked "
+                                                                "before any work): the outputs mirror the input "
                                                                 "tree; results.csv and results.json go here.")],
     suffix: Annotated[str | None, typer.Option(
         help="Output suffix for the takes (default: .bvh for loop and stretch, .mck for compress, .mosw for "
              "swings; any motion format 'mocycle.write' writes for loop and stretch).")] = None,
     resume: Annotated[bool, typer.Option(
-        "--resume", help="Keep the takes whose record and outputs are newer than their input and were made "
-                         "with the same options; run the rest (and the ones that ended in error).")] = False,
+        "--resume", help="Keep the takes whose record is theirs, was made with the same options and lists "
+                         "outputs that are there with the size and SHA-256 it holds, all newer than the input; "
+                         "run the rest (and the ones that ended in error).")] = False,
     scheduler: Annotated[str | None, typer.Option(
         help="Address of a running dask scheduler (tcp://host:8786); default: a LocalCluster here. Workers "
              "must see the inputs and the output folder at the same paths.")] = None,
@@ -88,7 +90,7 @@ def batch(
     try:
         command, inputs, options = parse_command_line(args)
     except click.UsageError as exc:
-        err.print(f"[bold red]error:[/] {exc.format_message()}", markup=True, soft_wrap=True)
+        err.print(f"[bold red]error:[/] {escape(exc.format_message())}", markup=True, soft_wrap=True)
         raise typer.Exit(EXIT_USAGE) from None
     if not inputs:
         raise MocycleError(f"batch {command}: no INPUTS (files, folders or glob patterns)")
@@ -105,6 +107,6 @@ def batch(
               f"{run['refused']} refused, {run['error']} error" + (f", {run['resumed']} kept (--resume)"
                                                                      if run["resumed"] else ""))
     if run["engine"]:
-        out.print(f"  {run['workers']} worker(s) at {run['scheduler']}; {run['wall_seconds']:.2f} s wall, "
+        out.print(f"  {run['workers']} worker(s) at {escape(run['scheduler'])}; {run['wall_seconds']:.2f} s wall, "
                   f"{run['task_seconds']:.2f} s in the tasks", soft_wrap=True)
-    out.print(f"wrote {Path(outdir) / 'results.csv'} and results.json", soft_wrap=True)
+    out.print(f"wrote {escape(Path(outdir) / 'results.csv')} and results.json", soft_wrap=True)

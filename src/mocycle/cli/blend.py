@@ -16,6 +16,7 @@ from .common import (
     check_motion_output,
     check_output,
     default,
+    escape,
     flag,
     friendly,
     out,
@@ -95,7 +96,7 @@ def blend(
         print_json(facts)
         return
     out.print(f"[bold]blend[/] of {len(paths)} takes, weights "
-              + ", ".join(f"{p.name} {x:.3g}" for p, x in zip(paths, result.weights, strict=True)))
+              + ", ".join(f"{escape(p.name)} {x:.3g}" for p, x in zip(paths, result.weights, strict=True)))
     out.print("  periods (frames): " + ", ".join(f"{x:.2f}" for x in result.input_periods)
               + f" -> {result.period_frames:.2f} (loop of {result.n_frames} frames)")
     out.print("  phase offsets (cycles): " + ", ".join(f"{x:.3f}" for x in result.phase_offsets))
@@ -105,9 +106,9 @@ def blend(
     seam = facts["seam"]
     out.print(f"  seam jump: pose {seam['seam_pose']:.3g}, velocity {seam['seam_velocity']:.3g} (× median step)")
     _print_feet(facts["feet"])
-    out.print(f"wrote {output}: {facts['frames_out']} frames ({cycles} cycle(s), root {root})", soft_wrap=True)
+    out.print(f"wrote {escape(output)}: {facts['frames_out']} frames ({cycles} cycle(s), root {root})", soft_wrap=True)
     if plot is not None:
-        out.print(f"wrote {plot}", soft_wrap=True)
+        out.print(f"wrote {escape(plot)}", soft_wrap=True)
     out.print(timing_line(report))
 
 
@@ -162,16 +163,17 @@ def transition(
     if as_json:
         print_json(facts)
         return
-    out.print(f"[bold]transition[/] {first.name} -> {second.name} over {cycles} cycle(s)")
+    out.print(f"[bold]transition[/] {escape(first.name)} -> {escape(second.name)} over {cycles} cycle(s)",
+              soft_wrap=True)
     out.print(f"  period {facts['period_frames_start']:.2f} -> {facts['period_frames_end']:.2f} frames; "
               f"phase offset of the second {facts['phase_offset']:.3f} cycles")
     sm = facts["smoothness"]
     out.print(f"  largest step {sm['step_local']:.3g} × its neighbours' median (inputs {sm['input_step_local']:.3g}); "
               f"largest velocity change {sm['velocity_local']:.3g} × (inputs {sm['input_velocity_local']:.3g})")
     _print_feet(facts["feet"])
-    out.print(f"wrote {output}: {facts['frames']} frames (root {root})", soft_wrap=True)
+    out.print(f"wrote {escape(output)}: {facts['frames']} frames (root {root})", soft_wrap=True)
     if plot is not None:
-        out.print(f"wrote {plot}", soft_wrap=True)
+        out.print(f"wrote {escape(plot)}", soft_wrap=True)
     out.print(timing_line(report))
 
 

@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
-import json
-import math
 import os
 import warnings
 from collections.abc import Callable, Mapping
@@ -24,6 +22,7 @@ from typer.core import TyperCommand, TyperGroup
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from ..tasks.options import MISSING, Choice, flag_of
+from ..text import json_text, printable
 
 #: sub-command -> (the module of ``mocycle.cli`` that defines it, the first paragraph of its help), in the
 #: order ``mocycle --help`` lists them.  tests/test_startup.py checks both against the commands themselves.
@@ -122,11 +121,17 @@ class _Console:
         return getattr(self._console, name)
 
 
-def escape(text: str) -> str:
-    """``text`` with rich markup escaped (``rich.markup.escape``)."""
+def escape(text) -> str:
+    """Text from a file (a joint or take name, a path, an error message quoting a file) as data for rich:
+    undecodable bytes, control and bidirectional characters written as visible escapes
+    (:func:`mocycle.text.printable`: ``bad\\xffname.bvh``, ``\\x1b[31m``), then rich markup escaped
+    (``rich.markup.escape``: a joint named ``[/]`` or ``[link=...]`` prints as those characters).
+
+    Every print path of the CLI passes such text through here, and only here: in a ``[bold]...[/]`` line, in
+    a table cell, in an ``error:`` or ``warning:`` line."""
     from rich.markup import escape as rich_escape
 
-    return rich_escape(text)
+    return rich_escape(printable(text))
 
 
 out = _Console(highlight=False)
@@ -209,7 +214,7 @@ def _print_warnings(caught) -> None:
 def print_warnings(report) -> None:
     """The warnings a task recorded in its report, as 'warning:' lines."""
     for text in report.warnings:
-        err.print(f"[yellow]warning:[/] {text}", markup=True, soft_wrap=True)
+        err.print(f"[yellow]warning:[/] {escape(text)}", markup=True, soft_wrap=True)
 
 
 def _version(value: bool):
@@ -377,36 +382,3 @@ def write_motion(report, role: str, path: Path, gltf_scale: str = "auto", gltf_u
     motion, clip = for_output(report, role, path, closing_frame)
     write(motion, path, clip=clip, gltf_scale=gltf_scale, gltf_up=gltf_up)
     return motion
-
-
-# ------------------------------------------------------------ output
-def json_text(facts, indent: int | None = 2) -> str:
-    """Strict JSON of ``facts``: NaN and infinities become ``null``, and the JSON says which and why.
-
-    ``json.dumps`` would write ``NaN``/``Infinity``, which JSON parsers refuse.  The paths of the values
-    written as ``null`` are listed under ``"null_because_not_finite"`` (for a dict at the top).
-    """
-    import numpy as np
-
-    nulls: list[str] = []
-
-    def clean(x, where: str):
-        if isinstance(x, (float, np.floating)):
-            if math.isfinite(x):
-                return float(x)
-            nulls.append(f"{where or 'value'} ({x})")
-            return None
-        if isinstance(x, np.integer):
-            return int(x)
-        if isinstance(x, np.ndarray):
-            x = x.tolist()
-        if isinstance(x, dict):
-            return {k: clean(v, f"{where}.{k}" if where else str(k)) for k, v in x.items()}
-        if isinstance(x, (list, tuple)):
-            return [clean(v, f"{where}[{i}]") for i, v in enumerate(x)]
-        return x
-
-    out = clean(facts, "")
-    if nulls and isinstance(out, dict):
-        out["null_because_not_finite"] = nulls
-    return json.dumps(out, indent=indent, allow_nan=False)

@@ -10,7 +10,7 @@ import typer
 from ..defaults import AMC_FPS
 from ..errors import MocycleError
 from ..tasks.loop import parse_range
-from .common import FORCE_HELP, GLTF_SCALE, GLTF_UP, app, check_motion_output, friendly, out, read, write
+from .common import FORCE_HELP, GLTF_SCALE, GLTF_UP, app, check_motion_output, escape, friendly, out, read, write
 
 
 @app.command()
@@ -45,7 +45,7 @@ def convert(
     if fps is not None:
         motion = motion.resample(fps)
     write(motion, target, gltf_scale=gltf_scale, gltf_up=gltf_up)
-    out.print(f"wrote {target}: {motion.n_frames} frames, {motion.n_joints} joints, {motion.fps:.6g} fps",
+    out.print(f"wrote {escape(target)}: {motion.n_frames} frames, {motion.n_joints} joints, {motion.fps:.6g} fps",
               soft_wrap=True)
 
 

@@ -12,6 +12,7 @@ from ..errors import MocycleError
 from .common import (
     app,
     check_folder,
+    escape,
     friendly,
     out,
     read,
@@ -43,7 +44,7 @@ def demo(
     import numpy as np
 
     true_period = float(np.median(take.period_frames))
-    out.print(f"[bold]{source}[/]: synthetic walk, {motion.n_frames} frames at {motion.fps:.6g} fps, 1° noise, "
+    out.print(f"[bold]{escape(source)}[/]: synthetic walk, {motion.n_frames} frames at {motion.fps:.6g} fps, 1° noise, "
               f"tempo +10 % over the take; true period {true_period:.1f} frames")
     report = tasks.loop.run(motion, tasks.loop.Options(cycles=4, root="motion"))
     cycle, metrics = report.result, report.facts["metrics"]
@@ -56,5 +57,6 @@ def demo(
                 "input_foot_sliding"):
         label, unit = METRIC_LABELS[key]
         out.print(f"  {label:28s} {metrics[key]:8.3f} {unit}")
-    out.print(f"wrote {loop_file} (one cycle, in place), {walk_file} (4 cycles walking on), {plot}", soft_wrap=True)
+    out.print(f"wrote {escape(loop_file)} (one cycle, in place), {escape(walk_file)} (4 cycles walking on), "
+              f"{escape(plot)}", soft_wrap=True)
     out.print(f"  time {time.perf_counter() - t0:.2f} s")

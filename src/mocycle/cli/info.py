@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import app, default, flag, friendly, out, print_json, print_warnings
+from .common import app, default, escape, flag, friendly, out, print_json, print_warnings
 
 O = tasks.info.Options
 
@@ -33,12 +33,12 @@ def info(
 def _print_info(facts: dict) -> None:
     from rich.table import Table
 
-    out.print(f"[bold]{facts['file']}[/]")
+    out.print(f"[bold]{escape(facts['file'])}[/]", soft_wrap=True)
     out.print(
         f"  {facts['frames']} frames × {facts['frame_time']:.6g} s = {facts['duration_s']:.3f} s "
         f"({facts['fps']:.6g} fps)\n"
         f"  {facts['joints']} joints, {facts['channels']} channels, {facts['end_sites']} end sites\n"
-        f"  travel of {facts['travel_joint']}: {facts['root_displacement']:.4g} net, "
+        f"  travel of {escape(facts['travel_joint'])}: {facts['root_displacement']:.4g} net, "
         f"{facts['root_path_length']:.4g} along the path (file units)"
     )
     ranges, spread = facts["rotation_range_deg"], facts["rotation_spread_deg"]
@@ -49,7 +49,8 @@ def _print_info(facts: dict) -> None:
     table.add_column("max angle from mean pose", justify="right")
     table.add_column("channel ranges (max - min; large near gimbal lock)")
     for name in shown:
-        table.add_row(name, f"{spread[name]:.1f}", "  ".join(f"{c[0]} {v:6.1f}" for c, v in ranges[name].items()))
+        table.add_row(escape(name), f"{spread[name]:.1f}",
+                      "  ".join(f"{c[0]} {v:6.1f}" for c, v in ranges[name].items()))
     out.print(table)
     if len(shown) < len(order):
         out.print(f"  ({len(order) - len(shown)} more joints; --json lists all)")

@@ -16,6 +16,7 @@ from .common import (
     check_motion_output,
     check_output,
     default,
+    escape,
     flag,
     friendly,
     out,
@@ -65,7 +66,7 @@ def compress(
     from rich.table import Table
 
     what = scheme if scheme != "spatial" else f"spatial/{projection}" + ("/optimised" if optimize else "")
-    table = Table(title=f"{path.name} -> {output.name} ({what}, {select} keyframes)")
+    table = Table(title=f"{escape(path.name)} -> {escape(output.name)} ({what}, {select} keyframes)")
     table.add_column("")
     table.add_column("value", justify="right")
     table.add_row("frames", str(r["frames"]))
@@ -79,7 +80,7 @@ def compress(
     table.add_row("formula 5.2/5.3 ratio (h = 0)", f"{r['formula_ratio']:.2%}")
     table.add_row("time (s)", f"{report.seconds:.2f}")
     out.print(table)
-    out.print(f"wrote {output}", soft_wrap=True)
+    out.print(f"wrote {escape(output)}", soft_wrap=True)
 
 
 @app.command()
@@ -103,7 +104,7 @@ def decompress(
     if as_json:
         print_json({**r, "seconds": report.seconds})
         return
-    out.print(f"{output}: {r['frames']} frames rebuilt from {r['keyframes']} keyframes ({r['scheme']})")
+    out.print(f"{escape(output)}: {r['frames']} frames rebuilt from {r['keyframes']} keyframes ({r['scheme']})")
     if r["feet"]["mode"] == "lock":
         out.print(f"  feet locked: skate {r['feet']['skate_before']:.4g} -> {r['feet']['skate_after']:.4g} units/s "
                   "(the keyframes near contacts changed with them)")
@@ -145,11 +146,11 @@ def project(
             facts["points_optimized"] = r["points_optimized"]
         print_json(facts, indent=None)
         return
-    out.print(f"[bold]{path}[/]: {r['frames']} frames, {len(r['keyframes'])} keyframes ({select}), "
+    out.print(f"[bold]{escape(path)}[/]: {r['frames']} frames, {len(r['keyframes'])} keyframes ({select}), "
               f"projection {projection}")
     out.print(f"  stress (eq. 4.1): {r['stress']:.4g}" + (
         f", optimised {r['stress_optimized']:.4g}" if "stress_optimized" in r else ""))
     out.print(f"  keyframes: {', '.join(map(str, r['keyframes']))}", soft_wrap=True)
     if plot is not None:
-        out.print(f"wrote {plot}", soft_wrap=True)
+        out.print(f"wrote {escape(plot)}", soft_wrap=True)
     out.print(timing_line(report))

@@ -6,7 +6,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.markup import escape
 
 from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
@@ -19,6 +18,7 @@ from .common import (
     check_motion_output,
     check_output,
     default,
+    escape,
     flag,
     friendly,
     out,
@@ -125,7 +125,7 @@ def loop(
     for facts, images in shown:
         _print_loop(facts)
         for image in images:
-            out.print(f"wrote {escape(str(image))}", soft_wrap=True)
+            out.print(f"wrote {escape(image)}", soft_wrap=True)
     out.print(timing_line(report))
 
 
@@ -133,7 +133,7 @@ def _print_parts(path: Path, facts: dict) -> None:
     """The take's parts, one line each, and which one was looped and why."""
     parts = facts["parts"]
     if len(parts) > 1:
-        out.print(f"[bold]{escape(str(path))}[/]: {len(parts)} parts")
+        out.print(f"[bold]{escape(path)}[/]: {len(parts)} parts")
         for k, p in enumerate(parts):
             a, b = p["frames"]
             what = (f"{p['n_periods']:.1f} cycles of {p['period_frames']:.1f} frames"
@@ -166,8 +166,9 @@ def _print_loop(facts: dict) -> None:
     out.print(f"[bold]{escape(facts['file'])}[/]: {facts['frames_in']} frames at {facts['fps']:.6g} fps")
     out.print(f"  {where}: {facts['n_periods']:.2f} periods of {facts['period_frames']:.2f} frames "
               f"(time axis: {facts['time_axis']}, {facts['excited_regions']} excited region(s): "
-              + ", ".join(f"{s}-{e}" for s, e in facts["excitation"]) + f"; joints used: {facts['joints_used']})")
-    out.print(f"  period: {facts['period_reason']}", soft_wrap=True)
+              + ", ".join(f"{s}-{e}" for s, e in facts["excitation"])
+              + f"; joints used: {escape(facts['joints_used'])})", soft_wrap=True)
+    out.print(f"  period: {escape(facts['period_reason'])}", soft_wrap=True)
     move = facts["travel_per_cycle"]
     out.print(f"  cycle: {facts['cycle_frames']} frames by {kind}; travel per cycle "
               f"({move[0]:.3g}, {move[1]:.3g}, {move[2]:.3g}), turn {facts['turn_per_cycle_deg']:.3g}°")
@@ -180,9 +181,9 @@ def _print_loop(facts: dict) -> None:
     out.print(table)
     f = facts["feet"]
     if f["mode"] == "lock":
-        spans = "; ".join(f"{side} {' '.join(f'{a}-{b}' for a, b in v['contacts'])}" for side, v in
+        spans = "; ".join(f"{escape(side)} {' '.join(f'{a}-{b}' for a, b in v['contacts'])}" for side, v in
                           f["contacts"].items())
         out.print(f"  feet locked (contacts, cycle frames: {spans}); skate {f['skate_before']:.4g} -> "
                   f"{f['skate_after']:.4g} units/s in {f['seconds']:.2f} s", soft_wrap=True)
-    out.print(f"wrote {facts['output']}: {facts['frames_out']} frames ({facts['cycles']} cycle(s), root "
+    out.print(f"wrote {escape(facts['output'])}: {facts['frames_out']} frames ({facts['cycles']} cycle(s), root "
               f"{facts['root']})", soft_wrap=True)

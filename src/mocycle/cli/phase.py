@@ -15,6 +15,7 @@ from .common import (
     check_output,
     default,
     err,
+    escape,
     flag,
     friendly,
     out,
@@ -61,9 +62,9 @@ def phase(
     else:
         _print_phase(path, report)
         if plot is not None:
-            out.print(f"wrote {plot}", soft_wrap=True)
+            out.print(f"wrote {escape(plot)}", soft_wrap=True)
     if not report.facts["classes"]:
-        err.print(f"no periodic motion found: {report.facts['reason']}", soft_wrap=True)
+        err.print(f"no periodic motion found: {escape(report.facts['reason'])}", soft_wrap=True)
         raise typer.Exit(EXIT_NOT_FOUND)
 
 
@@ -71,7 +72,7 @@ def _print_phase(path: Path, report) -> None:
     from rich.table import Table
 
     facts = report.facts
-    out.print(f"[bold]{path}[/]: {facts['frames']} frames at {facts['fps']:.6g} fps")
+    out.print(f"[bold]{escape(path)}[/]: {facts['frames']} frames at {facts['fps']:.6g} fps")
     table = Table(title="periodic motions (H1 classes)")
     for col in ("class", "bar [birth, death)", "period frames", "period s", "periods", "excitation frames"):
         table.add_column(col, justify="right" if col != "excitation frames" else "left")
@@ -85,8 +86,8 @@ def _print_phase(path: Path, report) -> None:
     out.print(f"  autocorrelation period (cross-check): {'none' if acf is None else f'{acf:.2f} frames'}")
     legs = facts["legs_period_frames"]
     out.print(f"  legs' autocorrelation period: {'none' if legs is None else f'{legs:.2f} frames'}; "
-              f"joints used: {facts['joints_used']}")
+              f"joints used: {escape(facts['joints_used'])}", soft_wrap=True)
     for k, c in enumerate(facts["classes"]):
-        out.print(f"  class {k} period: {c['period_reason']}", soft_wrap=True)
-    out.print(f"  why: {facts['reason']}", soft_wrap=True)
+        out.print(f"  class {k} period: {escape(c['period_reason'])}", soft_wrap=True)
+    out.print(f"  why: {escape(facts['reason'])}", soft_wrap=True)
     out.print(timing_line(report))

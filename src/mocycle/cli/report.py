@@ -10,7 +10,8 @@ import typer
 from .. import tasks
 from ..errors import NoPeriodicMotion
 from ..io.atomic import atomic_write
-from .common import app, check_output, default, err, flag, friendly, out, print_warnings
+from ..text import printable
+from .common import app, check_output, default, err, escape, flag, friendly, out, print_warnings
 
 L = tasks.loop.Options
 
@@ -49,6 +50,6 @@ def report(
     except NoPeriodicMotion as exc:
         take = tasks.info.run(path, tasks.info.Options(amc_fps=amc_fps)).motions["motion"]
         reason = str(exc)
-        err.print(f"[yellow]warning:[/] no loop in the report: {reason}", markup=True, soft_wrap=True)
-    atomic_write(output, report_pieces(path.name, take, loop_report, reason))
-    out.print(f"wrote {output}", soft_wrap=True)
+        err.print(f"[yellow]warning:[/] no loop in the report: {escape(reason)}", markup=True, soft_wrap=True)
+    atomic_write(output, report_pieces(printable(path.name), take, loop_report, reason))
+    out.print(f"wrote {escape(output)}", soft_wrap=True)

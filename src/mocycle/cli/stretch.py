@@ -15,6 +15,7 @@ from .common import (
     check_motion_output,
     check_output,
     default,
+    escape,
     flag,
     friendly,
     out,
@@ -73,14 +74,14 @@ def stretch(
     from rich.table import Table
 
     r = report.facts
-    out.print(f"[bold]{path}[/]: {r['frames_in']} frames -> {output}: {r['frames_out']} frames "
+    out.print(f"[bold]{escape(path)}[/]: {r['frames_in']} frames -> {escape(output)}: {r['frames_out']} frames "
               f"(factor {r['factor']:g}, {r['fps']:.6g} fps)", soft_wrap=True)
     table = Table(title="windows (frames)")
     for col in ("group", "window", "cycle found", "joints"):
         table.add_column(col, justify="left" if col in ("group", "joints") else "right")
     for g, n in r["windows"].items():
         cycle = report.result.cycles[g]
-        table.add_row(g, str(n), "given" if cycle is None else f"{cycle:.2f}", str(r["joints_per_group"][g]))
+        table.add_row(escape(g), str(n), "given" if cycle is None else f"{cycle:.2f}", str(r["joints_per_group"][g]))
     out.print(table)
     if r["periodic_regions"]:
         kept = r["frames_in"] - sum(e - s for s, e in r["periodic_regions"])
@@ -91,7 +92,7 @@ def stretch(
     if r["feet"]["mode"] == "lock":
         out.print(f"  feet locked: skate {r['feet']['skate_before']:.4g} -> {r['feet']['skate_after']:.4g} units/s")
     if r["trend_curves"]:
-        out.print(f"  warped as line + residual: {', '.join(r['trend_curves'])}", soft_wrap=True)
+        out.print(f"  warped as line + residual: {escape(', '.join(r['trend_curves']))}", soft_wrap=True)
     if plot is not None:
-        out.print(f"wrote {plot}", soft_wrap=True)
+        out.print(f"wrote {escape(plot)}", soft_wrap=True)
     out.print(timing_line(report))

@@ -9,7 +9,7 @@ import typer
 
 from .. import tasks
 from ..errors import MocycleError
-from .common import app, err, friendly, out
+from .common import app, err, escape, friendly, out
 
 
 def serve(application, host: str, port: int, open_browser: bool, ready=None) -> None:
@@ -29,7 +29,7 @@ def serve(application, host: str, port: int, open_browser: bool, ready=None) -> 
         raise MocycleError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
     url = f"http://{host if ':' not in host else f'[{host}]'}:{sock.getsockname()[1]}/"
     server = uvicorn.Server(uvicorn.Config(application, log_level="warning", lifespan="on"))
-    out.print(f"mocycle studio on {url} (Ctrl-C to stop)", soft_wrap=True)
+    out.print(f"mocycle studio on {escape(url)} (Ctrl-C to stop)", soft_wrap=True)
     if open_browser:
         threading.Timer(0.8, webbrowser.open, (url,)).start()
     if ready is not None:

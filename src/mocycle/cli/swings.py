@@ -16,6 +16,7 @@ from .common import (
     check_motion_output,
     check_output,
     default,
+    escape,
     flag,
     friendly,
     json_text,
@@ -87,12 +88,13 @@ def swings(
         return
     from rich.table import Table
 
-    out.print(f"[bold]{path}[/]: {r['frames']} frames at {r['fps']:.6g} fps, Acceptable Swing Error {r['threshold']:g}")
+    out.print(f"[bold]{escape(path)}[/]: {r['frames']} frames at {r['fps']:.6g} fps, "
+              f"Acceptable Swing Error {r['threshold']:g}", soft_wrap=True)
     table = Table(title="swings per joint", caption="swing indices: 0-based in time order, what edit --swing takes")
     for col in ("joint", "swings", "indices", "mean length s", "mean angle deg", "holds"):
         table.add_column(col, justify="left" if col == "joint" else "right")
     for row in r["per_joint"]:
-        table.add_row(row["joint"], str(row["swings"]), row["indices"] or "-", f"{row['mean_length_s']:.3f}",
+        table.add_row(escape(row["joint"]), str(row["swings"]), row["indices"] or "-", f"{row['mean_length_s']:.3f}",
                       f"{row['mean_angle_deg']:.1f}", str(row["holds"]))
     out.print(table)
     if r["segmentation_error"] is not None:
@@ -103,7 +105,7 @@ def swings(
               f"channels ({r['raw_float32_bytes']} bytes)"
               + (f", {r['ratio_bvh']:.3f} of the BVH text" if r["ratio_bvh"] else ""))
     for line in written:
-        out.print(f"wrote {line}", soft_wrap=True)
+        out.print(f"wrote {escape(line)}", soft_wrap=True)
     out.print(timing_line(report))
 
 
@@ -129,11 +131,12 @@ def search(
         return
     from rich.table import Table
 
-    table = Table(title=f"{query.name} against {report.facts['indexed']} takes in {folder}")
+    table = Table(title=f"{escape(query.name)} against {report.facts['indexed']} takes in {escape(folder)}")
     for col in ("rank", "score", "offset s", "take"):
         table.add_column(col, justify="left" if col == "take" else "right")
     for hit in report.facts["results"]:
-        table.add_row(str(hit["rank"]), f"{hit['score']:.3f}", f"{hit['offset_s']:+.2f}", Path(hit["path"]).name)
+        table.add_row(str(hit["rank"]), f"{hit['score']:.3f}", f"{hit['offset_s']:+.2f}",
+                      escape(Path(hit["path"]).name))
     out.print(table)
     out.print(timing_line(report))
 
@@ -166,5 +169,5 @@ def edit(
     if as_json:
         print_json({**r, "output": str(output), "seconds": report.seconds})
     else:
-        out.print(f"{joint} swing {swing} (frames {r['start']}-{r['end']}, {r['angle_deg']:.1f} deg): "
-                  f"angle x{angle_scale:g}, duration x{duration_scale:g} -> {output}")
+        out.print(f"{escape(joint)} swing {swing} (frames {r['start']}-{r['end']}, {r['angle_deg']:.1f} deg): "
+                  f"angle x{angle_scale:g}, duration x{duration_scale:g} -> {escape(output)}", soft_wrap=True)

@@ -1,0 +1,96 @@
+"""Text that leaves mocycle: names from files made printable, and strict JSON.
+
+Names that come from files (joint names, take names, paths, error messages quoting a file) are data: they may
+hold bytes that are not UTF-8 (a file name ``bad\\xffname.bvh`` reaches Python as ``'bad\\udcffname.bvh'``, a
+lone surrogate, by the ``surrogateescape`` rule of :func:`os.fsdecode`), terminal control codes (ESC
+sequences that recolour, retitle or hyperlink the terminal) or characters that turn the text around
+(bidirectional overrides). :func:`printable` writes each such character as a visible escape, the way Python's
+``backslashreplace`` does, so the text can be printed, encoded as UTF-8 and read by a person:
+
+* a byte that was not UTF-8 (a surrogate U+DC80..U+DCFF) -> ``\\xNN`` (the byte);
+* any other lone surrogate -> ``\\udNNN``;
+* C0 and C1 control characters and DEL -> ``\\xNN``; bidirectional controls -> ``\\uNNNN``.
+
+:func:`json_text` (what ``--json``, batch's ``results.json`` and its records write) keeps control characters
+(JSON escapes them) and writes only the lone surrogates that way, so the JSON is valid UTF-8. The front ends
+add their own escaping on top (``rich.markup.escape`` in the CLI, HTML escaping in the studio).
+
+Importing this module loads nothing but the standard library (numpy only when :func:`json_text` runs).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+
+__all__ = ["json_text", "path_hex", "printable", "unicode_clean"]
+
+_SURROGATES = re.compile("[\ud800-\udfff]")
+_UNPRINTABLE = re.compile("[\x00-\x1f\x7f-\x9f\u200e\u200f\u202a-\u202e\u2066-\u2069\ud800-\udfff]")
+
+
+def _escape(match: re.Match) -> str:
+    code = ord(match.group())
+    if 0xDC80 <= code <= 0xDCFF:  # a byte that was not UTF-8 (surrogateescape)
+        return f"\\x{code - 0xDC00:02x}"
+    return f"\\x{code:02x}" if code <= 0xFF else f"\\u{code:04x}"
+
+
+def printable(text) -> str:
+    """``text`` (any object, as ``str``) with undecodable bytes, control and bidirectional characters written
+    as visible escapes (``bad\\xffname.bvh``, ``\\x1b[31mred``); text without them comes back unchanged."""
+    text = os.fsdecode(text) if isinstance(text, bytes) else str(text)
+    return _UNPRINTABLE.sub(_escape, text)
+
+
+def unicode_clean(text: str) -> str:
+    """``text`` with lone surrogates written as escapes (as :func:`printable` does) and nothing else changed:
+    what strict UTF-8 (a JSON or CSV file) can hold."""
+    return _SURROGATES.sub(_escape, text)
+
+
+def path_hex(path) -> str | None:
+    """The bytes of a path as hex when its name is not valid Unicode (its printable form then differs from
+    the name itself), else ``None``: enough to find the very file again."""
+    text = os.fspath(path)
+    if isinstance(text, bytes):
+        return text.hex()
+    return os.fsencode(text).hex() if _SURROGATES.search(text) else None
+
+
+def json_text(facts, indent: int | None = 2) -> str:
+    """Strict JSON of ``facts``: NaN and infinities become ``null``, and the JSON says which and why; strings
+    (keys too) with lone surrogates get them escaped (:func:`unicode_clean`), so the text is valid UTF-8.
+
+    ``json.dumps`` would write ``NaN``/``Infinity``, which JSON parsers refuse.  The paths of the values
+    written as ``null`` are listed under ``"null_because_not_finite"`` (for a dict at the top).
+    """
+    import numpy as np
+
+    nulls: list[str] = []
+
+    def clean(x, where: str):
+        if isinstance(x, str):
+            return unicode_clean(x)
+        if isinstance(x, (float, np.floating)):
+            if math.isfinite(x):
+                return float(x)
+            nulls.append(f"{where or 'value'} ({x})")
+            return None
+        if isinstance(x, np.integer):
+            return int(x)
+        if isinstance(x, np.ndarray):
+            x = x.tolist()
+        if isinstance(x, dict):
+            return {(unicode_clean(k) if isinstance(k, str) else k): clean(v, f"{where}.{k}" if where else str(k))
+                    for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [clean(v, f"{where}[{i}]") for i, v in enumerate(x)]
+        return x
+
+    out = clean(facts, "")
+    if nulls and isinstance(out, dict):
+        out["null_because_not_finite"] = [unicode_clean(n) for n in nulls]
+    return json.dumps(out, indent=indent, allow_nan=False)
