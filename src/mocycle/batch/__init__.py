@@ -143,10 +143,11 @@ def check_collisions(job: Job, takes: list[Take]) -> None:
         if job.suffix:
             target = take.output(job.outdir, job.suffix)
             claim(target, f"the output of {rel}")
-            if every_class:  # <stem>.class<K><suffix>, K unknown until the take runs
+            if every_class:  # <stem>.part<K>-<kind><suffix> (.class<K>), K unknown until the take runs
                 stem = os.path.normcase(str(target.with_suffix("")))
-                patterns.append((re.compile(re.escape(stem) + r"\.class\d+" + re.escape(os.path.normcase(job.suffix))
-                                            + r"\Z"), f"the outputs of {rel} (--which all)"))
+                patterns.append((re.compile(re.escape(stem) + r"\.(class\d+|part\d+-[a-z-]+)"
+                                            + re.escape(os.path.normcase(job.suffix)) + r"\Z"),
+                                 f"the outputs of {rel} (--part all)"))
     found = [(path, whats) for path, whats in claims.items() if len(whats) > 1]
     for pattern, what in patterns:
         found += [(path, [what, *whats]) for path, whats in claims.items() if pattern.match(path)]

@@ -71,7 +71,7 @@ def _first_class(facts: Mapping, key: str):
 
 
 def _loop(facts: Mapping) -> Mapping:
-    """The first loop's facts (``--which all`` reports a list of loops)."""
+    """The first loop's facts (a loop report lists its loops, one per part with ``--part all``)."""
     return facts["loops"][0] if "loops" in facts else facts
 
 
@@ -94,12 +94,16 @@ COMMANDS: dict[str, Command] = {c.name: c for c in (
         "autocorrelation_period_frames": lambda f: f["autocorrelation_period_frames"]},
         imports=("mocycle.tasks.phase", "mocycle.phase", "pyRipser")),
     Command("loop", "motion", ".bvh", {
+        "part": lambda f: _loop(f)["part"], "kind": lambda f: _loop(f)["kind"],
+        "frames": lambda f: "{}-{}".format(*_loop(f)["frames"]),
+        "turn_per_cycle_deg": lambda f: _loop(f)["turn_per_cycle_deg"],
         "period_frames": lambda f: _loop(f)["period_frames"], "periods": lambda f: _loop(f)["n_periods"],
         "cycle_frames": lambda f: _loop(f)["cycle_frames"],
         "seam_pose": lambda f: _loop(f)["metrics"]["seam_pose"],
         "seam_velocity": lambda f: _loop(f)["metrics"]["seam_velocity"],
         "foot_skate": _skate},
-        imports=("mocycle.tasks.loop", "mocycle.phase", "pyRipser", "mocycle.cycle", "mocycle.cycle.checks",
+        imports=("mocycle.tasks.loop", "mocycle.activities", "mocycle.phase", "pyRipser", "mocycle.cycle",
+                 "mocycle.cycle.checks",
                  "mocycle.tasks.feet", "mocycle.contacts")),
     Command("swings", "swings", ".mosw", {
         "frames": lambda f: f["frames"], "swings": lambda f: f["n_swings"],
@@ -123,9 +127,25 @@ COMMANDS: dict[str, Command] = {c.name: c for c in (
 
 def motion_targets(report, target: Path) -> dict[str, Path]:
     """The motions a report holds that batch writes, by role, and where: ``loop`` -> ``target``; with
-    ``--which all`` ``loop.classK`` -> ``<target stem>.classK<suffix>``; ``stretched`` -> ``target``."""
-    roles = [r for r in report.motions if r == "stretched" or r == "loop" or r.startswith("loop.class")]
+    ``--part all`` each loop's file as ``mocycle loop`` names it (``<target stem>.part1-walk-turning-left<suffix>``,
+    ``.class<K>`` for a take looped whole: :func:`mocycle.tasks.loop.output_path`); ``stretched`` -> ``target``."""
+    if "stretched" in report.motions:
+        return {"stretched": target}
+    from ..tasks.loop import output_path
+
+    return {f["role"]: output_path(target, f) for f in report.facts.get("loops", []) if f.get("role") in report.motions}
+
+
+def part_rows(command: Command, facts: Mapping) -> list[dict]:
+    """One set of figures per loop of a ``loop`` report (a take cut into parts gets a results row per part)."""
+    return [_part_figures(command, {**facts, "loops": [loop]}) for loop in facts.get("loops") or []]
+
+
+def _part_figures(command: Command, facts: Mapping) -> dict:
     out = {}
-    for role in roles:
-        out[role] = target if "." not in role else target.with_suffix(f".{role.split('.', 1)[1]}{target.suffix}")
+    for name, get in command.figures.items():
+        try:
+            out[name] = get(facts)
+        except (KeyError, IndexError, TypeError):
+            out[name] = None
     return out

@@ -1,4 +1,5 @@
-"""``OUTDIR/results.csv`` and ``OUTDIR/results.json``: a row per take, written atomically at the end."""
+"""``OUTDIR/results.csv`` and ``OUTDIR/results.json``: a row per take (``loop``: a CSV line per part looped),
+written atomically at the end."""
 
 from __future__ import annotations
 
@@ -39,10 +40,11 @@ def csv_text(command: str, rows: list[dict]) -> str:
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow([*CSV_HEAD, *figures, *CSV_TAIL])
     for r in rows:
-        writer.writerow([_cell(r["file"]), r["status"], _cell(r["message"]),
-                         *(_cell(r["figures"].get(k)) for k in figures),
-                         _cell(r["seconds"]), _cell(r["outputs"]), _cell("; ".join(r["warnings"])),
-                         "yes" if r.get("resumed") else ""])
+        for part in r.get("parts") or [r["figures"]]:  # a take cut into parts (loop): a line per part
+            writer.writerow([_cell(r["file"]), r["status"], _cell(r["message"]),
+                             *(_cell(part.get(k)) for k in figures),
+                             _cell(r["seconds"]), _cell(r["outputs"]), _cell("; ".join(r["warnings"])),
+                             "yes" if r.get("resumed") else ""])
     return buffer.getvalue()
 
 

@@ -20,7 +20,7 @@ from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 from ..tasks.options import Options
 from ..text import json_text, path_hex, printable
-from .commands import COMMANDS, motion_targets
+from .commands import COMMANDS, motion_targets, part_rows
 from .discover import Take
 
 __all__ = ["STATUSES", "Job", "base_row", "fresh_record", "problem_row", "process", "row_key", "status_of",
@@ -102,6 +102,8 @@ def process(job: Job, take: Take) -> dict:
             row["facts"], row["seconds"] = dict(report.facts), report.seconds
             row["warnings"] = list(report.warnings)
             row["figures"] = _figures(command, report.facts)
+            if job.command == "loop":  # a take cut into parts: a results row per part
+                row["parts"] = part_rows(command, report.facts)
             if job.command == "phase" and not report.facts["classes"]:
                 row["status"], row["message"] = "no-periodic-motion", report.facts["reason"]
             else:

@@ -97,10 +97,8 @@ def loop(
     shown = []
     for facts, cycle in zip(loops, cycles_made, strict=True):  # every cycle was made and checked before writing
         role = facts["role"]
-        tag = role.split(".", 1)[1] if "." in role else None
-        if tag and facts.get("part") is not None:
-            tag = f"{tag}-{facts['kind'].replace(' ', '-')}"
-        target = output.with_suffix(f".{tag}{output.suffix}") if tag else output
+        tag = tasks.loop.output_tag(facts)
+        target = tasks.loop.output_path(output, facts)
         written = write_motion(report, role, target, gltf_scale, gltf_up, closing_frame)
         closing = report.motions[role].n_frames != written.n_frames
         images = []

@@ -211,6 +211,23 @@ def run(take, options: Options | None = None) -> Report:
     return rec.report("loop", facts, motions, cycles if everything else cycles[0], extras)
 
 
+def output_tag(facts) -> str | None:
+    """What a loop's output name adds before its suffix (``OUT.<tag>.bvh``), from its figures: ``None`` for the
+    one loop (``role`` ``loop``), ``part1-walk-turning-left`` for a part, ``class0`` for a periodic motion of
+    a take looped whole.  The CLI and batch name files by it."""
+    role = facts.get("role", "loop")
+    if role == "loop":
+        return None
+    tag = role.split(".", 1)[1]
+    return f"{tag}-{facts['kind'].replace(' ', '-')}" if tag.startswith("part") else tag
+
+
+def output_path(target, facts):
+    """``target`` (a ``pathlib.Path``) with :func:`output_tag` of a loop's figures before its suffix."""
+    tag = output_tag(facts)
+    return target if tag is None else target.with_suffix(f".{tag}{target.suffix}")
+
+
 def _role(index, k, everything) -> str:
     if not everything:
         return "loop"
