@@ -41,6 +41,8 @@ MIN_STEP_S, MAX_STEP_S = 0.15, 1.2
 STEP_RATIO = 1.6
 #: The legs of a gait part are like themselves one stride later: unlikeness (repetition distance) under this.
 UNLIKE = 0.5
+#: ... and a take of one step (two landings) must be more alike still, its evidence being the shorter.
+UNLIKE_ONE_STEP = 0.2
 #: A stride turning by more than this many degrees is a turning stride.
 TURN_DEG = 15.0
 #: Consecutive strides whose periods differ by more than this share are different activities.
@@ -323,7 +325,7 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activitie
             parts.append(_gait_part(kinds[i][0], f, chain, i, j, landings, strides, heading, path, fps))
             i = j
     # steps that land in turn but whose legs do not repeat a stride later (a wander, a stumble) are no gait
-    parts = [p for p in parts if not legs_repeat(motion, p.start, p.stop, p.period_frames) >= UNLIKE]
+    parts = [p for p in parts if _legs_repeat_in(motion, p)]
     parts.sort(key=lambda p: p.start)
     _reach(parts, landings, T)
     parts = _fill(motion, parts, landings, min_periods)
@@ -371,7 +373,7 @@ def _one_step_part(motion: Motion, chain, landings: Landings, heading, path, bod
     reach = b - a
     lo, hi = max(0, a - 2 * reach), min(motion.n_frames, b + 2 * reach)
     period, unlike = short_period(motion, 2.0 * reach, lo, hi)
-    if not np.isfinite(period):
+    if not (np.isfinite(period) and unlike < UNLIKE_ONE_STEP):
         return None
     speed = float(np.linalg.norm(path[hi - 1] - path[lo])) * fps / max(hi - 1 - lo, 1)
     turn = float(heading[hi - 1] - heading[lo])
@@ -413,6 +415,24 @@ def legs_repeat(motion: Motion, start: int, stop: int, period: float) -> float:
     X = _leg_features(motion, start, stop)
     lag = int(round(period)) if np.isfinite(period) else 0
     return float("nan") if X is None else _unlike(X, lag)
+
+
+def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
+    """Whether the legs of a gait part are like themselves one stride later, over the part and up to a stride
+    on either side: unlikeness under :data:`UNLIKE` where a stride or more of frames can be compared, under
+    :data:`UNLIKE_ONE_STEP` where less can."""
+    P = part.period_frames
+    if not (np.isfinite(P) and P >= 2):
+        return False
+    lag = int(round(P))
+    lo, hi = max(0, int(part.start - P)), min(motion.n_frames, int(np.ceil(part.stop + P)))
+    X = _leg_features(motion, lo, hi)
+    if X is None:
+        return True  # no legs to tell by: the landings decide
+    overlap = X.shape[0] - lag
+    if overlap < max(4, lag / 6.0):
+        return False
+    return _unlike(X, lag) < (UNLIKE if overlap >= lag else UNLIKE_ONE_STEP)
 
 
 def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[float, float]:

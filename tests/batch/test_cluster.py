@@ -124,7 +124,7 @@ def test_a_local_batch_processes_every_take(library, local_run):
     assert any(line.startswith("[7/7] ") for line in lines)  # plain progress lines off a terminal
     assert "7 takes: 4 ok, 2 no periodic motion, 0 refused, 1 error" in r.stdout
     head = (out / "results.csv").read_text().splitlines()[0]
-    assert head.startswith("file,status,message,period_frames,periods,cycle_frames,seam_pose")
+    assert head.startswith("file,status,message,part,kind,frames,turn_per_cycle_deg,period_frames,periods,cycle_frames")
     assert len((out / "results.csv").read_text().splitlines()) == 8
     run = json.loads((out / "results.json").read_text())["run"]
     assert run["workers"] == 2  # forked from the warm forkserver where there is one (Linux has it)

@@ -82,28 +82,29 @@ def test_demo_writes_the_take_the_cycle_and_the_plot(tmp_path):
     assert "periods of" in result.output
 
 
-def test_loop_class_all_writes_one_file_per_periodic_motion(tmp_path):
+def test_loop_part_all_writes_one_file_per_part(tmp_path):
     from mocycle.datasets import synthetic_walk_then_run
 
     take = synthetic_walk_then_run(n_walk=150, n_run=150, fps=30.0, noise_deg=1.0, seed=1)
     src = write(take.motion, tmp_path / "walk_run.bvh")
     out = tmp_path / "loop.bvh"
-    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--class", "all", "--json"])
+    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--part", "all", "--json"])
     assert result.exit_code == 0, result.output
     loops = json.loads(result.stdout)["loops"]
-    assert [f["output"] for f in loops] == [str(tmp_path / "loop.class0.bvh"), str(tmp_path / "loop.class1.bvh")]
+    assert [f["output"] for f in loops] == [str(tmp_path / "loop.part0-walk-straight.bvh"),
+                                            str(tmp_path / "loop.part1-run-straight.bvh")]
     assert not out.exists()
     walk, run = loops
     assert abs(walk["period_frames"] - 30) < 1 and abs(run["period_frames"] - 21) < 1
-    assert walk["excitation"][-1][1] <= 150 <= run["excitation"][0][0]  # each from its own region
-    assert read(tmp_path / "loop.class1.bvh").n_frames == run["cycle_frames"]
+    assert walk["frames"][1] <= 150 + 0.5 * 21 and run["frames"][0] >= 150 - 0.5 * 30  # each from its own part
+    assert read(tmp_path / "loop.part1-run-straight.bvh").n_frames == run["cycle_frames"]
     for f in loops:
-        assert f["joints_used"] == "all" and f["period_source"] in f["period_candidates"]
-    text = runner.invoke(app, ["loop", str(src), "-o", str(out), "--class", "1"])
-    assert text.exit_code == 0 and "class 1:" in text.output and out.exists()
-    for bad in ("two", "-1"):
-        refused = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.bvh"), "--class", bad])
-        assert refused.exit_code == 2 and "--class" in refused.stderr  # a bad option value: usage error
+        assert f["joints_used"] == "legs" and f["period_source"] in f["period_candidates"]
+    text = runner.invoke(app, ["loop", str(src), "-o", str(out), "--class", "1"])  # --class: the old name
+    assert text.exit_code == 0 and "part 1 (run straight" in text.output and out.exists()
+    for bad in ("two", "-1", "9"):
+        refused = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.bvh"), "--part", bad])
+        assert refused.exit_code == 2 and "--part" in refused.stderr  # a bad option value: usage error
 
 
 def test_loop_takes_the_phase_options_and_reports_the_period_decision(tmp_path):

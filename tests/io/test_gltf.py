@@ -256,14 +256,14 @@ def test_loop_all_classes_write_one_glb_each(tmp_path):
     take = synthetic_walk_then_run(n_walk=150, n_run=150, fps=30.0, noise_deg=1.0, seed=1)
     src = mocycle.write(take.motion, tmp_path / "wr.bvh")
     out = tmp_path / "wr.glb"
-    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--class", "all", "--json"])
+    result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--part", "all", "--json"])
     assert result.exit_code == 0, result.output
     loops = json.loads(result.stdout)["loops"]
-    assert len(loops) >= 2
+    assert [f["kind"] for f in loops] == ["walk straight", "run straight"]
     for f in loops:
         gl = glb_json(Path(f["output"]))
         assert Path(f["output"]).suffix == ".glb"
-        assert gl["animations"][0]["name"] == f"wr.class{f['class']}_loop"
+        assert gl["animations"][0]["name"] == f"wr.part{f['part']}-{f['kind'].replace(' ', '-')}_loop"
 
 
 # ------------------------------------------------------------------------------------------ every command

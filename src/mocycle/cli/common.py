@@ -145,20 +145,24 @@ EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion, or its cyc
 
 
 @cache
-def flags() -> dict[str, str]:
-    """Parameter names of the library -> the CLI flag that sets them (every task option, a few library names)."""
+def flags(command: str | None = None) -> dict[str, str]:
+    """Parameter names of the library -> the CLI flag that sets them (every task option, a few library names);
+    ``command``: the task whose own flags win where two tasks name one parameter differently (``loop``'s
+    ``which`` is ``--part``, ``blend``'s ``--class``)."""
     from ..tasks import TASKS
 
     names = {f.name: flag_of(f) for task in TASKS.values() for f in dataclasses.fields(task.Options)}
+    if command in TASKS:
+        names.update({f.name: flag_of(f) for f in dataclasses.fields(TASKS[command].Options)})
     names.update({"n_harmonics": "--harmonics", "time_axis_method": "--time", "phase_step": "--step",
                   "n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles",
                   "window": "--window", "gltf_scale": "--gltf-scale", "gltf_up": "--gltf-up"})
     return names
 
 
-def option_message(exc: OptionError) -> str:
+def option_message(exc: OptionError, command: str | None = None) -> str:
     """The error with the flag instead of the library's parameter name (``--cycles must be ...``)."""
-    return f"{flags().get(exc.parameter, exc.parameter)} {exc.reason}"
+    return f"{flags(command).get(exc.parameter, exc.parameter)} {exc.reason}"
 
 
 def friendly(func: Callable) -> Callable:
@@ -173,7 +177,7 @@ def friendly(func: Callable) -> Callable:
                 result = func(*args, **kwargs)
             except OptionError as exc:
                 _print_warnings(caught)
-                err.print(f"[bold red]error:[/] {option_message(exc)}", markup=True, soft_wrap=True)
+                err.print(f"[bold red]error:[/] {option_message(exc, func.__name__)}", markup=True, soft_wrap=True)
                 raise typer.Exit(EXIT_USAGE) from None
             except MocycleError as exc:
                 _print_warnings(caught)

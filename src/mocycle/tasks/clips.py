@@ -32,13 +32,13 @@ def closed_loop(cycle, cycles: int, root: str, repeated: Motion | None = None) -
 
 
 def cycle_of(report, role: str):
-    """The cycle behind a loop task's output motion ``role`` (``report.result``, or its ``k``-th cycle for
-    ``loop.class<k>`` roles): what :func:`closed_loop` repeats."""
+    """The cycle behind a loop task's output motion ``role`` (``report.result``, or, when it holds one cycle
+    per loop (``loop.part<k>``, ``loop.class<k>`` roles), the one of that role): what :func:`closed_loop`
+    repeats."""
     if report.task not in LOOP_TASKS:
         raise ValueError(f"a {report.task} report holds no cycle")
     if isinstance(report.result, list):
-        k = int(role.rsplit("class", 1)[1])
-        return report.result[[f["class"] for f in report.facts["loops"]].index(k)]
+        return report.result[[f.get("role") for f in report.facts["loops"]].index(role)]
     return report.result
 
 
