@@ -29,15 +29,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError
 from ..motion import Motion
 from .distance import joint_weights, pose_distance_matrix, pose_vectors
 from .select import METHODS, keyframe_count, select_pb, select_rols, select_scs, select_uniform
 
-ONE_STEP = ("pca", "mds", "isomap", "lle", "force", "tsne")
-TWO_STEP = ("rbfp", "lamp")
-PROJECTIONS = ONE_STEP + TWO_STEP
+#: the projections (one home: :mod:`mocycle.defaults`)
+ONE_STEP = defaults.ONE_STEP_PROJECTIONS
+TWO_STEP = defaults.TWO_STEP_PROJECTIONS
+PROJECTIONS = defaults.PROJECTIONS
 
 
 class PoseSpace:
