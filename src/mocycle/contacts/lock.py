@@ -635,7 +635,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     frames at a time); ``turn``: with ``period``, the loop's turn per period (rad about ``turn_axis``, default
     the vertical: each repeat is the one before turned, as :meth:`~mocycle.cycle.Cycle.repeat` makes them);
     ``hand_over``: the caller gives ``motion`` up, and the result is made from its arrays instead of copies
-    (:meth:`~mocycle.motion.Motion._hand_over`: ``motion`` is emptied; a long take is locked without a
+    (:meth:`~mocycle.motion.Motion.hand_over`: ``motion`` is emptied; a long take is locked without a
     second copy of it).  Returns a new Motion with the same skeleton and frame time.
     """
     if contacts.n_frames != motion.n_frames:
@@ -691,7 +691,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     del W  # the chain's world positions and rotations: not needed for the quaternions (memory)
     T, frame_time = motion.n_frames, motion.frame_time
     if hand_over:
-        rotations, static, tracks = motion._hand_over()
+        rotations, static, tracks = motion.hand_over()
     else:  # the input's tracks are shared (read-only), the travel joint's copied when it moves
         rotations, static = motion.rotations.copy(), motion.translations_at(0)
         tracks = motion.tracks
