@@ -52,6 +52,8 @@ joint's translation, so every bone keeps its length exactly.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -292,7 +294,8 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
 
 def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
                 reach: float, clearance: np.ndarray):
-    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and ``(T,)`` True where the foot is held."""
+    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, ``(T,)`` True where the foot is held (the ankle
+    holds or follows its hold) and ``(T,)`` True where either goal differs from the capture."""
     foot = contacts.feet[f]
     up, body = contacts.up, contacts.body
     low, near = EXTEND_HEIGHT * body, EXTEND_DISTANCE * body
@@ -325,8 +328,11 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
     corr_a, level_a = _own_holds(a, ma, held_a, up, low, near, n_extend)
     corr_t = None
     if foot.toe is not None:
-        corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body,
-                                     low, near, n_extend, n_fade)
+        ankle = _Contact(path=a, held=held_a, corr=corr_a, level=level_a)
+        toe = _Contact(path=t, mask=mt, runs=rt)
+        _toe_holds(ankle, toe, partner, _Holding(hips=hips, reach=R, up=up, body=body, low=low, near=near,
+                                                 n_extend=n_extend, n_ease=n_fade))
+        corr_t, level_t = toe.corr, toe.level
     corr_a = _bridge(corr_a, n_bridge, n_fade)
     clear = clearance * body
     clear_a, clear_t = clear[cols[foot.ankle]], clear[cols[foot.toe]] if foot.toe is not None else 0.0
@@ -367,19 +373,54 @@ def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, bod
     return np.minimum(lift, np.minimum.accumulate((lift + rate * frames)[::-1])[::-1] - rate * frames)
 
 
-def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend,
-               n_ease):
-    """The toe's corrections (NaN where not held); the ankle's (``corr_a``, ``level_a``) updated in place
-    where it follows the held toe (heel lifted where the leg cannot reach)."""
+@dataclass
+class _Contact:
+    """One contact joint of a foot (ankle or toe) while its holds are made: ``path`` ``(T, 3)`` (world),
+    ``mask`` ``(T,)`` True in contact, ``runs`` its contacts (``[start, end)``); then ``held`` (the place each
+    contact is held at), ``corr`` ``(T, 3)`` (the correction of ``path``) and ``level`` ``(T,)`` (how it is
+    held: :func:`_own_holds`)."""
+
+    path: np.ndarray
+    mask: np.ndarray | None = None
+    runs: list | None = None
+    held: list | None = None
+    corr: np.ndarray | None = None
+    level: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class _Holding:
+    """What the holds of one foot are made with: the hip's path ``hips`` ``(T, 3)`` and the leg's ``reach``
+    ``(T,)``; the take's ``up`` and ``body`` height; ``low``, ``near`` and ``n_extend``, how far around a
+    contact a joint stays held (:func:`_own_holds`); ``n_ease`` frames to ease a carried joint."""
+
+    hips: np.ndarray
+    reach: np.ndarray
+    up: np.ndarray
+    body: float
+    low: float
+    near: float
+    n_extend: int
+    n_ease: int
+
+
+def _toe_holds(ankle: _Contact, toe: _Contact, partner: dict, h: _Holding) -> None:
+    """The toe's holds, corrections (NaN where not held) and levels, set on ``toe``; the ankle's ``corr``
+    and ``level`` changed in place where it follows the held toe (heel lifted where the leg cannot reach).
+    ``partner`` maps a toe contact to the ankle contact it overlaps most and the middle frame of the two
+    (one rigid-foot hold)."""
+    a, t, held_a, corr_a, level_a = ankle.path, toe.path, ankle.held, ankle.corr, ankle.level
+    hips, R, up, body = h.hips, h.reach, h.up, h.body
     held_t = []
-    for i, (s, e) in enumerate(rt):
+    for i, (s, e) in enumerate(toe.runs):
         if i in partner:  # a rigid foot can meet both holds: toe = held ankle + foot vector
             k, mid = partner[i]
             held_t.append(held_a[k] + (t[mid] - a[mid]))
         else:
             fr = np.arange(s, e)
             held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
-    corr_t, level_t = _own_holds(t, mt, held_t, up, low, near, n_extend)
+    corr_t, level_t = _own_holds(t, toe.mask, held_t, up, h.low, h.near, h.n_extend)
+    toe.held, toe.corr, toe.level = held_t, corr_t, level_t
     # both low around a contact: the joint nearer its own contact leads and the other is carried with it
     # (the heel leads a landing, the toe a push-off), so the foot keeps its own roll and is not stretched
     # between two holds and then let go
@@ -401,13 +442,12 @@ def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R,
         goal_t = t[on_toe] + corr_t[on_toe]
         lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
         corr_a[on_toe] = lifted - a[on_toe]
-    _ease_carried(corr_a, level_a, n_ease)
-    _ease_carried(corr_t, level_t, n_ease)
+    _ease_carried(corr_a, level_a, h.n_ease)
+    _ease_carried(corr_t, level_t, h.n_ease)
     if on_toe.any():  # still one foot length from the held toe (the toe is aimed at, so it stays put)
         goal_t = t[on_toe] + corr_t[on_toe]
         length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
         corr_a[on_toe] = goal_t + length[:, None] * _normalize(a[on_toe] + corr_a[on_toe] - goal_t) - a[on_toe]
-    return corr_t, level_t
 
 
 def _ease_carried(corr: np.ndarray, level: np.ndarray, n: int) -> None:
