@@ -331,6 +331,7 @@ class Motion:
     """
 
     __slots__ = ("skeleton", "rotations", "_static", "_tracks", "frame_time", "_travel", "_cache")
+    _cache: dict[str, Any]  # Motion.cache's values
 
     def __init__(
         self,

@@ -288,15 +288,19 @@ def checked_segmentation(error, skel: Skeleton, T: int, frame_time: float, thres
             raise error(f"joint {j}'s translation values are not finite numbers within ±{MAX_VALUE:g}")
     names = skel.names
     out_swings = [Swing(joint=int(sj[i]), name=names[sj[i]], start=int(ss[i]), end=int(se[i]),
-                        axis=tuple(float(x) for x in axis[i]), start_angle=float(swings["start_angle"][i]),
+                        axis=_vec3(axis[i]), start_angle=float(swings["start_angle"][i]),
                         end_angle=float(swings["end_angle"][i]), start_speed=float(swings["start_speed"][i]),
-                        end_speed=float(swings["end_speed"][i]), base=tuple(float(x) for x in swings["base"][i]),
+                        end_speed=float(swings["end_speed"][i]), base=_vec3(swings["base"][i]),
                         error=float(swings["error"][i])) for i in range(sj.size)]
     out_holds = [Hold(joint=int(hj[i]), name=names[hj[i]], start=int(hs[i]), end=int(he[i]),
-                      mean=tuple(float(x) for x in hm[i])) for i in range(hj.size)]
+                      mean=_vec3(hm[i])) for i in range(hj.size)]
     return Segmentation(skeleton=skel, n_frames=T, frame_time=frame_time, joints=list(joints), swings=out_swings,
                         holds=out_holds, translation_keys=keys, threshold=threshold, window_s=window_s,
                         params=dict(params or {}))
+
+
+def _vec3(v) -> tuple[float, float, float]:
+    return float(v[0]), float(v[1]), float(v[2])
 
 
 #: The largest translation a swings file may hold (file units): far above any take, far below overflow.

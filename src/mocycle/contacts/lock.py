@@ -52,7 +52,7 @@ joint's translation, so every bone keeps its length exactly.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -61,7 +61,7 @@ from ..motion import Motion
 from ..rotations import axis_rotations
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
-from .feet import chain_joints, chain_positions, chain_rotation_blocks, leg_joints
+from .feet import ChainArray, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
 from .smooth import maximum, uniform
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
@@ -139,13 +139,13 @@ def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return Rotation.from_rotvec(rotvec).as_matrix()
 
 
-def _leg_length(W: np.ndarray, foot) -> np.ndarray:
+def _leg_length(W: ChainArray, foot) -> np.ndarray:
     """Hip-knee plus knee-ankle ``(T,)``."""
     H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
     return np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
 
 
-def _reach(W: np.ndarray, foot, reach: float) -> np.ndarray:
+def _reach(W: ChainArray, foot, reach: float) -> np.ndarray:
     """How far ``(T,)`` a held ankle may be from its hip: ``reach`` of the leg's length (a held knee never
     goes fully straight, where a millimetre of length takes a large knee angle)."""
     return np.maximum(reach * _leg_length(W, foot), np.linalg.norm(W[:, foot.ankle] - W[:, foot.hip], axis=1))
@@ -193,9 +193,9 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
     a, b = _contact_ends(mask)
     if a.size == 0:
         return corr, level
-    targets = np.asarray(targets, dtype=np.float64).reshape(-1, 3)
+    goal = np.asarray(targets, dtype=np.float64).reshape(-1, 3)
     held = np.flatnonzero(mask)
-    corr[held] = targets[np.repeat(np.arange(a.size), b - a)] - path[held]
+    corr[held] = goal[np.repeat(np.arange(a.size), b - a)] - path[held]
     level[held] = HELD
     height = path @ up
     third = (a[1:] - b[:-1]) // 3
@@ -205,13 +205,13 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
         f, k = _windows(first, count, step)
         if f.size == 0:
             continue
-        c = targets[k] - path[f]
+        c = goal[k] - path[f]
         cu = c @ up
-        ok = (height[f] < targets[k] @ up + low) & (np.linalg.norm(c - cu[:, None] * up, axis=1) <= near)
+        ok = (height[f] < goal[k] @ up + low) & (np.linalg.norm(c - cu[:, None] * up, axis=1) <= near)
         misses = np.cumsum(~ok)                                     # up to the first miss of each window
         keep = misses == np.concatenate([[0], misses])[np.cumsum(count) - count][k]
         f, k, c, cu = f[keep], k[keep], c[keep], cu[keep]
-        edge_u = (targets[k] - path[edge[k]]) @ up
+        edge_u = (goal[k] - path[edge[k]]) @ up
         # a joint held lower than it came in (or left) moves down with the hold only near the contact: the
         # shift eases out over the low frames, so a heel coming in at speed is not pulled down to skim
         # the floor from far away
@@ -292,7 +292,7 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
     return out
 
 
-def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
+def _foot_goals(W: ChainArray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
                 reach: float, clearance: np.ndarray):
     """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, ``(T,)`` True where the foot is held (the ankle
     holds or follows its hold) and ``(T,)`` True where either goal differs from the capture."""
@@ -328,7 +328,7 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
     corr_a, level_a = _own_holds(a, ma, held_a, up, low, near, n_extend)
     corr_t = None
     if foot.toe is not None:
-        ankle = _Contact(path=a, held=held_a, corr=corr_a, level=level_a)
+        ankle = _Contact(path=a, mask=ma, runs=ra, held=held_a, corr=corr_a, level=level_a)
         toe = _Contact(path=t, mask=mt, runs=rt)
         _toe_holds(ankle, toe, partner, _Holding(hips=hips, reach=R, up=up, body=body, low=low, near=near,
                                                  n_extend=n_extend, n_ease=n_fade))
@@ -381,11 +381,11 @@ class _Contact:
     held: :func:`_own_holds`)."""
 
     path: np.ndarray
-    mask: np.ndarray | None = None
-    runs: list | None = None
-    held: list | None = None
-    corr: np.ndarray | None = None
-    level: np.ndarray | None = None
+    mask: np.ndarray
+    runs: list
+    held: list = field(default_factory=list)
+    corr: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    level: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
 
 @dataclass(frozen=True)
@@ -484,7 +484,7 @@ def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray,
     return out
 
 
-def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray], reach: float,
+def _lowering(W: ChainArray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray], reach: float,
               n_blend: int) -> np.ndarray:
     """How far ``(T,)`` the root must go down so every held ankle goal (weight > 0) is within reach, smoothed
     so it is never less."""
@@ -544,7 +544,7 @@ def _weights(contacts: Contacts, n_blend: int) -> np.ndarray:
     return np.stack([_hold_weights(m, n_blend) for m in contacts.mask.T], axis=1)
 
 
-def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | None,
+def _root_shift(W: ChainArray, contacts: Contacts, n_blend: int, period: int | None,
                 turn: float = 0.0, turn_axis: np.ndarray | None = None) -> np.ndarray:
     """Horizontal world displacement ``(T, 3)`` of the root that cancels the hold-weighted mean horizontal
     velocity of the planted contact joints (the hips follow the planted foot, as in a real stance), less

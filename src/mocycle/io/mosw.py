@@ -25,6 +25,7 @@ import zlib
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..limits import check_frames, frame_time_problem
@@ -40,7 +41,7 @@ _RANGE_Q = 32767.0 / (4 * np.pi)  # for a swing's angle range within ±4π
 
 
 # ---------------------------------------------------------------- packing helpers
-def _put(buf: io.BytesIO, arr: np.ndarray, dtype: str) -> None:
+def _put(buf: io.BytesIO, arr: ArrayLike, dtype: str) -> None:
     a = np.ascontiguousarray(np.asarray(arr).astype(dtype))
     buf.write(struct.pack("<I", a.size))
     buf.write(a.astype(np.dtype(dtype).newbyteorder("<")).tobytes())
