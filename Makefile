@@ -3,7 +3,7 @@
 #               (the core needs numpy, scipy, scikit-learn, ripser; ".[test]" also pulls the
 #               cli and plot extras, typer/rich and matplotlib, which the demo and the tests use)
 #   make check  the fast tier, before each commit (a few minutes): ruff, mypy on the core, and the unit
-#               tests without Blender, a browser or the slow ones (pytest -m "not browser and not slow")
+#               tests without Blender, a browser, Node.js or the slow ones (pytest -m "not browser and not slow and not node")
 #   make test   lint with ruff, run the whole suite with numpy 2.x (.venv) and again
 #               with numpy 1.26 (.venv-numpy1, the line Blender bundles), then the Blender
 #               extension in headless Blender 5.0.1 and 4.2 LTS (make test-blender)
@@ -46,7 +46,7 @@ lint: $(VENV)/.installed
 check: $(VENV)/.installed
 	$(BIN)/ruff check src tests benchmarks blender tests_blender
 	$(BIN)/mypy
-	$(BIN)/python -m pytest -q -p no:cacheprovider -m "not browser and not slow"
+	$(BIN)/python -m pytest -q -p no:cacheprovider -m "not browser and not slow and not node"
 
 test-numpy2: $(VENV)/.installed $(JS)/node_modules/.installed
 	$(BIN)/python -c "import numpy; print('numpy', numpy.__version__)"
