@@ -177,9 +177,8 @@ class Segmentation:
 
 # ---------------------------------------------------------------- skeleton as text
 def skeleton_text(skeleton: Skeleton) -> str:
-    """The BVH text of the skeleton's rest pose (one frame), from which :func:`skeleton_from_text` rebuilds it."""
+    """The BVH text of the skeleton's rest pose (one frame), which :func:`mocycle.io.bvh.parse_bvh` reads back."""
     return format_bvh(Motion.rest(skeleton, 1))
-
 
 
 # ---------------------------------------------------------------- reading back, checked
@@ -192,9 +191,11 @@ _SWING_VECTORS = ("axis", "base")
 _HOLD_INTS = ("joint", "start", "end")
 
 
-def segmentation_from_dict(d: dict, path: str | os.PathLike | None = None):
-    """A checked :class:`~mocycle.swings.Segmentation` from :meth:`~mocycle.swings.Segmentation.to_dict`'s
-    document; ``path`` names the file in the error."""
+def segmentation_from_dict(d: dict, path: str | os.PathLike | None = None) -> Segmentation:
+    """A checked :class:`Segmentation` from :meth:`Segmentation.to_dict`'s document; ``path`` names the file in
+    the error.  Types are checked before any array is made, sizes against the take
+    (:func:`~mocycle.limits.check_frames`), and the columns by :func:`checked_segmentation`, as a ``.mosw``
+    file's are."""
 
     def error(reason: str) -> MotionFileError:
         return MotionFileError(f"swings JSON is damaged: {reason}", path)
