@@ -2,6 +2,8 @@
 #   make demo   set up .venv and run the main job on the built-in synthetic walk
 #               (the core needs numpy, scipy, scikit-learn, ripser; ".[test]" also pulls the
 #               cli and plot extras, typer/rich and matplotlib, which the demo and the tests use)
+#   make check  the fast tier, before each commit (a few minutes): ruff, mypy on the core, and the unit
+#               tests without Blender, a browser, Node.js or the slow ones (pytest -m "not browser and not slow and not node")
 #   make test   lint with ruff, run the whole suite with numpy 2.x (.venv) and again
 #               with numpy 1.26 (.venv-numpy1, the line Blender bundles), then the Blender
 #               extension in headless Blender 5.0.1 and 4.2 LTS (make test-blender)
@@ -10,7 +12,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 NP1    := .venv-numpy1
 
-.PHONY: demo test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender test-blender50 test-blender42 test-blender45 js chromium
+.PHONY: demo check test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender test-blender50 test-blender42 test-blender45 js chromium
 
 # the glTF tests' JavaScript side (Khronos glTF validator, three.js): tests/js/package-lock.json
 JS := tests/js
@@ -39,6 +41,12 @@ demo: $(VENV)/.installed
 
 lint: $(VENV)/.installed
 	$(BIN)/ruff check src tests benchmarks blender tests_blender
+
+# the fast tier (see the top): no Node.js, chromium or Blender needed; make test runs everything
+check: $(VENV)/.installed
+	$(BIN)/ruff check src tests benchmarks blender tests_blender
+	$(BIN)/mypy
+	$(BIN)/python -m pytest -q -p no:cacheprovider -m "not browser and not slow and not node"
 
 test-numpy2: $(VENV)/.installed $(JS)/node_modules/.installed
 	$(BIN)/python -c "import numpy; print('numpy', numpy.__version__)"

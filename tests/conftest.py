@@ -50,3 +50,32 @@ def shared_data() -> Path:
     if not SHARED_DATA.is_dir():
         pytest.skip(f"shared data {SHARED_DATA} is absent (clone ../shared beside the repo)")
     return SHARED_DATA
+
+
+
+# ``make check`` (pytest -m "not browser and not slow and not node") leaves these out; ``make test`` runs them:
+# every command end to end against the recorded outputs, the batch runner's dask clusters, the fuzzers
+# (hypothesis under memory and time limits), hostile command lines, the studio's server, fresh interpreters
+# (start-up, threads, import orders) and the few tests over ten seconds each on a busy machine.
+SLOW = ("tests/batch/", "tests/cli_json/", "_fuzz.py", "tests/test_cli_hostile.py", "tests/test_startup.py",
+        "tests/test_threads.py", "tests/test_cli_polish.py", "tests/studio/test_studio_api.py",
+        "::test_codec_modules_import_in_any_order", "::test_writing_holds_one_piece_of_text_at_a_time_not_the_take",
+        "::test_a_long_query_is_measured_on_evenly_spread_windows_and_still_finds_itself")
+
+
+def pytest_collection_modifyitems(items):
+    for item in items:
+        if any(part in item.nodeid or part in item.path.as_posix() for part in SLOW):
+            item.add_marker(pytest.mark.slow)
+        function = getattr(item, "function", None)
+        if function is not None and "run_js(" in _source(function):  # the glTF tests' Node.js side
+            item.add_marker(pytest.mark.node)
+
+
+def _source(function) -> str:
+    import inspect
+
+    try:
+        return inspect.getsource(function)
+    except (OSError, TypeError):
+        return ""

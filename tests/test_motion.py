@@ -106,7 +106,7 @@ def test_a_motion_hands_its_own_arrays_over_and_copies_shared_ones():
     walk = synthetic_walk(n_frames=60).motion
     own = Motion(walk.skeleton, walk.rotations, walk.translations, walk.frame_time)  # arrays it alone holds
     address = own.rotations.__array_interface__["data"][0], own.root_positions.__array_interface__["data"][0]
-    rotations, static, tracks = own._hand_over()
+    rotations, static, tracks = own.hand_over()
     assert list(tracks) == [0]
     assert (rotations.__array_interface__["data"][0], tracks[0].__array_interface__["data"][0]) == address
     assert rotations.flags.writeable and tracks[0].flags.writeable and static.flags.writeable
@@ -117,7 +117,7 @@ def test_a_motion_hands_its_own_arrays_over_and_copies_shared_ones():
     view = shared[10:50]                                    # shares both arrays
     moved = shared.replace(translations=shared.translations + 1.0)  # shares the rotations
     before = view.rotations.copy(), view.translations.copy(), moved.rotations.copy()
-    rotations, static, tracks = shared._hand_over()
+    rotations, static, tracks = shared.hand_over()
     rotations[:] = 0.0
     static[:] = 0.0
     tracks[0][:] = 0.0

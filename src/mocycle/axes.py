@@ -58,10 +58,7 @@ def vertical_axis(motion: Motion, up=None) -> np.ndarray:
     """
     if up is not None:
         return parse_up(up)
-    known = getattr(motion, "_up", None)  # the arrays are read-only: detected once per motion
-    if known is None:
-        known = motion._up = _detect_up(motion)
-    return known.copy()
+    return motion.cache("up", _detect_up).copy()  # detected once per motion
 
 
 def _detect_up(motion: Motion) -> np.ndarray:

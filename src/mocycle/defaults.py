@@ -11,3 +11,17 @@ AMC_FPS = 120.0
 MIN_PERIODS = 1.2
 #: Acceptable Swing Error of a swing segmentation (paper: 0.4); :mod:`mocycle.swings.segment`.
 SWING_THRESHOLD = 0.4
+
+# The names of the keyframe methods (thesis 002), one home: the algorithms (:mod:`mocycle.keyframes`), the
+# ``.mck`` reader's checks (:mod:`mocycle.io.mck`) and the task options all read them from here.
+#: keyframe selections; :mod:`mocycle.keyframes.select`.
+KEY_SELECTIONS = ("uniform", "scs", "pb", "rols")
+#: temporal reconstruction schemes; :mod:`mocycle.keyframes.temporal`.
+TEMPORAL_SCHEMES = ("linear", "hermite", "slerp", "rbf")
+#: every keyframe scheme: the temporal ones and the spatial one; :mod:`mocycle.keyframes.compress`.
+KEY_SCHEMES = TEMPORAL_SCHEMES + ("spatial",)
+#: one-step 2-D projections; :mod:`mocycle.keyframes.projection`.
+ONE_STEP_PROJECTIONS = ("pca", "mds", "isomap", "lle", "force", "tsne")
+#: two-step 2-D projections (their keyframes are placed by a one-step projection first).
+TWO_STEP_PROJECTIONS = ("rbfp", "lamp")
+PROJECTIONS = ONE_STEP_PROJECTIONS + TWO_STEP_PROJECTIONS

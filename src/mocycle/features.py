@@ -203,10 +203,7 @@ class HeadingFrame:
     @classmethod
     def fit(cls, motion: Motion) -> HeadingFrame:
         """The frame of ``motion``, fitted once per motion (its arrays are read-only), as its :meth:`tilt`."""
-        known = getattr(motion, "_heading", None)
-        if known is None:
-            known = motion._heading = [cls._fit(motion), None]
-        return known[0]
+        return motion.cache("heading", cls._fit)
 
     @classmethod
     def _fit(cls, motion: Motion) -> HeadingFrame:
@@ -234,16 +231,16 @@ class HeadingFrame:
         """The travel joint's rotation without its heading ``(T, 4)`` and the unwrapped heading ``(T,)`` rad
         (read-only arrays: computed once per motion and frame, as the phase's features and its leg curves
         both need them)."""
-        known = getattr(motion, "_heading", None)
-        if known is not None and known[0] is self and known[1] is not None:
-            return known[1]
+        if motion.cache("heading") is not self:  # a frame fitted on another motion: nothing to keep
+            return self._tilt(motion)
+        return motion.cache("heading tilt", self._tilt)
+
+    def _tilt(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
         q = motion.rotations[:, self.travel]
         psi = heading_angles(Rotation.from_quat(q).apply(self.forward), self.e1, self.e2)
         tilt = quat_multiply(axis_angle_quats(self.up, -psi), q)
         tilt.setflags(write=False)
         psi.setflags(write=False)
-        if known is not None and known[0] is self:
-            known[1] = (tilt, psi)
         return tilt, psi
 
     def turn(self, quats: np.ndarray, angles: np.ndarray) -> np.ndarray:

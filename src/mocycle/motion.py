@@ -22,8 +22,9 @@ import fnmatch
 import functools
 import re
 import sys
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
@@ -340,7 +341,8 @@ class Motion:
         normalises and freezes them in place instead of copying them (what the readers do: half the memory).
     """
 
-    __slots__ = ("skeleton", "rotations", "_static", "_tracks", "frame_time", "_travel", "_up", "_heading")
+    __slots__ = ("skeleton", "rotations", "_static", "_tracks", "frame_time", "_travel", "_cache")
+    _cache: dict[str, Any]  # Motion.cache's values
 
     def __init__(
         self,
@@ -498,6 +500,34 @@ class Motion:
             known = self._travel = moving[0] if moving else self.skeleton.body_root()
         return known
 
+    def cache(self, key: str, make: Callable[[Motion], Any] | None = None) -> Any:
+        """A value derived from this motion, made by ``make(motion)`` on the first call with ``key`` and kept
+        with the motion after that; with no ``make``, the kept value or ``None``.
+
+        The motion's arrays are read-only, so a derived value never goes stale: what several steps of one
+        run each need (the vertical axis, the heading frame) is computed once per motion.  A value is
+        returned as it was kept: make it read-only, or copy it where the caller may change it.  ``key`` names
+        the value; the modules that keep one say which (``"up"``: :func:`mocycle.axes.vertical_axis`,
+        ``"heading"`` and ``"heading tilt"``: :class:`mocycle.features.HeadingFrame`).
+
+        Examples
+        --------
+        >>> from mocycle.datasets import synthetic_walk
+        >>> walk = synthetic_walk(n_frames=60).motion
+        >>> walk.cache("frames x2") is None
+        True
+        >>> walk.cache("frames x2", lambda m: 2 * m.n_frames), walk.cache("frames x2", lambda m: 0)
+        (120, 120)
+        """
+        kept = getattr(self, "_cache", None)
+        if kept is None:
+            kept = self._cache = {}
+        if key not in kept:
+            if make is None:
+                return None
+            kept[key] = make(self)
+        return kept[key]
+
     def __repr__(self) -> str:
         return (
             f"Motion({self.n_frames} frames, {self.n_joints} joints, "
@@ -587,10 +617,10 @@ class Motion:
                       changes.get("translations", self._static), changes.get("frame_time", self.frame_time),
                       tracks={**kept, **given}, copy=copy)
 
-    def _hand_over(self) -> tuple[np.ndarray, np.ndarray, dict[int, np.ndarray]]:
+    def hand_over(self) -> tuple[np.ndarray, np.ndarray, dict[int, np.ndarray]]:
         """The motion's ``rotations``, constant translations ``(J, 3)`` and tracks, writable, for a caller that
         makes the next motion from them and holds the last reference to this one (a long take's edit without a
-        copy of it).
+        copy of it: ``Motion(skeleton, rotations, static, frame_time, tracks=tracks, copy=False)``).
 
         The motion is emptied: any later use of it raises AttributeError.  An array that another object may
         see (a view, a view's base or an array another motion shares, as :meth:`replace` and slices share
@@ -598,6 +628,7 @@ class Motion:
         probe = np.empty(0)  # an array only a local name holds: the count of a sole reference, measured alike
         static, tracks = self._static.copy(), self._tracks  # each motion has its own dict of tracks
         arrays = [self.rotations]
+        self._cache = {}  # values derived from the arrays go with them
         del self.rotations, self._static, self._tracks
         joints = list(tracks)
         arrays += [tracks.pop(j) for j in joints]

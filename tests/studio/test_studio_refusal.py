@@ -111,6 +111,7 @@ def test_the_api_refuses_without_force_and_gives_with_force(refused_library):
         assert not any(loop["refused"] for loop in takes["walk.bvh"]["loops"])
 
 
+@pytest.mark.browser
 def test_the_page_shows_a_refused_loop_as_refused(refused_library, tmp_path):
     """The library row and the review say refused with the reason, nothing is downloadable; the force button
     shows the loop marked FORCED and downloads it as ``limp_loop.forced.bvh``."""

@@ -52,6 +52,8 @@ joint's translation, so every bone keeps its length exactly.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -59,7 +61,7 @@ from ..motion import Motion
 from ..rotations import axis_rotations
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
-from .feet import chain_joints, chain_positions, chain_rotation_blocks, leg_joints
+from .feet import ChainArray, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
 from .smooth import maximum, uniform
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
@@ -137,13 +139,13 @@ def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return Rotation.from_rotvec(rotvec).as_matrix()
 
 
-def _leg_length(W: np.ndarray, foot) -> np.ndarray:
+def _leg_length(W: ChainArray, foot) -> np.ndarray:
     """Hip-knee plus knee-ankle ``(T,)``."""
     H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
     return np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
 
 
-def _reach(W: np.ndarray, foot, reach: float) -> np.ndarray:
+def _reach(W: ChainArray, foot, reach: float) -> np.ndarray:
     """How far ``(T,)`` a held ankle may be from its hip: ``reach`` of the leg's length (a held knee never
     goes fully straight, where a millimetre of length takes a large knee angle)."""
     return np.maximum(reach * _leg_length(W, foot), np.linalg.norm(W[:, foot.ankle] - W[:, foot.hip], axis=1))
@@ -191,9 +193,9 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
     a, b = _contact_ends(mask)
     if a.size == 0:
         return corr, level
-    targets = np.asarray(targets, dtype=np.float64).reshape(-1, 3)
+    goal = np.asarray(targets, dtype=np.float64).reshape(-1, 3)
     held = np.flatnonzero(mask)
-    corr[held] = targets[np.repeat(np.arange(a.size), b - a)] - path[held]
+    corr[held] = goal[np.repeat(np.arange(a.size), b - a)] - path[held]
     level[held] = HELD
     height = path @ up
     third = (a[1:] - b[:-1]) // 3
@@ -203,13 +205,13 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
         f, k = _windows(first, count, step)
         if f.size == 0:
             continue
-        c = targets[k] - path[f]
+        c = goal[k] - path[f]
         cu = c @ up
-        ok = (height[f] < targets[k] @ up + low) & (np.linalg.norm(c - cu[:, None] * up, axis=1) <= near)
+        ok = (height[f] < goal[k] @ up + low) & (np.linalg.norm(c - cu[:, None] * up, axis=1) <= near)
         misses = np.cumsum(~ok)                                     # up to the first miss of each window
         keep = misses == np.concatenate([[0], misses])[np.cumsum(count) - count][k]
         f, k, c, cu = f[keep], k[keep], c[keep], cu[keep]
-        edge_u = (targets[k] - path[edge[k]]) @ up
+        edge_u = (goal[k] - path[edge[k]]) @ up
         # a joint held lower than it came in (or left) moves down with the hold only near the contact: the
         # shift eases out over the low frames, so a heel coming in at speed is not pulled down to skim
         # the floor from far away
@@ -290,9 +292,10 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
     return out
 
 
-def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
+def _foot_goals(W: ChainArray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
                 reach: float, clearance: np.ndarray):
-    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, and ``(T,)`` True where the foot is held."""
+    """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, ``(T,)`` True where the foot is held (the ankle
+    holds or follows its hold) and ``(T,)`` True where either goal differs from the capture."""
     foot = contacts.feet[f]
     up, body = contacts.up, contacts.body
     low, near = EXTEND_HEIGHT * body, EXTEND_DISTANCE * body
@@ -325,8 +328,11 @@ def _foot_goals(W: np.ndarray, contacts: Contacts, f: int, n_extend: int, n_brid
     corr_a, level_a = _own_holds(a, ma, held_a, up, low, near, n_extend)
     corr_t = None
     if foot.toe is not None:
-        corr_t, level_t = _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body,
-                                     low, near, n_extend, n_fade)
+        ankle = _Contact(path=a, mask=ma, runs=ra, held=held_a, corr=corr_a, level=level_a)
+        toe = _Contact(path=t, mask=mt, runs=rt)
+        _toe_holds(ankle, toe, partner, _Holding(hips=hips, reach=R, up=up, body=body, low=low, near=near,
+                                                 n_extend=n_extend, n_ease=n_fade))
+        corr_t, level_t = toe.corr, toe.level
     corr_a = _bridge(corr_a, n_bridge, n_fade)
     clear = clearance * body
     clear_a, clear_t = clear[cols[foot.ankle]], clear[cols[foot.toe]] if foot.toe is not None else 0.0
@@ -367,19 +373,54 @@ def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, bod
     return np.minimum(lift, np.minimum.accumulate((lift + rate * frames)[::-1])[::-1] - rate * frames)
 
 
-def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R, up, body, low, near, n_extend,
-               n_ease):
-    """The toe's corrections (NaN where not held); the ankle's (``corr_a``, ``level_a``) updated in place
-    where it follows the held toe (heel lifted where the leg cannot reach)."""
+@dataclass
+class _Contact:
+    """One contact joint of a foot (ankle or toe) while its holds are made: ``path`` ``(T, 3)`` (world),
+    ``mask`` ``(T,)`` True in contact, ``runs`` its contacts (``[start, end)``); then ``held`` (the place each
+    contact is held at), ``corr`` ``(T, 3)`` (the correction of ``path``) and ``level`` ``(T,)`` (how it is
+    held: :func:`_own_holds`)."""
+
+    path: np.ndarray
+    mask: np.ndarray
+    runs: list
+    held: list = field(default_factory=list)
+    corr: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    level: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+
+@dataclass(frozen=True)
+class _Holding:
+    """What the holds of one foot are made with: the hip's path ``hips`` ``(T, 3)`` and the leg's ``reach``
+    ``(T,)``; the take's ``up`` and ``body`` height; ``low``, ``near`` and ``n_extend``, how far around a
+    contact a joint stays held (:func:`_own_holds`); ``n_ease`` frames to ease a carried joint."""
+
+    hips: np.ndarray
+    reach: np.ndarray
+    up: np.ndarray
+    body: float
+    low: float
+    near: float
+    n_extend: int
+    n_ease: int
+
+
+def _toe_holds(ankle: _Contact, toe: _Contact, partner: dict, h: _Holding) -> None:
+    """The toe's holds, corrections (NaN where not held) and levels, set on ``toe``; the ankle's ``corr``
+    and ``level`` changed in place where it follows the held toe (heel lifted where the leg cannot reach).
+    ``partner`` maps a toe contact to the ankle contact it overlaps most and the middle frame of the two
+    (one rigid-foot hold)."""
+    a, t, held_a, corr_a, level_a = ankle.path, toe.path, ankle.held, ankle.corr, ankle.level
+    hips, R, up, body = h.hips, h.reach, h.up, h.body
     held_t = []
-    for i, (s, e) in enumerate(rt):
+    for i, (s, e) in enumerate(toe.runs):
         if i in partner:  # a rigid foot can meet both holds: toe = held ankle + foot vector
             k, mid = partner[i]
             held_t.append(held_a[k] + (t[mid] - a[mid]))
         else:
             fr = np.arange(s, e)
             held_t.append(_best_hold(t[s:e], a[fr] - t[fr], hips[fr], R[fr], up, body))
-    corr_t, level_t = _own_holds(t, mt, held_t, up, low, near, n_extend)
+    corr_t, level_t = _own_holds(t, toe.mask, held_t, up, h.low, h.near, h.n_extend)
+    toe.held, toe.corr, toe.level = held_t, corr_t, level_t
     # both low around a contact: the joint nearer its own contact leads and the other is carried with it
     # (the heel leads a landing, the toe a push-off), so the foot keeps its own roll and is not stretched
     # between two holds and then let go
@@ -401,13 +442,12 @@ def _toe_holds(W, foot, a, t, mt, rt, partner, held_a, corr_a, level_a, hips, R,
         goal_t = t[on_toe] + corr_t[on_toe]
         lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
         corr_a[on_toe] = lifted - a[on_toe]
-    _ease_carried(corr_a, level_a, n_ease)
-    _ease_carried(corr_t, level_t, n_ease)
+    _ease_carried(corr_a, level_a, h.n_ease)
+    _ease_carried(corr_t, level_t, h.n_ease)
     if on_toe.any():  # still one foot length from the held toe (the toe is aimed at, so it stays put)
         goal_t = t[on_toe] + corr_t[on_toe]
         length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
         corr_a[on_toe] = goal_t + length[:, None] * _normalize(a[on_toe] + corr_a[on_toe] - goal_t) - a[on_toe]
-    return corr_t, level_t
 
 
 def _ease_carried(corr: np.ndarray, level: np.ndarray, n: int) -> None:
@@ -444,7 +484,7 @@ def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray,
     return out
 
 
-def _lowering(W: np.ndarray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray], reach: float,
+def _lowering(W: ChainArray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray], reach: float,
               n_blend: int) -> np.ndarray:
     """How far ``(T,)`` the root must go down so every held ankle goal (weight > 0) is within reach, smoothed
     so it is never less."""
@@ -504,7 +544,7 @@ def _weights(contacts: Contacts, n_blend: int) -> np.ndarray:
     return np.stack([_hold_weights(m, n_blend) for m in contacts.mask.T], axis=1)
 
 
-def _root_shift(W: np.ndarray, contacts: Contacts, n_blend: int, period: int | None,
+def _root_shift(W: ChainArray, contacts: Contacts, n_blend: int, period: int | None,
                 turn: float = 0.0, turn_axis: np.ndarray | None = None) -> np.ndarray:
     """Horizontal world displacement ``(T, 3)`` of the root that cancels the hold-weighted mean horizontal
     velocity of the planted contact joints (the hips follow the planted foot, as in a real stance), less
@@ -635,7 +675,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     frames at a time); ``turn``: with ``period``, the loop's turn per period (rad about ``turn_axis``, default
     the vertical: each repeat is the one before turned, as :meth:`~mocycle.cycle.Cycle.repeat` makes them);
     ``hand_over``: the caller gives ``motion`` up, and the result is made from its arrays instead of copies
-    (:meth:`~mocycle.motion.Motion._hand_over`: ``motion`` is emptied; a long take is locked without a
+    (:meth:`~mocycle.motion.Motion.hand_over`: ``motion`` is emptied; a long take is locked without a
     second copy of it).  Returns a new Motion with the same skeleton and frame time.
     """
     if contacts.n_frames != motion.n_frames:
@@ -691,7 +731,7 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     del W  # the chain's world positions and rotations: not needed for the quaternions (memory)
     T, frame_time = motion.n_frames, motion.frame_time
     if hand_over:
-        rotations, static, tracks = motion._hand_over()
+        rotations, static, tracks = motion.hand_over()
     else:  # the input's tracks are shared (read-only), the travel joint's copied when it moves
         rotations, static = motion.rotations.copy(), motion.translations_at(0)
         tracks = motion.tracks

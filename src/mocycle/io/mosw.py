@@ -25,32 +25,23 @@ import zlib
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import MocycleError, MocycleWarning, MotionFileError
-from ..io.atomic import atomic_write
-from ..io.bvh import bvh_size, format_bvh, parse_bvh
-from ..io.inflate import Inflater
 from ..limits import check_frames, frame_time_problem
-from ..motion import Motion, Skeleton
-from ..swings.segment import Hold, Segmentation, Swing
+from ..motion import Motion
+from ..segmentation import MAX_SKELETON_BYTES, Segmentation, checked_segmentation, skeleton_text
+from .atomic import atomic_write
+from .bvh import bvh_size, parse_bvh
+from .inflate import Inflater
 
 MAGIC = b"MOSW\x01"
 _PI_Q = 32767.0 / np.pi  # int16 steps per radian for angles within [-π, π]
 _RANGE_Q = 32767.0 / (4 * np.pi)  # for a swing's angle range within ±4π
 
 
-# ---------------------------------------------------------------- skeleton as text
-def skeleton_text(skeleton: Skeleton) -> str:
-    """The BVH text of the skeleton's rest pose (one frame), from which :func:`skeleton_from_text` rebuilds it."""
-    return format_bvh(Motion.rest(skeleton, 1))
-
-
-def skeleton_from_text(text: str) -> Skeleton:
-    return parse_bvh(text).skeleton
-
-
 # ---------------------------------------------------------------- packing helpers
-def _put(buf: io.BytesIO, arr: np.ndarray, dtype: str) -> None:
+def _put(buf: io.BytesIO, arr: ArrayLike, dtype: str) -> None:
     a = np.ascontiguousarray(np.asarray(arr).astype(dtype))
     buf.write(struct.pack("<I", a.size))
     buf.write(a.astype(np.dtype(dtype).newbyteorder("<")).tobytes())
@@ -122,10 +113,6 @@ def encode(seg: Segmentation) -> bytes:
     return MAGIC + zlib.compress(buf.getvalue(), 9)
 
 
-#: The longest skeleton text a swings file may hold (about 100k joints).
-MAX_SKELETON_BYTES = 64 * 2**20
-
-
 def decode(data: bytes, path: str | os.PathLike | None = None) -> Segmentation:
     """A :class:`Segmentation` from :func:`encode`'s bytes (quantised values).
 
@@ -195,94 +182,6 @@ def decode(data: bytes, path: str | os.PathLike | None = None) -> Segmentation:
     holds = dict(joint=hj.astype(np.int64), start=hs64, end=hs64 + hl, mean=hm.reshape(-1, 3))
     return checked_segmentation(r.error, skel, T, float(frame_time), float(threshold), float(window_s), joints,
                                 swings, holds, keys)
-
-
-def checked_segmentation(error, skel: Skeleton, T: int, frame_time: float, threshold: float, window_s: float,
-                         joints: list[int], swings: dict, holds: dict, keys: dict,
-                         params: dict | None = None) -> Segmentation:
-    """A :class:`Segmentation` from columns read out of a file, after checking every index, span and value.
-
-    ``error(reason)`` makes the :class:`MotionFileError` naming the file.  ``swings``: ``joint``, ``start``,
-    ``end`` ``(n,)`` int64, ``axis`` and ``base`` ``(n, 3)``, ``start_angle``, ``end_angle``, ``start_speed``,
-    ``end_speed``, ``error`` ``(n,)``; ``holds``: ``joint``, ``start``, ``end`` ``(m,)`` int64, ``mean``
-    ``(m, 3)``; ``keys``: joint -> (frames ``(k,)`` int64, values ``(k, 3)``).  Shared by the ``.mosw`` and
-    the JSON readers, so a damaged file of either gives one error and never a crash in playback.
-    """
-    J = skel.n_joints
-    sj, ss, se = swings["joint"], swings["start"], swings["end"]
-    hj, hs, he = holds["joint"], holds["start"], holds["end"]
-    _check_events(error, "swing", sj, ss, se - ss, T, J, min_length=1)
-    _check_events(error, "hold", hj, hs, he - hs, T, J, min_length=0)
-    _check_cover(error, np.concatenate([sj, hj]), np.concatenate([ss, hs]), np.concatenate([se, he]), T)
-    if len(set(joints)) != len(joints) or any(j >= J or j < 0 for j in joints):
-        raise error(f"its segmented joints repeat or exceed the skeleton's {J} joints")
-    for name in ("axis", "start_angle", "end_angle", "start_speed", "end_speed", "base", "error"):
-        v = swings[name]
-        if not np.all(np.isfinite(v)) or (v.size and np.abs(v).max() > MAX_VALUE):
-            raise error(f"a swing's {name.replace('_', ' ')} is not a finite number within ±{MAX_VALUE:g}")
-    norms = np.linalg.norm(swings["axis"], axis=1)
-    if np.any(np.abs(norms - 1.0) > 1e-3):
-        raise error("a swing's axis is not a unit vector")
-    axis = np.where(np.abs(norms - 1.0)[:, None] > 1e-12, swings["axis"] / norms[:, None], swings["axis"])
-    hm = holds["mean"]
-    if not np.all(np.isfinite(hm)) or (hm.size and np.abs(hm).max() > MAX_VALUE):
-        raise error(f"a hold's mean rotation is not a finite rotation vector within ±{MAX_VALUE:g}")
-    tj = np.array(sorted(keys), dtype=np.int64)
-    if np.any(tj >= J) or np.any(tj < 0):
-        raise error(f"its translated joints must be joint numbers below {J}")
-    for j, (f, v) in keys.items():
-        if f.size == 0 or v.shape != (f.size, 3):
-            raise error(f"joint {j}'s translation keys: {f.size} frames but {v.size} values")
-        if f[0] != 0 or f[-1] >= T or np.any(np.diff(f) <= 0) or (f.size > 1 and f[-1] != T - 1):
-            raise error(f"joint {j}'s translation key frames must increase from 0 (to {T - 1} when they move)")
-        if not np.all(np.isfinite(v)) or np.abs(v).max() > MAX_VALUE:
-            raise error(f"joint {j}'s translation values are not finite numbers within ±{MAX_VALUE:g}")
-    names = skel.names
-    out_swings = [Swing(joint=int(sj[i]), name=names[sj[i]], start=int(ss[i]), end=int(se[i]),
-                        axis=tuple(float(x) for x in axis[i]), start_angle=float(swings["start_angle"][i]),
-                        end_angle=float(swings["end_angle"][i]), start_speed=float(swings["start_speed"][i]),
-                        end_speed=float(swings["end_speed"][i]), base=tuple(float(x) for x in swings["base"][i]),
-                        error=float(swings["error"][i])) for i in range(sj.size)]
-    out_holds = [Hold(joint=int(hj[i]), name=names[hj[i]], start=int(hs[i]), end=int(he[i]),
-                      mean=tuple(float(x) for x in hm[i])) for i in range(hj.size)]
-    return Segmentation(skeleton=skel, n_frames=T, frame_time=frame_time, joints=list(joints), swings=out_swings,
-                        holds=out_holds, translation_keys=keys, threshold=threshold, window_s=window_s,
-                        params=dict(params or {}))
-
-
-#: The largest translation a swings file may hold (file units): far above any take, far below overflow.
-MAX_VALUE = 1e12
-
-
-def _check_cover(error, joint: np.ndarray, start: np.ndarray, end: np.ndarray, T: int) -> None:
-    """The swings and holds of every joint that has any run from frame 0 to the last frame (what
-    :func:`~mocycle.swings.segment` writes): a frame count that no record reaches is damage."""
-    if not joint.size:
-        return
-    first = np.full(joint.max() + 1, T, dtype=np.int64)
-    last = np.full(joint.max() + 1, -1, dtype=np.int64)
-    np.minimum.at(first, joint, start)
-    np.maximum.at(last, joint, end)
-    used = np.unique(joint)
-    if np.any(first[used] != 0) or np.any(last[used] != T - 1):
-        raise error(f"its swings and holds do not span the take's {T} frames (from 0 to {T - 1})")
-
-
-def _check_events(error, what: str, joint, start, length, T: int, J: int, min_length: int) -> None:
-    """Swings or holds: joints below ``J``, sorted by (joint, start), inside the take, not overlapping
-    (a swing may start on the frame the one before it ends)."""
-    if not joint.size:
-        return
-    j = joint.astype(np.int64)
-    s = start.astype(np.int64)
-    e = s + length.astype(np.int64)
-    if j.max() >= J:
-        raise error(f"a {what} names joint {int(j.max())}; the skeleton has {J}")
-    if np.any(j < 0) or np.any(s < 0) or np.any(length < min_length) or e.max() >= T:
-        raise error(f"a {what} lies outside the take's {T} frames or is shorter than {min_length} frame(s)")
-    same = j[1:] == j[:-1]
-    if np.any(j[1:] < j[:-1]) or np.any(same & (s[1:] < e[:-1])):
-        raise error(f"its {what}s are not in time order per joint or overlap")
 
 
 def write_swings(seg: Segmentation, path: str | os.PathLike) -> Path:

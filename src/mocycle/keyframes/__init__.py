@@ -2,11 +2,12 @@
 
 Pose distance and errors (:mod:`.distance`), keyframe selection (:mod:`.select`),
 temporal reconstruction (:mod:`.temporal`), projections to 2-D (:mod:`.projection`),
-Igarashi back-projection and Algorithm 12 (:mod:`.spatial`); ``compress``, ``Compressed``
-and the ``.mck`` file are in :mod:`mocycle.io.mck`.
+Igarashi back-projection and Algorithm 12 (:mod:`.spatial`); ``compress`` and the ``Compressed``
+take it makes (:mod:`.compressed`; its ``.mck`` file is encoded by :mod:`mocycle.io.mck`).
 """
 
 from .authoring import author_motion, relayout, resample_stroke
+from .compressed import SCHEMES, Compressed, compress, read_compressed
 from .density import KeyDensity, keyframe_density, rhythm_period
 from .distance import (
     error_per_frame_per_joint,
@@ -31,14 +32,3 @@ __all__ = [
     "select_pb", "select_rols", "select_scs", "select_uniform", "slerp", "spatial_layout", "stress",
 ]
 
-# compress/Compressed live in mocycle.io.mck, which itself imports this package's modules:
-# resolved on first use so that importing either package first works.
-_CODEC = ("SCHEMES", "Compressed", "compress", "read_compressed")
-
-
-def __getattr__(name: str):
-    if name in _CODEC:
-        from ..io import mck
-
-        return getattr(mck, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

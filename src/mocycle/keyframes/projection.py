@@ -29,15 +29,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError
 from ..motion import Motion
 from .distance import joint_weights, pose_distance_matrix, pose_vectors
 from .select import METHODS, keyframe_count, select_pb, select_rols, select_scs, select_uniform
 
-ONE_STEP = ("pca", "mds", "isomap", "lle", "force", "tsne")
-TWO_STEP = ("rbfp", "lamp")
-PROJECTIONS = ONE_STEP + TWO_STEP
+#: the projections (one home: :mod:`mocycle.defaults`)
+ONE_STEP = defaults.ONE_STEP_PROJECTIONS
+TWO_STEP = defaults.TWO_STEP_PROJECTIONS
+PROJECTIONS = defaults.PROJECTIONS
 
 
 class PoseSpace:
@@ -221,6 +222,7 @@ def _pad2(Y: np.ndarray) -> np.ndarray:
 
 def project_one_step(name: str, space: PoseSpace, random_state: int = 0) -> np.ndarray:
     """``(T, 2)`` projection of every pose of ``space`` with one of :data:`ONE_STEP`."""
+    _validate.choice("projection", name, ONE_STEP)
     if name == "pca":
         return project_pca(space.vectors, random_state)
     if name == "mds":
@@ -231,9 +233,7 @@ def project_one_step(name: str, space: PoseSpace, random_state: int = 0) -> np.n
         return project_lle(space.vectors, random_state=random_state)
     if name == "force":
         return project_force(space.distances, random_state=random_state)
-    if name == "tsne":
-        return project_tsne(space.distances, random_state=random_state)
-    _validate.choice("projection", name, ONE_STEP)
+    return project_tsne(space.distances, random_state=random_state)
 
 
 # ---------------------------------------------------------------- two-step maps
@@ -294,6 +294,7 @@ def select_keyframes(method: str, space: PoseSpace, k: int, points: np.ndarray |
 
     ROLS needs a 2-D projection: ``points`` when given (a spatial scheme's), else PCA.
     """
+    _validate.choice("select", method, METHODS)
     n = space.n
     k = keyframe_count(n, count=k)
     if method == "uniform":
@@ -302,12 +303,10 @@ def select_keyframes(method: str, space: PoseSpace, k: int, points: np.ndarray |
         return select_scs(space.quats, space.weights, k)
     if method == "pb":
         return select_pb(space.quats, space.weights, k)
-    if method == "rols":
-        cand = candidates(n, max_candidates)
-        sub = space.subset(cand)
-        Q = project_pca(sub.vectors, random_state) if points is None else np.asarray(points)[cand]
-        return cand[select_rols(sub.distances, Q, min(k, len(cand)))]
-    _validate.choice("select", method, METHODS)
+    cand = candidates(n, max_candidates)  # rols
+    sub = space.subset(cand)
+    Q = project_pca(sub.vectors, random_state) if points is None else np.asarray(points)[cand]
+    return cand[select_rols(sub.distances, Q, min(k, len(cand)))]
 
 
 def spatial_layout(space: PoseSpace, projection: str, select: str, k: int, seed: str = "mds",

@@ -15,12 +15,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError
 from .distance import pose_distance
 from .temporal import slerp
 
-METHODS = ("uniform", "scs", "pb", "rols")
+#: the selections (one home: :mod:`mocycle.defaults`)
+METHODS = defaults.KEY_SELECTIONS
 
 
 def keyframe_count(n_frames: int, ratio: float | None = None, count: int | None = None) -> int:

@@ -21,16 +21,17 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline, RBFInterpolator, make_interp_spline
 from scipy.spatial.transform import Rotation
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError
 from ..motion import Skeleton
 from ..rotations import continuous_euler, euler_to_quats, matrix_quats, nearest_rotations, slerp
 
-SCHEMES = ("linear", "hermite", "slerp", "rbf")
-
+#: the temporal schemes (one home: :mod:`mocycle.defaults`)
+SCHEMES = defaults.TEMPORAL_SCHEMES
 
 #: frames interpolated at a time
 BLOCK_FRAMES = 8192
+
 
 def check_keys(key_idx, n_frames: int) -> np.ndarray:
     """Validated keyframe indices: increasing, within ``[0, n_frames)``, first and last frame included."""

@@ -1,10 +1,12 @@
 """Joint swings (paper 003): segmentation, playback, a compact codec, retrieval and editing.
 
 ``segment(motion)`` → :class:`Segmentation` (swings and holds per joint) →
-``playback`` (a Motion again), ``encode``/``write_swings`` (the ``.mosw`` file, :mod:`mocycle.io.mosw`),
+``playback`` (a Motion again), ``encode``/``write_swings`` (the ``.mosw`` file, :mod:`mocycle.io.mosw`; the
+records themselves are :mod:`mocycle.segmentation`'s),
 ``signature``/``build_index`` (retrieval), ``edit_swing`` (angle and duration edits).
 """
 
+from ..io.mosw import decode, encode, read_swings, size_report, write_swings
 from .edit import edit_swing
 from .playback import geodesic_errors, playback, playback_errors, segmentation_error
 from .search import SearchHit, Signature, SwingIndex, bandai_content, build_index, compare, precision_at_k, signature
@@ -17,14 +19,3 @@ __all__ = [
     "segmentation_error", "signature", "size_report", "write_swings",
 ]
 
-# The .mosw codec lives in mocycle.io.mosw, which itself imports .segment: resolved on first use
-# so that importing either package first works.
-_CODEC = ("decode", "encode", "read_swings", "size_report", "write_swings")
-
-
-def __getattr__(name: str):
-    if name in _CODEC:
-        from ..io import mosw
-
-        return getattr(mosw, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

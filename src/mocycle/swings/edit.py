@@ -44,7 +44,7 @@ def edit_swing(motion: Motion, seg: Segmentation, joint: str | int, swing: int, 
     the angle the swing turns through; ``duration_scale`` (> 0) its length in
     frames, limited by the room up to the joint's next swing (the error says how far it can go).
     ``hand_over``: the caller gives ``motion`` up, and the edited take is made from its arrays
-    (:meth:`~mocycle.motion.Motion._hand_over`: ``motion`` is emptied once the edit is checked; a long take is
+    (:meth:`~mocycle.motion.Motion.hand_over`: ``motion`` is emptied once the edit is checked; a long take is
     edited without a second copy of it).
     """
     if seg.n_frames != motion.n_frames or not seg.skeleton.same_as(motion.skeleton):
@@ -98,7 +98,7 @@ def edit_swing(motion: Motion, seg: Segmentation, joint: str | int, swing: int, 
         q[sw.start:limit + 1] = _resample(q, old)
     if hand_over:
         skeleton, frame_time = motion.skeleton, motion.frame_time
-        rotations, static, tracks = motion._hand_over()
+        rotations, static, tracks = motion.hand_over()
         rotations[:, j] = q
         return Motion(skeleton, rotations, static, frame_time, tracks=tracks, copy=False)
     # a new array, handed over (no second copy); the translations are shared

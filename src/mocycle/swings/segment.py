@@ -19,34 +19,32 @@ For each chosen joint:
    parts between swings become **holds** with their mean rotation.
 
 The result :class:`Segmentation` is a table of :class:`Swing` and :class:`Hold`
-records (``to_records()``) that playback, the codec, search and editing read.
+records (``to_records()``) that playback, the codecs, search and editing read; the records live in
+:mod:`mocycle.segmentation`, below this module and the codecs.
 """
 
 from __future__ import annotations
 
 import fnmatch
 from collections.abc import Iterable
-from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
-from .. import _validate, defaults
+from .. import _validate
 from ..errors import MocycleError
-from ..motion import Motion, Skeleton
+from ..motion import Motion
 from ..rotations import (
-    axis_angle_quats,
     quat_conj,
     quat_log,
     quat_multiply,
-    rotvec_quat,
 )
+from ..segmentation import DEFAULT_THRESHOLD, PAPER_WINDOW_S, Hold, Segmentation, Swing, swing_angles
 from ..threads import limit_threads
 
-#: The paper's box filter and error window: 20 frames at 120 fps, in seconds.
-PAPER_WINDOW_S = 20.0 / 120.0
-#: The paper's Acceptable Swing Error.
-DEFAULT_THRESHOLD = defaults.SWING_THRESHOLD
+__all__ = ["DEFAULT_THRESHOLD", "PAPER_WINDOW_S", "Hold", "Segmentation", "Swing", "choose_joints", "segment",
+           "swing_angles"]  # the records are mocycle.segmentation's
+
 
 #: Name patterns of small bones left out by default (fingers, toes, twist and helper bones, face).
 MINOR_JOINT_PATTERNS = (
@@ -56,156 +54,6 @@ MINOR_JOINT_PATTERNS = (
 )
 #: frames per block where a whole take's angular velocities would otherwise be held at once
 SPEED_BLOCK = 8192
-
-
-# ---------------------------------------------------------------- records
-def swing_angles(frames, start, end, start_angle, end_angle, start_speed, end_speed, frame_time: float,
-                 profile: str = "hermite") -> np.ndarray:
-    """``θ`` (radians) of swings at (fractional) ``frames``: the cubic Hermite from ``start_angle`` to
-    ``end_angle`` with the end speeds (rad/s), or the paper's linear ramp.  Every argument but
-    ``frame_time`` and ``profile`` is a number or an array (broadcast), so many swings go at once."""
-    start = np.asarray(start, dtype=np.float64)
-    span = np.maximum(np.asarray(end, dtype=np.float64) - start, 1)
-    u = np.clip((np.asarray(frames, dtype=np.float64) - start) / span, 0.0, 1.0)
-    if profile == "linear":
-        return start_angle + (end_angle - start_angle) * u
-    dur = span * frame_time
-    h00 = 2 * u**3 - 3 * u**2 + 1
-    h10 = u**3 - 2 * u**2 + u
-    h01 = -2 * u**3 + 3 * u**2
-    h11 = u**3 - u**2
-    return h00 * start_angle + h10 * dur * start_speed + h01 * end_angle + h11 * dur * end_speed
-
-
-@dataclass(frozen=True, kw_only=True)
-class Swing:
-    """One geodesic swing of one joint: ``q(t) = Rot(axis, θ(t)) ⊗ base`` for frames ``start..end``.
-
-    ``start``/``end`` are frame indices (inclusive); ``axis`` a unit vector in the
-    parent's frame; ``start_angle``/``end_angle`` radians about ``axis``;
-    ``start_speed``/``end_speed`` the angular speed (rad/s) at the ends (the
-    cubic Hermite shape of ``θ(t)``); ``base`` the rotation vector (radians) of
-    the fixed part ``base``; ``error`` the swing's mean axis error (0-2).
-    """
-
-    joint: int
-    name: str
-    start: int
-    end: int
-    axis: tuple[float, float, float]
-    start_angle: float
-    end_angle: float
-    start_speed: float = 0.0
-    end_speed: float = 0.0
-    base: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    error: float = 0.0
-
-    @property
-    def n_frames(self) -> int:
-        return self.end - self.start + 1
-
-    def angles(self, frames: np.ndarray, frame_time: float, profile: str = "hermite") -> np.ndarray:
-        """``θ`` (radians) at (fractional) ``frames`` inside the swing: cubic Hermite or the paper's linear."""
-        return swing_angles(frames, self.start, self.end, self.start_angle, self.end_angle, self.start_speed,
-                            self.end_speed, frame_time, profile)
-
-    def quats(self, frames: np.ndarray, frame_time: float, profile: str = "hermite") -> np.ndarray:
-        """Local rotations ``(n, 4)`` (x, y, z, w) of the swing at ``frames``."""
-        theta = self.angles(frames, frame_time, profile)
-        return quat_multiply(axis_angle_quats(np.asarray(self.axis), theta), rotvec_quat(np.asarray(self.base)))
-
-
-@dataclass(frozen=True, kw_only=True)
-class Hold:
-    """A still part of one joint: frames ``start..end`` (inclusive) and their mean rotation (rotation vector, rad)."""
-
-    joint: int
-    name: str
-    start: int
-    end: int
-    mean: tuple[float, float, float]
-
-    @property
-    def n_frames(self) -> int:
-        return self.end - self.start + 1
-
-
-@dataclass(kw_only=True)
-class Segmentation:
-    """Swings and holds of every joint of a take, plus what playback needs to rebuild it.
-
-    ``joints`` are the indices that were segmented into swings; every other
-    joint is one or more holds.  ``translation_keys`` maps a joint index to
-    ``(frames (K,), values (K, 3))``, a piecewise-linear track of its local
-    translation (one key when it never changes).
-    """
-
-    skeleton: Skeleton
-    n_frames: int
-    frame_time: float
-    joints: list[int]
-    swings: list[Swing]
-    holds: list[Hold]
-    translation_keys: dict[int, tuple[np.ndarray, np.ndarray]]
-    threshold: float = DEFAULT_THRESHOLD
-    window_s: float = PAPER_WINDOW_S
-    params: dict = field(default_factory=dict)
-
-    @property
-    def n_swings(self) -> int:
-        return len(self.swings)
-
-    @property
-    def fps(self) -> float:
-        return 1.0 / self.frame_time
-
-    def swings_of(self, joint: int | str) -> list[Swing]:
-        """The swings of one joint in time order."""
-        j = self.skeleton.index(joint) if isinstance(joint, str) else int(joint)
-        return sorted((s for s in self.swings if s.joint == j), key=lambda s: s.start)
-
-    def holds_of(self, joint: int | str) -> list[Hold]:
-        j = self.skeleton.index(joint) if isinstance(joint, str) else int(joint)
-        return sorted((h for h in self.holds if h.joint == j), key=lambda h: h.start)
-
-    def to_records(self) -> list[dict]:
-        """One flat dict per swing and hold (``kind``, ``joint``, frames, seconds, axis, angles in degrees)."""
-        dt = self.frame_time
-        rows = []
-        for s in sorted(self.swings, key=lambda s: (s.joint, s.start)):
-            rows.append(dict(kind="swing", joint=s.name, start=s.start, end=s.end, start_s=s.start * dt,
-                             end_s=s.end * dt, axis_x=s.axis[0], axis_y=s.axis[1], axis_z=s.axis[2],
-                             start_angle_deg=float(np.degrees(s.start_angle)),
-                             end_angle_deg=float(np.degrees(s.end_angle)),
-                             start_speed_deg_s=float(np.degrees(s.start_speed)),
-                             end_speed_deg_s=float(np.degrees(s.end_speed)), error=s.error))
-        for h in sorted(self.holds, key=lambda h: (h.joint, h.start)):
-            rows.append(dict(kind="hold", joint=h.name, start=h.start, end=h.end, start_s=h.start * dt,
-                             end_s=h.end * dt, mean_rotvec=list(h.mean)))
-        return rows
-
-    def to_dict(self) -> dict:
-        """Everything as JSON-ready values (read back with :meth:`from_dict`)."""
-        from ..io.mosw import skeleton_text
-
-        return dict(
-            frames=self.n_frames, frame_time=self.frame_time, fps=self.fps, threshold=self.threshold,
-            window_s=self.window_s, params=dict(self.params),
-            joints=[self.skeleton.names[j] for j in self.joints], n_swings=self.n_swings,
-            swings=[asdict(s) for s in sorted(self.swings, key=lambda s: (s.joint, s.start))],
-            holds=[asdict(h) for h in sorted(self.holds, key=lambda h: (h.joint, h.start))],
-            translation_keys={str(j): dict(frames=f.tolist(), values=v.tolist())
-                              for j, (f, v) in self.translation_keys.items()},
-            skeleton_bvh=skeleton_text(self.skeleton),
-        )
-
-    @classmethod
-    def from_dict(cls, d: dict) -> Segmentation:
-        """The segmentation in :meth:`to_dict`'s document, every field checked (a damaged one raises
-        :class:`~mocycle.errors.MotionFileError`)."""
-        from ..io.swings_json import segmentation_from_dict
-
-        return segmentation_from_dict(d)
 
 
 # ---------------------------------------------------------------- the paper's steps

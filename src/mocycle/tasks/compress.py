@@ -5,12 +5,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..defaults import KEY_SCHEMES as SCHEME_CHOICES
 from . import fields, keyframe_fields
 from .options import Choice, Real, option
 from .options import Options as _Options
 from .report import Recorder, Report, is_motion, load
 
-SCHEME_CHOICES = ("linear", "hermite", "slerp", "rbf", "spatial")
 LABELS = {
     "frames": ("frames", ""), "keyframes": ("keyframes", ""), "ratio": ("keyframe ratio asked", ""),
     "period_frames": ("rhythm period", "frames"), "keys_per_period": ("keys per period", ""),

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
+from ..defaults import KEY_SELECTIONS as SELECT_CHOICES
+from ..defaults import ONE_STEP_PROJECTIONS as SEED_CHOICES
+from ..defaults import PROJECTIONS as PROJECTION_CHOICES
 from .options import Choice, Flag, Real, option
-
-SELECT_CHOICES = ("uniform", "scs", "pb", "rols")
-PROJECTION_CHOICES = ("pca", "mds", "isomap", "lle", "force", "tsne", "rbfp", "lamp")
-SEED_CHOICES = ("pca", "mds", "isomap", "lle", "force", "tsne")
 
 
 def ratio(help: str = "Keyframes as a fraction of the frames (thesis: 0.03)."):
