@@ -46,8 +46,6 @@ def test_old_names_still_resolve():
         mck.decompress  # noqa: B018
 
 
-@pytest.mark.xfail(strict=True, reason="io/__init__.py write() still names mocycle.swings.segment.Segmentation: "
-                                       "it must name mocycle.segmentation.Segmentation (one line)")
 def test_a_read_segmentation_writes_back_in_a_fresh_process(tmp_path):
     from mocycle import write
     from mocycle.swings import segment

@@ -8,7 +8,7 @@ suffix     holds                                       :func:`read` returns / :f
 ``.bvh``   a motion (:mod:`.bvh`)                      :class:`~mocycle.motion.Motion`
 ``.glb``   a motion as binary glTF (:mod:`.gltf`)      :class:`~mocycle.motion.Motion` (write only)
 ``.amc``   a CMU motion, skeleton in an ``.asf``       :class:`~mocycle.motion.Motion` (read only)
-``.mck``   a keyframe-compressed take (:mod:`.mck`)    :class:`~mocycle.io.mck.Compressed`
+``.mck``   a keyframe-compressed take (:mod:`.mck`)    :class:`~mocycle.keyframes.Compressed`
 ``.mosw``  joint swings, compact (:mod:`.mosw`)        :class:`~mocycle.swings.Segmentation`
 ``.json``  joint swings as JSON records                :class:`~mocycle.swings.Segmentation`
 =========  ==========================================  =======================================
@@ -95,7 +95,7 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: 
     Returns
     -------
     Motion, Compressed or Segmentation
-        A :class:`Motion` for ``.bvh``/``.amc``, a :class:`~mocycle.io.mck.Compressed` take for
+        A :class:`Motion` for ``.bvh``/``.amc``, a :class:`~mocycle.keyframes.Compressed` take for
         ``.mck`` (``.decompress()`` gives the motion), a :class:`~mocycle.swings.Segmentation` for
         ``.mosw`` and swings ``.json`` (``mocycle.swings.playback`` gives the motion).
 
@@ -146,7 +146,7 @@ def write(obj, path: str | os.PathLike, *, clip=None, gltf_scale: float | str = 
 
     Parameters
     ----------
-    obj : a :class:`Motion` (``.bvh`` or ``.glb``), a :class:`~mocycle.io.mck.Compressed` take (``.mck``), a
+    obj : a :class:`Motion` (``.bvh`` or ``.glb``), a :class:`~mocycle.keyframes.Compressed` take (``.mck``), a
         :class:`~mocycle.swings.Segmentation` (``.mosw`` or ``.json``), or any result with a
         ``to_dict()`` (``.json``).
     path : the file to write.
@@ -181,8 +181,8 @@ def write(obj, path: str | os.PathLike, *, clip=None, gltf_scale: float | str = 
     suffix = _suffix(p, WRITE_SUFFIXES, "mocycle writes")
     # the kinds whose modules are loaded (an object of a kind whose module is not loaded cannot exist; so writing
     # a motion does not import the keyframe and swing packages)
-    kinds = {"mocycle.motion.Motion": MOTION_WRITE_SUFFIXES, "mocycle.io.mck.Compressed": (".mck",),
-             "mocycle.swings.segment.Segmentation": (".mosw", ".json")}
+    kinds = {"mocycle.motion.Motion": MOTION_WRITE_SUFFIXES, "mocycle.keyframes.compressed.Compressed": (".mck",),
+             "mocycle.segmentation.Segmentation": (".mosw", ".json")}
     fits = {getattr(sys.modules.get(name.rsplit(".", 1)[0]), name.rsplit(".", 1)[1], None): suffixes
             for name, suffixes in kinds.items()}
     for kind, suffixes in fits.items():
