@@ -16,7 +16,7 @@ BIN    := $(VENV)/bin
 NP1    := .venv-numpy1
 
 .PHONY: demo test test-numpy2 test-numpy1 lint bench clean blender-extension test-blender-zips test-blender \
-	test-blender52 test-blender50 test-blender42 test-blender45 js chromium
+	test-blender52 test-blender51 test-blender50 test-blender42 test-blender45 js chromium
 
 # the glTF tests' JavaScript side (Khronos glTF validator, three.js): tests/js/package-lock.json
 JS := tests/js
@@ -73,20 +73,23 @@ bench: $(VENV)/.installed
 
 # --- Blender extension (docs/blender.md) ------------------------------------------------------------------
 # Headless Blender from PyPI (the bpy module), one venv per Blender: 5.2 LTS (Python 3.13, numpy 2, slotted actions,
-# no action.fcurves) and 4.2 LTS (Python 3.11, numpy 1.26, legacy action.fcurves) run in make test; 5.0 and 4.5 LTS
-# on demand. bpy links to X11/GL client libraries: installed with apt-get when `import bpy` fails (a fresh root
+# no action.fcurves) and 4.2 LTS (Python 3.11, numpy 1.26, legacy action.fcurves) run in make test; 5.1, 5.0 and
+# 4.5 LTS on demand. bpy links to X11/GL client libraries: installed with apt-get when `import bpy` fails (a fresh root
 # CI machine).
 BPY52 := .venv-bpy52
 BPY42 := .venv-bpy42
 BPY_VERSION_52 := 5.2.3
+BPY_VERSION_51 := 5.1.2
 BPY_VERSION_50 := 5.0.1
 BPY_VERSION_45 := 4.5.15
 BPY_VERSION_42 := 4.2.23
 BPY_PYTHON_52 := $(PYTHON313)
+BPY_PYTHON_51 := $(PYTHON313)
 BPY_PYTHON_50 := $(PYTHON)
 BPY_PYTHON_45 := $(PYTHON)
 BPY_PYTHON_42 := $(PYTHON)
 BPY_NUMPY_52 := "numpy>=2.2,<3"
+BPY_NUMPY_51 := "numpy>=2.2,<3"
 BPY_NUMPY_50 := "numpy>=1.26,<2"
 BPY_NUMPY_45 := "numpy>=1.26,<2"
 BPY_NUMPY_42 := "numpy>=1.26,<2"
@@ -122,6 +125,9 @@ BLENDER_TESTS = cd tests_blender && MOCYCLE_BLENDER_ZIP=$(ZIP_LINUX) nice -n 5 .
 test-blender52: .venv-bpy52/.installed blender-extension
 	$(call BLENDER_TESTS,52)
 
+test-blender51: .venv-bpy51/.installed blender-extension
+	$(call BLENDER_TESTS,51)
+
 test-blender50: .venv-bpy50/.installed blender-extension
 	$(call BLENDER_TESTS,50)
 
@@ -132,8 +138,8 @@ test-blender42: .venv-bpy42/.installed blender-extension
 	$(call BLENDER_TESTS,42)
 
 # 5.2 LTS (Python 3.13) and 4.2 LTS (Python 3.11): the first and the last Blender the extension supports, both
-# animation APIs. `make test-blender50` and `make test-blender45` (not part of make test) run the same tests.
+# animation APIs. `make test-blender51`, `test-blender50` and `test-blender45` (not in make test) run the same tests.
 test-blender: test-blender-zips test-blender52 test-blender42
 
 clean:
-	rm -rf $(VENV) $(NP1) $(BPY52) $(BPY42) .venv-bpy50 .venv-bpy45 out .pytest_cache .ruff_cache build dist $(JS)/node_modules
+	rm -rf $(VENV) $(NP1) $(BPY52) $(BPY42) .venv-bpy51 .venv-bpy50 .venv-bpy45 out .pytest_cache .ruff_cache build dist $(JS)/node_modules
