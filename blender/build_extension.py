@@ -42,8 +42,9 @@ PLATFORMS = {
 #: draws diagrams, Cython only builds); numpy comes with Blender
 RESOLVED = ["scipy", "scikit-learn", "threadpoolctl"]
 NO_DEPS = ["ripser"]
-#: the Pythons Blender ships -> the numpy the wheels are resolved against (the oldest one that Blender line has):
-#: 3.11 in Blender 4.2 LTS to 5.0 (numpy 1.26.4), 3.13 in 5.1 and 5.2 LTS (the bpy 5.1+ wheels need numpy>=2.2)
+#: the Pythons Blender ships -> the numpy their wheels are resolved against (so they need no newer one): 3.11 in
+#: Blender 4.2 LTS to 5.0 (which bring numpy 1.26.4), 3.13 in 5.1 and 5.2 LTS (numpy 2; the bpy 5.1+ wheels on
+#: PyPI ask numpy>=2.2, so 2.2.6, the last 2.2)
 PYTHONS = {"3.11": "numpy==1.26.4", "3.13": "numpy==2.2.6"}
 LEFT_OUT = ("numpy-",)
 
