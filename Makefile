@@ -119,9 +119,12 @@ blender-extension: $(BPY52)/.installed
 test-blender-zips: blender-extension
 	MOCYCLE_BLENDER_DIST=$(CURDIR)/dist $(BPY52)/bin/python -m pytest -q -p no:cacheprovider tests/test_blender_zips.py
 
-# the Blender tests install the linux zip built above (MOCYCLE_BLENDER_ZIP) into each Blender
+# the Blender tests install the linux zip built above (MOCYCLE_BLENDER_ZIP) into each Blender; pygltflib (the glTF-out
+# test writes .glb files) is added to a bpy venv made before it was part of the recipe above
 ZIP_LINUX := $(CURDIR)/dist/mocycle-$(VERSION)-linux_x64.zip
-BLENDER_TESTS = cd tests_blender && MOCYCLE_BLENDER_ZIP=$(ZIP_LINUX) nice -n 5 ../.venv-bpy$(1)/bin/python -m pytest -q
+BLENDER_TESTS = .venv-bpy$(1)/bin/python -c "import pygltflib" 2>/dev/null || \
+	.venv-bpy$(1)/bin/python -m pip install --quiet pygltflib; \
+	cd tests_blender && MOCYCLE_BLENDER_ZIP=$(ZIP_LINUX) nice -n 5 ../.venv-bpy$(1)/bin/python -m pytest -q
 
 test-blender52: .venv-bpy52/.installed blender-extension
 	$(call BLENDER_TESTS,52)
