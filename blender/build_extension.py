@@ -2,13 +2,20 @@
 
     python blender/build_extension.py [--platform linux-x64 ...] [--out dist]
 
-Run it with a Python that has the ``bpy`` wheel (``make blender-extension`` uses ``.venv-bpy50``): Blender's
+Run it with a Python that has the ``bpy`` wheel (``make blender-extension`` uses ``.venv-bpy52``): Blender's
 ``extension build`` command lives in the bundled ``addons_core/bl_pkg/cli/blender_ext.py``, which runs
 without the ``blender`` binary. Steps: copy the add-on (``blender/mocycle_blender``) to a staging folder,
-build mocycle itself as a wheel, download the binary wheels of its dependencies for each platform (Python
-3.11, resolved against numpy 1.26.4, the numpy Blender 4.2–5.0 bring, which is left out of the bundle), write
-``blender_manifest.toml`` listing them, and call ``blender_ext.py build --split-platforms``: one zip per
-platform, ``dist/mocycle-<version>-<platform>.zip``.
+build mocycle itself as a wheel, download from PyPI the binary wheels of its dependencies for each platform
+and each Python that Blender ships (3.11 in 4.2-5.0, resolved against numpy 1.26.4; 3.13 in 5.1+, resolved
+against numpy 2.2.6, the oldest numpy the 5.1+ ``bpy`` wheels accept; numpy itself is left out of the
+bundle), write ``blender_manifest.toml`` listing them, and call ``blender_ext.py build --split-platforms``:
+one zip per platform, ``dist/mocycle-<version>-<platform>.zip``, holding the cp311 and the cp313 wheels side
+by side. Blender installs only the wheels that match its own Python and platform, and lists the extension as
+compatible with the Python versions its wheels name (3.11 and 3.13).
+
+Pure-Python dependencies (joblib, threadpoolctl, ...) are pinned to the versions resolved for 3.11 when the
+3.13 wheels are resolved, so the zip holds one version of each (Blender installs the newest of duplicates,
+which could be one that no longer runs on 3.11).
 """
 
 from __future__ import annotations
@@ -35,7 +42,10 @@ PLATFORMS = {
 #: draws diagrams, Cython only builds); numpy comes with Blender
 RESOLVED = ["scipy", "scikit-learn", "threadpoolctl"]
 NO_DEPS = ["ripser"]
-BLENDER_NUMPY = "numpy==1.26.4"
+#: the Pythons Blender ships -> the numpy their wheels are resolved against (so they need no newer one): 3.11 in
+#: Blender 4.2 LTS to 5.0 (which bring numpy 1.26.4), 3.13 in 5.1 and 5.2 LTS (numpy 2; the bpy 5.1+ wheels on
+#: PyPI ask numpy>=2.2, so 2.2.6, the last 2.2)
+PYTHONS = {"3.11": "numpy==1.26.4", "3.13": "numpy==2.2.6"}
 LEFT_OUT = ("numpy-",)
 
 
@@ -43,7 +53,7 @@ def blender_ext() -> Path:
     """Blender's extension command line (``bl_pkg/cli/blender_ext.py``) inside the installed ``bpy`` wheel."""
     spec = importlib.util.find_spec("bpy")
     if spec is None or not spec.submodule_search_locations:
-        sys.exit("error: the bpy module is not installed in this Python (make blender-extension uses .venv-bpy50)")
+        sys.exit("error: the bpy module is not installed in this Python (make blender-extension uses .venv-bpy52)")
     base = Path(list(spec.submodule_search_locations)[0])
     hits = sorted(glob.glob(str(base / "*" / "scripts" / "addons_core" / "bl_pkg" / "cli" / "blender_ext.py")))
     if not hits:
@@ -55,16 +65,42 @@ def pip(*args: str) -> None:
     subprocess.run([sys.executable, "-m", "pip", *args, "--quiet", "--disable-pip-version-check"], check=True)
 
 
+def _pure(wheel: Path) -> bool:
+    return wheel.name.endswith("-none-any.whl")
+
+
+def _pin(wheel: Path) -> str:
+    name, version = wheel.name.split("-")[:2]
+    return f"{name}=={version}"
+
+
 def download(platform: str, cache: Path) -> list[Path]:
-    """The dependency wheels for one Blender platform (cached in ``cache/<platform>``)."""
-    dest = cache / platform
-    dest.mkdir(parents=True, exist_ok=True)
+    """The dependency wheels for one Blender platform, every Python in :data:`PYTHONS` (downloaded afresh into
+    ``cache/<platform>/<python>``, so nothing from an earlier resolution slips in; pip's own HTTP cache makes a
+    second build quick)."""
     tags = [a for t in PLATFORMS[platform] for a in ("--platform", t)]
-    common = ["download", "--only-binary=:all:", "--python-version", "3.11", "--implementation", "cp",
-              "--abi", "cp311", *tags, "-d", str(dest)]
-    pip(*common, *RESOLVED, BLENDER_NUMPY)
-    pip(*common, "--no-deps", *NO_DEPS)
-    return sorted(p for p in dest.glob("*.whl") if not p.name.startswith(LEFT_OUT))
+    found: dict[str, Path] = {}
+    pins: list[str] = []
+    for python, numpy in PYTHONS.items():
+        dest = cache / platform / python
+        shutil.rmtree(dest, ignore_errors=True)
+        dest.mkdir(parents=True)
+        abi = "cp" + python.replace(".", "")
+        common = ["download", "--only-binary=:all:", "--python-version", python, "--implementation", "cp",
+                  "--abi", abi, *tags, "-d", str(dest)]
+        constraints = []
+        if pins:  # the pure-Python wheels resolved for the first Python, for every other
+            pin_file = dest / "pure-pins.txt"
+            pin_file.write_text("\n".join(pins) + "\n")
+            constraints = ["-c", str(pin_file)]
+        pip(*common, *constraints, *RESOLVED, numpy)
+        pip(*common, "--no-deps", *NO_DEPS)
+        wheels = [p for p in dest.glob("*.whl") if not p.name.startswith(LEFT_OUT)]
+        for whl in wheels:
+            found.setdefault(whl.name, whl)
+        if not pins:
+            pins = [_pin(w) for w in wheels if _pure(w)]
+    return sorted(found.values(), key=lambda p: p.name)
 
 
 def manifest(version: str, wheels: list[str], platforms: list[str]) -> str:

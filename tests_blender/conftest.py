@@ -1,9 +1,10 @@
 """Blender test session: build the extension zip, install it as a user extension into a temporary Blender user
 folder, and give each test an empty scene.
 
-Run by ``make test-blender`` in ``.venv-bpy50`` (bpy 5.0.1, slotted actions) and ``.venv-bpy42`` (bpy 4.2 LTS,
-legacy ``action.fcurves``). ``MOCYCLE_BLENDER_ZIP`` names a zip already built (else the linux-x64 one is built
-here with ``blender/build_extension.py``). mocycle and its dependencies come from the installed extension's
+Run by ``make test-blender`` in ``.venv-bpy52`` (bpy 5.2 LTS, Python 3.13, slotted actions) and ``.venv-bpy42``
+(bpy 4.2 LTS, Python 3.11, legacy ``action.fcurves``). ``MOCYCLE_BLENDER_ZIP`` names a zip already built (the
+Makefile passes the one ``make blender-extension`` built; else the linux-x64 one is built here with
+``blender/build_extension.py``). mocycle and its dependencies come from the installed extension's
 wheels, not from the repository: the tests check the bundle too.
 """
 
@@ -49,8 +50,20 @@ def extension(tmp_path_factory):
     seconds = time.perf_counter() - t
     assert result == {"FINISHED"}
     assert hasattr(bpy.ops.mocycle, "extract_cycle")
-    print(f"\nbpy {bpy.app.version_string}: installed {zip_path.name} "
-          f"({zip_path.stat().st_size / 1e6:.1f} MB) in {seconds:.1f} s")
+    # the library and its compiled dependencies come from the wheels Blender picked for its own Python
+    import ripser
+    import scipy
+    import sklearn
+
+    import mocycle
+
+    tag = f"cp{sys.version_info[0]}{sys.version_info[1]}"
+    for module in (mocycle, scipy, sklearn, ripser):
+        assert Path(module.__file__).resolve().is_relative_to(USER.resolve()), (
+            f"{module.__name__} imported from {module.__file__}, not from the installed extension")
+    print(f"\nbpy {bpy.app.version_string} (Python {sys.version.split()[0]}, {tag}): installed {zip_path.name} "
+          f"({zip_path.stat().st_size / 1e6:.1f} MB) in {seconds:.1f} s; scipy {scipy.__version__}, "
+          f"scikit-learn {sklearn.__version__}")
     return zip_path, seconds
 
 
