@@ -37,6 +37,8 @@ from .motion import Motion
 
 #: A step (landing to the other foot's landing) lasts at least / at most this long, seconds.
 MIN_STEP_S, MAX_STEP_S = 0.15, 1.2
+#: A step next to a turning one turns too when its strides turn the same way by more than this many degrees.
+TURN_EDGE_DEG = 7.0
 #: Two consecutive steps of a gait differ in length by at most this factor (a limp stays under it).
 STEP_RATIO = 1.6
 #: The legs of a gait part are like themselves one stride later: unlikeness (repetition distance) under this.
@@ -268,16 +270,29 @@ def _stride_figures(chain, landings, heading, path, fps):
 
 
 def _step_kinds(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
-    """Each step's kind and stride period: step i lies in strides i-1 and i (those that exist)."""
+    """Each step's kind and stride period: step i lies in strides i-1 and i (those that exist).
+
+    A step turns when its strides turn by more than :data:`TURN_DEG` (the core of a turn), or by more than
+    :data:`TURN_EDGE_DEG` the same way next to such steps (a turn's gentle start and end); a straight walk's
+    steps stay under both (on the shared walks 95 % under 6 degrees, all under 11)."""
     n_steps = strides.shape[0] + 1
-    kinds = []
+    turns, periods, gaits = [], [], []
     for i in range(n_steps):
         rows = strides[max(0, i - 1): i + 1]
-        period, turn = rows[:, 0].mean(), rows[:, 1].mean()
-        gait = "run" if rows[:, 2].mean() > RUN_SPEED * body else "walk"
-        way = "straight" if abs(turn) <= TURN_DEG else ("turning left" if turn > 0 else "turning right")
-        kinds.append((f"{gait} {way}", float(period)))
-    return kinds
+        periods.append(float(rows[:, 0].mean()))
+        turns.append(float(rows[:, 1].mean()))
+        gaits.append("run" if rows[:, 2].mean() > RUN_SPEED * body else "walk")
+    way = [0 if abs(t) <= TURN_DEG else int(np.sign(t)) for t in turns]
+    grown = True
+    while grown:  # a turn's edges: neighbours turning the same way by more than TURN_EDGE_DEG
+        grown = False
+        for i in range(n_steps):
+            if way[i] == 0 and abs(turns[i]) > TURN_EDGE_DEG:
+                sign = int(np.sign(turns[i]))
+                if (i > 0 and way[i - 1] == sign) or (i + 1 < n_steps and way[i + 1] == sign):
+                    way[i], grown = sign, True
+    names = {0: "straight", 1: "turning left", -1: "turning right"}
+    return [(f"{g} {names[w]}", p) for g, w, p in zip(gaits, way, periods, strict=True)]
 
 
 def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activities:

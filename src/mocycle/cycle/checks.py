@@ -6,7 +6,8 @@ A cycle is refused (:class:`~mocycle.errors.LoopRefused`, CLI exit 3) when
   hold one whole cycle, so the "cycle" is an extrapolation (a 573-frame take gave
   an 872-frame cycle);
 * **fit** — its template error (thesis eq. 4.4-4.5, the repeated cycle slid along
-  the take's longest excited region) is more than :data:`MAX_FIT_RATIO` times that
+  the take's longest excited region) is more than :data:`MAX_FIT_RATIO` times (widened for few periods,
+  :func:`fit_limit`) that
   of the best *plain cut*: frames ``a .. a+lag`` of the take itself, with ``lag``
   near the found period or near the take's own autocorrelation period
   (:func:`best_cut_error`).  A cut copies the take, so a fitted cycle that fits
@@ -145,6 +146,15 @@ def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = 
     return best
 
 
+def fit_limit(frames: int, period: float) -> float:
+    """The largest template error of a cycle over the best plain cut's on ``frames`` frames of a ``period``:
+    :data:`MAX_FIT_RATIO`, widened by ``sqrt(n / (n - 1))`` for ``n`` periods (at least 2): the cut copies one
+    period of the take exactly, its error comes from the other ``n - 1`` only, while a typical cycle errs on all
+    ``n`` (on a part of 2 periods the cut copies half of it: limit 2.83; 10 periods: 2.11)."""
+    n = max(2.0, frames / period) if np.isfinite(period) and period > 0 else 2.0
+    return MAX_FIT_RATIO * float(np.sqrt(n / (n - 1.0)))
+
+
 def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> list[FailedCheck]:
     """The checks of the module docstring that ``cycle`` (extracted from ``motion``) fails; empty when it is
     a loop.  ``metrics``: :func:`~mocycle.cycle.loop_metrics` of the pair if already computed (saves time)."""
@@ -168,14 +178,15 @@ def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> li
     cut, cut_period = best_cut_error(motion, cycle, features=Y)
     spread = Y.spread()
     del Y
-    if np.isfinite(cut) and not tmpl <= max(MAX_FIT_RATIO * cut, FIT_FLOOR * spread):
+    limit = fit_limit(e - s, cycle.period_frames)
+    if np.isfinite(cut) and not tmpl <= max(limit * cut, FIT_FLOOR * spread):
         why = (f"the period found ({cycle.period_frames:.1f} frames) is probably wrong"
                if abs(cut_period / cycle.period_frames - 1) > PERIOD_AGREES else
                "the take's cycles differ too much for one typical cycle (a cut copies one of them)")
         failed.append(FailedCheck(
-            "fit", float(tmpl / cut), MAX_FIT_RATIO,
+            "fit", float(tmpl / cut), limit,
             f"the cycle fits the take {tmpl / cut:.2f} times worse than a plain cut of {cut_period:.0f} frames "
-            f"(template error {tmpl:.3g} against {cut:.3g} rad; limit {MAX_FIT_RATIO:g}×): {why}"))
+            f"(template error {tmpl:.3g} against {cut:.3g} rad; limit {limit:.3g}×): {why}"))
     if not seam <= MAX_SEAM:
         failed.append(FailedCheck(
             "seam", float(seam), MAX_SEAM,

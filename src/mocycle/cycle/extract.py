@@ -332,10 +332,10 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     if model != "M2" and sum(e - s - 2 * HALF for s, e in _derivative_regions(axis)) < max(2 * K, 1):
         raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the excited "
                            f"regions are too short: use --model M2 or fewer harmonics")
-    # On a part of under SHORT_PERIODS periods a linear term fitted beside the harmonics trades off against
-    # them (a turn that speeds up and slows down came out 40 % too fast): there the drift per period is the
-    # path's change between its ends, and the harmonics fit what is left.
-    drift = end_drift(L, axis) if axis.n_periods < SHORT_PERIODS else None
+    # On a part of under SHORT_PERIODS periods a linear term fitted beside all the harmonics trades off against
+    # them (a turn that speeds up and slows down came out 40 % too fast): there the drift per period is fitted
+    # with few harmonics (short_drift), and the harmonics fit what is left.
+    drift = short_drift(L, axis) if axis.n_periods < SHORT_PERIODS else None
     if drift is not None:
         L = L - np.outer(np.nan_to_num(axis.x), drift)
     linear = drift is None
@@ -376,21 +376,29 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     return cycle
 
 
-#: Fewer periods than this: the path's drift is measured between its ends, not fitted (:func:`end_drift`).
+#: Fewer periods than this: the path's drift is fitted with few harmonics (:func:`short_drift`).
 SHORT_PERIODS = 3.0
+#: ... this many: the sway of a stride (a hip's swing, a step's sideways shift) and its first overtone.
+DRIFT_HARMONICS = 2
 
 
-def end_drift(L: np.ndarray, axis: TimeAxis) -> np.ndarray:
-    """``(D,)`` change per period of the curves ``L (T, D)`` along ``axis`` between the ends of its longest
-    region: the means of the first and last tenth of a period (at least a frame) against their times."""
+def short_drift(L: np.ndarray, axis: TimeAxis, n_harmonics: int = DRIFT_HARMONICS) -> np.ndarray:
+    """``(D,)`` change per period of the curves ``L (T, D)`` along ``axis`` on a part of few periods: the
+    linear term of a least-squares fit of a line and ``n_harmonics`` harmonics on the longest region.
+
+    With the cycle's full set of harmonics beside it, a linear term on 1-3 periods trades off against them
+    (a turn that speeds up and slows down came out 40 % too fast); a line alone follows the sway of the
+    stride at the part's ends.  A stride's sway lives in its first harmonics, so those are fitted with it."""
     s, e = max(axis.regions, key=lambda r: r[1] - r[0])
-    h = max(1, int(round(0.1 * axis.period_frames)))
-    h = min(h, max(1, (e - s) // 4))
-    L = np.asarray(L, dtype=np.float64)
-    dx = float(axis.x[e - h:e].mean() - axis.x[s:s + h].mean())
-    if not dx > 0:
-        return np.zeros(L.shape[1])
-    return (L[e - h:e].mean(axis=0) - L[s:s + h].mean(axis=0)) / dx
+    x = axis.x[s:e]
+    cols = [np.ones_like(x), x]
+    for k in range(1, n_harmonics + 1):
+        cols += [np.cos(2 * np.pi * k * x), np.sin(2 * np.pi * k * x)]
+    B = np.column_stack(cols)
+    if B.shape[0] <= B.shape[1]:
+        B = B[:, :2]
+    coef, *_ = np.linalg.lstsq(B, np.asarray(L[s:e], dtype=np.float64), rcond=None)
+    return coef[1]
 
 
 # ------------------------------------------------------------------ centroid

@@ -417,8 +417,9 @@ def _activity_checks(motion, cycle, part, offset) -> list:
                     "stride", float(abs(off)), STRIDE_AGREEMENT,
                     f"the cycle ({cycle.period_frames:.1f} frames) is {abs(off):.0%} off the strides (each foot "
                     f"lands every {stride:.1f} frames here)"))
-    heading = heading_degrees(motion)
-    take_turn = float(heading[e - 1] - heading[s]) / max(e - 1 - s, 1) * cycle.period_frames
+    heading = heading_degrees(motion)[s:e]  # the hips' heading: a line through it, as a ruler would
+    t = np.arange(heading.size, dtype=np.float64)
+    take_turn = float(np.polyfit(t, heading, 1)[0]) * cycle.period_frames if heading.size > 2 else 0.0
     loop_turn = float(cycle.to_dict()["turn_per_cycle_deg"])
     slack = max(TURN_SLACK_DEG, TURN_SLACK_SHARE * abs(take_turn))
     if abs(loop_turn - take_turn) > slack:
