@@ -99,3 +99,21 @@ def test_walk_then_wave_and_gesture(ruler):
     assert body.arms_period(a, b) == pytest.approx(36.0, rel=0.03)
     gesture = synthetic_gesture(240, 60, noise_deg=0.5, seed=0)
     assert ruler.Body.of(gesture.motion).stride_period(0, 240)[1] == "legs standing"
+
+
+def test_reads_both_json_shapes(ruler):
+    new = {"status": "ok", "reason": "", "loops": [
+        {"frames": [120, 250], "kind": "walk turning left", "period_frames": 33.0, "turn_per_cycle_deg": 30.0,
+         "output": "x.turning_left.bvh"}],
+        "not_looped": [{"frames": [0, 120], "kind": "walk", "reason": "too short"}]}
+    loops, not_looped, status, _ = ruler.read_loops(new, True)
+    assert status == "ok" and not_looped[0]["kind"] == "walk"
+    assert loops == [{"frames": (120, 250), "kind": "walk turning left", "period": 33.0, "turn": 30.0,
+                      "output": "x.turning_left.bvh", "cycle_frames": None}]
+    old = {"file": "f.bvh", "loops": [{"class": 1, "excitation": [[5, 90], [120, 300]], "period_frames": 60.0,
+                                       "turn_per_cycle_deg": 1.0, "output": "o.class1.bvh", "cycle_frames": 60}]}
+    loops, _, status, _ = ruler.read_loops(old, False)
+    assert status == "ok" and loops[0]["frames"] == (5, 300) and loops[0]["kind"] == "class 1"
+    flat = {"file": "f.bvh", "output": "o.bvh", "period_frames": 30.0, "excitation": [[0, 100]]}
+    assert ruler.read_loops(flat, False)[0][0]["frames"] == (0, 100)
+    assert ruler.read_loops(None, True) == ([], [], "", "")
