@@ -67,6 +67,10 @@ def test_heading_turn_rate_and_turn_per_cycle(ruler, turn, strides):
     truth = np.polyfit(np.arange(b, c) / fps, take.heading_deg[b:c], 1)[0]
     assert body.turn_rate(b, c) == pytest.approx(truth, rel=0.1)
     assert abs(body.turn_rate(0, b)) < 1.0 and abs(body.turn_rate(c, take.n_frames)) < 1.0
+    # the turn over a cycle inside a range: the truth's one-cycle heading change, pelvis swing cancelled
+    for lo, hi in ((b - 30, c + 30), (0, b), (b + 10, b + 80)):
+        want = np.mean(take.heading_deg[lo + 60:hi] - take.heading_deg[lo:hi - 60])
+        assert body.turn_over(lo, hi, 60) == pytest.approx(want, abs=1.5)
     # the whole take mixes a straight and a turning part for the windows of one stride (90 deg only:
     # 45 deg in 3 strides turns 17 deg/s, under the 20 deg/s the ruler calls turning)
     w = body.window_rates(0, take.n_frames, period_s * fps)
