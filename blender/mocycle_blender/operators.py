@@ -150,8 +150,11 @@ def _extract_cycle(self, context, arm):
     f = report.facts
     skate = f["feet"]["skate_after"] if f["feet"].get("skate_after") is not None else f["metrics"]["skate"]
     self._warnings = report.warnings
-    message = (f"{new.name}: period {f['period_frames']:.1f} frames, {f['cycle_frames']} frames a cycle × "
-               f"{options.cycles}, seam {f['metrics']['seam_pose']:.2f}× median step, foot skate {skate:.3g}")
+    a, b = f["frames"]
+    part = "" if f.get("part") is None else f" ({f['kind']}, frames {a + first}-{b + first - 1})"
+    message = (f"{new.name}{part}: period {f['period_frames']:.1f} frames, {f['cycle_frames']} frames a cycle × "
+               f"{options.cycles}, seam {f['metrics']['seam_pose']:.2f}× median step, foot skate {skate:.3g}"
+               f"; {f['reason']}")
     _record(context, "extract_cycle", new, f["period_frames"], f["metrics"]["seam_pose"], skate, message)
     return message
 
