@@ -354,10 +354,19 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activitie
                                            f"most alike {p.period_frames:.2f} frames apart")
             elif p.loop:
                 x, period = stride_phase(p, landings.frames, landings.foot, p.start, p.stop)
-                p.periodic = line_periodic(x, period, motion.frame_time, "strides", "legs",
-                                           f"the strides: landings of each foot {period:.2f} frames apart "
-                                           f"(a line through {sum(map(len, p.landings.values()))} landings)")
-                p.period_frames = period
+                legs, why = legs_check(motion, p.start, p.stop, period)
+                n = sum(map(len, p.landings.values()))
+                if np.isfinite(legs):  # a landing seen early or late: the legs' own repeat decides the period
+                    x = (x - x[0]) * period / legs + x[0]
+                    p.periodic = line_periodic(x, legs, motion.frame_time, "legs self-similarity", "legs",
+                                               f"the legs' self-similarity: {why} (the {n} landings said "
+                                               f"{period:.2f})")
+                    p.period_frames = legs
+                else:
+                    p.periodic = line_periodic(x, period, motion.frame_time, "strides", "legs",
+                                               f"the strides: landings of each foot {period:.2f} frames apart "
+                                               f"(a line through {n} landings; {why})")
+                    p.period_frames = period
             else:
                 p.reason = (f"{p.kind} for only {p.n_periods:.1f} stride(s): too short for a loop "
                             f"(at least {min_periods:g} wanted)")
@@ -450,6 +459,37 @@ def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
     return _unlike(X, lag) < (UNLIKE if overlap >= lag else UNLIKE_ONE_STEP)
 
 
+#: The legs' self-similar period overrules the landings' when it is this far off and at least twice as alike.
+LEGS_OVERRULE = 0.05
+
+
+def legs_check(motion: Motion, start: int, stop: int, period: float) -> tuple[float, str]:
+    """The landings' ``period`` checked by the legs over frames ``start .. stop-1``: ``(NaN, why)`` when the
+    legs agree (or cannot tell), ``(their period, why)`` when they are most alike more than
+    :data:`LEGS_OVERRULE` away from it and at least twice as alike there (a landing detected early or late)."""
+    legs, unlike = short_period(motion, period, start, stop)
+    at = legs_repeat(motion, start, stop, period)
+    if not np.isfinite(legs) or abs(legs / period - 1) <= LEGS_OVERRULE:
+        return float("nan"), (f"the legs agree ({legs:.2f} frames)" if np.isfinite(legs) else
+                              "the legs cannot tell")
+    if not (np.isfinite(at) and unlike < 0.5 * at):
+        return float("nan"), f"the legs' {legs:.2f} frames are not clearly better"
+    return float(legs), (f"the legs are most alike {legs:.2f} frames apart (unlikeness {unlike:.2f} against "
+                         f"{at:.2f} at the landings' {period:.2f})")
+
+
+def stride_reference(motion: Motion, landings: Landings, start: int, stop: int) -> tuple[float, int]:
+    """The stride period over frames ``start .. stop`` that a loop is checked against: the median stride of the
+    landings there, or the legs' own when they overrule it (:func:`legs_check`); and the number of strides
+    measured (0: NaN, no ruler)."""
+    strides = stride_periods(landings, motion.fps, start, stop)
+    if not strides:
+        return float("nan"), 0
+    median = float(np.median(strides))
+    legs, _ = legs_check(motion, start, stop, median)
+    return (legs if np.isfinite(legs) else median), len(strides)
+
+
 def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[float, float]:
     """The period (frames) of the legs over frames ``start .. stop-1`` of little more than a cycle: the lag within
     ``[0.75, 1.33]`` of ``guess`` at which the legs' rotations are most like themselves
@@ -524,6 +564,10 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
         return [Activity(start=start, stop=stop, kind="standing", limbs="none",
                          reason="the actor stands: nothing moves enough to loop")]
     found = _periodic_in(piece, spread, min_periods)
+    if found is not None:  # what repeats must move: noise while the actor stands still after a gesture does not
+        a, b = found[3]
+        if float(_rotation_spread(piece[a:b]).max()) < STILL_DEG:
+            found = None
     still = _legs_still(piece.skeleton, spread)
     if found is None:
         return [Activity(start=start, stop=stop, kind="gesture", limbs="none", legs_still=still,
@@ -643,8 +687,8 @@ def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float):
             pm = max(agree, key=lambda c: len(c.frames()))
             a, b = pm.excitation[0][0], pm.excitation[-1][1]
             return limbs, kind, _rebased(pm, a, b), (s + a, s + b)
-        if not np.isfinite(acf):
-            continue
+        if not np.isfinite(acf) or joints is None:
+            continue  # the whole body needs the cohomology's word; an arm that swings on its own, the autocorrelation's
         x = np.arange(e - s, dtype=np.float64) / acf
         why = (f"the autocorrelation of the {'moving arm joints' if joints else 'body'}' velocities: "
                f"{acf:.2f} frames" + (f" (the cohomology's {', '.join(f'{c.period_frames:.2f}' for c in classes)} "

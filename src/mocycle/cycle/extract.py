@@ -383,22 +383,25 @@ DRIFT_HARMONICS = 2
 
 
 def short_drift(L: np.ndarray, axis: TimeAxis, n_harmonics: int = DRIFT_HARMONICS) -> np.ndarray:
-    """``(D,)`` change per period of the curves ``L (T, D)`` along ``axis`` on a part of few periods: the
-    linear term of a least-squares fit of a line and ``n_harmonics`` harmonics on the longest region.
+    """``(D,)`` change per period of the curves ``L (T, D)`` along ``axis`` on a part of few periods: their
+    change between the ends of the longest region over the periods between, once the stride's sway (a line
+    and ``n_harmonics`` harmonics fitted by least squares; only the harmonics are taken out) is removed.
 
     With the cycle's full set of harmonics beside it, a linear term on 1-3 periods trades off against them
-    (a turn that speeds up and slows down came out 40 % too fast); a line alone follows the sway of the
-    stride at the part's ends.  A stride's sway lives in its first harmonics, so those are fitted with it."""
+    (a turn that speeds up and slows down came out 40 % too fast); a line through a turn that starts and
+    ends gently is steeper than the turn made over the part; the bare ends carry the sway of the stride.
+    So: the ends (a tenth of a period each), less the sway."""
     s, e = max(axis.regions, key=lambda r: r[1] - r[0])
     x = axis.x[s:e]
-    cols = [np.ones_like(x), x]
-    for k in range(1, n_harmonics + 1):
-        cols += [np.cos(2 * np.pi * k * x), np.sin(2 * np.pi * k * x)]
-    B = np.column_stack(cols)
-    if B.shape[0] <= B.shape[1]:
-        B = B[:, :2]
-    coef, *_ = np.linalg.lstsq(B, np.asarray(L[s:e], dtype=np.float64), rcond=None)
-    return coef[1]
+    Y = np.asarray(L[s:e], dtype=np.float64)
+    waves = [f(2 * np.pi * k * x) for k in range(1, n_harmonics + 1) for f in (np.cos, np.sin)]
+    B = np.column_stack([np.ones_like(x), x, *waves])
+    if B.shape[0] > B.shape[1]:
+        coef, *_ = np.linalg.lstsq(B, Y, rcond=None)
+        Y = Y - B[:, 2:] @ coef[2:]
+    h = min(max(1, int(round(0.1 * axis.period_frames))), max(1, x.size // 4))
+    dx = float(x[-h:].mean() - x[:h].mean())
+    return (Y[-h:].mean(axis=0) - Y[:h].mean(axis=0)) / dx if dx > 0 else np.zeros(Y.shape[1])
 
 
 # ------------------------------------------------------------------ centroid

@@ -398,29 +398,34 @@ def _activity_checks(motion, cycle, part, offset) -> list:
     there (the hips' heading)."""
     import numpy as np
 
-    from ..activities import find_landings, heading_degrees, stride_periods
+    from ..activities import find_landings, heading_degrees, stride_reference
     from ..cycle.checks import FailedCheck
 
     failed = []
     s, e = cycle.axis.regions[0][0], cycle.axis.regions[-1][1]
     landings = find_landings(motion)
     if landings is not None:
-        strides = stride_periods(landings, motion.fps, s, e)
+        stride, count = stride_reference(motion, landings, s, e)
         # one stride measured from contacts that come and go (a gliding foot) is no ruler; a gait part's
         # strides are (its phase was made from them)
-        enough = len(strides) >= 2 if part is None or not part.gait else bool(strides)
+        enough = count >= 2 if part is None or not part.gait else count >= 1
         if enough and (part is None or part.gait):
-            stride = float(np.median(strides))
             off = cycle.period_frames / stride - 1.0
             if abs(off) > STRIDE_AGREEMENT:
                 failed.append(FailedCheck(
                     "stride", float(abs(off)), STRIDE_AGREEMENT,
                     f"the cycle ({cycle.period_frames:.1f} frames) is {abs(off):.0%} off the strides (each foot "
-                    f"lands every {stride:.1f} frames here)"))
-    heading = heading_degrees(motion)[s:e]  # the hips' heading: a line through it, as a ruler would
+                    f"lands every {stride:.1f} frames here, the legs repeating)"))
+    # the hips' heading over the frames looped, read two ways a ruler might: a line through it, and its change
+    # between the ends (a tenth of a period each) over the periods between; the loop must agree with one
+    heading = heading_degrees(motion)[s:e]
+    P = cycle.period_frames
     t = np.arange(heading.size, dtype=np.float64)
-    take_turn = float(np.polyfit(t, heading, 1)[0]) * cycle.period_frames if heading.size > 2 else 0.0
+    h = min(max(1, int(round(0.1 * P))), max(1, heading.size // 4))
+    line = float(np.polyfit(t, heading, 1)[0]) * P if heading.size > 2 else 0.0
+    ends = float(heading[-h:].mean() - heading[:h].mean()) / max(heading.size - h, 1) * P
     loop_turn = float(cycle.to_dict()["turn_per_cycle_deg"])
+    take_turn = min((line, ends), key=lambda v: abs(loop_turn - v))
     slack = max(TURN_SLACK_DEG, TURN_SLACK_SHARE * abs(take_turn))
     if abs(loop_turn - take_turn) > slack:
         failed.append(FailedCheck(
