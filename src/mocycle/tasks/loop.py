@@ -113,7 +113,6 @@ def run(take, options: Options | None = None) -> Report:
     instead); both carry ``facts`` with the same shape (``status`` ``no-periodic-motion`` or ``refused``).
     """
     from ..activities import segment_activities
-    from ..cycle import cycle_phase
 
     o = options or Options()
     everything = o.which == "all"
@@ -126,44 +125,11 @@ def run(take, options: Options | None = None) -> Report:
             acts = segment_activities(motion, min_periods=o.min_periods) if o.joints is None and o.step == 1 \
                 else None
         parts = acts.parts if acts is not None else []
-        loopable = [k for k, p in enumerate(parts) if p.loop]
         plan = _plan(acts)
         whole = plan != "parts"
         if isinstance(o.which, int) and not whole and o.which >= len(parts):
             raise OptionError("which", f"the take has {len(parts)} part(s) (0 to {len(parts) - 1}); got {o.which}")
-        jobs = []  # (part index or None, motion to loop, offset, PhaseResult, class index or None, Activity or None)
-        if whole:
-            part = parts[loopable[0]] if plan == "single" else None
-            with rec.part("cycle"):
-                try:
-                    phase = cycle_phase(motion, phase_step=o.step, joints=o.joints, classes=o.classes, pca=o.pca,
-                                        delay=o.delay, min_periods=o.min_periods)
-                except NoPeriodicMotion as exc:
-                    if part is None:
-                        raise _no_loop(exc, acts, start) from None
-                    phase = None  # a take of little more than a stride: its strides' phase decides
-            if part is not None and (phase is None or not phase.classes):
-                jobs.append((loopable[0], motion[part.start:part.stop], part.start, _part_phase(part), None, part))
-            elif part is not None and not isinstance(o.which, int) and _off_strides(phase, part):
-                # the cohomology's period disagrees with the landings: the part's stride phase decides
-                jobs.append((loopable[0], motion[part.start:part.stop], part.start, _part_phase(part, phase), None,
-                             part))
-            elif part is not None:
-                jobs.append((loopable[0], motion, 0, phase, o.which if isinstance(o.which, int) else None, part))
-            else:
-                ks = list(range(len(phase.classes))) or [None] if everything else \
-                    [o.which if isinstance(o.which, int) else None]
-                jobs.extend((None, motion, 0, phase, k, None) for k in ks)
-        else:
-            if isinstance(o.which, int):
-                chosen = [o.which] if parts[o.which].loop else []
-            else:
-                # all: in frame order; by default the part with the most cycles first, the next ones only if it
-                # is refused
-                chosen = loopable if everything else sorted(loopable, key=lambda k: -parts[k].n_periods)
-            for k in chosen:
-                p = parts[k]
-                jobs.append((k, motion[p.start:p.stop], p.start, _part_phase(p), None, p))
+        jobs = _jobs(motion, acts, plan, o, rec, start)
         loops, not_looped, motions, cycles, extras, refusals = [], [], {}, [], {}, []
         for index, piece, offset, phase, k, part in jobs:
             try:
@@ -232,6 +198,50 @@ def _role(index, k, everything) -> str:
     if not everything:
         return "loop"
     return f"loop.part{index}" if index is not None else f"loop.class{k or 0}"
+
+
+def _jobs(motion, acts, plan: str, o: Options, rec, start: int) -> list[tuple]:
+    """What to loop, in order: ``(part index or None, motion to loop, its first frame in the take, PhaseResult,
+    class index or None, Activity or None)`` for each try (``plan``: :func:`_plan`)."""
+    from ..cycle import cycle_phase
+
+    parts = acts.parts if acts is not None else []
+    loopable = [k for k, p in enumerate(parts) if p.loop]
+    everything = o.which == "all"
+    jobs = []
+    if plan != "parts":
+        part = parts[loopable[0]] if plan == "single" else None
+        with rec.part("cycle"):
+            try:
+                phase = cycle_phase(motion, phase_step=o.step, joints=o.joints, classes=o.classes, pca=o.pca,
+                                    delay=o.delay, min_periods=o.min_periods)
+            except NoPeriodicMotion as exc:
+                if part is None:
+                    raise _no_loop(exc, acts, start) from None
+                phase = None  # a take of little more than a stride: its strides' phase decides
+        if part is not None and (phase is None or not phase.classes):
+            jobs.append((loopable[0], motion[part.start:part.stop], part.start, _part_phase(part), None, part))
+        elif part is not None and not isinstance(o.which, int) and _off_strides(phase, part):
+            # the cohomology's period disagrees with the landings: the part's stride phase decides
+            jobs.append((loopable[0], motion[part.start:part.stop], part.start, _part_phase(part, phase), None,
+                         part))
+        elif part is not None:
+            jobs.append((loopable[0], motion, 0, phase, o.which if isinstance(o.which, int) else None, part))
+        else:
+            ks = list(range(len(phase.classes))) or [None] if everything else \
+                [o.which if isinstance(o.which, int) else None]
+            jobs.extend((None, motion, 0, phase, k, None) for k in ks)
+    else:
+        if isinstance(o.which, int):
+            chosen = [o.which] if parts[o.which].loop else []
+        else:
+            # all: in frame order; by default the part with the most cycles first, the next ones only if it
+            # is refused
+            chosen = loopable if everything else sorted(loopable, key=lambda k: -parts[k].n_periods)
+        for k in chosen:
+            p = parts[k]
+            jobs.append((k, motion[p.start:p.stop], p.start, _part_phase(p), None, p))
+    return jobs
 
 
 def _plan(acts) -> str:
