@@ -142,7 +142,7 @@ def test_extract_cycle_options_reach_the_task(walk):
     assert set(f["joints_used"].split(",")) == {pb.name for pb in legs}
     assert f["feet"]["mode"] == "lock"
     # the cycle is now the active action: one period, too short to find a cycle in, so it is refused
-    with pytest.raises(RuntimeError, match="no periodic motion"):
+    with pytest.raises(RuntimeError, match="no periodic motion|no repeating motion|repeats long enough"):
         bpy.ops.mocycle.extract_cycle()
     walk.animation_data.action = bpy.data.actions["Walk"]
     assert bpy.ops.mocycle.extract_cycle(method="centroid") == {"FINISHED"}
@@ -155,6 +155,22 @@ def test_which_periodic_motion_from_the_list(walk):
     assert facts(walk.animation_data.action)["class"] == 0
     with pytest.raises((RuntimeError, TypeError), match="which|class|periodic"):
         bpy.ops.mocycle.extract_cycle(which=7)
+
+
+def test_extract_cycle_lists_the_parts_and_loops_the_one_picked(scene, tmp_path):
+    """A walk that turns mid-take (issue 28): the panel lists its parts; the part picked is the one looped."""
+    from mocycle.datasets import synthetic_walk_turn_walk
+
+    arm = import_bvh(write_take(tmp_path, "Turn", synthetic_walk_turn_walk, turn_deg=90.0, seed=4))
+    assert bpy.ops.mocycle.extract_cycle() == {"FINISHED"}
+    st = bpy.context.scene.mocycle
+    kinds = [p.kind for p in st.parts]
+    assert kinds == ["walk straight", "walk turning left", "walk straight"] and all(p.loops for p in st.parts)
+    assert "(walk" in st.last_message and "the steady part with the most cycles" in st.last_message
+    arm.animation_data.action = bpy.data.actions["Turn"]
+    assert bpy.ops.mocycle.extract_cycle(which=1, root="motion") == {"FINISHED"}
+    f = facts(arm.animation_data.action)
+    assert f["part"] == 1 and f["kind"] == "walk turning left" and f["turn_per_cycle_deg"] > 20
 
 
 def test_blend_cycles(walk, run_action):
@@ -187,7 +203,7 @@ def test_no_periodic_motion_is_refused(scene, tmp_path):
 
     arm = import_bvh(write_take(tmp_path, "Wander", synthetic_nonperiodic, n_frames=240))
     before = set(bpy.data.actions.keys())
-    with pytest.raises(RuntimeError, match="(?i)periodic"):
+    with pytest.raises(RuntimeError, match="(?i)periodic|repeat"):
         bpy.ops.mocycle.extract_cycle()
     assert set(bpy.data.actions.keys()) == before and arm.animation_data.action.name == "Wander"
 

@@ -68,6 +68,21 @@ def _record(context, task: str, action, period=-1.0, seam=-1.0, skate=-1.0, mess
     st.last_period, st.last_seam, st.last_skate, st.last_message = period, seam, skate, message
 
 
+def _keep_parts(context, parts: list[dict], first: int) -> None:
+    """The action's steady parts (``tasks.loop`` facts) in the panel's list, in the action's frame numbers."""
+    st = _state(context)
+    picked = st.part_index
+    st.parts.clear()
+    for p in parts:
+        item = st.parts.add()
+        a, b = p["frames"]
+        item.kind, item.frames, item.loops = p["kind"], f"{a + first}-{b + first - 1}", p["loop"]
+        item.period_frames = p["period_frames"] or 0.0
+        item.n_periods = p["n_periods"] or 0.0
+        item.reason = p["reason"] or ""
+    st.part_index = picked if 0 <= picked < len(st.parts) else -1
+
+
 def _keep_facts(action, report) -> None:
     action["mocycle"] = json.dumps({"task": report.task, **report.facts}, default=str)
 
@@ -142,6 +157,7 @@ def _extract_cycle(self, context, arm):
     options = props.options_from(tasks.loop.Options, self, frame_range=window, joints=_joints(self, arm),
                                  which=None if self.which < 0 else self.which)
     report = tasks.loop.run(motion, options)
+    _keep_parts(context, report.facts["parts"], first)
     cycle, loop = report.result, report.motions["loop"]
     new = rig.write_action(arm, loop, f"{action.name}_cycle", first, wrap=_wrap(cycle, options.cycles, options.root),
                            travel=options.root == "motion")

@@ -20,6 +20,12 @@ class MOCYCLE_UL_periodic(bpy.types.UIList):
                           f"  [{item.excitation}]")
 
 
+class MOCYCLE_UL_parts(bpy.types.UIList):
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
+        what = f"{item.n_periods:.1f} × {item.period_frames:.1f} fr" if item.loops else item.reason
+        layout.label(text=f"{index}: {item.kind} [{item.frames}]  {what}", icon="CHECKMARK" if item.loops else "BLANK1")
+
+
 def _options(layout, group, options_cls, advanced: bool):
     for name in props.option_names(options_cls):
         if (name in ADVANCED) == advanced:
@@ -32,6 +38,8 @@ def _button(layout, idname, text, group, options_cls, st, extra=()):
     for k in extra:
         if k == "which":
             op.which = st.periodic_index if 0 <= st.periodic_index < len(st.periodic) else -1
+        elif k == "part":  # Extract Cycle's which is a part of the action (the list its last run filled)
+            op.which = st.part_index if 0 <= st.part_index < len(st.parts) else -1
         elif k == "other":
             op.other = st.other_action.name if st.other_action else ""
         else:
@@ -76,7 +84,9 @@ class MOCYCLE_PT_panel(bpy.types.Panel):
         box = layout.box()
         box.label(text="Cycle")
         _options(box, st.loop, tasks.loop.Options, advanced=False)
-        _button(box, "mocycle.extract_cycle", "Extract Cycle", st.loop, tasks.loop.Options, st, common + ("which",))
+        _button(box, "mocycle.extract_cycle", "Extract Cycle", st.loop, tasks.loop.Options, st, common + ("part",))
+        if len(st.parts):  # the steady parts the last Extract Cycle found: pick one, Extract Cycle loops it
+            box.template_list("MOCYCLE_UL_parts", "", st, "parts", st, "part_index", rows=3)
 
         box = layout.box()
         box.label(text="Blend / Transition")
@@ -126,4 +136,4 @@ class MOCYCLE_PT_advanced(bpy.types.Panel):
             _options(box, group, cls, advanced=True)
 
 
-CLASSES = (MOCYCLE_UL_periodic, MOCYCLE_PT_panel, MOCYCLE_PT_advanced)
+CLASSES = (MOCYCLE_UL_periodic, MOCYCLE_UL_parts, MOCYCLE_PT_panel, MOCYCLE_PT_advanced)

@@ -108,6 +108,17 @@ class MOCYCLE_PG_periodic(bpy.types.PropertyGroup):
     excitation: StringProperty(name="Excitation (frames)")
 
 
+class MOCYCLE_PG_part(bpy.types.PropertyGroup):
+    """One steady part of the action that Extract Cycle found (walk straight, turning, run, arms, ...)."""
+
+    kind: StringProperty(name="Kind")
+    frames: StringProperty(name="Frames")
+    period_frames: FloatProperty(name="Period (frames)")
+    n_periods: FloatProperty(name="Cycles")
+    loops: BoolProperty(name="Loops")
+    reason: StringProperty(name="Why not looped")
+
+
 #: the panel's settings and the last result, on the scene (saved and undone with it)
 MOCYCLE_PG_state = type("MOCYCLE_PG_state", (bpy.types.PropertyGroup,), {"__annotations__": {
     "phase": PointerProperty(type=PhaseSettings),
@@ -121,6 +132,8 @@ MOCYCLE_PG_state = type("MOCYCLE_PG_state", (bpy.types.PropertyGroup,), {"__anno
     "other_weight": FloatProperty(name="Weight of the other", default=0.5, min=0.0, max=1.0),
     "periodic": CollectionProperty(type=MOCYCLE_PG_periodic),
     "periodic_index": IntProperty(name="Periodic motion", default=-1),
+    "parts": CollectionProperty(type=MOCYCLE_PG_part),
+    "part_index": IntProperty(name="Part", default=-1),
     "last_task": StringProperty(),
     "last_action": StringProperty(),
     "last_period": FloatProperty(default=-1.0),
@@ -131,4 +144,4 @@ MOCYCLE_PG_state = type("MOCYCLE_PG_state", (bpy.types.PropertyGroup,), {"__anno
 
 
 CLASSES = (PhaseSettings, LoopSettings, BlendSettings, TransitionSettings, StretchSettings, MOCYCLE_PG_periodic,
-           MOCYCLE_PG_state)
+           MOCYCLE_PG_part, MOCYCLE_PG_state)
