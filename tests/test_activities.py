@@ -65,7 +65,8 @@ def test_a_walk_that_turns_mid_take_gives_a_straight_a_turning_and_a_straight_lo
         written = read(loop["output"])
         assert written.n_frames == loop["cycles"] * loop["cycle_frames"]
     turning = facts["loops"][1]
-    assert _overlap(turning["frames"], (b, c)) >= 0.75 * (c - b)
+    a0, b0 = turning["frames"]  # the loop of the turn lies in the turn (its gentle ends may stay out)
+    assert b - 0.5 * period <= a0 and b0 <= c + 0.5 * period and b0 - a0 >= 0.9 * period
     assert abs(turning["turn_per_cycle_deg"]) > 20 and np.sign(turning["turn_per_cycle_deg"]) == np.sign(turn_deg)
     assert "walk-turning" in turning["output"]
 

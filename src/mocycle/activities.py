@@ -343,6 +343,7 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activitie
     parts = [p for p in parts if _legs_repeat_in(motion, p)]
     parts.sort(key=lambda p: p.start)
     _reach(parts, landings, T)
+    _turn_borders(parts, heading)
     parts = _fill(motion, parts, landings, min_periods)
     for p in parts:
         if p.gait:
@@ -516,6 +517,43 @@ def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[f
     if not d[i] < UNLIKE:
         return float("nan"), float(d[i])
     return best, float(d[i])
+
+
+def _turn_borders(parts: list[Activity], heading: np.ndarray) -> None:
+    """Move each border between a straight and a turning part of one gait to where the turn is half made: the
+    frame nearest the landing (within a stride) where the hips' turn over the stride centred on it crosses half
+    the turning part's largest.  A step is judged by the strides it lies in, which reach half a stride
+    beyond it, so a turning part found from its steps starts and ends about half a stride early and late; the
+    turn's half-way rate is where it begins and ends as a viewer sees it."""
+    T = heading.size
+    for a, b in zip(parts, parts[1:], strict=False):
+        if a.stop != b.start or not (a.gait and b.gait) or a.kind.split()[0] != b.kind.split()[0]:
+            continue
+        turning = [p for p in (a, b) if "turning" in p.kind]
+        if len(turning) != 1:
+            continue
+        turn = turning[0]
+        P = int(round(turn.period_frames))
+        half = P // 2
+        if P < 4 or turn.n_frames <= P:
+            continue
+        t = np.arange(half, T - half)
+        rate = np.full(T, np.nan)
+        rate[t] = heading[t + half] - heading[t - half]           # degrees per stride, centred on each frame
+        inside = np.abs(rate[turn.start:turn.stop])
+        if not np.isfinite(inside).any():
+            continue
+        level = 0.5 * np.nanmax(inside)
+        lo, hi = max(a.start + 1, b.start - P), min(b.stop - 1, b.start + P)
+        window = np.abs(rate[lo:hi + 1])
+        turning_side = window >= level
+        if not np.isfinite(window).all() or turning_side.all() or not turning_side.any():
+            continue
+        # the crossing nearest the landing, on the side of the straight part
+        flips = np.flatnonzero(turning_side[1:] != turning_side[:-1]) + lo + 1
+        border = int(flips[np.argmin(np.abs(flips - b.start))])
+        if a.start < border < b.stop and min(border - a.start, b.stop - border) >= half:
+            a.stop = b.start = border
 
 
 def _reach(parts: list[Activity], landings: Landings, T: int) -> None:
