@@ -106,7 +106,7 @@ class Fuzzer:
         try:
             r = self.http.request(method, self.url + path, content=content, headers=h)
         except Exception as exc:  # the connection itself failed: count it, it is a finding too
-            self.status[f"no answer ({type(exc).__name__})"] += 1
+            self.status[f"not sent or no answer ({type(exc).__name__})"] += 1
             self.sent += 1
             return None
         self.sent += 1

@@ -46,6 +46,8 @@ class Busy(HTTPProblem):
 #: most keyframes a request may name; most samples a stroke may have (a 10-minute stroke at 120 Hz is 72,000)
 MAX_KEYFRAMES = 4096
 MAX_STROKE_POINTS = 100_000
+#: most cycles a loop job repeats (the page's form offers 1 to 20)
+MAX_CYCLES = 100
 #: the loop form's fields and the stroke's options (each checked again by the task's Options)
 LOOP_FIELDS = ("method", "model", "root", "feet", "cycles")
 STROKE_OPTIONS = ("plant", "feet")
@@ -172,9 +174,18 @@ def _option_text(body: dict, fields) -> dict:
 
 
 def loop_request(body: dict) -> tuple[dict, bool]:
-    """``POST /api/takes/{id}/loop``: the loop's options and ``force``."""
+    """``POST /api/takes/{id}/loop``: the loop's options and ``force``; ``cycles`` at most :data:`MAX_CYCLES`
+    (the studio's bound: the task's own is the output's length, found only after the cycle is made)."""
     _known(body, (*LOOP_FIELDS, "force"))
-    return _option_text(body, LOOP_FIELDS), boolean("force", body.get("force", False))
+    options = _option_text(body, LOOP_FIELDS)
+    if "cycles" in options:
+        n = options["cycles"]
+        if isinstance(n, str) and n.strip().isdigit() and len(n.strip()) < 6:
+            n = int(n)
+        if not isinstance(n, int) or not 1 <= n <= MAX_CYCLES:
+            raise BadRequest(f"cycles must be an integer from 1 to {MAX_CYCLES}; got {_show(options['cycles'])}")
+        options["cycles"] = n
+    return options, boolean("force", body.get("force", False))
 
 
 def _keyed_markers(body: dict, n_frames: int) -> tuple[list[int], list[list[float]]]:
@@ -214,7 +225,8 @@ def stroke_request(body: dict, n_frames: int, frame_time: float, max_frames: int
 
 def plane_query(query) -> dict:
     """``GET /api/takes/{id}/plane?...``: the plane's options as ``tasks.project.Options`` takes them."""
-    _known(dict(query), PLANE_FIELDS)
+    query = {k: v for k, v in query.items() if k != "token"}  # a network server's token (see guard.py)
+    _known(query, PLANE_FIELDS)
     params = {k: v for k, v in query.items() if k != "optimize"}
     for name, value in params.items():
         if len(value) > 64:
