@@ -203,11 +203,31 @@ class Fuzzer:
         elif kind == 2:
             self.send("POST", path, raw=b'{"keyframes": "\xff\xfe"}')
         elif kind == 3:
-            self.send("POST", path, raw=b"x", headers={"Content-Length": str(rng.choice([9 << 20, 64 << 20]))})
+            self.declared(path, rng.choice([9 << 20, 64 << 20, 1 << 30]))
         elif kind == 4:
             self.send("POST", path, raw=b" " * rng.choice([1 << 20, 9 << 20]))
         else:
             self.send("POST", path, raw=b'{"keyframes": [' + b"1" * 5000 + b"]}")
+
+    def declared(self, path: str, length: int):
+        """A POST that declares ``length`` bytes and sends one (over a socket: httpx will not send it)."""
+        import socket
+
+        host, port = self.host.rsplit(":", 1)
+        head = (f"POST {path} HTTP/1.1\r\nHost: {self.host}\r\nContent-Type: application/json\r\n"
+                f"X-Mocycle-Token: {self.token}\r\nContent-Length: {length}\r\nConnection: close\r\n\r\n")
+        self.sent += 1
+        try:
+            with socket.create_connection((host, int(port)), timeout=60) as sock:
+                sock.sendall(head.encode() + b"[")
+                answer = sock.recv(65536)
+            code = int(answer.split()[1])
+        except (OSError, ValueError, IndexError) as exc:
+            self.status[f"not sent or no answer ({type(exc).__name__})"] += 1
+            return
+        self.status[code] += 1
+        if code >= 500:
+            self.errors.append(f"{code} POST {path} Content-Length {length} -> {answer[:300]!r}")
 
     def paths(self):
         rng = self.rng
