@@ -304,6 +304,7 @@ def main(argv=None) -> int:
             fz.setup()
             rss = {"start": rss_mb(proc.pid)}
             peak = rss["start"]
+            by_minute = []
             t0 = time.monotonic()
             last = t0
             while time.monotonic() - t0 < 60 * args.minutes:
@@ -314,6 +315,8 @@ def main(argv=None) -> int:
                     peak = max(peak, rss_mb(proc.pid))
                     if "1 min" not in rss and now - t0 > 60:
                         rss["1 min"] = rss_mb(proc.pid)
+                    if now - t0 > 60 * (len(by_minute) + 1):
+                        by_minute.append(rss_mb(proc.pid))
                     if proc.poll() is not None:
                         fz.errors.append(f"the server stopped (exit {proc.returncode})")
                         break
@@ -333,6 +336,7 @@ def main(argv=None) -> int:
         print(f"| {code} | {n} |")
     print(f"server RSS MB: start {rss['start']:.0f}, after 1 min {rss.get('1 min', float('nan')):.0f}, "
           f"peak {rss['peak']:.0f}, end {rss['end']:.0f}; tracebacks on the server's stderr: {tracebacks}")
+    print("server RSS MB at the end of each minute: " + " ".join(f"{m:.0f}" for m in by_minute))
     print(f"500s and failures: {len(fz.errors)}")
     for e in fz.errors[:20]:
         print("  " + e)
