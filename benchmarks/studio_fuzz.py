@@ -16,6 +16,12 @@ The library: a generated walk of ``--frames`` frames, a 240-frame wandering take
 
 Prints requests sent, the count of each status, every 500 (with the request), and the server's resident
 memory (VmRSS) at start, after the first minute, at its highest and at the end; exit 1 if any 500 was seen.
+
+    python benchmarks/studio_fuzz.py --attacks [--take PATH]
+
+runs instead the memory attacks of issue 30 against a studio serving ``PATH`` (default: CMU 07_01 on the
+100-joint iClone rig from ../shared/data, else a generated 2000-frame walk): a 1 GiB body, 60 loop jobs of
+20 cycles, 68 strokes as long as the studio allows (and one longer), with the server's RSS after each.
 """
 
 from __future__ import annotations
@@ -276,13 +282,117 @@ class Fuzzer:
             self.headers()
 
 
+def start(paths, env):
+    proc = subprocess.Popen([sys.executable, "-m", "mocycle", "studio", *map(str, paths), "--no-browser", "--port",
+                             "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    url = proc.stdout.readline().split()[3]
+    import httpx
+
+    token = re.search(r'name="mocycle-token" content="([^"]+)"', httpx.get(url, timeout=60).text).group(1)
+    while True:
+        data = httpx.get(url + "api/takes", timeout=60).json()
+        if data["done"] == data["total"]:
+            return proc, url, token, data["takes"]
+        time.sleep(0.5)
+
+
+def attacks(take: Path, env) -> int:
+    """The issue's memory attacks against a real server; the server's RSS after each."""
+    import socket
+
+    import httpx
+
+    from mocycle.studio.payload import unpack
+
+    proc, url, token, takes = start([take], env)
+    rows = [("library analysed", "", rss_mb(proc.pid))]
+    try:
+        host = re.match(r"http://([^/]+)/", url).group(1)
+        h = {"X-Mocycle-Token": token, "Content-Type": "application/json"}
+        c = httpx.Client(base_url=url.rstrip("/"), headers=h, timeout=600)
+        tid = takes[0]["id"]
+        # 1 GiB body, declared and then streamed until the server stops reading
+        sent = 0
+        with socket.create_connection(tuple(host.rsplit(":", 1)), timeout=60) as sock:
+            sock.sendall(f"POST /api/takes/{tid}/strokes HTTP/1.1\r\nHost: {host}\r\nContent-Type: "
+                         f"application/json\r\nX-Mocycle-Token: {token}\r\nContent-Length: {1 << 30}\r\n\r\n"
+                         .encode())
+            chunk = b" " * (1 << 20)
+            try:
+                for _ in range(1024):
+                    sock.sendall(chunk)
+                    sent += len(chunk)
+            except OSError:
+                pass
+            try:
+                answer = sock.recv(65536).split(b"\r\n")[0].decode()
+            except OSError as exc:
+                answer = f"connection closed ({exc})"
+        rows.append(("a 1 GiB body (Content-Length: 1073741824)", f"{answer}; {sent >> 20} MiB sent before the "
+                     "server closed", rss_mb(proc.pid)))
+        # 60 loop jobs of 20 cycles
+        t0 = time.monotonic()
+        codes = collections.Counter()
+        for _ in range(60):
+            r = c.post(f"/api/takes/{tid}/loop", json={"cycles": 20, "root": "motion", "force": True})
+            codes[r.status_code] += 1
+            if r.status_code == 202:
+                j = r.json()
+                while j["status"] in ("queued", "running"):
+                    time.sleep(0.1)
+                    j = c.get(f"/api/jobs/{j['id']}").json()
+                codes[j["status"]] += 1
+        first = c.get("/api/jobs/j2/loop.bvh")
+        rows.append(("60 loop jobs of 20 cycles, one after another", f"{dict(codes)}; the first job now "
+                     f"{first.status_code} in {time.monotonic() - t0:.0f} s", rss_mb(proc.pid)))
+        # strokes as long as allowed, and one longer
+        header, arrays = unpack(c.get(f"/api/takes/{tid}/plane", params={"optimize": 0}).content)
+        key = header["keyframes"]
+        pts = arrays["points"].astype(float)
+        fps = next(t for t in c.get("/api/takes").json()["takes"] if t["id"] == tid)["facts"]["fps"]
+
+        def stroke(frames):
+            return c.post(f"/api/takes/{tid}/strokes", json={
+                "keyframes": key, "markers": pts[key].tolist(), "points": [pts[0].tolist(), pts[-1].tolist()],
+                "times_s": [0, (frames - 1) / fps], "feet": "keep"})
+
+        long = stroke(17_971)
+        rows.append(("a stroke of 17,971 frames", f"{long.status_code}: {long.json().get('error', '')}",
+                     rss_mb(proc.pid)))
+        t0 = time.monotonic()
+        codes = collections.Counter(stroke(12_000).status_code for _ in range(68))
+        gone = c.get("/api/strokes/s1/motion")
+        rows.append(("68 strokes of 12,000 frames", f"{dict(codes)}; the first stroke now {gone.status_code} "
+                     f"in {time.monotonic() - t0:.0f} s", rss_mb(proc.pid)))
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(60)
+    print(f"studio memory attacks on {take.name} ({takes[0]['facts'].get('joints')} joints, "
+          f"{takes[0]['facts'].get('frames')} frames)")
+    print("| attack | answer | server RSS after, MB |\n|---|---|---|")
+    for what, answer, mb in rows:
+        print(f"| {what} | {answer} | {mb:.0f} |")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--minutes", type=float, default=1.0)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--frames", type=int, default=1000, help="frames of the walk the valid requests work on")
+    ap.add_argument("--attacks", action="store_true", help="the issue's memory attacks instead of the fuzz")
+    ap.add_argument("--take", type=Path, default=REPO.parent / "shared" / "data" / "cmu-iclone" / "07_01.bvh")
     args = ap.parse_args(argv)
     env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
+    if args.attacks:
+        take = args.take
+        if not take.exists():
+            from mocycle import write
+            from mocycle.datasets import synthetic_walk
+
+            take = Path(tempfile.mkdtemp(prefix="mocycle-studio-attacks-")) / "walk_2000.bvh"
+            write(synthetic_walk(n_frames=2000).motion, take)
+        return attacks(take, env)
     with tempfile.TemporaryDirectory(prefix="mocycle-studio-fuzz-") as tmp:
         folder = Path(tmp)
         make_library(folder, args.frames)

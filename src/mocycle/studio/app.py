@@ -49,7 +49,7 @@ from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from ..tasks import author
 from . import validate as v
 from .guard import MAX_BODY, Access, Guard
-from .jobs import Held, Jobs, held_bytes
+from .jobs import Held, Jobs, held_bytes, release_memory
 from .library import Take, display, find_takes, loop_summary
 from .payload import motion_payload, plane_payload
 from .review import loop_view
@@ -232,9 +232,12 @@ class Studio:
         report = author.run((motion, asked["stroke"]), author.Options(**asked["options"], amc_fps=self.amc_fps))
         sid = f"s{next(self._stroke_ids)}"
         kept = {"take": take.id, "motion": report.motions["authored"], "report": report}
-        self.strokes.put(sid, kept, held_bytes(kept, self._shared()))
         facts = {k: val for k, val in report.facts.items() if k != "trajectory"}
-        return {"id": sid, **facts, "warnings": list(report.warnings), "timings_s": dict(report.timings_s),
+        warnings, timings = list(report.warnings), dict(report.timings_s)
+        self.strokes.put(sid, kept, held_bytes(kept, self._shared()))
+        del report, kept
+        release_memory()  # what the work made and dropped
+        return {"id": sid, **facts, "warnings": warnings, "timings_s": timings,
                 "server_ms": 1000 * (time.perf_counter() - t0)}
 
 

@@ -7,6 +7,8 @@ and evicted is *gone* (410), one never given out is *not found* (404).
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import itertools
 import threading
 import traceback
@@ -46,6 +48,24 @@ def held_bytes(obj, skip=(), _seen=None, _depth=0) -> int:
     return sum(held_bytes(v, skip, seen, _depth + 1) for v in items)
 
 
+def _libc_trim():
+    try:
+        return ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim
+    except (OSError, AttributeError):  # not glibc: nothing to do
+        return None
+
+
+_TRIM = _libc_trim()
+
+
+def release_memory() -> None:
+    """Give the memory freed by an evicted job or stroke back to the system (glibc's ``malloc_trim``): the
+    server's worker threads each allocate from their own malloc arena, which otherwise keeps what was freed
+    in it, so the process would stay at its highest even though what it holds is bounded."""
+    if _TRIM is not None:
+        _TRIM(0)
+
+
 class Held:
     """Items by id, least recently used first out past ``max_items`` or ``max_bytes`` (each item's size given
     when stored); ``get`` of an evicted id raises :class:`Gone`, of an unknown id :class:`NotFound`."""
@@ -64,13 +84,18 @@ class Held:
                 self.bytes -= self._items.pop(key)[1]
             self._items[key] = (item, size)
             self.bytes += size
+            evicted = []
             while len(self._items) > self.max_items or (self.bytes > self.max_bytes and len(self._items) > 1):
-                old, (_, old_size) = self._items.popitem(last=False)
+                old, (item, old_size) = self._items.popitem(last=False)
                 self.bytes -= old_size
                 self.evicted += 1
                 self._gone[old] = None
+                evicted.append(item)
                 while len(self._gone) > 4096:
                     self._gone.popitem(last=False)
+        if evicted:
+            del evicted, item
+            release_memory()
 
     def peek(self, key: str):
         with self._lock:
@@ -150,6 +175,7 @@ class Jobs:
             with self._lock:
                 self._live.pop(job.id, None)
                 self.finished.put(job.id, job, size)
+            release_memory()  # what the work made and dropped
 
     @staticmethod
     def _work(job: Job, fn) -> None:
