@@ -128,7 +128,8 @@ def main() -> None:
         paths.append(real)
     t0 = time.perf_counter()
     with served(create_app(paths)) as url, chromium() as browser:
-        page = browser.new_page(viewport={"width": 1440, "height": 900}, accept_downloads=True)
+        page = browser.new_page(viewport={"width": 1440, "height": 900}, accept_downloads=True,
+                                bypass_csp=True)  # wait_for_function evaluates strings
         errors = watch_console(page)
         page.goto(url)
         page.wait_for_function(READY, timeout=120_000)

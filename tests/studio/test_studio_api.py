@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import time
-import warnings
 
 import numpy as np
 import pytest
@@ -11,13 +10,11 @@ import pytest
 pytest.importorskip("starlette")
 pytest.importorskip("httpx")
 
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore")  # starlette 1.x suggests httpx2 over httpx; both work
-    from starlette.testclient import TestClient  # noqa: E402
 
 from mocycle.io.bvh import parse_bvh  # noqa: E402
 from mocycle.studio.app import create_app  # noqa: E402
 from mocycle.studio.payload import pack, unpack  # noqa: E402
+from mocycle.studio.testing import api_client  # noqa: E402
 
 
 def wait(client, job, timeout=120.0):
@@ -32,7 +29,7 @@ def wait(client, job, timeout=120.0):
 
 @pytest.fixture(scope="module")
 def client(library):
-    with TestClient(create_app([library])) as c:
+    with api_client(create_app([library])) as c:
         yield c
 
 

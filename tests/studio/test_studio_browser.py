@@ -33,7 +33,9 @@ READY = "window.__studio && window.__studio.ready"
 @pytest.fixture(scope="module")
 def session(library):
     with served(create_app([library])) as url, chromium() as browser:
-        page = browser.new_page(viewport={"width": 1400, "height": 900}, accept_downloads=True)
+        # bypass_csp: Playwright polls wait_for_function with eval, which the page's CSP forbids (tests/studio/
+        # test_security.py drives the page under its CSP)
+        page = browser.new_page(viewport={"width": 1400, "height": 900}, accept_downloads=True, bypass_csp=True)
         errors = watch_console(page)
         page.goto(url)
         page.wait_for_function(READY, timeout=60_000)

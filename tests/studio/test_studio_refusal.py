@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import os
-import warnings
 
 import numpy as np
 import pytest
@@ -24,12 +23,10 @@ from mocycle.phase import find_phase
 
 pytest.importorskip("starlette")
 pytest.importorskip("httpx")
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore")
-    from starlette.testclient import TestClient  # noqa: E402
 
 from mocycle.studio.app import create_app  # noqa: E402
 from mocycle.studio.payload import unpack  # noqa: E402
+from mocycle.studio.testing import api_client  # noqa: E402
 
 REFUSED_FRAMES = 500
 
@@ -80,7 +77,7 @@ def wait(client, job, timeout=120.0):
 
 @pytest.mark.filterwarnings("ignore:.*kept although it fails:UserWarning")
 def test_the_api_refuses_without_force_and_gives_with_force(refused_library):
-    with TestClient(create_app([refused_library])) as client:
+    with api_client(create_app([refused_library])) as client:
         tid = next(t["id"] for t in client.get("/api/takes").json()["takes"] if t["name"] == "limp.bvh")
         j = wait(client, client.post(f"/api/takes/{tid}/loop", json={"root": "motion"}).json())
         assert j["status"] == "refused" and j["error"].startswith("limp.bvh: not a loop (fit:")
@@ -122,7 +119,9 @@ def test_the_page_shows_a_refused_loop_as_refused(refused_library, tmp_path):
     if not os.path.exists(CHROMIUM):
         pytest.skip(f"{CHROMIUM} is absent (make chromium installs Debian's chromium)")
     with served(create_app([refused_library])) as url, chromium() as browser:
-        page = browser.new_page(viewport={"width": 1400, "height": 900}, accept_downloads=True)
+        # bypass_csp: Playwright polls wait_for_function with eval, which the page's CSP forbids (tests/studio/
+        # test_security.py drives the page under its CSP)
+        page = browser.new_page(viewport={"width": 1400, "height": 900}, accept_downloads=True, bypass_csp=True)
         errors = watch_console(page)
         page.goto(url)
         page.wait_for_function("window.__studio && window.__studio.ready", timeout=60_000)

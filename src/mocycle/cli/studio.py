@@ -27,7 +27,16 @@ def serve(application, host: str, port: int, open_browser: bool, ready=None) -> 
         sock.listen(128)  # connections wait in the queue until uvicorn serves them
     except OSError as exc:
         raise MocycleError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
-    url = f"http://{host if ':' not in host else f'[{host}]'}:{sock.getsockname()[1]}/"
+    port = sock.getsockname()[1]
+    url = f"http://{host if ':' not in host else f'[{host}]'}:{port}/"
+    access = getattr(application.state, "access", None)
+    if access is not None:
+        access.bind(host, port)  # the Host the server answers for (and whether it serves the network)
+        if access.remote:  # every request needs the token: the URL carries it
+            url += f"?token={access.token}"
+            err.print(f"warning: --host {host} serves your motion library to the network (every machine that "
+                      "can reach this one); only the URL below, which carries the server's token, opens it",
+                      soft_wrap=True, markup=False)
     server = uvicorn.Server(uvicorn.Config(application, log_level="warning", lifespan="on"))
     out.print(f"mocycle studio on {escape(url)} (Ctrl-C to stop)", soft_wrap=True)
     if open_browser:
@@ -41,7 +50,9 @@ def serve(application, host: str, port: int, open_browser: bool, ready=None) -> 
 @friendly
 def studio(
     paths: Annotated[list[Path], typer.Argument(help="Motion files (.bvh, .amc) or folders of them.")],
-    host: Annotated[str, typer.Option(help="Address to listen on (127.0.0.1: this machine only).")] = "127.0.0.1",
+    host: Annotated[str, typer.Option(help="Address to listen on (127.0.0.1: this machine only; any other address "
+                                            "serves the network, prints a warning and needs the printed URL's "
+                                            "token).")] = "127.0.0.1",
     port: Annotated[int, typer.Option(help="Port to listen on (0: any free port).", min=0, max=65535)] = 8765,
     no_browser: Annotated[bool, typer.Option("--no-browser", help="Do not open a browser.")] = False,
     amc_fps: Annotated[float, typer.Option(help="Frame rate of AMC input files (CMU: 120).")] = tasks.AMC_FPS,

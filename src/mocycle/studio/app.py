@@ -31,49 +31,92 @@ import re
 import tempfile
 import threading
 import time
+import traceback
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from starlette.applications import Starlette
+from starlette.concurrency import run_in_threadpool
+from starlette.middleware import Middleware
 from starlette.requests import Request
-from starlette.responses import FileResponse, JSONResponse, Response
+from starlette.responses import HTMLResponse, JSONResponse, Response
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from ..tasks import author
-from .jobs import Jobs
-from .library import Take, find_takes, loop_summary
+from . import validate as v
+from .guard import MAX_BODY, Access, Guard
+from .jobs import Held, Jobs, held_bytes, release_memory
+from .library import Take, display, find_takes, loop_summary
 from .payload import motion_payload, plane_payload
 from .review import loop_view
 
 STATIC = Path(__file__).parent / "static"
 BINARY = "application/octet-stream"
 DOWNLOADS = {".bvh": "text/plain", ".glb": "model/gltf-binary"}
-MAX_STROKES = 64  # authored animations kept in memory per server (oldest dropped)
+MB = 1 << 20
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What one studio server holds at most (``mocycle studio`` uses the defaults; docs/studio.md lists them)."""
+
+    max_body: int = MAX_BODY  #: bytes of one request body (413 above)
+    max_stroke_frames: int = 12_000  #: frames of one authored animation (400 above)
+    max_strokes: int = 32  #: authored animations kept (least recently used evicted; 410 after)
+    max_stroke_bytes: int = 256 * MB  #: ... and their bytes together
+    max_jobs_kept: int = 16  #: finished loop and re-layout jobs kept (least recently used evicted; 410 after)
+    max_job_bytes: int = 256 * MB  #: ... and their results' bytes together
+    max_pending: int = 8  #: loop and re-layout jobs waiting or running at once (429 above)
+    max_planes: int = 16  #: authoring planes kept (made again when asked after eviction)
+    max_payloads: int = 4  #: takes' motion payloads kept (made again when asked after eviction)
 
 
 class Studio:
     """The server's state: the library, its background analysis and the interactive jobs."""
 
-    def __init__(self, paths, amc_fps: float = tasks.AMC_FPS, analyse: bool = True):
+    def __init__(self, paths, amc_fps: float = tasks.AMC_FPS, analyse: bool = True, limits: Limits | None = None):
         self.amc_fps = amc_fps
-        self.takes = {f"t{i}": Take(id=f"t{i}", path=p) for i, p in enumerate(find_takes(paths))}
-        self.analysis = Jobs(workers=1)
-        self.interactive = Jobs(workers=1)
-        self.strokes: dict[str, dict] = {}
+        self.limits = lim = limits or Limits()
+        self.takes = {f"t{i}": take for i, take in enumerate(find_takes(paths))}
+        for tid, take in self.takes.items():
+            take.id = tid
+        ids = itertools.count(1)  # one job numbering for both queues
+        self.analysis = Jobs(workers=1, ids=ids)
+        self.interactive = Jobs(workers=1, ids=ids, max_pending=lim.max_pending, keep=lim.max_jobs_kept,
+                                keep_bytes=lim.max_job_bytes, size=lambda job: held_bytes(job.result, self._shared()))
+        self.strokes = Held("stroke", lim.max_strokes, lim.max_stroke_bytes)
         self._stroke_ids = itertools.count(1)
-        self._planes: dict[tuple, tuple[bytes, dict]] = {}
-        self._motions: dict[str, bytes] = {}
+        self._planes = Held("plane", lim.max_planes, 1 << 62)
+        self._motions = Held("payload", lim.max_payloads, 1 << 62)
         self._relayout: dict[str, str] = {}  # take id -> its running relayout job
         self._lock = threading.Lock()
         if analyse:
             for take in self.takes.values():
                 self.analysis.submit("analyse", lambda job, t=take: self._analyse(t))
 
+    def _shared(self) -> set[int]:
+        """The ids of what the library holds anyway (takes and their motions): not counted in a result's bytes."""
+        out = set()
+        for take in self.takes.values():
+            out.add(id(take))
+            if take._motion is not None:
+                out.add(id(take._motion))
+        return out
+
+    def held(self) -> dict:
+        """How much the server holds now (jobs, strokes, caches): for tests and the fuzz benchmark."""
+        return {"jobs": self.interactive.held(), "job_bytes": self.interactive.finished.bytes,
+                "strokes": len(self.strokes), "stroke_bytes": self.strokes.bytes, "planes": len(self._planes),
+                "payloads": len(self._motions)}
+
     # ------------------------------------------------------------ background analysis of the library
     def _analyse(self, take: Take) -> None:
+        if take.status == "refused":  # a link out of the served folder: never read
+            return
         take.status = "running"
         try:
             motion = take.motion(self.amc_fps)
@@ -85,36 +128,45 @@ class Studio:
                 report = tasks.loop.run(motion, tasks.loop.Options(which="all", force=True))
                 take.loops = [loop_summary(loop) for loop in report.facts["loops"]]
             except NoPeriodicMotion as exc:
-                take.reason = str(exc)
+                take.reason = display(str(exc))
             take.status = "done"
         except MocycleError as exc:
-            take.status, take.error = "failed", str(exc)
+            take.status, take.error = "failed", display(str(exc))
 
     def take(self, take_id: str) -> Take:
-        if take_id not in self.takes:
-            raise KeyError(take_id)
-        return self.takes[take_id]
+        take = self.takes.get(v.path_id("take", take_id))
+        if take is None:
+            raise v.NotFound(f"no take {take_id}")
+        return take
+
+    def job(self, job_id: str):
+        v.path_id("job", job_id)
+        job = self.interactive.get(job_id) or self.analysis.get(job_id)
+        return job if job is not None else self.interactive.find(job_id)  # Gone or NotFound
+
+    def stroke_of(self, stroke_id: str) -> dict:
+        v.path_id("stroke", stroke_id)
+        s = self.strokes.peek(stroke_id)
+        if s is not None:
+            return s
+        if self.strokes.was_evicted(stroke_id):
+            raise v.Gone(f"stroke {stroke_id} is gone: only the last {self.limits.max_strokes} authored "
+                         "animations are kept (and as many as fit the studio's memory budget); draw it again")
+        raise v.NotFound(f"no stroke {stroke_id}")
 
     def motion_bytes(self, take: Take) -> bytes:
-        """The take's payload, made once."""
-        with self._lock:
-            data = self._motions.get(take.id)
+        """The take's payload, made once (while it stays among the last few asked for)."""
+        data = self._motions.peek(take.id)
         if data is None:
             data = motion_payload(take.motion(self.amc_fps), {"name": take.name})
-            with self._lock:
-                self._motions[take.id] = data
+            self._motions.put(take.id, data, len(data))
         return data
 
     # ------------------------------------------------------------ the review: loops with options
-    def loop_job(self, take: Take, options: dict):
+    def loop_job(self, take: Take, options: dict, force: bool):
         """``tasks.loop`` with the form's options; ``force`` as ``mocycle loop --force`` (without it a loop that
         fails its checks ends the job as ``refused``, see :class:`~.jobs.Jobs`)."""
-        opts = {k: options[k] for k in ("method", "model", "root", "feet", "cycles") if options.get(k) not in
-                (None, "")}
-        force = options.get("force", False)
-        if not isinstance(force, bool):
-            raise ValueError(f"force must be true or false; got {force!r}")
-        o = tasks.loop.Options(force=force, **opts)  # an OptionError here is the caller's 400
+        o = tasks.loop.Options(force=force, **options)  # an OptionError here is the caller's 400
 
         def named(text: str) -> str:  # messages name the take as the library lists it, not as "take 0"
             memory = "take 0: "  # how tasks name a motion given in memory
@@ -139,20 +191,21 @@ class Studio:
 
     # ------------------------------------------------------------ the authoring plane
     def plane(self, take: Take, params: dict) -> bytes:
-        fields = {"projection", "select", "ratio", "seed_projection", "optimize"}
-        o = tasks.project.Options(**{k: v for k, v in params.items() if k in fields}, amc_fps=self.amc_fps)
-        key = (take.id, tuple(sorted((k, str(getattr(o, k))) for k in fields)))
-        with self._lock:
-            if key in self._planes:
-                return self._planes[key][0]
+        fields = v.PLANE_FIELDS
+        o = tasks.project.Options(**params, amc_fps=self.amc_fps)
+        key = repr((take.id, tuple(sorted((k, str(getattr(o, k))) for k in fields))))
+        data = self._planes.peek(key)
+        if data is not None:
+            return data
         motion = take.motion(self.amc_fps)
         report = tasks.project.run(motion, o)
         data = plane_payload(motion, report.result, {**report.facts, "seconds": report.seconds})
-        with self._lock:
-            self._planes[key] = (data, report.facts)
+        self._planes.put(key, data, len(data))
         return data
 
-    def relayout_job(self, take: Take, keyframes, markers, optimize: bool):
+    def relayout_job(self, take: Take, body: dict):
+        motion = take.motion(self.amc_fps)
+        keyframes, markers, optimize = v.relayout_request(body, motion.n_frames)
         with self._lock:
             previous = self._relayout.get(take.id)
         if previous:
@@ -162,7 +215,8 @@ class Studio:
             def progress(fraction):
                 job.progress = fraction
 
-            report = author.relayout(take.motion(self.amc_fps), keyframes, markers, optimize,
+            report = author.relayout(motion, np.asarray(keyframes, dtype=np.int64),
+                                     np.asarray(markers, dtype=np.float64), optimize,
                                      stop=job.cancelled, progress=progress)
             return {"facts": {**report.facts, "seconds": report.seconds}}
 
@@ -173,38 +227,65 @@ class Studio:
 
     def stroke(self, take: Take, body: dict) -> dict:
         t0 = time.perf_counter()
-        opts = {k: body[k] for k in ("plant", "feet") if body.get(k)}
-        report = author.run((take.motion(self.amc_fps), body), author.Options(**opts, amc_fps=self.amc_fps))
+        motion = take.motion(self.amc_fps)
+        asked = v.stroke_request(body, motion.n_frames, motion.frame_time, self.limits.max_stroke_frames)
+        report = author.run((motion, asked["stroke"]), author.Options(**asked["options"], amc_fps=self.amc_fps))
         sid = f"s{next(self._stroke_ids)}"
-        with self._lock:
-            self.strokes[sid] = {"take": take.id, "motion": report.motions["authored"], "report": report,
-                                 "facts": report.facts}
-            while len(self.strokes) > MAX_STROKES:
-                self.strokes.pop(next(iter(self.strokes)))
-        facts = {k: v for k, v in report.facts.items() if k != "trajectory"}
-        return {"id": sid, **facts, "warnings": list(report.warnings), "timings_s": dict(report.timings_s),
+        kept = {"take": take.id, "motion": report.motions["authored"], "report": report}
+        facts = {k: val for k, val in report.facts.items() if k != "trajectory"}
+        warnings, timings = list(report.warnings), dict(report.timings_s)
+        self.strokes.put(sid, kept, held_bytes(kept, self._shared()))
+        del report, kept
+        release_memory()  # what the work made and dropped
+        return {"id": sid, **facts, "warnings": warnings, "timings_s": timings,
                 "server_ms": 1000 * (time.perf_counter() - t0)}
 
 
 # ---------------------------------------------------------------- HTTP
+def _clean(value):
+    """``value`` with every string valid UTF-8 (a non-UTF-8 file name's bytes shown as ``\\xff``)."""
+    if isinstance(value, str):
+        return display(value)
+    if isinstance(value, dict):
+        return {_clean(k): _clean(x) for k, x in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean(x) for x in value]
+    return value
+
+
+class JSON(JSONResponse):
+    """JSON whose strings are valid UTF-8 whatever file names they carry."""
+
+    def render(self, content) -> bytes:
+        try:
+            return super().render(content)
+        except UnicodeEncodeError:
+            return super().render(_clean(content))
+
+
 def _error(status: int, message: str) -> JSONResponse:
-    return JSONResponse({"error": message}, status_code=status)
+    return JSON({"error": display(message)}, status_code=status)
 
 
-def _guard(handler):
-    """Errors as JSON: unknown take/job 404, bad options or input 400."""
+def answers(handler):
+    """The handler's errors as JSON, one message each: the request's own problem (:class:`~.validate.
+    HTTPProblem`: 400, 404, 410, 413, 429), a loop refused 409, bad options or input 400; anything else is
+    the studio's fault: 500 with the message (and a traceback on the server's terminal)."""
 
     async def wrapped(request: Request):
         try:
             return await handler(request)
-        except KeyError as exc:
-            return _error(404, f"not found: {exc.args[0] if exc.args else ''}")
+        except v.HTTPProblem as exc:
+            return _error(exc.status, str(exc))
         except LoopRefused as exc:
             return _error(409, str(exc))
         except OptionError as exc:
             return _error(400, f"{exc.parameter} {exc.reason}")
-        except (MocycleError, ValueError, TypeError) as exc:
+        except MocycleError as exc:
             return _error(400, str(exc))
+        except Exception as exc:  # a bug: say so in one line, keep serving
+            traceback.print_exc()
+            return _error(500, f"internal error: {type(exc).__name__}")
 
     return wrapped
 
@@ -234,144 +315,185 @@ def _download(data, name: str, headers: dict | None = None) -> Response:
 
 
 async def _body(request: Request) -> dict:
-    body = await request.json()
-    if not isinstance(body, dict):
-        raise ValueError("the request body must be a JSON object")
-    return body
+    return v.parse_body(await request.body())  # the Guard cut it off past the body limit (413)
 
 
-def create_app(paths=(), *, studio: Studio | None = None, amc_fps: float = tasks.AMC_FPS) -> Starlette:
-    """The studio's ASGI app over the takes in ``paths`` (files or folders)."""
-    from starlette.concurrency import run_in_threadpool
+def _suffix(request) -> str:
+    suffix = "." + request.path_params["suffix"]
+    if suffix not in DOWNLOADS:
+        raise v.NotFound(f"no {suffix[:20]} download (only {', '.join(DOWNLOADS)})")
+    return suffix
 
-    st = studio or Studio(paths, amc_fps=amc_fps)
 
-    async def index(request):
-        return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-store"})
+def _studio(request) -> Studio:
+    return request.app.state.studio
 
-    async def list_takes(request):
-        takes = [t.to_dict() for t in st.takes.values()]
-        done = sum(t["status"] in ("done", "failed") for t in takes)
-        return JSONResponse({"takes": takes, "done": done, "total": len(takes)})
 
-    async def options(request):
-        return JSONResponse({"loop": tasks.schema(tasks.loop.Options), "plane": tasks.schema(tasks.project.Options),
-                             "author": tasks.schema(author.Options)})
+# ---------------------------------------------------------------- the handlers (one per route)
+_PAGE = None
 
-    async def take_motion(request):
-        take = st.take(request.path_params["id"])
-        data = await run_in_threadpool(st.motion_bytes, take)
-        return Response(data, media_type=BINARY)
 
-    async def loop(request):
-        take = st.take(request.path_params["id"])
-        job = st.loop_job(take, await _body(request))
-        return JSONResponse(job.to_dict(), status_code=202)
+async def index(request):
+    """The page, with the server's token (for the page's own requests) and this answer's script nonce."""
+    global _PAGE
+    if _PAGE is None:
+        _PAGE = (STATIC / "index.html").read_text(encoding="utf-8")
+    nonce = request.scope["state"].get("csp_nonce", "")
+    token = request.app.state.access.token
+    html = _PAGE.replace("<script", f'<script nonce="{nonce}"').replace(
+        "<head>", f'<head>\n<meta name="mocycle-token" content="{token}">', 1)
+    return HTMLResponse(html, headers={"Cache-Control": "no-store"})
 
-    async def plane(request):
-        take = st.take(request.path_params["id"])
-        params = dict(request.query_params)
-        if "optimize" in params:
-            params["optimize"] = params["optimize"] in ("1", "true", "yes")
-        data = await run_in_threadpool(st.plane, take, params)
-        return Response(data, media_type=BINARY)
 
-    async def relayout(request):
-        take = st.take(request.path_params["id"])
-        body = await _body(request)
-        job = st.relayout_job(take, np.asarray(body["keyframes"], dtype=np.int64),
-                              np.asarray(body["markers"], dtype=np.float64), bool(body.get("optimize", True)))
-        return JSONResponse(job.to_dict(), status_code=202)
+async def list_takes(request):
+    takes = [t.to_dict() for t in _studio(request).takes.values()]
+    done = sum(t["status"] in ("done", "failed", "refused") for t in takes)
+    return JSON({"takes": takes, "done": done, "total": len(takes)})
 
-    async def stroke(request):
-        take = st.take(request.path_params["id"])
-        body = await _body(request)
-        return JSONResponse(await run_in_threadpool(st.stroke, take, body))
 
-    async def stroke_motion(request):
-        s = st.strokes[request.path_params["stroke"]]
-        data = await run_in_threadpool(motion_payload, s["motion"], {"name": "authored"})
-        return Response(data, media_type=BINARY)
+async def options(request):
+    return JSON({"loop": tasks.schema(tasks.loop.Options), "plane": tasks.schema(tasks.project.Options),
+                 "author": tasks.schema(author.Options)})
 
-    def _suffix(request) -> str:
-        suffix = "." + request.path_params["suffix"]
-        if suffix not in DOWNLOADS:
-            raise KeyError(request.url.path)
-        return suffix
 
-    async def stroke_file(request):
-        sid, suffix = request.path_params["stroke"], _suffix(request)
-        s = st.strokes[sid]
-        name = f"{_file_name(Path(st.take(s['take']).name).stem)}_authored_{sid}"
-        data = await run_in_threadpool(motion_file, s["report"], "authored", name, suffix)
-        return _download(data, name + suffix)
+async def take_motion(request):
+    st = _studio(request)
+    data = await run_in_threadpool(st.motion_bytes, st.take(request.path_params["id"]))
+    return Response(data, media_type=BINARY)
 
-    def _job(request):
-        job = st.interactive.get(request.path_params["job"]) or st.analysis.get(request.path_params["job"])
-        if job is None:
-            raise KeyError(request.path_params["job"])
-        return job
 
-    async def job_status(request):
-        job = _job(request)
-        out = job.to_dict()
-        if job.status in ("done", "refused") and isinstance(job.result, dict):
-            out["result"] = job.result.get("facts")
-        return JSONResponse(out)
+async def loop(request):
+    st = _studio(request)
+    take = st.take(request.path_params["id"])
+    opts, force = v.loop_request(await _body(request))
+    return JSON(st.loop_job(take, opts, force).to_dict(), status_code=202)
 
-    async def job_cancel(request):
-        job = _job(request)
-        job.cancel_event.set()
-        return JSONResponse(job.to_dict())
 
-    def _loop_job(request):
-        job = _job(request)
-        if job.kind == "loop" and job.status == "refused":
-            raise LoopRefused(f"{job.error} (ask again with force)")
-        if job.status != "done" or job.kind != "loop":
-            raise ValueError(f"job {job.id} has no loop ({job.status})")
-        return job.result
+async def plane(request):
+    st = _studio(request)
+    take = st.take(request.path_params["id"])
+    data = await run_in_threadpool(st.plane, take, v.plane_query(request.query_params))
+    return Response(data, media_type=BINARY)
 
-    async def job_motion(request):
-        result = _loop_job(request)
-        data = await run_in_threadpool(motion_payload, result["view"], {
-            "name": "loop", "forced": result["facts"]["forced"]})
-        return Response(data, media_type=BINARY)
 
-    async def job_file(request):
-        result = _loop_job(request)
-        suffix = _suffix(request)
-        name = f"{_file_name(Path(result['take'].name).stem)}_loop"
-        data = await run_in_threadpool(motion_file, result["report"], "loop", name, suffix)
-        failed = [c["check"] for c in result["facts"]["failed_checks"]]
-        if failed:  # forced: the file's name and a header say so
-            return _download(data, f"{name}.forced{suffix}", {"X-Mocycle-Failed-Checks": ", ".join(failed)})
-        return _download(data, name + suffix)
+async def relayout(request):
+    st = _studio(request)
+    take = st.take(request.path_params["id"])
+    body = await _body(request)
+    job = await run_in_threadpool(st.relayout_job, take, body)
+    return JSON(job.to_dict(), status_code=202)
 
-    g = _guard
-    routes = [
-        Route("/", index),
-        Route("/api/takes", g(list_takes)),
-        Route("/api/options", g(options)),
-        Route("/api/takes/{id}/motion", g(take_motion)),
-        Route("/api/takes/{id}/loop", g(loop), methods=["POST"]),
-        Route("/api/takes/{id}/plane", g(plane)),
-        Route("/api/takes/{id}/relayout", g(relayout), methods=["POST"]),
-        Route("/api/takes/{id}/strokes", g(stroke), methods=["POST"]),
-        Route("/api/strokes/{stroke}/motion", g(stroke_motion)),
-        Route("/api/strokes/{stroke}.{suffix:str}", g(stroke_file)),
-        Route("/api/jobs/{job}", g(job_status)),
-        Route("/api/jobs/{job}", g(job_cancel), methods=["DELETE"]),
-        Route("/api/jobs/{job}/motion", g(job_motion)),
-        Route("/api/jobs/{job}/loop.{suffix:str}", g(job_file)),
-        Mount("/static", StaticFiles(directory=STATIC), name="static"),
-    ]
-    @contextlib.asynccontextmanager
-    async def lifespan(app):
-        yield
-        st.analysis.shutdown()
-        st.interactive.shutdown()
 
-    app = Starlette(routes=routes, lifespan=lifespan)
+async def stroke(request):
+    st = _studio(request)
+    take = st.take(request.path_params["id"])
+    body = await _body(request)
+    return JSON(await run_in_threadpool(st.stroke, take, body))
+
+
+async def stroke_motion(request):
+    s = _studio(request).stroke_of(request.path_params["stroke"])
+    data = await run_in_threadpool(motion_payload, s["motion"], {"name": "authored"})
+    return Response(data, media_type=BINARY)
+
+
+async def stroke_file(request):
+    st = _studio(request)
+    sid, suffix = request.path_params["stroke"], _suffix(request)
+    s = st.stroke_of(sid)
+    name = f"{_file_name(Path(st.takes[s['take']].name).stem)}_authored_{sid}"
+    data = await run_in_threadpool(motion_file, s["report"], "authored", name, suffix)
+    return _download(data, name + suffix)
+
+
+async def job_status(request):
+    job = _studio(request).job(request.path_params["job"])
+    out = job.to_dict()
+    if job.status in ("done", "refused") and isinstance(job.result, dict):
+        out["result"] = job.result.get("facts")
+    return JSON(out)
+
+
+async def job_cancel(request):
+    job = _studio(request).job(request.path_params["job"])
+    job.cancel_event.set()
+    return JSON(job.to_dict())
+
+
+def _loop_job(request):
+    job = _studio(request).job(request.path_params["job"])
+    if job.kind == "loop" and job.status == "refused":
+        raise LoopRefused(f"{job.error} (ask again with force)")
+    if job.status != "done" or job.kind != "loop":
+        raise v.BadRequest(f"job {job.id} has no loop ({job.status})")
+    return job.result
+
+
+async def job_motion(request):
+    result = _loop_job(request)
+    data = await run_in_threadpool(motion_payload, result["view"], {
+        "name": "loop", "forced": result["facts"]["forced"]})
+    return Response(data, media_type=BINARY)
+
+
+async def job_file(request):
+    result = _loop_job(request)
+    suffix = _suffix(request)
+    name = f"{_file_name(Path(result['take'].name).stem)}_loop"
+    data = await run_in_threadpool(motion_file, result["report"], "loop", name, suffix)
+    failed = [c["check"] for c in result["facts"]["failed_checks"]]
+    if failed:  # forced: the file's name and a header say so
+        return _download(data, f"{name}.forced{suffix}", {"X-Mocycle-Failed-Checks": ", ".join(failed)})
+    return _download(data, name + suffix)
+
+
+async def not_found(request, exc):
+    return _error(404, f"no such page: {request.url.path[:80]}")
+
+
+async def not_allowed(request, exc):
+    if getattr(exc, "status_code", 500) == 405:
+        return _error(405, f"{request.method} is not allowed on {request.url.path[:80]}")
+    return _error(getattr(exc, "status_code", 500), getattr(exc, "detail", "error"))
+
+
+ROUTES = [
+    Route("/", index),
+    Route("/api/takes", answers(list_takes)),
+    Route("/api/options", answers(options)),
+    Route("/api/takes/{id}/motion", answers(take_motion)),
+    Route("/api/takes/{id}/loop", answers(loop), methods=["POST"]),
+    Route("/api/takes/{id}/plane", answers(plane)),
+    Route("/api/takes/{id}/relayout", answers(relayout), methods=["POST"]),
+    Route("/api/takes/{id}/strokes", answers(stroke), methods=["POST"]),
+    Route("/api/strokes/{stroke}/motion", answers(stroke_motion)),
+    Route("/api/strokes/{stroke}.{suffix:str}", answers(stroke_file)),
+    Route("/api/jobs/{job}", answers(job_status)),
+    Route("/api/jobs/{job}", answers(job_cancel), methods=["DELETE"]),
+    Route("/api/jobs/{job}/motion", answers(job_motion)),
+    Route("/api/jobs/{job}/loop.{suffix:str}", answers(job_file)),
+    Mount("/static", StaticFiles(directory=STATIC), name="static"),
+]
+
+
+@contextlib.asynccontextmanager
+async def _lifespan(app):
+    yield
+    app.state.studio.analysis.shutdown()
+    app.state.studio.interactive.shutdown()
+
+
+def create_app(paths=(), *, studio: Studio | None = None, amc_fps: float = tasks.AMC_FPS,
+               limits: Limits | None = None, access: Access | None = None) -> Starlette:
+    """The studio's ASGI app over the takes in ``paths`` (files or folders).
+
+    ``access``: who may ask (the token, the address served; see :mod:`.guard`); by default a random token and
+    127.0.0.1 on any port until the command binds its socket (``app.state.access.bind(host, port)``).
+    """
+    st = studio or Studio(paths, amc_fps=amc_fps, limits=limits)
+    access = access or Access(max_body=st.limits.max_body)
+    app = Starlette(routes=ROUTES, lifespan=_lifespan, middleware=[Middleware(Guard, access=access)],
+                    exception_handlers={404: not_found, 405: not_allowed})
     app.state.studio = st
+    app.state.access = access
     return app

@@ -1,14 +1,119 @@
-"""Background work for the studio: a job runs in a worker thread, reports its progress and can be cancelled."""
+"""Background work for the studio: a job runs in a worker thread, reports its progress and can be cancelled.
+
+Memory stays bounded: at most ``max_pending`` jobs wait or run (more is a 429), and finished jobs are kept in
+a :class:`Held` store (least recently used evicted past a count and a byte budget); an id that was given out
+and evicted is *gone* (410), one never given out is *not found* (404).
+"""
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import itertools
 import threading
 import traceback
+from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..errors import LoopRefused, MocycleError
+from .validate import Busy, Gone, NotFound
+
+
+def held_bytes(obj, skip=(), _seen=None, _depth=0) -> int:
+    """About the bytes ``obj`` holds: its numpy arrays and bytes, 32 per number in lists, through dicts, lists,
+    tuples and object attributes, each object counted once; objects whose ``id`` is in ``skip`` (a take shared
+    with the library) are not counted."""
+    seen = set(skip) if _seen is None else _seen
+    if obj is None or isinstance(obj, (bool, int, float, str)) or id(obj) in seen or _depth > 8:
+        return 0
+    seen.add(id(obj))
+    if isinstance(obj, (bytes, bytearray)):
+        return len(obj)
+    if isinstance(obj, np.ndarray):
+        return obj.nbytes
+    if isinstance(obj, dict):
+        items = list(obj.values())
+    elif isinstance(obj, (list, tuple)):
+        if obj and isinstance(obj[0], (int, float)):
+            return 32 * len(obj)
+        items = obj
+    elif hasattr(obj, "__dict__") or hasattr(obj, "__slots__"):
+        items = list(getattr(obj, "__dict__", {}).values())
+        items += [getattr(obj, n, None) for n in getattr(type(obj), "__slots__", ())]
+    else:
+        return 0
+    return sum(held_bytes(v, skip, seen, _depth + 1) for v in items)
+
+
+def _libc_trim():
+    try:
+        return ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim
+    except (OSError, AttributeError):  # not glibc: nothing to do
+        return None
+
+
+_TRIM = _libc_trim()
+
+
+def release_memory() -> None:
+    """Give the memory freed by an evicted job or stroke back to the system (glibc's ``malloc_trim``): the
+    server's worker threads each allocate from their own malloc arena, which otherwise keeps what was freed
+    in it, so the process would stay at its highest even though what it holds is bounded."""
+    if _TRIM is not None:
+        _TRIM(0)
+
+
+class Held:
+    """Items by id, least recently used first out past ``max_items`` or ``max_bytes`` (each item's size given
+    when stored); ``get`` of an evicted id raises :class:`Gone`, of an unknown id :class:`NotFound`."""
+
+    def __init__(self, kind: str, max_items: int, max_bytes: int):
+        self.kind, self.max_items, self.max_bytes = kind, max_items, max_bytes
+        self._items: OrderedDict[str, tuple[object, int]] = OrderedDict()
+        self._gone: OrderedDict[str, None] = OrderedDict()  # the last evicted ids, for a clearer message
+        self.bytes = 0
+        self.evicted = 0
+        self._lock = threading.Lock()
+
+    def put(self, key: str, item, size: int) -> None:
+        with self._lock:
+            if key in self._items:
+                self.bytes -= self._items.pop(key)[1]
+            self._items[key] = (item, size)
+            self.bytes += size
+            evicted = []
+            while len(self._items) > self.max_items or (self.bytes > self.max_bytes and len(self._items) > 1):
+                old, (item, old_size) = self._items.popitem(last=False)
+                self.bytes -= old_size
+                self.evicted += 1
+                self._gone[old] = None
+                evicted.append(item)
+                while len(self._gone) > 4096:
+                    self._gone.popitem(last=False)
+        if evicted:
+            del evicted, item
+            release_memory()
+
+    def peek(self, key: str):
+        with self._lock:
+            entry = self._items.get(key)
+            if entry is not None:
+                self._items.move_to_end(key)
+            return None if entry is None else entry[0]
+
+    def was_evicted(self, key: str) -> bool:
+        with self._lock:
+            return key in self._gone
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def values(self) -> list:
+        with self._lock:
+            return [item for item, _ in self._items.values()]
 
 
 @dataclass
@@ -35,23 +140,45 @@ class Job:
 
 class Jobs:
     """A queue of jobs on ``workers`` threads; ``submit(kind, fn)`` runs ``fn(job)`` (which may set
-    ``job.progress`` and should look at ``job.cancelled()``); what it returns becomes ``job.result``."""
+    ``job.progress`` and should look at ``job.cancelled()``); what it returns becomes ``job.result``.
 
-    def __init__(self, workers: int = 1):
+    ``max_pending``: most jobs queued or running at once (``None``: no limit, for the library's analysis);
+    finished jobs are kept in a :class:`Held` store of ``keep`` jobs and ``keep_bytes`` bytes of results
+    (``size(job)`` measures one); ``prefix`` starts the ids (``j``)."""
+
+    def __init__(self, workers: int = 1, *, max_pending: int | None = None, keep: int = 10_000,
+                 keep_bytes: int = 1 << 62, size=None, prefix: str = "j", ids=None):
         self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="mocycle-studio")
-        self._jobs: dict[str, Job] = {}
-        self._ids = itertools.count(1)
+        self._live: dict[str, Job] = {}  # queued or running
+        self.finished = Held("job", keep, keep_bytes)
+        self.max_pending = max_pending
+        self._size = size or (lambda job: held_bytes(job.result))
+        self._ids = ids if ids is not None else itertools.count(1)
+        self._prefix = prefix
         self._lock = threading.Lock()
 
     def submit(self, kind: str, fn) -> Job:
-        job = Job(id=f"j{next(self._ids)}", kind=kind)
         with self._lock:
-            self._jobs[job.id] = job
+            if self.max_pending is not None and len(self._live) >= self.max_pending:
+                raise Busy(f"{len(self._live)} jobs are waiting or running; at most {self.max_pending} "
+                           "(wait for one to finish or cancel it)")
+            job = Job(id=f"{self._prefix}{next(self._ids)}", kind=kind)
+            self._live[job.id] = job
         self._pool.submit(self._run, job, fn)
         return job
 
+    def _run(self, job: Job, fn) -> None:
+        try:
+            self._work(job, fn)
+        finally:
+            size = self._size(job)
+            with self._lock:
+                self._live.pop(job.id, None)
+                self.finished.put(job.id, job, size)
+            release_memory()  # what the work made and dropped
+
     @staticmethod
-    def _run(job: Job, fn) -> None:
+    def _work(job: Job, fn) -> None:
         if job.cancelled():
             job.status = "cancelled"
             return
@@ -71,7 +198,23 @@ class Jobs:
 
     def get(self, job_id: str) -> Job | None:
         with self._lock:
-            return self._jobs.get(job_id)
+            job = self._live.get(job_id)
+        return job if job is not None else self.finished.peek(job_id)
+
+    def find(self, job_id: str) -> Job:
+        """The job, or :class:`Gone` (finished and evicted) or :class:`NotFound`."""
+        job = self.get(job_id)
+        if job is not None:
+            return job
+        if self.finished.was_evicted(job_id):
+            raise Gone(f"job {job_id} is gone: only the last {self.finished.max_items} finished jobs are kept "
+                       "(and as many as fit the studio's memory budget); run it again")
+        raise NotFound(f"no job {job_id}")
+
+    def held(self) -> int:
+        """How many jobs are kept (queued, running and finished)."""
+        with self._lock:
+            return len(self._live) + len(self.finished)
 
     def cancel(self, job_id: str) -> Job | None:
         job = self.get(job_id)
@@ -81,6 +224,6 @@ class Jobs:
 
     def shutdown(self) -> None:
         with self._lock:
-            for job in self._jobs.values():
+            for job in self._live.values():
                 job.cancel_event.set()
         self._pool.shutdown(wait=False, cancel_futures=True)

@@ -1,4 +1,9 @@
-"""The takes the studio shows: found in files and folders, read on demand, looped in the background."""
+"""The takes the studio shows: found in files and folders, read on demand, looped in the background.
+
+A file in a served folder that is a link to a file outside it is listed as ``refused`` and never read (the
+studio shows a folder, not what its links reach).  A file name that is not UTF-8 is kept as the operating
+system gave it (Python's surrogate escapes) and shown with its odd bytes written ``\xff``.
+"""
 
 from __future__ import annotations
 
@@ -13,24 +18,52 @@ from ..motion import Motion
 SUFFIXES = (".bvh", ".amc")
 
 
-def find_takes(paths) -> list[Path]:
-    """The motion files named by ``paths`` (files, or folders searched recursively), sorted, no repeats."""
-    found: list[Path] = []
+def display(text: str) -> str:
+    """``text`` as valid UTF-8 for a page or a message: the bytes of a non-UTF-8 file name (which Python keeps
+    as surrogate escapes) written ``\xff``."""
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    try:
+        path.resolve().relative_to(folder.resolve())
+        return True
+    except (ValueError, OSError, RuntimeError):
+        return False
+
+
+def find_takes(paths) -> list[Take]:
+    """The motion files named by ``paths`` (files, or folders searched recursively), sorted, no repeats; a
+    file of a folder that links outside that folder is a take with status ``refused`` (never read).  Ids are
+    given by the caller."""
+    found: list[tuple[Path, str | None]] = []
     for p in map(Path, paths):
         if p.is_dir():
-            found += sorted(f for f in p.rglob("*") if f.suffix.lower() in SUFFIXES and f.is_file())
+            for f in sorted(f for f in p.rglob("*") if f.suffix.lower() in SUFFIXES and f.is_file()):
+                found.append((f, None if _inside(f, p) else
+                              "refused: a link to a file outside the served folder (not read)"))
         elif p.is_file():
             if p.suffix.lower() not in SUFFIXES:
-                raise MocycleError(f"{p}: not a motion file the studio reads ({', '.join(SUFFIXES)})")
-            found.append(p)
+                raise MocycleError(f"{display(str(p))}: not a motion file the studio reads ({', '.join(SUFFIXES)})")
+            found.append((p, None))
         else:
-            raise MocycleError(f"{p}: no such file or folder")
+            raise MocycleError(f"{display(str(p))}: no such file or folder")
     seen, out = set(), []
-    for f in found:
-        key = f.resolve()
+    for f, refusal in found:
+        try:
+            key = f.resolve()
+        except (OSError, RuntimeError):
+            key = f.absolute()
         if key not in seen:
             seen.add(key)
-            out.append(f)
+            take = Take(id="", path=f)
+            if refusal:
+                take.status, take.error = "refused", refusal
+            out.append(take)
     return out
 
 
@@ -50,10 +83,13 @@ class Take:
 
     @property
     def name(self) -> str:
-        return self.path.name
+        """The file's name as the page shows it (valid UTF-8)."""
+        return display(self.path.name)
 
     def motion(self, amc_fps: float) -> Motion:
-        """The take, read once."""
+        """The take, read once (a refused take: an error, never read)."""
+        if self.status == "refused":
+            raise MocycleError(f"{self.name}: {self.error}")
         with self._lock:
             if self._motion is None:
                 from .. import tasks
@@ -62,7 +98,7 @@ class Take:
             return self._motion
 
     def to_dict(self) -> dict:
-        return {"id": self.id, "name": self.name, "path": str(self.path), "status": self.status,
+        return {"id": self.id, "name": self.name, "path": display(str(self.path)), "status": self.status,
                 "facts": self.facts, "loops": self.loops, "reason": self.reason, "error": self.error}
 
 

@@ -22,6 +22,9 @@ def served(app):
     sock = socket.socket()
     sock.bind(("127.0.0.1", 0))
     server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
+    access = getattr(getattr(app, "state", None), "access", None)
+    if access is not None:
+        access.bind("127.0.0.1", sock.getsockname()[1])  # as mocycle studio does: only this Host is answered
     thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
     thread.start()
     t0 = time.monotonic()
@@ -33,6 +36,19 @@ def served(app):
         server.should_exit = True
         thread.join(15)
         sock.close()
+
+
+def api_client(app, **kwargs):
+    """Starlette's TestClient for the studio app as its own page talks to it: ``Host: 127.0.0.1`` and the
+    server's token on every request (``headers=`` adds or replaces headers)."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # starlette 1.x suggests httpx2 over httpx; both work
+        from starlette.testclient import TestClient
+
+    headers = {"X-Mocycle-Token": app.state.access.token, **kwargs.pop("headers", {})}
+    return TestClient(app, base_url=kwargs.pop("base_url", "http://127.0.0.1"), headers=headers, **kwargs)
 
 
 @contextlib.contextmanager

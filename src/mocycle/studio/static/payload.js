@@ -14,8 +14,14 @@ export function decode(buffer) {
   return { header, arrays };
 }
 
+// the server's token (studio/guard.py), in the page the studio served; none in an offline report
+export function token() {
+  const meta = typeof document === "undefined" ? null : document.querySelector('meta[name="mocycle-token"]');
+  return meta ? meta.content : "";
+}
+
 export async function fetchPayload(url) {
-  const r = await fetch(url);
+  const r = await fetch(url, { headers: { "X-Mocycle-Token": token() } });
   if (!r.ok) throw new Error((await r.json().catch(() => ({}))).error || `${url}: ${r.status}`);
   return decode(await r.arrayBuffer());
 }

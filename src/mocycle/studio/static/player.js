@@ -46,6 +46,16 @@ export class Player {
     this.setLayout(this.mode);
   }
 
+  // nothing to play (a take that could not be read): no figures, an empty transport
+  clear() {
+    this.pause();
+    this.main = null; this.loop = null; this.loopFrames = null; this.phase = null; this.excitation = null;
+    this.viewer.setFigure("main", null); this.viewer.setFigure("loop", null);
+    this.els.scrub.max = 0; this.els.scrub.value = 0; this.els.label.textContent = "";
+    this.viewer.render();
+    this.drawStrip();
+  }
+
   setPhase(phase, excitation) { this.phase = phase; this.excitation = excitation; this.drawStrip(); }
 
   setLayout(mode) {

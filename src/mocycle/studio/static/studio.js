@@ -3,22 +3,34 @@ import { Viewer } from "mocycle/viewer.js";
 import { Player } from "mocycle/player.js";
 import { Plane } from "mocycle/plane.js";
 import { PosePlane } from "mocycle/spatial.js";
-import { fetchPayload } from "mocycle/payload.js";
+import { fetchPayload, token } from "mocycle/payload.js";
 
 const $ = (id) => document.getElementById(id);
 const S = (window.__studio = { ready: false, stats: { scrub: [], hover: [], draw: [], strokes: [], firstRender_ms: [] } });
 
+// every request carries the server's token (studio/guard.py refuses a POST or DELETE without it)
 async function json(url, body, method) {
-  const r = await fetch(url, body === undefined ? { method: method || "GET" } :
-    { method: method || "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
-  const out = await r.json();
+  const headers = { "X-Mocycle-Token": token() };
+  const r = await fetch(url, body === undefined ? { method: method || "GET", headers } :
+    { method: method || "POST", headers: { ...headers, "Content-Type": "application/json" }, body: JSON.stringify(body) });
+  const out = await r.json().catch(() => ({}));
   if (!r.ok) throw new Error(out.error || `${url}: ${r.status}`);
   return out;
 }
 
+// an element built from data: text is always set as text (names from files are never parsed as HTML)
+function h(tag, attrs = {}, ...children) {
+  const el = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (v == null || v === false) continue;
+    if (k === "class") el.className = v; else el.setAttribute(k, v);
+  }
+  for (const c of children.flat()) if (c != null && c !== false) el.append(c instanceof Node ? c : String(c));
+  return el;
+}
+
 function status(text, isError = false) { const el = $("status"); el.textContent = text; el.classList.toggle("error", isError); }
 const fmt = (v, d = 2) => (v == null || !isFinite(v) ? "–" : Number(v).toFixed(d));
-const esc = (s) => String(s ?? "").replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
 
 // ---------------------------------------------------------------- library
 function renderLibrary(data) {
@@ -26,10 +38,10 @@ function renderLibrary(data) {
   $("progress-label").textContent = `analysed ${data.done} / ${data.total}`;
   const list = $("takes");
   for (const t of data.takes) {
-    let row = list.querySelector(`[data-id="${t.id}"]`);
+    let row = [...list.children].find((r) => r.dataset.id === t.id);
     if (!row) {
       row = document.createElement("div");
-      row.className = "take"; row.dataset.id = t.id; row.dataset.testid = "take";
+      row.className = "take"; row.dataset.id = t.id;
       row.setAttribute("data-testid", "take");
       row.addEventListener("click", () => openTake(t.id));
       list.appendChild(row);
@@ -37,12 +49,15 @@ function renderLibrary(data) {
     row.classList.toggle("current", t.id === S.take);
     const f = t.facts || {};
     // a loop that fails its checks is refused (as mocycle loop refuses it): its status and the reason
-    const loops = t.loops.map((l) => `<li class="${l.refused ? "refused" : "ok"}" data-state="${l.refused ? "refused" : "ok"}"${l.refused ? ` title="${esc(l.refusal)}"` : ""}>${l.refused ? `<span class="bad">refused (${esc(l.failed_checks.join(", "))})</span> · ` : ""}period ${fmt(l.period_s)} s (${fmt(l.period_frames, 1)} fr) · seam ${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} · skate ${fmt(l.skate)}${l.refused ? `<div class="reason">${esc(l.refusal)}</div>` : ""}</li>`).join("");
-    const state = t.status === "done" ? "" : t.status === "failed" ? `<span class="bad">${esc(t.error)}</span>` : `<span class="busy">${t.status}…</span>`;
+    const loops = t.loops.map((l) => h("li", { class: l.refused ? "refused" : "ok", "data-state": l.refused ? "refused" : "ok", title: l.refused ? l.refusal : null },
+      l.refused ? [h("span", { class: "bad" }, `refused (${l.failed_checks.join(", ")})`), " · "] : [],
+      `period ${fmt(l.period_s)} s (${fmt(l.period_frames, 1)} fr) · seam ${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} · skate ${fmt(l.skate)}`,
+      l.refused ? h("div", { class: "reason" }, l.refusal) : null));
+    const state = t.status === "done" ? "" : ["failed", "refused"].includes(t.status) ? h("span", { class: "bad" }, t.error) : h("span", { class: "busy" }, `${t.status}…`);
     row.dataset.state = t.status !== "done" ? t.status : !t.loops.length ? "no-loop" : t.loops.some((l) => !l.refused) ? "ok" : "refused";
-    row.innerHTML = `<div class="name">${esc(t.name)}</div>
-      <div class="facts">${f.frames ?? "…"} frames · ${fmt(f.fps, 0)} fps · ${t.status === "done" ? `${t.loops.length} periodic motion${t.loops.length === 1 ? "" : "s"}` : ""} ${state}</div>
-      <ul class="loops">${loops}${t.reason ? `<li class="muted">no loop: ${esc(t.reason)}</li>` : ""}</ul>`;
+    row.replaceChildren(h("div", { class: "name" }, t.name),
+      h("div", { class: "facts" }, `${f.frames ?? "…"} frames · ${fmt(f.fps, 0)} fps · ${t.status === "done" ? `${t.loops.length} periodic motion${t.loops.length === 1 ? "" : "s"}` : ""} `, state),
+      h("ul", { class: "loops" }, loops, t.reason ? h("li", { class: "muted" }, `no loop: ${t.reason}`) : null));
   }
 }
 
@@ -62,7 +77,23 @@ async function openTake(id) {
   $("loop-options").elements.force.checked = false;  // force is asked for one take's loop, not kept for the next
   document.querySelectorAll(".take").forEach((r) => r.classList.toggle("current", r.dataset.id === id));
   status("loading the take…");
-  const motion = await fetchPayload(`/api/takes/${id}/motion`);
+  const listed = S.library ? S.library.takes.find((t) => t.id === id) : null;
+  $("take-name").textContent = listed ? listed.name : "";
+  let motion;
+  try {
+    motion = await fetchPayload(`/api/takes/${id}/motion`);
+  } catch (e) {
+    // a take that cannot be read: its name and why, nothing of the previous take left to play or author on
+    if (S.take !== id) return;
+    S.motion = null; S.pose = null; S.plane = null; S.keys = null; S.loopJob = null;
+    S.player.clear();
+    loopState("failed", `cannot read this take: ${e.message}`);
+    $("metrics").replaceChildren();
+    setDownloads("loop", null);
+    $("plane-status").textContent = "";
+    status(e.message, true);
+    return;
+  }
   if (S.take !== id) return;
   S.player.setLoop(null); S.player.setPhase(null, null);
   S.player.setMain(motion, "take");
@@ -98,9 +129,9 @@ function setDownloads(prefix, base) {
   }
 }
 
-function loopState(state, html) {
+function loopState(state, ...content) {
   const el = $("loop-status");
-  el.dataset.state = state; el.innerHTML = html;
+  el.dataset.state = state; el.replaceChildren(...content);
   el.classList.toggle("bad", state === "refused" || state === "forced");
 }
 
@@ -108,7 +139,7 @@ async function runLoop() {
   const id = S.take;
   if (!id) return;
   loopState("running", "looping…");
-  $("metrics").innerHTML = "";
+  $("metrics").replaceChildren();
   setDownloads("loop", null);
   try {
     const job = await json(`/api/takes/${id}/loop`, formValues($("loop-options")));
@@ -118,12 +149,13 @@ async function runLoop() {
     if (j.status === "refused") {
       // refused as mocycle loop refuses it: no loop shown, nothing to download unless asked with force
       S.player.setLoop(null); S.player.setPhase(null, null);
-      loopState("refused", `refused: ${esc(j.error)} <button id="loop-force" type="button" data-testid="force-loop">Show and download anyway (force)</button>`);
-      $("loop-force").addEventListener("click", () => { $("loop-options").elements.force.checked = true; runLoop(); });
-      $("metrics").innerHTML = `<table>${j.result.failed_checks.map((c) => `<tr><th>failed check: ${esc(c.check)}</th><td>${esc(c.reason)}</td></tr>`).join("")}</table>`;
+      const force = h("button", { id: "loop-force", type: "button", "data-testid": "force-loop" }, "Show and download anyway (force)");
+      loopState("refused", `refused: ${j.error} `, force);
+      force.addEventListener("click", () => { $("loop-options").elements.force.checked = true; runLoop(); });
+      $("metrics").replaceChildren(h("table", {}, j.result.failed_checks.map((c) => h("tr", {}, h("th", {}, `failed check: ${c.check}`), h("td", {}, c.reason)))));
       return;
     }
-    if (j.status !== "done") { loopState("failed", esc(j.error || j.status)); S.player.setLoop(null); return; }
+    if (j.status !== "done") { loopState("failed", j.error || j.status); S.player.setLoop(null); return; }
     const loop = await fetchPayload(`/api/jobs/${j.id}/motion`);
     if (S.take !== id) return;
     loop.header.cycle_frames = j.result.view.cycle_frames;
@@ -131,15 +163,17 @@ async function runLoop() {
     S.player.setPhase(j.result.phase, j.result.excitation);
     const l = j.result.loop, failed = j.result.failed_checks;
     const text = `loop ${l.cycle_frames} frames · period ${fmt(l.period_s)} s · ${fmt(j.result.seconds)} s`;
-    if (failed.length) loopState("forced", `FORCED: this loop fails its checks (${esc(failed.map((c) => c.check).join(", "))}) and is shown because you asked · ${text}`);
+    if (failed.length) loopState("forced", `FORCED: this loop fails its checks (${failed.map((c) => c.check).join(", ")}) and is shown because you asked · ${text}`);
     else loopState("ok", text);
-    $("metrics").innerHTML = `<table><tr><th>period</th><td>${fmt(l.period_frames, 1)} frames (${fmt(l.period_s)} s)</td></tr>
-      <tr><th>seam jump, pose / velocity</th><td>${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} × median step</td></tr>
-      <tr><th>foot skate, loop / take</th><td>${fmt(l.skate)} / ${fmt(l.input_skate)} units/s</td></tr>
-      <tr><th>failed checks</th><td class="${failed.length ? "bad" : ""}">${failed.map((c) => `${esc(c.check)}: ${esc(c.reason)}`).join("; ") || "none"}</td></tr>
-      ${j.result.warnings.map((w) => `<tr><th>warning</th><td>${esc(w)}</td></tr>`).join("")}</table>`;
+    const row = (k, v, cls) => h("tr", {}, h("th", {}, k), h("td", { class: cls }, v));
+    $("metrics").replaceChildren(h("table", {},
+      row("period", `${fmt(l.period_frames, 1)} frames (${fmt(l.period_s)} s)`),
+      row("seam jump, pose / velocity", `${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} × median step`),
+      row("foot skate, loop / take", `${fmt(l.skate)} / ${fmt(l.input_skate)} units/s`),
+      row("failed checks", failed.map((c) => `${c.check}: ${c.reason}`).join("; ") || "none", failed.length ? "bad" : null),
+      j.result.warnings.map((w) => row("warning", w))));
     setDownloads("loop", `/api/jobs/${j.id}/loop`);
-  } catch (e) { loopState("failed", esc(e.message)); S.player.setLoop(null); }
+  } catch (e) { loopState("failed", e.message); S.player.setLoop(null); }
 }
 
 function buildOptions(schema) {
