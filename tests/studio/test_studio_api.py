@@ -56,7 +56,7 @@ def test_library_is_analysed_in_the_background(client):
     loop = walk["loops"][0]
     assert loop["period_s"] == pytest.approx(1.0, rel=0.05)
     assert loop["seam_pose"] is not None and loop["skate"] is not None
-    assert takes["wander.bvh"]["loops"] == [] and "no periodic motion" in takes["wander.bvh"]["reason"]
+    assert takes["wander.bvh"]["loops"] == [] and "no repeating motion" in takes["wander.bvh"]["reason"]
 
 
 def test_motion_payload_has_world_positions(client):
@@ -247,12 +247,12 @@ def test_report_of_a_take_without_loop_and_bad_outputs(library, tmp_path):
     out = tmp_path / "wander.html"
     r = subprocess.run([sys.executable, "-m", "mocycle", "report", str(library / "wander.bvh"), "-o", str(out)],
                        capture_output=True, text=True, env=_env())
-    assert r.returncode == 0 and "warning: no loop in the report: no periodic motion" in r.stderr, r.stderr
+    assert r.returncode == 0 and "warning: no loop in the report: no repeating motion" in r.stderr, r.stderr
     import json
 
     text = out.read_text()
     data = json.loads(text.split('<script id="report-data" type="application/json">')[1].split("</script>")[0])
-    assert "loop" not in data and data["reason"].startswith("no periodic motion") and data["take"]
+    assert "loop" not in data and data["reason"].startswith("no repeating motion") and data["take"]
     bad = subprocess.run([sys.executable, "-m", "mocycle", "report", str(library / "walk.bvh"), "-o",
                           str(tmp_path / "r.txt")], capture_output=True, text=True, env=_env())
     assert bad.returncode == 1 and "must name a .html or .htm file" in bad.stderr

@@ -60,7 +60,7 @@ def test_library_lists_the_takes_and_their_loops(session):
     page.wait_for_function("window.__studio.library && window.__studio.library.done === 2", timeout=120_000)
     page.wait_for_timeout(700)  # the next poll draws the analysed rows
     walk = takes.filter(has_text="walk.bvh").inner_text()
-    assert "240 frames" in walk and "1 periodic motion" in walk and "period 1.0" in walk and "seam" in walk
+    assert "240 frames" in walk and "1 loop" in walk and "period 1.0" in walk and "seam" in walk
     assert "no loop" in takes.filter(has_text="wander.bvh").inner_text()
     assert page.locator('[data-testid="viewer"] canvas').count() == 1
     assert not errors, errors

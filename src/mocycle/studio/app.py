@@ -52,7 +52,7 @@ from .guard import MAX_BODY, Access, Guard
 from .jobs import Held, Jobs, held_bytes, release_memory
 from .library import Take, display, find_takes, loop_summary
 from .payload import motion_payload, plane_payload
-from .review import loop_view
+from .review import loop_view, strip_excitation, strip_parts, take_phase
 
 STATIC = Path(__file__).parent / "static"
 BINARY = "application/octet-stream"
@@ -177,14 +177,13 @@ class Studio:
                 report = tasks.loop.run(take.motion(self.amc_fps), o)
             except LoopRefused as exc:
                 raise LoopRefused(named(str(exc)), exc.failed) from None
-            cycle = report.result
             f = report.facts
-            phase = np.asarray(cycle.periodic.coords, dtype=np.float64)
             view, view_facts = loop_view(report)
             return {"report": report, "view": view, "take": take, "facts": {
                 "loop": loop_summary(f), "options": o.to_dict(), "warnings": [named(w) for w in report.warnings],
                 "failed_checks": f["failed_checks"], "forced": bool(f["failed_checks"]),
-                "frames_out": f["frames_out"], "phase": phase.round(4).tolist(), "excitation": f["excitation"],
+                "frames_out": f["frames_out"], "phase": take_phase(report), "excitation": strip_excitation(report),
+                "parts": strip_parts(report),
                 "view": view_facts, "seconds": report.seconds}}
 
         return self.interactive.submit("loop", work)

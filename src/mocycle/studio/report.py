@@ -72,7 +72,7 @@ def report_pieces(title: str, take, loop_report=None, reason: str | None = None)
     motions = {"take": (take, {"name": title})}
     data: dict = {"title": title, "take": MARK["take"], "reason": reason}
     if loop_report is not None:
-        from .review import loop_view
+        from .review import loop_view, strip_excitation, strip_parts, take_phase
 
         facts = loop_report.facts
         view, view_facts = loop_view(loop_report)  # phase-aligned with the take, repeated with root motion
@@ -81,8 +81,8 @@ def report_pieces(title: str, take, loop_report=None, reason: str | None = None)
                     summary=loop_summary(facts), metrics=facts["metrics"], options={
                         **{k: facts.get(k) for k in ("method", "model", "harmonics", "time_axis", "root")},
                         "feet": facts["feet"]["mode"]},
-                    phase=[round(float(v), 4) for v in loop_report.result.periodic.coords],
-                    excitation=facts["excitation"], warnings=list(loop_report.warnings),
+                    phase=take_phase(loop_report), excitation=strip_excitation(loop_report),
+                    parts=strip_parts(loop_report), warnings=list(loop_report.warnings),
                     failed_checks=facts["failed_checks"])
     imports = {name: _data_url(_module_text(name)) for name in MODULES}
     payload = json.dumps(data, allow_nan=False).replace("</", "<\\/")

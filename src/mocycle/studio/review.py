@@ -14,16 +14,47 @@ from ..motion import Motion
 from ..rotations import axis_rotations, continuous_quats
 
 
-def cycle_frames(cycle, n_frames: int) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
+def loop_offset(report, role: str = "loop") -> int:
+    """The take frame where the motion a loop was fitted on starts (a part of the take: its first frame; 0
+    when the whole take was looped)."""
+    return int((report.extras.get(role) or {}).get("offset", 0))
+
+
+def take_phase(report, role: str = "loop") -> list:
+    """The loop's phase at every frame of the take (``report.motions["input"]``), rounded, ``None`` outside
+    the part it was fitted on (JSON has no NaN)."""
+    coords = np.asarray(report.result.periodic.coords, dtype=np.float64)
+    T, at = report.motions["input"].n_frames, loop_offset(report, role)
+    out: list = [None] * T
+    for k, v in enumerate(coords[: max(0, T - at)]):
+        out[at + k] = round(float(v), 4)
+    return out
+
+
+def strip_parts(report) -> list[dict]:
+    """The take's parts for the phase strip: frames (the input's), kind, whether it loops."""
+    start = report.facts.get("first_frame", 0)
+    return [{"frames": [p["frames"][0] - start, p["frames"][1] - start], "kind": p["kind"], "loop": p["loop"]}
+            for p in report.facts.get("parts", [])]
+
+
+def strip_excitation(report) -> list[list[int]]:
+    """The loop's excited regions in the input's frames (the facts give them in the take's)."""
+    start = report.facts.get("first_frame", 0)
+    return [[a - start, b - start] for a, b in report.facts.get("excitation", [])]
+
+
+def cycle_frames(cycle, n_frames: int, offset: int = 0) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
     """Where each of the take's ``n_frames`` frames falls in the repeated cycle: ``(u, segments)``.
 
     ``u (T,)``: cycle frames, unwrapped within each excited region (``u mod N`` is the cycle frame whose
     phase is the take's at that frame, from ``cycle.positions``); outside the regions the count goes on at
     the loop's own rate (``N / period_frames`` cycle frames per frame) from the nearest region before (or,
     before the first region, back from it).  ``segments``: ``(start, stop, anchor)`` frame ranges, one per
-    excited region, ``anchor`` its first frame: where the loop is placed at the take."""
+    excited region, ``anchor`` its first frame: where the loop is placed at the take.  ``offset``: the take
+    frame where the motion the cycle was fitted on starts (a part of the take)."""
     N = cycle.n_frames
-    regions = list(cycle.axis.regions)
+    regions = [(s + offset, e + offset) for s, e in cycle.axis.regions]
     if len(cycle.positions) != sum(e - s for s, e in regions) or regions[-1][1] > n_frames:
         raise ValueError(f"the cycle's positions ({len(cycle.positions)}) do not cover its excited regions "
                          f"{regions} of a {n_frames}-frame take")
@@ -54,7 +85,7 @@ def loop_view(report):
     ``segments``."""
     take, cycle, root = report.motions["input"], report.result, report.facts["root"]
     space, N, T = cycle.space, cycle.n_frames, report.motions["input"].n_frames
-    u, segments = cycle_frames(cycle, T)
+    u, segments = cycle_frames(cycle, T, loop_offset(report))
     index = np.empty(T)
     for start, stop, _ in segments:  # each region's passes counted from the first repeat
         index[start:stop] = u[start:stop] - N * np.floor(u[start:stop].min() / N)

@@ -338,7 +338,7 @@ def _facts(status, reason, loops, not_looped, acts, offset) -> dict:
         parts.append(d)
     first = dict(loops[0]) if loops else {}
     return {**first, "status": status, "reason": reason, "loops": loops, "not_looped": not_looped,
-            "parts": parts}
+            "parts": parts, "first_frame": int(offset)}
 
 
 def _loop_one(motion, phase, k, o, label, offset, part, rec):
@@ -389,7 +389,7 @@ def _loop_one(motion, phase, k, o, label, offset, part, rec):
         "feet": feet_facts,
         "excited_regions": len(cycle.periodic.excitation),
     }
-    return facts, result, {"fitted": fitted, "contacts": contacts}, cycle
+    return facts, result, {"fitted": fitted, "contacts": contacts, "offset": offset}, cycle
 
 
 def _speed(cycle) -> float:

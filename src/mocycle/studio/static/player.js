@@ -56,7 +56,7 @@ export class Player {
     this.drawStrip();
   }
 
-  setPhase(phase, excitation) { this.phase = phase; this.excitation = excitation; this.drawStrip(); }
+  setPhase(phase, excitation, parts) { this.phase = phase; this.excitation = excitation; this.parts = parts || null; this.drawStrip(); }
 
   setLayout(mode) {
     this.mode = mode;
@@ -70,7 +70,7 @@ export class Player {
   drawStrip() {
     if (!this.els.strip) return;
     drawPhaseStrip(this.els.strip, this.kind === "take" ? this.phase : null, this.kind === "take" ? this.excitation : [],
-                   this.frame, this.main ? this.main.header.frames : 0);
+                   this.frame, this.main ? this.main.header.frames : 0, this.kind === "take" ? this.parts : null);
   }
 
   toggle() { if (this.playing) this.pause(); else this.play(); }

@@ -21,7 +21,7 @@ export function startReport(data) {
     const loop = fromBase64(data.loop);
     loop.header.cycle_frames = data.view.cycle_frames;
     player.setLoop(loop, data.view.loop_frame);
-    player.setPhase(data.phase, data.excitation);
+    player.setPhase(data.phase, data.excitation, data.parts);
   }
   $("layout").addEventListener("change", () => player.setLayout($("layout").value));
   $("follow").addEventListener("change", () => { viewer.follow = $("follow").checked; });

@@ -51,12 +51,13 @@ function renderLibrary(data) {
     // a loop that fails its checks is refused (as mocycle loop refuses it): its status and the reason
     const loops = t.loops.map((l) => h("li", { class: l.refused ? "refused" : "ok", "data-state": l.refused ? "refused" : "ok", title: l.refused ? l.refusal : null },
       l.refused ? [h("span", { class: "bad" }, `refused (${l.failed_checks.join(", ")})`), " · "] : [],
+      l.kind ? `${l.kind} ${l.frames ? `${l.frames[0]}–${l.frames[1]} ` : ""}· ` : "",
       `period ${fmt(l.period_s)} s (${fmt(l.period_frames, 1)} fr) · seam ${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} · skate ${fmt(l.skate)}`,
       l.refused ? h("div", { class: "reason" }, l.refusal) : null));
     const state = t.status === "done" ? "" : ["failed", "refused"].includes(t.status) ? h("span", { class: "bad" }, t.error) : h("span", { class: "busy" }, `${t.status}…`);
     row.dataset.state = t.status !== "done" ? t.status : !t.loops.length ? "no-loop" : t.loops.some((l) => !l.refused) ? "ok" : "refused";
     row.replaceChildren(h("div", { class: "name" }, t.name),
-      h("div", { class: "facts" }, `${f.frames ?? "…"} frames · ${fmt(f.fps, 0)} fps · ${t.status === "done" ? `${t.loops.length} periodic motion${t.loops.length === 1 ? "" : "s"}` : ""} `, state),
+      h("div", { class: "facts" }, `${f.frames ?? "…"} frames · ${fmt(f.fps, 0)} fps · ${t.status === "done" ? `${t.loops.length} loop${t.loops.length === 1 ? "" : "s"}` : ""} `, state),
       h("ul", { class: "loops" }, loops, t.reason ? h("li", { class: "muted" }, `no loop: ${t.reason}`) : null));
   }
 }
@@ -160,7 +161,7 @@ async function runLoop() {
     if (S.take !== id) return;
     loop.header.cycle_frames = j.result.view.cycle_frames;
     S.player.setLoop(loop, j.result.view.loop_frame);
-    S.player.setPhase(j.result.phase, j.result.excitation);
+    S.player.setPhase(j.result.phase, j.result.excitation, j.result.parts);
     const l = j.result.loop, failed = j.result.failed_checks;
     const text = `loop ${l.cycle_frames} frames · period ${fmt(l.period_s)} s · ${fmt(j.result.seconds)} s`;
     if (failed.length) loopState("forced", `FORCED: this loop fails its checks (${failed.map((c) => c.check).join(", ")}) and is shown because you asked · ${text}`);
