@@ -142,9 +142,9 @@ class Jobs:
     """A queue of jobs on ``workers`` threads; ``submit(kind, fn)`` runs ``fn(job)`` (which may set
     ``job.progress`` and should look at ``job.cancelled()``); what it returns becomes ``job.result``.
 
-    ``max_pending``: most jobs queued or running at once (``None``: no limit, for the library's analysis);
-    finished jobs are kept in a :class:`Held` store of ``keep`` jobs and ``keep_bytes`` bytes of results
-    (``size(job)`` measures one); ``prefix`` starts the ids (``j``)."""
+    ``max_pending``: most jobs queued or running at once, not counting cancelled ones (``None``: no limit, for
+    the library's analysis); finished jobs are kept in a :class:`Held` store of ``keep`` jobs and ``keep_bytes``
+    bytes of results (``size(job)`` measures one); ``prefix`` starts the ids (``j``)."""
 
     def __init__(self, workers: int = 1, *, max_pending: int | None = None, keep: int = 10_000,
                  keep_bytes: int = 1 << 62, size=None, prefix: str = "j", ids=None):
@@ -159,8 +159,9 @@ class Jobs:
 
     def submit(self, kind: str, fn) -> Job:
         with self._lock:
-            if self.max_pending is not None and len(self._live) >= self.max_pending:
-                raise Busy(f"{len(self._live)} jobs are waiting or running; at most {self.max_pending} "
+            waiting = sum(not j.cancelled() for j in self._live.values())  # a cancelled one ends when reached
+            if self.max_pending is not None and waiting >= self.max_pending:
+                raise Busy(f"{waiting} jobs are waiting or running; at most {self.max_pending} "
                            "(wait for one to finish or cancel it)")
             job = Job(id=f"{self._prefix}{next(self._ids)}", kind=kind)
             self._live[job.id] = job

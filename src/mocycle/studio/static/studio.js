@@ -86,6 +86,9 @@ async function openTake(id) {
   } catch (e) {
     // a take that cannot be read: its name and why, nothing of the previous take left to play or author on
     if (S.take !== id) return;
+    S.loopSeq = (S.loopSeq || 0) + 1;  // the previous take's loop, if still running, is not this take's
+    if (S.loopRunning) json(`/api/jobs/${S.loopRunning}`, undefined, "DELETE").catch(() => {});
+    S.loopRunning = null;
     S.motion = null; S.pose = null; S.plane = null; S.keys = null; S.loopJob = null;
     S.player.clear();
     loopState("failed", `cannot read this take: ${e.message}`);
@@ -139,12 +142,20 @@ function loopState(state, ...content) {
 async function runLoop() {
   const id = S.take;
   if (!id) return;
+  // a newer loop supersedes the one still running (its job is cancelled, its answer ignored)
+  const seq = S.loopSeq = (S.loopSeq || 0) + 1;
+  if (S.loopRunning) json(`/api/jobs/${S.loopRunning}`, undefined, "DELETE").catch(() => {});
+  S.loopRunning = null;
   loopState("running", "looping…");
   $("metrics").replaceChildren();
   setDownloads("loop", null);
   try {
     const job = await json(`/api/takes/${id}/loop`, formValues($("loop-options")));
+    if (seq !== S.loopSeq) { json(`/api/jobs/${job.id}`, undefined, "DELETE").catch(() => {}); return; }
+    S.loopRunning = job.id;
     const j = await waitJob(job);
+    if (seq !== S.loopSeq) return;
+    S.loopRunning = null;
     if (S.take !== id) return;
     S.loopJob = j;
     if (j.status === "refused") {
@@ -158,7 +169,7 @@ async function runLoop() {
     }
     if (j.status !== "done") { loopState("failed", j.error || j.status); S.player.setLoop(null); return; }
     const loop = await fetchPayload(`/api/jobs/${j.id}/motion`);
-    if (S.take !== id) return;
+    if (S.take !== id || seq !== S.loopSeq) return;
     loop.header.cycle_frames = j.result.view.cycle_frames;
     S.player.setLoop(loop, j.result.view.loop_frame);
     S.player.setPhase(j.result.phase, j.result.excitation, j.result.parts);
@@ -174,7 +185,7 @@ async function runLoop() {
       row("failed checks", failed.map((c) => `${c.check}: ${c.reason}`).join("; ") || "none", failed.length ? "bad" : null),
       j.result.warnings.map((w) => row("warning", w))));
     setDownloads("loop", `/api/jobs/${j.id}/loop`);
-  } catch (e) { loopState("failed", e.message); S.player.setLoop(null); }
+  } catch (e) { if (seq === S.loopSeq) { loopState("failed", e.message); S.player.setLoop(null); } }
 }
 
 function buildOptions(schema) {
