@@ -11,7 +11,7 @@ from pathlib import Path
 from ..errors import MocycleError
 
 #: the suffixes of the files that hold a take (``.amc`` with its ``.asf`` beside it)
-TAKE_SUFFIXES = (".bvh", ".amc")
+TAKE_SUFFIXES = (".bvh", ".amc", ".fbx", ".glb", ".gltf")
 
 __all__ = ["TAKE_SUFFIXES", "Take", "find_takes"]
 
@@ -71,10 +71,10 @@ def _inside(p: Path, folder: Path | None) -> bool:
 def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None = None) -> list[Take]:
     """The takes named by ``inputs`` (files, folders, glob patterns), sorted by their relative path.
 
-    A folder is searched recursively for ``.bvh`` and ``.amc`` files (hidden files and anything under
-    ``outdir`` are left out, so outputs written into the input tree are never read back as inputs). The
-    relative path of a take is taken from the common folder of the inputs' roots (a folder is its own root,
-    a file's root is its folder, a pattern's root is its folder before the first wildcard).
+    A folder is searched recursively for motion files (``.bvh``, ``.amc``, ``.fbx``, ``.glb``, ``.gltf``;
+    hidden files and anything under ``outdir`` are left out, so outputs written into the input tree are never
+    read back as inputs). The relative path of a take is taken from the common folder of the inputs' roots (a
+    folder is its own root, a file's root is its folder, a pattern's root is its folder before the first wildcard).
 
     Raises
     ------
@@ -93,17 +93,17 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
             files = [f for f in sorted(root.rglob("*")) if _is_take(f) and not _inside(f, skip)
                      and not any(part.startswith(".") for part in f.relative_to(root).parts)]
             if not files:
-                raise MocycleError(f"{item}: no .bvh or .amc files in this folder")
+                raise MocycleError(f"{item}: no {', '.join(TAKE_SUFFIXES)} files in this folder")
         elif p.exists():
             if p.suffix.lower() not in TAKE_SUFFIXES:
-                raise MocycleError(f"{item}: not a take; batch reads {' and '.join(TAKE_SUFFIXES)} files")
+                raise MocycleError(f"{item}: not a take; batch reads {', '.join(TAKE_SUFFIXES)} files")
             root, files = _abs(p).parent, [_abs(p)]
         elif _magic(item):
             root = _abs(_root_of_pattern(item))
             files = [_abs(f) for f in sorted(glob.glob(item, recursive=True))]
             files = [f for f in files if _is_take(f) and not _inside(f, skip)]
             if not files:
-                raise MocycleError(f"{item}: the pattern matches no .bvh or .amc file")
+                raise MocycleError(f"{item}: the pattern matches no {', '.join(TAKE_SUFFIXES)} file")
         else:
             raise MocycleError(f"{item}: no such file or folder")
         found += [(f, root) for f in files]
