@@ -175,7 +175,9 @@ def _read(pufbx, scene, p: Path, take, fps) -> Motion:
                 raise MotionFileError("the node tree is not a tree", p)
             parents[j] = i
             children[i].append(j)
-    bone_type = pufbx.ElementType.BONE
+    from pufbx.enums import ElementType
+
+    bone_type = ElementType.BONE
     bones = [i for i, n in enumerate(nodes) if n.attrib_type == bone_type]
     if not bones:
         raise MotionFileError("no bones (LimbNode, Root or Limb nodes): nothing to read as a skeleton", p)
@@ -234,9 +236,9 @@ def _read(pufbx, scene, p: Path, take, fps) -> Motion:
                            _sample(times, st, sv, False) if moving[2] else sv[:1], animated=any(moving))
         else:
             local = nodes[i].local_transform
-            node = NodeTRS(names[i], np.asarray(local.translation.as_array(), dtype=float)[None],
-                           np.asarray(local.rotation.as_array(), dtype=float)[None],
-                           np.asarray(local.scale.as_array(), dtype=float)[None])
+            t, r, s = local.translation, local.rotation, local.scale
+            node = NodeTRS(names[i], np.array([[t.x, t.y, t.z]], dtype=float),
+                           np.array([[r.x, r.y, r.z, r.w]], dtype=float), np.array([[s.x, s.y, s.z]], dtype=float))
         trs[i] = node
         return node
 
