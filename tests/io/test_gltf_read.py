@@ -265,3 +265,26 @@ def test_not_json_and_not_glb(tmp_path):
     fake.write_bytes(b"glTF" + struct.pack("<II", 2, 10**9) + b"\0" * 30)
     with pytest.raises(MotionFileError, match="truncated"):
         mocycle.read(fake)
+
+
+def test_cli_info_lists_the_takes_and_take_chooses(tmp_path):
+    import json
+
+    from typer.testing import CliRunner
+
+    from mocycle.cli import app
+
+    path = small_glb(tmp_path / "a.glb", [("first", "LINEAR", [0.0, 1.0], [turn(0), turn(10)]),
+                                          ("second", "LINEAR", [0.0, 2.0], [turn(0), turn(60)])])
+    runner = CliRunner()
+    done = runner.invoke(app, ["info", str(path), "--json"])
+    assert done.exit_code == 0, done.output
+    facts = json.loads(done.output)
+    assert facts["takes"] == ["first", "second"] and facts["take"] == "first"
+    done = runner.invoke(app, ["info", str(path), "--take", "second", "--json"])
+    assert done.exit_code == 0, done.output
+    facts = json.loads(done.output)
+    assert facts["take"] == "second" and facts["duration_s"] == pytest.approx(2.0) and facts["fps"] == 30
+    done = runner.invoke(app, ["info", str(path), "--take", "third"])
+    assert done.exit_code == 1 and "no animation named 'third'" in done.output
+    assert "Traceback" not in done.output

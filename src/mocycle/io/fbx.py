@@ -12,9 +12,10 @@ binding and not ``pyufbx``).  What is read:
 * **the animation**: one animation stack (``take``: its name or 0-based index; default the first), baked by
   ufbx (``ufbx_bake_anim``): layers, pre/post rotations, rotation orders, pivots and scaling offsets composed
   into each node's local translation, rotation and scale, linearly keyed; then sampled at the frame rate.
-* **the frame rate**: ``fps`` when given; else the keys' own rate when the baked keys lie on a regular grid
-  (rounded to a whole number when within 1e-4), else 30 fps.  (pufbx 0.1.0 does not expose the scene's
-  settings, so the file's declared ``TimeMode`` is not read; exporters key every frame, which gives it.)
+* **the frame rate**: ``fps`` when given; else the keys' own rate when the baked keys lie on a regular grid of at
+  least 12 keys a second (rounded to a whole number when within 1e-4), else 30 fps.  (pufbx 0.1.0 does not
+  expose the scene's settings, so the file's declared ``TimeMode`` is not read; exporters key every frame, which
+  gives it.)
 * **units and axes**: the file's own, as its nodes hold them (FBX files are often centimetres, Y up; Blender's
   exporter writes the unit into the armature's scale): the joints' world positions are the file's, whatever
   scale (also non-uniform or animated) sits above or on the bones; see :mod:`._nodes`.
@@ -130,6 +131,8 @@ def _regular_rate(times: np.ndarray) -> float | None:
     if not np.allclose(k, np.round(k), rtol=0, atol=1e-3):
         return None
     rate = 1.0 / step
+    if rate < 12.0:  # a few keys far apart: authored keys, not one per frame
+        return None
     return float(round(rate)) if abs(rate - round(rate)) < 1e-4 * rate else rate
 
 

@@ -42,6 +42,8 @@ __all__ = ["DEFAULT_FPS", "gltf_takes", "read_gltf"]
 
 #: the frame rate of an animation whose keys lie on no regular grid (unless ``fps`` says otherwise)
 DEFAULT_FPS = 30.0
+#: key rates below this (frames per second) are taken for sparse authored keys: sampled at DEFAULT_FPS instead
+MIN_KEY_RATE = 12.0
 #: the largest file read whole (bytes): a glTF's buffers are read into memory
 MAX_FILE_BYTES = 2**31
 
@@ -402,6 +404,8 @@ def _frame_rate(all_keys: list[np.ndarray], fps: float | None) -> tuple[float, f
     if not regular or not step > 0:
         return start, end, DEFAULT_FPS
     rate = 1.0 / step
+    if rate < MIN_KEY_RATE:  # a few keys far apart: an authored clip, not one key per frame
+        return start, end, DEFAULT_FPS
     if abs(rate - round(rate)) < 1e-4 * rate and round(rate) > 0:
         rate = float(round(rate))
     return start, end, rate
