@@ -261,6 +261,7 @@ def test_mixamo_style_fbx(extension, scene, tmp_path):
           f"{err:.2e}")
     assert read.n_frames == blender.shape[0]
     assert err <= 0.01
+    assert 50 < height < 300  # centimetres, as the scene's unit says (metres would be 1.5)
     slow = mocycle.read(path, take=next(t for t in takes if "walk_half" in t))
     assert slow.n_frames >= 2 * read.n_frames - 3
     loop = tasks.loop.run(path, tasks.loop.Options(take=name)).facts  # a plain walk: the loop passes its checks
