@@ -388,6 +388,7 @@ def run_reader(reader: str, engine: str, args) -> dict:
     cmd = [sys.executable, __file__, "--child", reader, "--engine", engine, "--seconds", str(args.seconds),
            "--rss-mb", str(args.rss_mb), "--timeout", str(args.timeout), "--out", str(args.out)]
     if engine == "random":
+        cmd += ["--seed", str(args.seed)]  # another seed, other mutations
         proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
         try:
             return json.loads(proc.stdout.strip().splitlines()[-1])

@@ -148,6 +148,7 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
             world[:, j] = (top if parents[j] < 0 else world[:, parents[j]]) @ local
         rot = _rotation_part(world[:, :, :3, :3].reshape(-1, 3, 3)).reshape(n, J, 3, 3)
         pos = world[:, :, :3, 3]
+        r_locals = np.empty((n, K, 3, 3))
         for j in range(J):
             p = parents[j]
             if p < 0:
@@ -161,11 +162,12 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
                     site_offsets[j] = t_local[0].copy()
                 continue
             k = new_index[j]
-            rotations[rows, k] = Rotation.from_matrix(r_local).as_quat()
+            r_locals[:, k] = r_local
             if k in tracks:
                 tracks[k][rows] = t_local
             elif start == 0:
                 static[k] = t_local[0]
+        rotations[rows] = Rotation.from_matrix(r_locals.reshape(-1, 3, 3)).as_quat().reshape(n, K, 4)
     if not np.isfinite(rotations).all():
         raise MotionFileError("the node transforms give no usable rotation (a zero scale?)", path)
 
