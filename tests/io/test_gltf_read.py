@@ -288,3 +288,7 @@ def test_cli_info_lists_the_takes_and_take_chooses(tmp_path):
     done = runner.invoke(app, ["info", str(path), "--take", "third"])
     assert done.exit_code == 1 and "no animation named 'third'" in done.output
     assert "Traceback" not in done.output
+    out = tmp_path / "second.bvh"
+    done = runner.invoke(app, ["convert", str(path), str(out), "--take", "second"])
+    assert done.exit_code == 0, done.output
+    assert mocycle.read(out).n_frames == 61  # two seconds at 30 fps (two keys far apart: sparse, 30 fps)
