@@ -163,3 +163,17 @@ def test_no_bones(tmp_path):
     path.write_text(ascii_fbx(tmp_path / "x.fbx").read_text().replace('"LimbNode"', '"Null"'))
     with pytest.raises(MotionFileError, match="no bones"):
         read_fbx(path)
+
+
+def test_scale_on_a_bone_scales_what_hangs_below(tmp_path):
+    """Hips scaled by 2: the knee hangs 80 below it, the foot 20 above the knee (world positions as the file's)."""
+    text = ascii_fbx(tmp_path / "x.fbx").read_text()
+    scaled = text.replace(p3("Lcl Translation", "Lcl Translation", 0, 90, 0),
+                          p3("Lcl Translation", "Lcl Translation", 0, 90, 0)
+                          + p3("Lcl Scaling", "Lcl Scaling", 2, 2, 2), 1)
+    assert scaled != text
+    path = tmp_path / "scaled.fbx"
+    path.write_text(scaled)
+    p = positions(read_fbx(path))
+    assert p["mixamorig:LeftLeg"][0] == pytest.approx([0, 10, 0], abs=1e-6)
+    assert p["mixamorig:LeftFoot"][-1] == pytest.approx([0, 30, 0], abs=1e-6)
