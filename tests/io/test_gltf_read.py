@@ -292,3 +292,18 @@ def test_cli_info_lists_the_takes_and_take_chooses(tmp_path):
     done = runner.invoke(app, ["convert", str(path), str(out), "--take", "second"])
     assert done.exit_code == 0, done.output
     assert mocycle.read(out).n_frames == 61  # two seconds at 30 fps (two keys far apart: sparse, 30 fps)
+
+
+def test_gltf_text_with_data_uri_and_bin_file(tmp_path):
+    path = small_glb(tmp_path / "a.glb", [("swing", "LINEAR", [0.0, 1.0], [turn(0), turn(90)])])
+    expected = tip_angle(read_gltf(path, fps=10))
+    gl = g.GLTF2.load(path)
+    gl.convert_buffers(g.BufferFormat.DATAURI)
+    gl.save_json(str(tmp_path / "uri.gltf"))
+    assert tip_angle(mocycle.read(tmp_path / "uri.gltf", sample_fps=10)) == pytest.approx(expected, abs=1e-9)
+    gl = g.GLTF2.load(path)
+    gl._path = tmp_path
+    gl.convert_buffers(g.BufferFormat.BINFILE)
+    gl.save_json(str(tmp_path / "file.gltf"))
+    assert any(p.suffix == ".bin" for p in tmp_path.iterdir())
+    assert tip_angle(mocycle.read(tmp_path / "file.gltf", sample_fps=10)) == pytest.approx(expected, abs=1e-9)
