@@ -265,6 +265,11 @@ def test_not_json_and_not_glb(tmp_path):
     fake.write_bytes(b"glTF" + struct.pack("<II", 2, 10**9) + b"\0" * 30)
     with pytest.raises(MotionFileError, match="truncated"):
         mocycle.read(fake)
+    # the header claims no room for any chunk (found by benchmarks/fuzz.py: an AttributeError before)
+    for claimed in (0, 2, 12):
+        fake.write_bytes(b"glTF" + struct.pack("<II", 2, claimed) + b"\0" * 30)
+        with pytest.raises(MotionFileError, match="no room for the JSON chunk"):
+            mocycle.read(fake)
 
 
 def test_cli_info_lists_the_takes_and_take_chooses(tmp_path):

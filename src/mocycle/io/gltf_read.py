@@ -155,6 +155,8 @@ class _File:
                 blob = data[at + 8:at + 8 + n]
             at += 8 + n
             chunks += 1
+        if text is None:
+            raise MotionFileError(f"the header says {length} bytes: no room for the JSON chunk", self.path)
         return text, blob
 
     def items(self, kind: str) -> list:
