@@ -1,19 +1,25 @@
 """Long fuzzing run of every reader, to run before releases (the suite's fuzz tests are the short version).
 
-    python benchmarks/fuzz.py [--seconds 3600] [--readers bvh,asf,amc,mck,mosw,json] [--engine auto|atheris|random]
+    python benchmarks/fuzz.py [--seconds 3600] [--readers bvh,asf,amc,mck,mosw,json,glb,fbx]
+                              [--engine auto|atheris|random]
                               [--rss-mb 2048] [--timeout 10] [--max-frames 100000] [--out DIR] [--data DIR]
     python benchmarks/fuzz.py --replay DIR/json-oom-... [...]    # saved inputs, each in a fresh process
 
 Each reader runs in its own process under a memory limit (``RLIMIT_AS`` of ``--rss-mb``) and a time limit
 per input (``--timeout`` seconds).  A reader passes an input when it returns a result that goes on working
-(``.mck`` decompresses, ``.mosw`` and swings JSON play back, BVH/ASF/AMC write as BVH and read back) or raises one
+(``.mck`` decompresses, ``.mosw`` and swings JSON play back, BVH/ASF/AMC write as BVH and read back, glTF and FBX
+give a finite motion) or raises one
 :class:`~mocycle.errors.MotionFileError`; anything else is a crash, a run past the time limit a hang, a
 ``MemoryError`` a blow-up.
 
 Engines: ``atheris`` (coverage-guided libFuzzer; ``pip install atheris``, a wheel exists for CPython 3.11 on
 x86-64 Linux; the binary formats are mutated inside their zlib payload by a custom mutator) or ``random``
 (mutations of the seeds, no coverage feedback); ``auto`` takes atheris when it imports.  Seeds are generated
-takes and, when ``../shared/data`` is present, a few real files.
+takes and, when ``../shared/data`` is present, a few real files.  The glTF reader (``glb``) is seeded with GLBs
+mocycle writes; the FBX reader (``fbx``) with the ``.fbx`` files under ``$MOCYCLE_FUZZ_FBX`` (a folder; e.g. the ones
+Blender exports in ``tests_blender/test_formats_in.py``, or ``benchmarks/fbx_seeds.py`` run in the bpy environment),
+and is skipped, saying so, without them.  Both read from a file (their readers take paths), written anew for
+each input.  ufbx is C: a crash there kills the child, reported as ``child died``.
 
 Prints per reader: inputs tried, accepted, refused, crashes (by signature), hangs, blow-ups and peak memory
 (an input libFuzzer's RSS watchdog blames is tried again alone in a fresh process: a blow-up only if it fails
@@ -39,7 +45,7 @@ from pathlib import Path
 
 from mocycle.datasets.asfamc_text import TINY_AMC, TINY_ASF
 
-READERS = ("bvh", "asf", "amc", "mck", "mosw", "json")
+READERS = ("bvh", "asf", "amc", "mck", "mosw", "json", "glb", "fbx")
 DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
 ASF, AMC = TINY_ASF, TINY_AMC
@@ -97,9 +103,38 @@ def _targets():
     data = Path(os.environ.get("MOCYCLE_FUZZ_DATA", DEFAULT_DATA))
     real_bvh = sorted(data.glob("*/*.bvh"), key=lambda p: p.stat().st_size)[:2] if data.is_dir() else []
     bvh_seeds += [p.read_bytes() for p in real_bvh]
+    scratch = Path(tempfile.mkdtemp(prefix="mocycle-fuzz-files-"))
+
+    def from_file(suffix, read):
+        def run(data):
+            path = scratch / f"fuzz{suffix}"
+            path.write_bytes(data)
+            finite(read(path))
+        return run
+
+    def glb_reader(path):
+        from mocycle.io.gltf_read import read_gltf
+
+        return read_gltf(path)
+
+    def fbx_reader(path):
+        from mocycle.io.fbx import read_fbx
+
+        return read_fbx(path)
+
+    glb_seeds = []
+    for k, m in enumerate((walk[:30], walk[:3])):
+        from mocycle.io.gltf import write_gltf
+
+        glb_seeds.append(write_gltf(m, scratch / f"seed{k}.glb").read_bytes())
+    fbx_dir = os.environ.get("MOCYCLE_FUZZ_FBX")
+    fbx_seeds = [p.read_bytes() for p in sorted(Path(fbx_dir).glob("**/*.fbx"), key=lambda p: p.stat().st_size)[:4]] \
+        if fbx_dir and Path(fbx_dir).is_dir() else []
     return {"bvh": (bvh, bvh_seeds, None), "asf": (asf, [ASF.encode()], None), "amc": (amc, [AMC.encode()], None),
             "mck": (mck, mck_seeds, MCK), "mosw": (mosw, [encode(segment(walk))], MOSW),
-            "json": (swings_json, [json.dumps(segment(walk[:40]).to_dict()).encode()], None)}
+            "json": (swings_json, [json.dumps(segment(walk[:40]).to_dict()).encode()], None),
+            "glb": (from_file(".glb", glb_reader), glb_seeds, None),
+            "fbx": (from_file(".fbx", fbx_reader), fbx_seeds, None)}
 
 
 INTERESTING = [b"\x00", b"\xff", b"\x7f", b"\x80", b"\x00\x00\x00\x00", b"\xff\xff\xff\xff", b"\x00\xca\x9a\x3b",
@@ -169,6 +204,10 @@ def child_random(reader: str, seconds: float, rss_mb: int, timeout: float, out: 
     rng = random.Random(seed)
     stats = {"reader": reader, "engine": "random", "tried": 0, "accepted": 0, "refused": 0, "crashes": {},
              "hangs": 0, "blowups": 0, "slowest_s": 0.0}
+    if not seeds:
+        stats["skipped"] = "no seed files (set MOCYCLE_FUZZ_FBX to a folder of .fbx files)"
+        stats["peak_mb"] = _peak_mb()
+        return stats
 
     def alarm(signum, frame):
         raise Hang()
@@ -224,8 +263,11 @@ def child_atheris(reader: str, seconds: float, rss_mb: int, timeout: float, out:
     import scipy.spatial.transform  # noqa: F401
 
     with atheris.instrument_imports(include=["mocycle"]):
+        import mocycle.io._nodes  # noqa: F401
         import mocycle.io.asfamc  # noqa: F401
         import mocycle.io.bvh  # noqa: F401
+        import mocycle.io.fbx  # noqa: F401
+        import mocycle.io.gltf_read  # noqa: F401
         import mocycle.io.inflate  # noqa: F401
         import mocycle.io.mck  # noqa: F401
         import mocycle.io.mosw  # noqa: F401
@@ -346,6 +388,7 @@ def run_reader(reader: str, engine: str, args) -> dict:
     cmd = [sys.executable, __file__, "--child", reader, "--engine", engine, "--seconds", str(args.seconds),
            "--rss-mb", str(args.rss_mb), "--timeout", str(args.timeout), "--out", str(args.out)]
     if engine == "random":
+        cmd += ["--seed", str(args.seed)]  # another seed, other mutations
         proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
         try:
             return json.loads(proc.stdout.strip().splitlines()[-1])
@@ -434,6 +477,9 @@ def main(argv=None) -> int:
     bad = False
     for reader in args.readers.split(","):
         s = run_reader(reader, engine, args)
+        if s.get("skipped"):
+            table.add_row(reader, "skipped", "", "", "", "", "", s["skipped"])
+            continue
         n_crash = sum(s["crashes"].values())
         bad |= bool(n_crash or s["hangs"] or s["blowups"])
         table.add_row(reader, f"{s['tried']:,}", str(n_crash), str(s["hangs"]), str(s["blowups"]),

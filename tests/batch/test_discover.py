@@ -62,7 +62,7 @@ def test_the_output_folder_is_not_read_back_and_duplicates_count_once(tmp_path):
 @pytest.mark.parametrize("make, match", [
     (lambda r: [r / "missing"], "no such file or folder"),
     (lambda r: [r / "a" / "notes.txt"], "not a take"),
-    (lambda r: [r / "empty"], "no .bvh or .amc files"),
+    (lambda r: [r / "empty"], "no .bvh, .amc, .fbx, .glb, .gltf files"),
     (lambda r: [str(r / "*.fbx")], "matches no"),
     (lambda r: [], "no inputs"),
 ])

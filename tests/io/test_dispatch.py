@@ -59,9 +59,9 @@ def test_result_with_to_dict_written_as_json(tmp_path):
 
 def test_unknown_suffix_names_file_and_known_suffixes(tmp_path):
     with pytest.raises(MotionFileError) as info:
-        mocycle.read(tmp_path / "take.fbx")
+        mocycle.read(tmp_path / "take.c3d")
     msg = str(info.value)
-    assert "take.fbx" in msg and "'.fbx'" in msg
+    assert "take.c3d" in msg and "'.c3d'" in msg
     assert all(s in msg for s in READ_SUFFIXES)
 
 

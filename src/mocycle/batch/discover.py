@@ -13,7 +13,7 @@ from pathlib import Path
 from ..errors import MocycleError
 
 #: the suffixes of the files that hold a take (``.amc`` with its ``.asf`` beside it)
-TAKE_SUFFIXES = (".bvh", ".amc")
+TAKE_SUFFIXES = (".bvh", ".amc", ".fbx", ".glb", ".gltf")
 
 __all__ = ["TAKE_SUFFIXES", "Take", "find_takes"]
 
@@ -45,10 +45,6 @@ class Take:
         if self.source.suffix.lower() == ".amc":
             return [self.source] + sorted(p for p in self.source.parent.iterdir() if p.suffix.lower() == ".asf")
         return [self.source]
-
-
-def _is_take(p: Path) -> bool:
-    return p.is_file() and p.suffix.lower() in TAKE_SUFFIXES and not p.name.startswith(".")
 
 
 def _why(exc: OSError) -> str:
@@ -157,9 +153,9 @@ def _inside(p: Path, folder: Path | None) -> bool:
 def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None = None) -> list[Take]:
     """The takes named by ``inputs`` (files, folders, glob patterns), sorted by their relative path.
 
-    A folder is searched recursively for ``.bvh`` and ``.amc`` files (hidden files and anything under
-    ``outdir``, when it lies inside the folder, are left out, so outputs written into the input tree are never
-    read back as inputs; an input folder inside ``outdir`` is searched whole). The
+    A folder is searched recursively for motion files (``.bvh``, ``.amc``, ``.fbx``, ``.glb``, ``.gltf``;
+    hidden files and anything under ``outdir``, when it lies inside the folder, are left out, so outputs written
+    into the input tree are never read back as inputs; an input folder inside ``outdir`` is searched whole). The
     relative path of a take is taken from the common folder of the inputs' roots (a folder is its own root,
     a file's root is its folder, a pattern's root is its folder before the first wildcard).
 
@@ -179,10 +175,10 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
             root = _abs(p)
             files, problems = _walk(root, _below(skip, root))
             if not files and not problems:
-                raise MocycleError(f"{item}: no .bvh or .amc files in this folder")
+                raise MocycleError(f"{item}: no {', '.join(TAKE_SUFFIXES)} files in this folder")
         elif p.exists():
             if p.suffix.lower() not in TAKE_SUFFIXES:
-                raise MocycleError(f"{item}: not a take; batch reads {' and '.join(TAKE_SUFFIXES)} files")
+                raise MocycleError(f"{item}: not a take; batch reads {', '.join(TAKE_SUFFIXES)} files")
             why = problem_of(_abs(p))
             if why is not None:
                 raise MocycleError(f"{item}: {why}")
@@ -200,7 +196,7 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
                 else:
                     problems.append((f, why))
             if not files and not problems:
-                raise MocycleError(f"{item}: the pattern matches no .bvh or .amc file")
+                raise MocycleError(f"{item}: the pattern matches no {', '.join(TAKE_SUFFIXES)} file")
         elif os.path.islink(item):
             raise MocycleError(f"{item}: {problem_of(Path(item))}")
         else:

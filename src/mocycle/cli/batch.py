@@ -58,7 +58,7 @@ def batch(
     args: Annotated[list[str], typer.Argument(
         metavar="ARGS", show_default=False,
         help="COMMAND INPUTS... [options of COMMAND]: COMMAND is info, phase, loop, swings, compress or stretch; "
-             "INPUTS are .bvh/.amc files, folders "
+             "INPUTS are motion files (.bvh, .amc, .fbx, .glb, .gltf), folders "
              "(searched recursively) or glob patterns; then any flag of 'mocycle COMMAND' that sets an option "
              "of the task (e.g. --harmonics 5, --root motion, --factor 2).")],
     outdir: Annotated[Path, typer.Option("--output", "-o", help="The output folder (made when missing; checked "

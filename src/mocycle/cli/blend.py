@@ -52,6 +52,7 @@ def blend(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help=PLOT_HELP)] = None,
     amc_fps: Annotated[float, flag(B, "amc_fps")] = default(B, "amc_fps"),
+    take: Annotated[str | None, flag(B, "take")] = default(B, "take"),
     force: Annotated[bool, flag(B, "force")] = default(B, "force"),
     feet: Annotated[str, flag(B, "feet")] = default(B, "feet"),
     foot_joints: Annotated[str | None, flag(B, "foot_joints")] = default(B, "foot_joints"),
@@ -70,7 +71,7 @@ def blend(
     check_output(plot, paths, force, ".png", "--plot")
     options = B(weights=weights, root=root, cycles=cycles, method=method, model=model, harmonics=harmonics,
                 align=align, joints=joints, classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods,
-                amc_fps=amc_fps, force=force, feet=feet, foot_joints=foot_joints)
+                amc_fps=amc_fps, take=take, force=force, feet=feet, foot_joints=foot_joints)
     report = tasks.blend.run(paths, options)
     print_warnings(report)
     written = write_motion(report, "loop", output, gltf_scale, gltf_up, closing_frame)
@@ -115,7 +116,7 @@ def blend(
 @app.command()
 @friendly
 def transition(
-    first: Annotated[Path, typer.Argument(help="The take to start as (.bvh or .amc).")],
+    first: Annotated[Path, typer.Argument(help="The take to start as (.bvh, .fbx, .glb, .gltf or .amc).")],
     second: Annotated[Path, typer.Argument(help="The take to end as, on the same skeleton.")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The transition as a .bvh or .glb file.")],
     cycles: Annotated[int, flag(T, "cycles")] = default(T, "cycles"),
@@ -133,6 +134,7 @@ def transition(
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves over the transition's phase, and the weight.")] = None,
     amc_fps: Annotated[float, flag(T, "amc_fps")] = default(T, "amc_fps"),
+    take: Annotated[str | None, flag(T, "take")] = default(T, "take"),
     force: Annotated[bool, flag(T, "force")] = default(T, "force"),
     feet: Annotated[str, flag(T, "feet")] = default(T, "feet"),
     foot_joints: Annotated[str | None, flag(T, "foot_joints")] = default(T, "foot_joints"),
@@ -148,7 +150,7 @@ def transition(
     check_motion_output(output, [first, second], force, "--output", gltf_scale, gltf_up)
     check_output(plot, [first, second], force, ".png", "--plot")
     options = T(cycles=cycles, root=root, method=method, model=model, harmonics=harmonics, joints=joints,
-                classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods, amc_fps=amc_fps,
+                classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods, amc_fps=amc_fps, take=take,
                 force=force, feet=feet, foot_joints=foot_joints)
     report = tasks.transition.run([first, second], options)
     print_warnings(report)

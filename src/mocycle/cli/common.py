@@ -28,8 +28,8 @@ from ..text import json_text, printable
 #: order ``mocycle --help`` lists them.  tests/test_startup.py checks both against the commands themselves.
 COMMANDS = {
     "info": ("info", "Frames, frame time, fps, duration, joints, channels, root travel and rotation ranges."),
-    "convert": ("convert", "Convert ASF/AMC to BVH or glTF (.glb), or rewrite a BVH (optionally a frame range, "
-                           "another fps)."),
+    "convert": ("convert", "Convert ASF/AMC, FBX or glTF to BVH or glTF (.glb), or rewrite a BVH (optionally a "
+                           "frame range, another fps)."),
     "phase": ("phase", "Find periodic motions and the phase of every frame (persistent cohomology)."),
     "loop": ("loop", "Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH or "
                      "glTF."),

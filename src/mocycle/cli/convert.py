@@ -17,21 +17,26 @@ from .common import FORCE_HELP, GLTF_SCALE, GLTF_UP, app, check_motion_output, e
 @friendly
 def convert(
     paths: Annotated[list[Path], typer.Argument(
-        help="Input then output: IN.bvh OUT.bvh, or SKELETON.asf MOTION.amc OUT.bvh (or OUT.glb).")],
+        help="Input then output: IN OUT.bvh (IN: .bvh, .fbx, .glb, .gltf), or SKELETON.asf MOTION.amc OUT.bvh "
+             "(or OUT.glb).")],
     fps: Annotated[float | None, typer.Option(
         help="Resample the output to this frame rate (slerp; the first and last frame's times are kept).")] = None,
     amc_fps: Annotated[float, typer.Option(
         help="Frame rate of AMC input files, which do not store it (CMU: 120).")] = AMC_FPS,
+    take: Annotated[str | None, typer.Option(
+        help="Which take of a glTF or FBX input to read: its name or 0-based index (mocycle info lists them); "
+             "default the first.")] = None,
     frame_range: Annotated[str | None, typer.Option("--range", help="Keep frames START:STOP.")] = None,
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
     gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
     gltf_up: Annotated[str, GLTF_UP] = "auto",
 ):
-    """Convert ASF/AMC to BVH or glTF (.glb), or rewrite a BVH (optionally a frame range, another fps)."""
+    """Convert ASF/AMC, FBX or glTF to BVH or glTF (.glb), or rewrite a BVH (optionally a frame range, another
+    fps)."""
     if len(paths) in (2, 3):
         check_motion_output(paths[-1], paths[:-1], force, "the output", gltf_scale, gltf_up)
     if len(paths) == 2:
-        motion = read(paths[0], fps=amc_fps)
+        motion = read(paths[0], fps=amc_fps, take=take)
     elif len(paths) == 3:
         asf, amc = paths[0], paths[1]
         if asf.suffix.lower() != ".asf" or amc.suffix.lower() != ".amc":

@@ -16,12 +16,13 @@ O = tasks.info.Options
 @app.command()
 @friendly
 def info(
-    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON instead of tables.")] = False,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
+    take: Annotated[str | None, flag(O, "take")] = default(O, "take"),
 ):
     """Frames, frame time, fps, duration, joints, channels, root travel and rotation ranges."""
-    report = tasks.info.run(path, O(amc_fps=amc_fps))
+    report = tasks.info.run(path, O(amc_fps=amc_fps, take=take))
     print_warnings(report)
     facts = {**report.facts, "file": str(path), "seconds": report.seconds}
     if as_json:
@@ -40,6 +41,7 @@ def _print_info(facts: dict) -> None:
         f"  {facts['joints']} joints, {facts['channels']} channels, {facts['end_sites']} end sites\n"
         f"  travel of {escape(facts['travel_joint'])}: {facts['root_displacement']:.4g} net, "
         f"{facts['root_path_length']:.4g} along the path (file units)"
+        + (f"\n  takes: {', '.join(facts['takes'])} (read: {facts['take']})" if "takes" in facts else "")
     )
     ranges, spread = facts["rotation_range_deg"], facts["rotation_spread_deg"]
     order = sorted(spread, key=lambda n: -spread[n])

@@ -34,7 +34,7 @@ P = tasks.project.Options
 @app.command()
 @friendly
 def compress(
-    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="The .mck file to write.")],
     ratio: Annotated[str, flag(C, "ratio")] = default(C, "ratio"),
     select: Annotated[str, flag(C, "select")] = default(C, "select"),
@@ -44,6 +44,7 @@ def compress(
     optimize: Annotated[bool, flag(C, "optimize")] = default(C, "optimize"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(C, "amc_fps")] = default(C, "amc_fps"),
+    take: Annotated[str | None, flag(C, "take")] = default(C, "take"),
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size.
@@ -53,7 +54,7 @@ def compress(
     """
     check_output(output, [path], force, ".mck", "--output")
     options = C(ratio=ratio, select=select, scheme=scheme, projection=projection, seed_projection=seed_projection,
-                optimize=optimize, amc_fps=amc_fps)
+                optimize=optimize, amc_fps=amc_fps, take=take)
     report = tasks.compress.run(path, options)
     print_warnings(report)
     report.result.save(output)
@@ -113,7 +114,7 @@ def decompress(
 @app.command()
 @friendly
 def project(
-    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
     projection: Annotated[str, flag(P, "projection")] = default(P, "projection"),
     select: Annotated[str, flag(P, "select")] = default(P, "select"),
     ratio: Annotated[float, flag(P, "ratio")] = default(P, "ratio"),
@@ -123,12 +124,13 @@ def project(
                                                    "marked (thesis Figure 6.2).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON (includes the 2-D points).")] = False,
     amc_fps: Annotated[float, flag(P, "amc_fps")] = default(P, "amc_fps"),
+    take: Annotated[str | None, flag(P, "take")] = default(P, "take"),
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."""
     check_output(plot, [path], force, ".png", "--plot")
     options = P(projection=projection, select=select, ratio=ratio, seed_projection=seed_projection,
-                optimize=optimize, amc_fps=amc_fps)
+                optimize=optimize, amc_fps=amc_fps, take=take)
     report = tasks.project.run(path, options)
     print_warnings(report)
     r, arrays = report.facts, report.result

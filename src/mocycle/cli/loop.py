@@ -34,7 +34,7 @@ O = tasks.loop.Options
 @app.command()
 @friendly
 def loop(
-    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The cycle as a .bvh or .glb file.")],
     method: Annotated[str, flag(O, "method")] = default(O, "method"),
     model: Annotated[str, flag(O, "model")] = default(O, "model"),
@@ -55,6 +55,7 @@ def loop(
         help="Write a PNG: PCA of input and cycle, phase, joint curves (with --class all: OUT.classK.png).")]
     = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
+    take: Annotated[str | None, flag(O, "take")] = default(O, "take"),
     force: Annotated[bool, flag(O, "force")] = default(O, "force"),
     feet: Annotated[str, flag(O, "feet")] = default(O, "feet"),
     feet_plot: Annotated[Path | None, typer.Option(
@@ -78,7 +79,7 @@ def loop(
     check_output(feet_plot, [path], force, ".png", "--feet-plot")
     options = O(method=method, model=model, harmonics=harmonics, root=root, frame_range=frame_range, step=step,
                 joints=joints, cycles=cycles, classes=classes, which=which, pca=pca, delay=delay,
-                min_periods=min_periods, time_axis=time_axis, amc_fps=amc_fps, force=force, feet=feet,
+                min_periods=min_periods, time_axis=time_axis, amc_fps=amc_fps, take=take, force=force, feet=feet,
                 foot_joints=foot_joints)
     try:
         report = tasks.loop.run(path, options)

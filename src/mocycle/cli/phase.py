@@ -30,7 +30,7 @@ O = tasks.phase.Options
 @app.command()
 @friendly
 def phase(
-    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
     classes: Annotated[str, flag(O, "classes")] = default(O, "classes"),
     joints: Annotated[str | None, flag(O, "joints")] = default(O, "joints"),
     pca: Annotated[str, flag(O, "pca")] = default(O, "pca"),
@@ -40,6 +40,7 @@ def phase(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: diagram, phase per frame, PCA by phase.")] = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
+    take: Annotated[str | None, flag(O, "take")] = default(O, "take"),
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ):
     """Find periodic motions and the phase of every frame (persistent cohomology).
@@ -49,7 +50,7 @@ def phase(
     """
     check_output(plot, [path], force, ".png", "--plot")
     options = O(classes=classes, joints=joints, pca=pca, delay=delay, min_periods=min_periods, n_landmarks=landmarks,
-                amc_fps=amc_fps)
+                amc_fps=amc_fps, take=take)
     report = tasks.phase.run(path, options, keep_features=plot is not None)
     print_warnings(report)
     if plot is not None:

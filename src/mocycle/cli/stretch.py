@@ -31,7 +31,7 @@ O = tasks.stretch.Options
 @app.command()
 @friendly
 def stretch(
-    path: Annotated[Path, typer.Argument(help="A .bvh file, or an .amc file (its .asf beside it).")],
+    path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
     factor: Annotated[float, flag(O, "factor")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The .bvh or .glb file to write.")],
     window: Annotated[str, flag(O, "window_frames")] = default(O, "window_frames"),
@@ -39,6 +39,7 @@ def stretch(
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves of the input and the stretched take in seconds.")] = None,
     amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
+    take: Annotated[str | None, flag(O, "take")] = default(O, "take"),
     force: Annotated[bool, flag(O, "force")] = default(O, "force"),
     feet: Annotated[str, flag(O, "feet")] = default(O, "feet"),
     foot_joints: Annotated[str | None, flag(O, "foot_joints")] = default(O, "foot_joints"),
@@ -57,8 +58,8 @@ def stretch(
     """
     check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
     check_output(plot, [path], force, ".png", "--plot")
-    report = tasks.stretch.run(path, O(factor=factor, window_frames=window, amc_fps=amc_fps, force=force, feet=feet,
-                                       foot_joints=foot_joints))
+    report = tasks.stretch.run(path, O(factor=factor, window_frames=window, amc_fps=amc_fps, take=take, force=force,
+                                       feet=feet, foot_joints=foot_joints))
     print_warnings(report)
     write_motion(report, "stretched", output, gltf_scale, gltf_up)
     if plot is not None:

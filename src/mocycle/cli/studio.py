@@ -69,5 +69,5 @@ def studio(
         raise typer.Exit(1) from None
     studio_app = create_app(paths, amc_fps=amc_fps)
     if not studio_app.state.studio.takes:
-        raise MocycleError(f"no motion files (.bvh, .amc) in {', '.join(map(str, paths))}")
+        raise MocycleError(f"no motion files (.bvh, .amc, .fbx, .glb, .gltf) in {', '.join(map(str, paths))}")
     serve(studio_app, host, port, not no_browser)

@@ -38,7 +38,8 @@ _FACT_KEYS = ("joints", "n_swings", "segmentation_error", "per_angle_error_deg",
 @app.command()
 @friendly
 def swings(
-    path: Annotated[Path, typer.Argument(help="A .bvh or .amc file, or a .mosw swings file to play back.")],
+    path: Annotated[Path, typer.Argument(
+        help="A motion file (.bvh, .fbx, .glb, .gltf, .amc), or a .mosw swings file to play back.")],
     threshold: Annotated[float, flag(S, "threshold")] = default(S, "threshold"),
     joints: Annotated[str | None, flag(S, "joints")] = default(S, "joints"),
     output: Annotated[Path | None, typer.Option(
@@ -50,6 +51,7 @@ def swings(
     = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(S, "amc_fps")] = default(S, "amc_fps"),
+    take: Annotated[str | None, flag(S, "take")] = default(S, "take"),
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
     gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
     gltf_up: Annotated[str, GLTF_UP] = "auto",
@@ -61,7 +63,7 @@ def swings(
     check_output(output, [path], force, (".json", ".mosw"), "--output")
     check_motion_output(playback_path, [path], force, "--playback", gltf_scale, gltf_up)
     check_output(plot, [path], force, ".png", "--plot")
-    report = tasks.swings.run(path, S(threshold=threshold, joints=joints, amc_fps=amc_fps))
+    report = tasks.swings.run(path, S(threshold=threshold, joints=joints, amc_fps=amc_fps, take=take))
     print_warnings(report)
     seg, r = report.result, report.facts
     written = []
@@ -112,7 +114,7 @@ def swings(
 @app.command()
 @friendly
 def search(
-    query: Annotated[Path, typer.Argument(help="The example take (.bvh or .amc).")],
+    query: Annotated[Path, typer.Argument(help="The example take (.bvh, .fbx, .glb, .gltf or .amc).")],
     folder: Annotated[Path, typer.Argument(help="Folder of takes to search.")],
     top: Annotated[int, flag(Q, "top")] = default(Q, "top"),
     pattern: Annotated[str, flag(Q, "pattern")] = default(Q, "pattern"),
@@ -120,9 +122,10 @@ def search(
     window: Annotated[float, flag(Q, "window_s")] = default(Q, "window_s"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(Q, "amc_fps")] = default(Q, "amc_fps"),
+    take: Annotated[str | None, flag(Q, "take")] = default(Q, "take"),
 ):
     """Rank the takes of a folder by how alike their swings are to an example (query by example)."""
-    options = Q(top=top, pattern=pattern, threshold=threshold, window_s=window, amc_fps=amc_fps)
+    options = Q(top=top, pattern=pattern, threshold=threshold, window_s=window, amc_fps=amc_fps, take=take)
     report = tasks.search.run(query, folder, options)
     print_warnings(report)
     if as_json:
@@ -144,7 +147,7 @@ def search(
 @app.command()
 @friendly
 def edit(
-    path: Annotated[Path, typer.Argument(help="A .bvh or .amc file.")],
+    path: Annotated[Path, typer.Argument(help="A motion file (.bvh, .fbx, .glb, .gltf or .amc).")],
     joint: Annotated[str, flag(E, "joint")],
     swing: Annotated[int, flag(E, "swing")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Edited motion (.bvh or .glb).")],
@@ -154,6 +157,7 @@ def edit(
     joints: Annotated[str | None, flag(E, "joints")] = default(E, "joints"),
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     amc_fps: Annotated[float, flag(E, "amc_fps")] = default(E, "amc_fps"),
+    take: Annotated[str | None, flag(E, "take")] = default(E, "take"),
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
     gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
     gltf_up: Annotated[str, GLTF_UP] = "auto",
@@ -161,7 +165,7 @@ def edit(
     """Scale the angle or the duration of one swing of one joint and write the edited motion."""
     check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
     options = E(joint=joint, swing=swing, angle_scale=angle_scale, duration_scale=duration_scale,
-                threshold=threshold, joints=joints, amc_fps=amc_fps)
+                threshold=threshold, joints=joints, amc_fps=amc_fps, take=take)
     report = tasks.edit.run(path, options)
     print_warnings(report)
     write_motion(report, "edited", output, gltf_scale, gltf_up)

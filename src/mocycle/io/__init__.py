@@ -6,7 +6,10 @@ One way in and one way out, chosen by the file's suffix:
 suffix     holds                                       :func:`read` returns / :func:`write` takes
 =========  ==========================================  =======================================
 ``.bvh``   a motion (:mod:`.bvh`)                      :class:`~mocycle.motion.Motion`
-``.glb``   a motion as binary glTF (:mod:`.gltf`)      :class:`~mocycle.motion.Motion` (write only)
+``.glb``   a motion as binary glTF (:mod:`.gltf`,       :class:`~mocycle.motion.Motion`
+           read by :mod:`.gltf_read`)
+``.gltf``  a motion as glTF text (:mod:`.gltf_read`)   :class:`~mocycle.motion.Motion` (read only)
+``.fbx``   a motion in an FBX file (:mod:`.fbx`)       :class:`~mocycle.motion.Motion` (read only)
 ``.amc``   a CMU motion, skeleton in an ``.asf``       :class:`~mocycle.motion.Motion` (read only)
 ``.mck``   a keyframe-compressed take (:mod:`.mck`)    :class:`~mocycle.keyframes.Compressed`
 ``.mosw``  joint swings, compact (:mod:`.mosw`)        :class:`~mocycle.swings.Segmentation`
@@ -15,7 +18,8 @@ suffix     holds                                       :func:`read` returns / :f
 
 ``write`` also writes any result that has a ``to_dict()`` (cycles, phases, reports) as
 ``.json``.  :func:`read_motion` is :func:`read` for the files that hold a motion
-(``.bvh``, ``.amc``), which is what the commands that take a motion use.
+(``.bvh``, ``.amc``, ``.glb``, ``.gltf``, ``.fbx``), which is what the commands that take a motion use.
+glTF and FBX files may hold several animations (takes): ``take`` names one (:func:`takes` lists them).
 """
 
 from __future__ import annotations
@@ -31,11 +35,13 @@ from .asfamc import AMC_FPS, read_amc, read_asf, read_asfamc
 from .atomic import atomic_write
 from .bvh import parse_bvh, read_bvh, write_bvh
 
-__all__ = ["AMC_FPS", "MOTION_WRITE_SUFFIXES", "READ_SUFFIXES", "WRITE_SUFFIXES", "parse_bvh", "read", "read_amc",
-           "read_asf", "read_asfamc", "read_bvh", "read_motion", "write", "write_bvh"]
+__all__ = ["AMC_FPS", "MOTION_WRITE_SUFFIXES", "READ_SUFFIXES", "TAKE_SUFFIXES", "WRITE_SUFFIXES", "parse_bvh", "read",
+           "read_amc", "read_asf", "read_asfamc", "read_bvh", "read_motion", "takes", "write", "write_bvh"]
 
-MOTION_SUFFIXES = (".bvh", ".amc")
-READ_SUFFIXES = (".bvh", ".amc", ".mck", ".mosw", ".json")
+MOTION_SUFFIXES = (".bvh", ".amc", ".glb", ".gltf", ".fbx")
+#: the motion files that may hold several takes (animations, animation stacks)
+TAKE_SUFFIXES = (".glb", ".gltf", ".fbx")
+READ_SUFFIXES = (".bvh", ".amc", ".glb", ".gltf", ".fbx", ".mck", ".mosw", ".json")
 WRITE_SUFFIXES = (".bvh", ".glb", ".mck", ".mosw", ".json")
 #: the files a Motion is written as
 MOTION_WRITE_SUFFIXES = (".bvh", ".glb")
@@ -52,15 +58,37 @@ def _suffix(p: Path, known: tuple[str, ...], what: str) -> str:
     return suffix
 
 
-def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = AMC_FPS) -> Motion:
-    """Read a motion file (``.bvh``, or ``.amc`` with its ``.asf``) into a :class:`Motion`.
+def takes(path: str | os.PathLike) -> list[str]:
+    """The names of the takes (glTF animations, FBX animation stacks) a motion file holds; one for other files
+    (its stem)."""
+    p = Path(path)
+    suffix = _suffix(p, MOTION_SUFFIXES, "mocycle reads motions from")
+    if suffix in (".glb", ".gltf"):
+        from .gltf_read import gltf_takes
+
+        return gltf_takes(p)
+    if suffix == ".fbx":
+        from .fbx import fbx_takes
+
+        return fbx_takes(p)
+    return [p.stem]
+
+
+def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = AMC_FPS,
+                take: str | None = None, sample_fps: float | None = None) -> Motion:
+    """Read a motion file (``.bvh``, ``.glb``, ``.gltf``, ``.fbx``, or ``.amc`` with its ``.asf``) into a
+    :class:`Motion`.
 
     Parameters
     ----------
-    path : the ``.bvh`` or ``.amc`` file.
+    path : the motion file.
     asf : the ``.asf`` skeleton of an ``.amc`` file; default: the one beside it (same
         subject number, or the only one).
     fps : frame rate of ``.amc`` files, which do not store it (CMU: 120).
+    take : glTF and FBX only: the animation (stack) to read, by name or 0-based index; default the first.
+        Other files hold one take: a name other than their stem is an error.
+    sample_fps : glTF and FBX only: the frame rate to sample the animation at; default the file's own (glTF: the
+        keys' rate when regular, else 30; FBX: the scene's frame rate).
 
     Raises
     ------
@@ -69,7 +97,18 @@ def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None
         (the message names the file and the line).
     """
     p = Path(path)
-    if _suffix(p, MOTION_SUFFIXES, "mocycle reads motions from") == ".bvh":
+    suffix = _suffix(p, MOTION_SUFFIXES, "mocycle reads motions from")
+    if suffix in (".glb", ".gltf"):
+        from .gltf_read import read_gltf
+
+        return read_gltf(p, take=take, fps=sample_fps)
+    if suffix == ".fbx":
+        from .fbx import read_fbx
+
+        return read_fbx(p, take=take, fps=sample_fps)
+    if take is not None and str(take) not in (p.stem, "0"):
+        raise MotionFileError(f"no take named {take!r}: a {suffix} file holds one take", p)
+    if suffix == ".bvh":
         return read_bvh(p)
     if asf is None:
         candidates = sorted(p.parent.glob("*.asf")) + sorted(p.parent.glob("*.ASF"))
@@ -84,20 +123,23 @@ def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None
     return read_asfamc(asf, p, fps=fps)
 
 
-def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = AMC_FPS):
+def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: float = AMC_FPS,
+         take: str | None = None, sample_fps: float | None = None):
     """Read any file mocycle writes, chosen by its suffix (table in the module notes).
 
     Parameters
     ----------
-    path : a ``.bvh``, ``.amc``, ``.mck``, ``.mosw`` or swings ``.json`` file.
+    path : a ``.bvh``, ``.amc``, ``.glb``, ``.gltf``, ``.fbx``, ``.mck``, ``.mosw`` or swings ``.json`` file.
     asf, fps : for ``.amc`` files only (see :func:`read_motion`).
+    take, sample_fps : for ``.glb``, ``.gltf`` and ``.fbx`` files (see :func:`read_motion`).
 
     Returns
     -------
     Motion, Compressed or Segmentation
-        A :class:`Motion` for ``.bvh``/``.amc``, a :class:`~mocycle.keyframes.Compressed` take for
-        ``.mck`` (``.decompress()`` gives the motion), a :class:`~mocycle.swings.Segmentation` for
-        ``.mosw`` and swings ``.json`` (``mocycle.swings.playback`` gives the motion).
+        A :class:`Motion` for ``.bvh``/``.amc``/``.glb``/``.gltf``/``.fbx``, a
+        :class:`~mocycle.keyframes.Compressed` take for ``.mck`` (``.decompress()`` gives the motion), a
+        :class:`~mocycle.swings.Segmentation` for ``.mosw`` and swings ``.json`` (``mocycle.swings.playback``
+        gives the motion).
 
     Raises
     ------
@@ -122,7 +164,7 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: 
     p = Path(path)
     suffix = _suffix(p, READ_SUFFIXES, "mocycle reads")
     if suffix in MOTION_SUFFIXES:
-        return read_motion(p, asf=asf, fps=fps)
+        return read_motion(p, asf=asf, fps=fps, take=take, sample_fps=sample_fps)
     if suffix == ".mck":
         from .mck import read_compressed
 

@@ -15,7 +15,7 @@ from ..errors import MocycleError
 from ..motion import Motion
 
 #: the motion files the library lists (``.amc`` needs its ``.asf`` beside it)
-SUFFIXES = (".bvh", ".amc")
+SUFFIXES = (".bvh", ".amc", ".fbx", ".glb", ".gltf")
 
 
 def display(text: str) -> str:

@@ -40,6 +40,7 @@ class Options(_Options):
                             "keep, or auto (lock when the animation travels and feet are found).")
     foot_joints: str | None = fields.foot_joints()
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
 
 
 def _stroke(stroke: Mapping, n_frames: int):
@@ -68,7 +69,7 @@ def run(inputs, options: Options | None = None) -> Report:
     o = options or Options()
     take, stroke = inputs
     with Recorder() as rec:
-        motion = load(take, o.amc_fps)
+        motion = load(take, o.amc_fps, o.take)
         key, markers, points, times = _stroke(stroke, motion.n_frames)
         with rec.part("back-projection"):
             traj = resample_stroke(points, times, motion.frame_time)

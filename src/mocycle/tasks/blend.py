@@ -62,7 +62,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
             raise OptionError("weights", f"needs {len(takes)} numbers, one per take; got {len(o.weights)}")
         check_weights(o.weights, len(takes))  # refuse bad weights before the (slower) extraction
     with Recorder() as rec:
-        motions = [load(t, o.amc_fps) for t in takes]
+        motions = [load(t, o.amc_fps, o.take) for t in takes]
         result = blend_cycles(motions, o.weights, align=o.align, labels=[label_of(t, k) for k, t in enumerate(takes)],
                               method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force,
                               **phase_options(o))

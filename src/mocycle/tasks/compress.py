@@ -37,6 +37,7 @@ class Options(_Options):
     seed_projection: str = keyframe_fields.seed_projection()
     optimize: bool = keyframe_fields.optimize()
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
 
 
 def run(take, options: Options | None = None) -> Report:
@@ -46,7 +47,7 @@ def run(take, options: Options | None = None) -> Report:
 
     o = options or Options()
     with Recorder() as rec:
-        motion = load(take, o.amc_fps)
+        motion = load(take, o.amc_fps, o.take)
         density = keyframe_density(motion, o.ratio, o.scheme)
         packed = compress(motion, count=density.count, select=o.select, scheme=o.scheme, projection=o.projection,
                           optimize=o.optimize, seed=o.seed_projection)

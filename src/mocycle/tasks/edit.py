@@ -27,6 +27,7 @@ class Options(_Options):
     threshold: float = fields.threshold()
     joints: str | None = fields.swing_joints()
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
 
 
 def run(take, options: Options) -> Report:
@@ -35,7 +36,7 @@ def run(take, options: Options) -> Report:
 
     o = options
     with Recorder() as rec:
-        motion = load(take, o.amc_fps)
+        motion = load(take, o.amc_fps, o.take)
         seg = segment(motion, threshold=o.threshold, joints=o.joints)
         j = motion.skeleton.index(o.joint)
         if j not in seg.joints and o.joints is None:

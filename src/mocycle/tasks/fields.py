@@ -9,7 +9,7 @@ from .options import Choice, Flag, Integer, Options, Real, Text, option
 
 __all__ = ["AMC_FPS", "CycleOptions", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay",
            "feet", "foot_joints", "force_cycle", "harmonics", "joints", "method", "min_periods", "model", "pca",
-           "phase_joints", "root", "swing_joints", "threshold", "which"]
+           "phase_joints", "root", "swing_joints", "take", "threshold", "which"]
 
 METHODS = ("harmonic", "centroid", "cut")
 MODELS = ("M1", "M2", "M3")
@@ -19,6 +19,11 @@ ROOTS = ("inplace", "motion")
 def amc_fps():
     return option(AMC_FPS, "Frame rate of AMC input files, which do not store it (CMU: 120).",
                   Real(0, low_open=True))
+
+
+def take():
+    return option(None, "Which take of a glTF or FBX input to read: an animation's (FBX: animation stack's) name or "
+                        "0-based index, as mocycle info lists them; default the first.", Text())
 
 
 def method(help: str = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."):
@@ -122,6 +127,7 @@ class CycleOptions(Options):
     delay: int = delay()
     min_periods: float = min_periods()
     amc_fps: float = amc_fps()
+    take: str | None = take()
     force: bool = force_cycle()
     feet: str = feet()
     foot_joints: str | None = foot_joints()

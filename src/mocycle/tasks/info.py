@@ -20,6 +20,7 @@ LABELS = {
     "root_displacement": ("travel, net", "file units"), "root_path_length": ("travel along the path", "file units"),
     "rotation_spread_deg": ("max angle from mean pose", "deg"),
     "rotation_range_deg": ("channel ranges (max - min)", "deg"),
+    "takes": ("takes in the file", ""), "take": ("take read", ""),
 }
 
 
@@ -28,6 +29,7 @@ class Options(_Options):
     """Options of ``info``."""
 
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
 
 
 def motion_info(motion: Motion) -> dict:
@@ -77,10 +79,29 @@ def motion_info(motion: Motion) -> dict:
     }
 
 
+def take_names(item, chosen: str | None) -> dict:
+    """``takes`` (the names of the takes a glTF or FBX file holds) and ``take`` (the one read); nothing for other
+    inputs."""
+    from pathlib import Path
+
+    from ..io import TAKE_SUFFIXES, takes
+    from .report import is_motion
+
+    if is_motion(item) or Path(item).suffix.lower() not in TAKE_SUFFIXES:
+        return {}
+    names = takes(item)
+    if chosen is None:
+        read = names[0] if names else None
+    else:
+        read = str(chosen) if str(chosen) in names else names[int(chosen)]
+    return {"takes": names, "take": read}
+
+
 def run(take, options: Options | None = None) -> Report:
     """The facts of one take (a :class:`Motion` or a motion file)."""
     options = options or Options()
     with Recorder() as rec:
-        motion = load(take, options.amc_fps)
+        motion = load(take, options.amc_fps, options.take)
         facts = motion_info(motion)
+        facts.update(take_names(take, options.take))
     return rec.report("info", facts, {"motion": motion})

@@ -86,6 +86,7 @@ class Options(_Options):
     time_axis: str = option("smooth", "Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) "
                                       "or line.", Choice(TIME_AXES), flag="--time")
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
     force: bool = option(False, "Write the cycle even when it fails a loop check (longer than the take, fits much "
                                 "worse than a plain cut, seam jumps); a warning names the check. It also lets an "
                                 "output replace an input file.", Flag())
@@ -117,7 +118,7 @@ def run(take, options: Options | None = None) -> Report:
     o = options or Options()
     everything = o.which == "all"
     with Recorder() as rec:
-        motion = load(take, o.amc_fps)
+        motion = load(take, o.amc_fps, o.take)
         start, stop = parse_range(o.frame_range, motion.n_frames)
         motion = motion[start:stop]
         label = label_of(take)

@@ -33,6 +33,7 @@ class Options(_Options):
     min_periods: float = fields.min_periods()
     n_landmarks: int = option(120, "Landmarks for the Rips filtration.", Integer(3), flag="--landmarks")
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
 
 
 def run(take, options: Options | None = None, *, keep_features: bool = False) -> Report:
@@ -43,7 +44,7 @@ def run(take, options: Options | None = None, *, keep_features: bool = False) ->
 
     options = options or Options()
     with Recorder() as rec:
-        motion = load(take, options.amc_fps)
+        motion = load(take, options.amc_fps, options.take)
         result = find_phase(motion, classes=options.classes, joints=options.joints, pca=options.pca,
                             delay=options.delay, min_periods=options.min_periods, n_landmarks=options.n_landmarks,
                             keep_features=keep_features)

@@ -23,6 +23,7 @@ class Options(_Options):
     seed_projection: str = keyframe_fields.seed_projection()
     optimize: bool = keyframe_fields.optimize("Also optimise the projection (Algorithm 12) and plot both.")
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
 
 
 def run(take, options: Options | None = None) -> Report:
@@ -33,7 +34,7 @@ def run(take, options: Options | None = None) -> Report:
 
     o = options or Options()
     with Recorder() as rec:
-        motion = load(take, o.amc_fps)
+        motion = load(take, o.amc_fps, o.take)
         check_pairwise_frames(motion.n_frames)  # the stress needs every pair: refused before any work
         space = PoseSpace(motion)
         k = keyframe_count(motion.n_frames, ratio=o.ratio)

@@ -114,13 +114,14 @@ def is_motion(item) -> bool:
     return motion is not None and isinstance(item, motion.Motion)
 
 
-def load(item: Motion | str | os.PathLike, amc_fps: float = AMC_FPS) -> Motion:
-    """A task input: a :class:`Motion` as is, or a motion file read (``amc_fps``: AMC files only)."""
+def load(item: Motion | str | os.PathLike, amc_fps: float = AMC_FPS, take: str | None = None) -> Motion:
+    """A task input: a :class:`Motion` as is, or a motion file read (``amc_fps``: AMC files only; ``take``: the
+    animation of a glTF or FBX file)."""
     if is_motion(item):
         return item
     from ..io import read_motion
 
-    return read_motion(item, fps=amc_fps)
+    return read_motion(item, fps=amc_fps, take=take)
 
 
 def label_of(item, k: int = 0) -> str:

@@ -23,6 +23,7 @@ class Options(_Options):
     threshold: float = fields.threshold()
     window_s: float = option(1.0, "Sliding window length, seconds.", Real(0, low_open=True), flag="--window")
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
 
 
 def run(query, folder: str | os.PathLike, options: Options | None = None) -> Report:
@@ -35,7 +36,7 @@ def run(query, folder: str | os.PathLike, options: Options | None = None) -> Rep
         check_index_options(folder, o.window_s)
         # the query's signature first, with the index's settings: its take is let go before the folder is read
         signature = SwingIndex([], [], threshold=o.threshold, window_s=o.window_s).signature_of(
-            load(query, o.amc_fps))
+            load(query, o.amc_fps, o.take))
         index = build_index(folder, pattern=o.pattern, threshold=o.threshold, window_s=o.window_s)
         exclude = None if is_motion(query) else Path(query)
         hits = index.query(signature, top=o.top, exclude=exclude)

@@ -27,6 +27,7 @@ class Options(_Options):
                                               "fundamental cycle) or N.", Integer(1, words={"auto": "auto"}),
                                       flag="--window")
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
     force: bool = option(False, "Warp the whole take even when it has no periodic motion (a warning says so). It "
                                 "also lets an output replace an input file.", Flag())
     feet: str = fields.feet("lock (feet held still on the floor during each contact), keep (as warped) or auto "
@@ -43,7 +44,7 @@ def run(take, options: Options) -> Report:
     from .feet import lock_motion, travels
 
     with Recorder() as rec:
-        motion = load(take, options.amc_fps)
+        motion = load(take, options.amc_fps, options.take)
         result, report = stretch_motion(motion, options.factor, window=options.window_frames, force=options.force)
         with rec.part("feet"):
             # the stretched take before locking is not kept: the locked one is made from its arrays (memory)

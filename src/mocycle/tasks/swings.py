@@ -26,6 +26,7 @@ class Options(_Options):
     threshold: float = fields.threshold()
     joints: str | None = fields.swing_joints()
     amc_fps: float = fields.amc_fps()
+    take: str | None = fields.take()
 
 
 def swing_table(seg) -> list[dict]:
@@ -57,7 +58,7 @@ def run(source, options: Options | None = None) -> Report:
         if not is_motion(source) and Path(source).suffix.lower() == ".mosw":
             motion, seg = None, read_swings(source)
         else:
-            motion = load(source, o.amc_fps)
+            motion = load(source, o.amc_fps, o.take)
             seg = segment(motion, threshold=o.threshold, joints=o.joints)
         rebuilt = playback(seg)
         facts = {"joints": [seg.skeleton.names[j] for j in seg.joints], "n_swings": seg.n_swings}

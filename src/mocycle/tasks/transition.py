@@ -35,7 +35,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     if len(takes) != 2:
         raise OptionError("takes", f"must be two takes (first, second); got {len(takes)}")
     with Recorder() as rec:
-        a, b = (load(t, o.amc_fps) for t in takes)
+        a, b = (load(t, o.amc_fps, o.take) for t in takes)
         result = transition(a, b, o.cycles, root=o.root, labels=[label_of(t, k) for k, t in enumerate(takes)],
                             method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force,
                             **phase_options(o))

@@ -1,0 +1,234 @@
+"""From a scene's node transforms to a :class:`~mocycle.motion.Motion`: what the glTF and FBX readers share.
+
+A scene file (glTF, FBX) gives each node a local translation, rotation and scale (TRS), some of them animated.
+A mocycle motion has neither scale nor nodes between joints, so the readers hand over the chain of nodes from
+the scene's top down to the skeleton's root (*ancestors*: an ``Armature`` object, a unit or axis conversion)
+and the joints below it, with their TRS sampled at the motion's frames, and this module
+
+* composes each node's world matrix ``M = M_parent · T · R · S`` a block of frames at a time;
+* takes each joint's world position and world rotation (the matrix's rotation, scale divided out: the nearest
+  rotation when the scale is not uniform), and gives the motion what reproduces them: the root's world
+  rotation and position, and every other joint's rotation and offset seen from its parent's world rotation.
+
+Every joint's world position is therefore the file's, whatever pre/post rotations, scales (also animated or
+non-uniform) and conversions sit above it; the joints' orientations are the file's up to any shear a
+non-uniform parent scale adds (a mocycle joint cannot shear).  Joints whose offset stays still (within
+``1e-7`` of the skeleton's size) keep one constant offset; the others get a translation track and position
+channels.  A leaf joint with no animation of its own becomes an End Site (its orientation moves nothing).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..errors import MocycleError, MotionFileError
+from ..limits import MAX_MAGNITUDE, check_frames
+from ..motion import EndSite, Motion, Skeleton
+from ..rotations import nearest_rotations
+
+_MOVING = ("Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation", "Yrotation")
+_TURNING = ("Zrotation", "Xrotation", "Yrotation")
+_BLOCK = 2048  # frames per block of world matrices: 2048 x J x 128 bytes
+
+
+@dataclass
+class NodeTRS:
+    """One node's local transform, sampled at the motion's frames: ``translation (T, 3)`` or ``(1, 3)`` when
+    constant, ``rotation (T, 4)`` or ``(1, 4)`` (x, y, z, w), ``scale (T, 3)`` or ``(1, 3)``."""
+
+    name: str
+    translation: np.ndarray
+    rotation: np.ndarray
+    scale: np.ndarray
+    animated: bool = False
+
+
+def _matrices(node: NodeTRS, rows: slice, n: int) -> np.ndarray:
+    """``(n, 4, 4)`` local matrices ``T · R · S`` of ``node`` over the frames ``rows``."""
+    def take(a):
+        return np.broadcast_to(a if len(a) == 1 else a[rows], (n, a.shape[1]))
+
+    q = take(node.rotation)
+    m = np.zeros((n, 4, 4))
+    m[:, :3, :3] = Rotation.from_quat(q).as_matrix() * take(node.scale)[:, None, :]
+    m[:, :3, 3] = take(node.translation)
+    m[:, 3, 3] = 1.0
+    return m
+
+
+def _rotation_part(m: np.ndarray) -> np.ndarray:
+    """The rotations ``(n, 3, 3)`` of world matrices ``(n, 3, 3)``: scale divided out (per column), then the
+    nearest rotation (exact already when the scale is uniform; a mirror's reflection taken out)."""
+    norms = np.linalg.norm(m, axis=1, keepdims=True)
+    norms[norms < 1e-300] = 1.0
+    r = m / norms
+    det = np.linalg.det(r)
+    if np.all(np.abs(det - 1.0) < 1e-9):
+        return r
+    return nearest_rotations(r)
+
+
+def check_trs(nodes: list[NodeTRS], path) -> None:
+    """Refuse NaN, infinite or absurd values and zero rotations in the transforms (one clear error)."""
+    for node in nodes:
+        for what, a in (("translation", node.translation), ("rotation", node.rotation), ("scale", node.scale)):
+            if a.size and not (np.isfinite(a).all() and np.abs(a).max() <= MAX_MAGNITUDE):
+                raise MotionFileError(f"node {node.name!r}: its {what} holds NaN, infinite or absurd values", path)
+        if node.rotation.size and np.any(np.linalg.norm(node.rotation, axis=1) < 1e-12):
+            raise MotionFileError(f"node {node.name!r}: a zero rotation quaternion", path)
+
+
+def unique_names(names: list[str | None], prefix: str = "node") -> list[str]:
+    """Node names made usable as joint names: a name for each unnamed node, ``.1``, ``.2`` after repeats."""
+    out, taken = [], set()
+    for i, name in enumerate(names):
+        base = str(name).strip() if name is not None and str(name).strip() else f"{prefix}{i}"
+        base = " ".join(base.split())  # one line, no tabs: a BVH joint name
+        candidate, k = base, 1
+        while candidate in taken:
+            candidate, k = f"{base}.{k}", k + 1
+        taken.add(candidate)
+        out.append(candidate)
+    return out
+
+
+def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: list[int], n_frames: int,
+                      frame_time: float, path, *, leaves_as_sites: bool = True) -> Motion:
+    """The motion that plays ``joints`` as the scene does.
+
+    Parameters
+    ----------
+    ancestors : the nodes above the root joint, top first (each the parent of the next; may be empty).
+    joints : the skeleton's nodes, parents first; ``joints[0]`` is the root, child of ``ancestors[-1]``.
+    parents : index of each joint's parent among ``joints`` (``-1`` for the root only).
+    n_frames, frame_time : the frames the transforms were sampled at.
+    path : the file, for messages.
+    leaves_as_sites : make leaf joints without animation End Sites.
+    """
+    T, J = int(n_frames), len(joints)
+    check_frames(T, J, "the animation", path)
+    parents = np.asarray(parents, dtype=np.int64)
+    if J == 0 or parents.shape != (J,) or parents[0] != -1 or np.any(parents[1:] < 0) \
+            or np.any(parents[1:] >= np.arange(1, J)):
+        raise MotionFileError("the skeleton's joints are not in parents-first order under one root", path)
+    check_trs(ancestors + joints, path)
+
+    children = np.zeros(J, dtype=int)
+    np.add.at(children, parents[1:], 1)
+    sites = [j for j in range(1, J) if leaves_as_sites and children[j] == 0 and not joints[j].animated]
+    keep = [j for j in range(J) if j not in set(sites)]
+    new_index = {j: k for k, j in enumerate(keep)}
+
+    # which joints' local translations can change: their own translation is animated, or a scale above them
+    scale_moves = any(len(a.scale) > 1 for a in ancestors)
+    anc_moves = any(len(a.translation) > 1 or len(a.rotation) > 1 or len(a.scale) > 1 for a in ancestors)
+    varying = np.zeros(J, dtype=bool)
+    scaled_above = np.zeros(J, dtype=bool)  # some node above the joint has an animated scale
+    for j in range(J):
+        p = parents[j]
+        scaled_above[j] = scale_moves if p < 0 else (scaled_above[p] or len(joints[p].scale) > 1)
+        varying[j] = len(joints[j].translation) > 1 or scaled_above[j] or (j == 0 and anc_moves)
+    K = len(keep)
+    rotations = np.empty((T, K, 4))
+    tracks = {new_index[j]: np.empty((T, 3)) for j in keep if varying[j]}
+    static = np.zeros((K, 3))
+    site_offsets = {j: np.zeros(3) for j in sites}
+    for start in range(0, T, _BLOCK):
+        rows = slice(start, min(T, start + _BLOCK))
+        n = rows.stop - start
+        top = np.broadcast_to(np.eye(4), (n, 4, 4))
+        for a in ancestors:
+            top = top @ _matrices(a, rows, n)
+        world = np.empty((n, J, 4, 4))
+        for j in range(J):
+            local = _matrices(joints[j], rows, n)
+            world[:, j] = (top if parents[j] < 0 else world[:, parents[j]]) @ local
+        rot = _rotation_part(world[:, :, :3, :3].reshape(-1, 3, 3)).reshape(n, J, 3, 3)
+        pos = world[:, :, :3, 3]
+        r_locals = np.empty((n, K, 3, 3))
+        for j in range(J):
+            p = parents[j]
+            if p < 0:
+                r_local, t_local = rot[:, j], pos[:, j]
+            else:
+                rp = rot[:, p]
+                r_local = np.swapaxes(rp, 1, 2) @ rot[:, j]
+                t_local = (np.swapaxes(rp, 1, 2) @ (pos[:, j] - pos[:, p])[..., None])[..., 0]
+            if j in site_offsets:
+                if start == 0:
+                    site_offsets[j] = t_local[0].copy()
+                continue
+            k = new_index[j]
+            r_locals[:, k] = r_local
+            if k in tracks:
+                tracks[k][rows] = t_local
+            elif start == 0:
+                static[k] = t_local[0]
+        rotations[rows] = Rotation.from_matrix(r_locals.reshape(-1, 3, 3)).as_quat().reshape(n, K, 4)
+    if not np.isfinite(rotations).all():
+        raise MotionFileError("the node transforms give no usable rotation (a zero scale?)", path)
+
+    # tracks that stand still (within 1e-7 of the skeleton's size) become constant offsets
+    size = max(float(np.abs(static).max(initial=0.0)), max((float(np.abs(t).max()) for t in tracks.values()),
+                                                             default=0.0), 1e-12)
+    for k in list(tracks):
+        if np.ptp(tracks[k], axis=0).max() <= 1e-7 * size:
+            static[k] = tracks.pop(k)[0]
+    offsets = static.copy()
+    for k, t in tracks.items():
+        offsets[k] = t[0]
+    names = [joints[j].name for j in keep]
+    kparents = [-1] + [new_index[int(parents[j])] for j in keep[1:]]
+    channels = [_MOVING if k in tracks else _TURNING for k in range(K)]
+    end_sites = tuple(EndSite(parent=new_index[int(parents[j])], offset=tuple(float(v) for v in site_offsets[j]),
+                              name=joints[j].name) for j in sites)
+    try:
+        skeleton = Skeleton(tuple(names), kparents, offsets, tuple(channels), end_sites)
+        return Motion(skeleton, rotations, static, frame_time, tracks=tracks, copy=False)
+    except MocycleError as exc:
+        raise MotionFileError(str(exc), path) from None
+
+
+def skeleton_order(parents: np.ndarray, children: list[list[int]], chosen, path) -> list[int]:
+    """The skeleton's nodes, depth first from its root with children in the file's order (a BVH's order): the
+    ``chosen`` nodes (a skin's joints, a file's bones), any node lying between two of them, and, when they have
+    several roots, their lowest common ancestor (refused when they have none).  ``parents`` must form a tree."""
+    members = set(int(i) for i in chosen)
+    if not members:
+        raise MotionFileError("no joints: nothing to read as a skeleton", path)
+
+    def ancestors(i):
+        out = []
+        while parents[i] >= 0:
+            i = int(parents[i])
+            out.append(i)
+        return out
+
+    chains = {i: ancestors(i) for i in members}
+    tops = [i for i in members if not any(a in members for a in chains[i])]
+    if len(tops) > 1:
+        common = set(chains[tops[0]])
+        for t in tops[1:]:
+            common &= set(chains[t])
+        if not common:
+            raise MotionFileError(f"the skeleton's joints have {len(tops)} roots with no common parent node", path)
+        root = next(a for a in chains[tops[0]] if a in common)
+        members.add(root)
+        chains[root] = ancestors(root)
+    for i in list(members):  # nodes between a joint and its nearest joint above are joints too
+        between = []
+        for a in chains[i]:
+            if a in members:
+                members.update(between)
+                break
+            between.append(a)
+    root = next(i for i in members if not any(a in members for a in ancestors(i)))
+    order, stack = [], [root]
+    while stack:
+        i = stack.pop()
+        order.append(i)
+        stack += [c for c in reversed(children[i]) if c in members]
+    return order

@@ -1,0 +1,570 @@
+"""glTF 2.0 input (``.glb`` and ``.gltf``): a skinned skeleton and one of its animations as a Motion.
+
+What is read (``docs/formats.md`` has the whole story):
+
+* **the skeleton**: the joints of the file's skin (the one with the most joints when there are several), plus any
+  node lying between two of them; parents first.  The nodes above the skeleton's root (Blender's armature object,
+  an axis or unit conversion) are composed into the root.  Without a skin, the animated nodes and the nodes
+  between them form the skeleton.  A leaf joint that no channel animates becomes an End Site.
+* **the animation**: one of the file's animations (``take``: its name or its 0-based index; default the first),
+  its ``translation``, ``rotation`` and ``scale`` channels on those nodes (``weights`` are morph targets: not
+  read), with LINEAR (slerp for rotations), STEP and CUBICSPLINE (Hermite, glTF's tangents scaled by the key
+  interval) samplers, sampled at one frame rate: the keys' own when all key times lie on one regular grid
+  (rounded to a whole number of frames per second when within 1e-4 of one), else ``fps`` (default 30).
+  A file without animations is its rest pose, one frame.
+* **units and axes**: glTF's metres and +Y up, as the file holds them; except in a file mocycle wrote (its
+  scene's ``extras.mocycle.units``), whose unit scale and vertical turn are undone, so the motion read is the
+  one written.
+* scale on nodes (also animated): the joints' world positions are the file's; see :mod:`._nodes`.
+
+Hostile files: every index, count, offset and stride is checked against the buffers the file holds before any
+array is made, the node tree must be a tree (no cycles, one parent per node), and anything else wrong is one
+:class:`~mocycle.errors.MotionFileError` naming the file and what was expected.
+
+The JSON is read with the standard library (pygltflib, which the writer uses, builds a dataclass per JSON object:
+85% of the time of a 100-joint file) and every field is checked here.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..errors import MotionFileError
+from ..limits import check_frames, frame_time_problem
+from ..motion import Motion
+from ._nodes import NodeTRS, motion_from_nodes, skeleton_order, unique_names
+
+__all__ = ["DEFAULT_FPS", "gltf_takes", "read_gltf"]
+
+#: the frame rate of an animation whose keys lie on no regular grid (unless ``fps`` says otherwise)
+DEFAULT_FPS = 30.0
+#: key rates below this (frames per second) are taken for sparse authored keys: sampled at DEFAULT_FPS instead
+MIN_KEY_RATE = 12.0
+#: the largest file read whole (bytes): a glTF's buffers are read into memory
+MAX_FILE_BYTES = 2**31
+
+_COMPONENTS = {5120: ("i1", 127.0), 5121: ("u1", 255.0), 5122: ("<i2", 32767.0), 5123: ("<u2", 65535.0),
+               5125: ("<u4", None), 5126: ("<f4", None)}
+_WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
+_PATHS = {"translation": 3, "rotation": 4, "scale": 3}
+
+
+class _Obj(dict):
+    """A glTF JSON object with attribute access (``node.children``; a missing key is ``None``); objects and lists
+    inside are wrapped when reached."""
+
+    def __getattr__(self, name):
+        value = self.get(name)
+        wrapped = _wrap(value)
+        if wrapped is not value:
+            self[name] = wrapped  # wrapped once
+        return wrapped
+
+
+class _List(list):
+    """A JSON list whose objects are wrapped."""
+
+
+def _wrap(value):
+    if isinstance(value, dict) and not isinstance(value, _Obj):
+        return _Obj(value)
+    if isinstance(value, list) and not isinstance(value, _List):
+        return _List(_Obj(v) if isinstance(v, dict) and not isinstance(v, _Obj) else v for v in value)
+    return value
+
+
+def _int(value, what: str, path, low: int = 0, high: int | None = None) -> int:
+    """``value`` as an int within [low, high], or one clear error."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low \
+            or (high is not None and value > high):
+        bound = f"{low} to {high}" if high is not None else f"at least {low}"
+        raise MotionFileError(f"{what} must be a whole number, {bound}; got {value!r}", path)
+    return int(value)
+
+
+def _list(value, what: str, path) -> list:
+    if value is None:
+        return []
+    if not isinstance(value, list):
+        raise MotionFileError(f"{what} must be a list; got {type(value).__name__}", path)
+    return value
+
+
+class _File:
+    """A loaded glTF: its JSON (as pygltflib objects) and its buffers' bytes, every access checked."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        try:
+            size = path.stat().st_size
+        except OSError as exc:
+            raise MotionFileError(f"cannot read file ({exc.strerror or exc})", path) from None
+        if size > MAX_FILE_BYTES:
+            raise MotionFileError(f"the file holds {size:,} bytes; glTF files over {MAX_FILE_BYTES:,} are not read",
+                                  path)
+        try:
+            data = path.read_bytes()
+        except OSError as exc:
+            raise MotionFileError(f"cannot read file ({exc.strerror or exc})", path) from None
+        binary = data[:4] == b"glTF"
+        if path.suffix.lower() == ".glb" and not binary:
+            raise MotionFileError("not a binary glTF file: expected it to start with 'glTF'", path)
+        self.blob = None
+        if binary:
+            text, self.blob = self._chunks(data)
+        else:
+            text = data
+        try:
+            document = json.loads(text.decode("utf-8"))
+        except RecursionError:
+            raise MotionFileError("the glTF JSON is nested too deeply", path) from None
+        except (UnicodeDecodeError, ValueError) as exc:
+            raise MotionFileError(f"the glTF JSON does not parse ({str(exc)[:120]})", path) from None
+        if not isinstance(document, dict) or not isinstance(document.get("nodes", []), list):
+            raise MotionFileError("not a glTF file: expected a JSON object with a 'nodes' list", path)
+        self.gl = _Obj(document)
+        self._buffers: dict[int, bytes] = {}
+
+    def _chunks(self, data: bytes) -> tuple[bytes, bytes | None]:
+        """The JSON chunk and the binary chunk (or ``None``) of a GLB, every length checked against the file."""
+        if len(data) < 20:
+            raise MotionFileError(f"a binary glTF file holds at least 20 bytes; this one {len(data)}", self.path)
+        length = int.from_bytes(data[8:12], "little")
+        if length > len(data):
+            raise MotionFileError(f"the header says {length:,} bytes; the file holds {len(data):,} (truncated?)",
+                                  self.path)
+        at, chunks, text, blob = 12, 0, None, None
+        while at < length:
+            if at + 8 > length:
+                raise MotionFileError(f"a chunk header at byte {at} runs past the end of the file", self.path)
+            n = int.from_bytes(data[at:at + 4], "little")
+            kind = data[at + 4:at + 8]
+            if chunks == 0 and kind != b"JSON":
+                raise MotionFileError("the first chunk of a binary glTF must be JSON", self.path)
+            if at + 8 + n > length:
+                raise MotionFileError(f"chunk {chunks} claims {n:,} bytes; the file holds {length - at - 8:,} after "
+                                      f"its header (truncated?)", self.path)
+            if chunks == 0:
+                text = data[at + 8:at + 8 + n]
+            elif chunks == 1 and kind == b"BIN\0":
+                blob = data[at + 8:at + 8 + n]
+            at += 8 + n
+            chunks += 1
+        if text is None:
+            raise MotionFileError(f"the header says {length} bytes: no room for the JSON chunk", self.path)
+        return text, blob
+
+    def items(self, kind: str) -> list:
+        return _list(getattr(self.gl, kind, None), kind, self.path)
+
+    def item(self, kind: str, index, what: str):
+        items = self.items(kind)
+        i = _int(index, what, self.path, 0, max(len(items) - 1, 0))
+        if i >= len(items):
+            raise MotionFileError(f"{what} is {i}, but the file has no {kind}", self.path)
+        return items[i]
+
+    def buffer(self, index: int) -> bytes:
+        if index in self._buffers:
+            return self._buffers[index]
+        buf = self.item("buffers", index, "bufferView.buffer")
+        uri = getattr(buf, "uri", None)
+        length = _int(getattr(buf, "byteLength", None), f"buffers[{index}].byteLength", self.path)
+        if uri is None:
+            if self.blob is None or index != 0:
+                raise MotionFileError(f"buffers[{index}] has no uri and the file no binary chunk for it", self.path)
+            data = self.blob
+        elif not isinstance(uri, str):
+            raise MotionFileError(f"buffers[{index}].uri must be text", self.path)
+        elif uri.startswith("data:"):
+            import base64
+            import binascii
+
+            head, _, body = uri.partition(",")
+            if not head.endswith(";base64"):
+                raise MotionFileError(f"buffers[{index}]: only base64 data URIs are read", self.path)
+            if len(body) > 4 * (length // 3 + 2):
+                raise MotionFileError(f"buffers[{index}]: the data URI is longer than byteLength {length}", self.path)
+            try:
+                data = base64.b64decode(body, validate=True)
+            except (binascii.Error, ValueError):
+                raise MotionFileError(f"buffers[{index}]: the data URI is not base64", self.path) from None
+        else:
+            from urllib.parse import unquote
+
+            file = (self.path.parent / unquote(uri))
+            try:
+                if file.stat().st_size > MAX_FILE_BYTES:
+                    raise MotionFileError(f"buffers[{index}]: {uri} is over {MAX_FILE_BYTES:,} bytes", self.path)
+                data = file.read_bytes()
+            except OSError as exc:
+                raise MotionFileError(f"buffers[{index}]: cannot read {uri} ({exc.strerror or exc})", self.path) \
+                    from None
+        if len(data) < length:
+            raise MotionFileError(f"buffers[{index}] says {length:,} bytes but holds {len(data):,} (truncated?)",
+                                  self.path)
+        self._buffers[index] = data
+        return data
+
+    def accessor(self, index, what: str, widths: tuple[int, ...]) -> np.ndarray:
+        """Accessor ``index`` as float64 ``(count, width)`` (normalised integers scaled to [-1, 1] or [0, 1]);
+        every size checked against its buffer before anything is made."""
+        acc = self.item("accessors", index, what)
+        label = f"accessors[{index}] ({what})"
+        if getattr(acc, "sparse", None) is not None:
+            raise MotionFileError(f"{label} is sparse; sparse accessors are not read", self.path)
+        kind = getattr(acc, "type", None)
+        if kind not in _WIDTH or _WIDTH[kind] not in widths:
+            raise MotionFileError(f"{label}: expected {' or '.join(str(w) for w in widths)} components a value; "
+                                  f"type is {kind!r}", self.path)
+        width = _WIDTH[kind]
+        component = getattr(acc, "componentType", None)
+        if component not in _COMPONENTS:
+            raise MotionFileError(f"{label}: unknown componentType {component!r}", self.path)
+        dtype, norm = _COMPONENTS[component]
+        if component != 5126 and not getattr(acc, "normalized", False):
+            raise MotionFileError(f"{label}: integer values must be normalized to be read as numbers", self.path)
+        count = _int(getattr(acc, "count", None), f"{label}.count", self.path, 1)
+        size = np.dtype(dtype).itemsize
+        element = size * width
+        view_index = getattr(acc, "bufferView", None)
+        if view_index is None:
+            raise MotionFileError(f"{label} has no bufferView (all zeros) where values are expected", self.path)
+        view = self.item("bufferViews", view_index, f"{label}.bufferView")
+        buf_index = _int(getattr(view, "buffer", None), f"bufferViews[{view_index}].buffer", self.path)
+        data = self.buffer(buf_index)
+        v_off = _int(getattr(view, "byteOffset", None) or 0, f"bufferViews[{view_index}].byteOffset", self.path)
+        v_len = _int(getattr(view, "byteLength", None), f"bufferViews[{view_index}].byteLength", self.path, 1)
+        stride = getattr(view, "byteStride", None)
+        stride = element if stride is None else _int(stride, f"bufferViews[{view_index}].byteStride", self.path,
+                                                     4, 252)
+        a_off = _int(getattr(acc, "byteOffset", None) or 0, f"{label}.byteOffset", self.path)
+        if stride < element:
+            raise MotionFileError(f"{label}: byteStride {stride} is shorter than one value ({element} bytes)",
+                                  self.path)
+        if v_off + v_len > len(data):
+            raise MotionFileError(f"bufferViews[{view_index}] ends at byte {v_off + v_len:,}; its buffer holds "
+                                  f"{len(data):,}", self.path)
+        need = a_off + stride * (count - 1) + element
+        if need > v_len:
+            raise MotionFileError(f"{label}: {count:,} values need {need:,} bytes; its bufferView holds {v_len:,}",
+                                  self.path)
+        if (v_off + a_off) % size:
+            raise MotionFileError(f"{label}: values not aligned to their {size}-byte components", self.path)
+        raw = np.ndarray((count, width), dtype=dtype, buffer=data, offset=v_off + a_off, strides=(stride, size))
+        out = raw.astype(np.float64)
+        if norm is not None:
+            out /= norm
+            if dtype.lstrip("<")[0] == "i":
+                np.maximum(out, -1.0, out=out)
+        return out
+
+
+def _parents(f: _File) -> np.ndarray:
+    """Each node's parent (``-1`` at the top); a node with two parents or a cycle is refused."""
+    nodes = f.items("nodes")
+    N = len(nodes)
+    parents = np.full(N, -1, dtype=np.int64)
+    for i, node in enumerate(nodes):
+        for c in _list(getattr(node, "children", None), f"nodes[{i}].children", f.path):
+            c = _int(c, f"nodes[{i}].children", f.path, 0, N - 1)
+            if c == i or parents[c] >= 0:
+                raise MotionFileError(f"node {c} has two parents (or is its own child); the nodes must form a tree",
+                                      f.path)
+            parents[c] = i
+    # cycles: every node must reach the top within N steps
+    depth = np.zeros(N, dtype=np.int64)
+    for i in range(N):
+        j, steps = i, 0
+        while parents[j] >= 0:
+            j = int(parents[j])
+            steps += 1
+            if steps > N:
+                raise MotionFileError(f"the node tree has a cycle through node {i}", f.path)
+        depth[i] = steps
+    return parents
+
+
+def _rest_trs(f: _File, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A node's own translation, rotation and scale (its ``matrix`` decomposed when it has one)."""
+    node = f.items("nodes")[i]
+
+    def vec(name, n, default):
+        v = getattr(node, name, None)
+        if v is None:
+            return np.asarray(default, dtype=float)
+        try:
+            a = np.asarray(v, dtype=float)
+        except (TypeError, ValueError):
+            a = np.zeros(0)
+        if a.shape != (n,):
+            raise MotionFileError(f"nodes[{i}].{name} must hold {n} numbers", f.path)
+        return a
+
+    m = getattr(node, "matrix", None)
+    if m is not None and not np.array_equal(np.asarray(vec("matrix", 16, np.eye(4).ravel())), np.eye(4).ravel()):
+        mat = vec("matrix", 16, None).reshape(4, 4).T  # column-major
+        if not np.isfinite(mat).all():
+            raise MotionFileError(f"nodes[{i}].matrix holds NaN or infinite values", f.path)
+        t = mat[:3, 3].copy()
+        s = np.linalg.norm(mat[:3, :3], axis=0)
+        if np.linalg.det(mat[:3, :3]) < 0:
+            s[0] = -s[0]
+        if np.any(np.abs(s) < 1e-300):
+            raise MotionFileError(f"nodes[{i}].matrix has a zero scale", f.path)
+        from ..rotations import nearest_rotations
+
+        q = Rotation.from_matrix(nearest_rotations(mat[:3, :3] / s)).as_quat()
+        return t, q, s
+    return (vec("translation", 3, [0, 0, 0]), vec("rotation", 4, [0, 0, 0, 1]), vec("scale", 3, [1, 1, 1]))
+
+
+def _animations(f: _File) -> list:
+    return f.items("animations")
+
+
+def _names(f: _File) -> list[str]:
+    anims = _animations(f)
+    return unique_names([getattr(a, "name", None) for a in anims], prefix="animation")
+
+
+def gltf_takes(path: str | os.PathLike) -> list[str]:
+    """The names of the animations in a glTF file (unnamed ones are ``animation0``, ``animation1``, ...)."""
+    return _names(_File(Path(path)))
+
+
+def _choose(f: _File, take) -> int | None:
+    anims = _animations(f)
+    if not anims:
+        if take is not None:
+            raise MotionFileError(f"no animation named {take!r}: the file holds no animation", f.path)
+        return None
+    names = _names(f)
+    if take is None:
+        return 0
+    text = str(take)
+    if text in names:
+        return names.index(text)
+    if text.isdigit() and int(text) < len(anims):
+        return int(text)
+    raise MotionFileError(f"no animation named {text!r}; the file holds: {', '.join(names)}", f.path)
+
+
+def _sample(times: np.ndarray, keys: np.ndarray, values: np.ndarray, interpolation: str, rotation: bool,
+            path, label: str) -> np.ndarray:
+    """``values`` keyed at ``keys`` (glTF sampler) at ``times``: ``(len(times), width)``."""
+    n = len(keys)
+    cubic = interpolation == "CUBICSPLINE"
+    if cubic:
+        if len(values) != 3 * n:
+            raise MotionFileError(f"{label}: a CUBICSPLINE sampler needs 3 values per key ({3 * n}); it has "
+                                  f"{len(values)}", path)
+        tin, v, tout = values[0::3], values[1::3], values[2::3]
+    else:
+        if len(values) != n:
+            raise MotionFileError(f"{label}: {n} key times but {len(values)} values", path)
+        v = values
+    k = np.clip(np.searchsorted(keys, times, side="right") - 1, 0, n - 1)
+    if interpolation == "STEP" or n == 1:
+        out = v[k]
+    else:
+        k = np.minimum(k, n - 2)
+        t0, t1 = keys[k], keys[k + 1]
+        span = t1 - t0
+        safe = np.where(span > 0, span, 1.0)
+        s = np.clip((times - t0) / safe, 0.0, 1.0)
+        s[span <= 0] = 0.0
+        s = s[:, None]
+        if cubic:
+            s2, s3 = s * s, s * s * s
+            d = span[:, None]
+            out = ((2 * s3 - 3 * s2 + 1) * v[k] + (s3 - 2 * s2 + s) * d * tout[k] + (-2 * s3 + 3 * s2) * v[k + 1]
+                   + (s3 - s2) * d * tin[k + 1])
+        elif rotation:
+            a, b = v[k], v[k + 1].copy()
+            flip = np.sum(a * b, axis=1) < 0
+            b[flip] = -b[flip]
+            dot = np.clip(np.sum(a * b, axis=1), -1.0, 1.0)[:, None]
+            theta = np.arccos(dot)
+            sin = np.sin(theta)
+            small = sin[:, 0] < 1e-9
+            wa = np.where(small[:, None], 1 - s, np.sin((1 - s) * theta) / np.where(small[:, None], 1.0, sin))
+            wb = np.where(small[:, None], s, np.sin(s * theta) / np.where(small[:, None], 1.0, sin))
+            out = wa * a + wb * b
+        else:
+            out = v[k] + s * (v[k + 1] - v[k])
+    if rotation:
+        norms = np.linalg.norm(out, axis=1, keepdims=True)
+        if np.any(norms < 1e-12) or not np.isfinite(norms).all():
+            raise MotionFileError(f"{label}: a zero, NaN or infinite rotation", path)
+        out = out / norms
+    return out
+
+
+def _frame_rate(all_keys: list[np.ndarray], fps: float | None) -> tuple[float, float, float]:
+    """(first key time, last key time, frames per second) of an animation's key times."""
+    start = min(float(k[0]) for k in all_keys)
+    end = max(float(k[-1]) for k in all_keys)
+    if fps is not None:
+        return start, end, float(fps)
+    steps = np.concatenate([np.diff(k) for k in all_keys if len(k) > 1] or [np.zeros(0)])
+    steps = steps[steps > 0]
+    if not len(steps):
+        return start, end, DEFAULT_FPS
+    step = float(np.median(steps))
+    regular = all(np.allclose((k - start) / step, np.round((k - start) / step), rtol=0, atol=1e-3)
+                  for k in all_keys)
+    if not regular or not step > 0:
+        return start, end, DEFAULT_FPS
+    rate = 1.0 / step
+    if rate < MIN_KEY_RATE:  # a few keys far apart: an authored clip, not one key per frame
+        return start, end, DEFAULT_FPS
+    if abs(rate - round(rate)) < 1e-4 * rate and round(rate) > 0:
+        rate = float(round(rate))
+    return start, end, rate
+
+
+def _skeleton_nodes(f: _File, parents: np.ndarray, animated: set[int]) -> list[int]:
+    """The skeleton's nodes, parents first: the skin's joints (and any node between two of them)."""
+    skins = f.items("skins")
+    N = len(parents)
+    chosen: list[int] = []
+    if skins:
+        best = max(range(len(skins)), key=lambda s: len(_list(getattr(skins[s], "joints", None), "skin.joints",
+                                                                 f.path)))
+        chosen = [_int(j, f"skins[{best}].joints", f.path, 0, N - 1)
+                  for j in _list(getattr(skins[best], "joints", None), "skin.joints", f.path)]
+    if not chosen:
+        chosen = sorted(animated)
+    if not chosen:
+        raise MotionFileError("no skin and no animated node: nothing to read as a skeleton", f.path)
+    nodes = f.items("nodes")
+    children = [[int(c) for c in _list(getattr(n, "children", None), "children", f.path)] for n in nodes]
+    return skeleton_order(parents, children, chosen, f.path)
+
+
+def _is_mocycle(f: _File) -> dict | None:
+    """The unit conversion of a file mocycle wrote (its scene's extras), or ``None``."""
+    asset = getattr(f.gl, "asset", None)
+    if getattr(asset, "generator", None) != "mocycle":
+        return None
+    for scene in f.items("scenes"):
+        extras = getattr(scene, "extras", None)
+        units = extras.get("mocycle", {}).get("units") if isinstance(extras, dict) else None
+        if isinstance(units, dict):
+            try:
+                scale = float(units["metres_per_unit"])
+                quat = np.asarray(units["source_to_gltf_rotation_xyzw"], dtype=float)
+            except (KeyError, TypeError, ValueError):
+                return None
+            if np.isfinite(scale) and scale > 0 and quat.shape == (4,) and np.isfinite(quat).all() \
+                    and np.linalg.norm(quat) > 0.5:
+                return {"scale": scale, "rotation": quat / np.linalg.norm(quat)}
+    return None
+
+
+def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: float | None = None) -> Motion:
+    """Read a glTF file's skeleton and one of its animations as a :class:`Motion`.
+
+    Parameters
+    ----------
+    path : a ``.glb`` or ``.gltf`` file.
+    take : the animation's name (or 0-based index); default the first (:func:`gltf_takes` lists them).
+    fps : the frame rate to sample at; default the keys' own when regular, else :data:`DEFAULT_FPS`.
+
+    Raises
+    ------
+    MotionFileError
+        A damaged or hostile file, an unknown animation name (the message lists them), or no skeleton.
+    """
+    p = Path(path)
+    if fps is not None and not (np.isfinite(fps) and fps > 0):
+        raise MotionFileError(f"the frame rate must be positive; got {fps!r}", p)
+    f = _File(p)
+    parents = _parents(f)
+    index = _choose(f, take)
+    channels = []  # (node, path, times, values, interpolation)
+    if index is not None:
+        anim = _animations(f)[index]
+        samplers = _list(getattr(anim, "samplers", None), "animation.samplers", p)
+        for c, ch in enumerate(_list(getattr(anim, "channels", None), "animation.channels", p)):
+            target = getattr(ch, "target", None)
+            kind = getattr(target, "path", None)
+            node = getattr(target, "node", None)
+            if kind not in _PATHS or node is None:
+                continue  # morph weights, pointers, no node: nothing a skeleton plays
+            node = _int(node, f"channels[{c}].target.node", p, 0, len(parents) - 1)
+            s = _int(getattr(ch, "sampler", None), f"channels[{c}].sampler", p, 0, max(len(samplers) - 1, 0))
+            if s >= len(samplers):
+                raise MotionFileError(f"channels[{c}] names sampler {s}; the animation has none", p)
+            sampler = samplers[s]
+            interp = getattr(sampler, "interpolation", None) or "LINEAR"
+            if interp not in ("LINEAR", "STEP", "CUBICSPLINE"):
+                raise MotionFileError(f"samplers[{s}]: unknown interpolation {interp!r}", p)
+            keys = f.accessor(getattr(sampler, "input", None), f"samplers[{s}].input", (1,))[:, 0]
+            if not np.isfinite(keys).all() or np.any(np.diff(keys) < 0):
+                raise MotionFileError(f"samplers[{s}].input: key times must be finite and increasing", p)
+            values = f.accessor(getattr(sampler, "output", None), f"samplers[{s}].output", (_PATHS[kind],))
+            if not np.isfinite(values).all():
+                raise MotionFileError(f"samplers[{s}].output holds NaN or infinite values", p)
+            channels.append((node, kind, keys, values, interp, f"animation {index} channel {c}"))
+    animated = {c[0] for c in channels}
+    members = _skeleton_nodes(f, parents, animated)
+    if channels:
+        start, end, rate = _frame_rate([c[2] for c in channels], fps)
+        if frame_time_problem(1.0 / rate):
+            raise MotionFileError(frame_time_problem(1.0 / rate), p)
+        if not end - start < 1e9:
+            raise MotionFileError(f"the animation spans {end - start:g} s", p)
+        T = check_frames(int(round((end - start) * rate)) + 1, len(members), "the animation", p)
+        times = start + np.arange(T) / rate
+    else:
+        rate, T, times = fps or DEFAULT_FPS, 1, np.zeros(1)
+
+    names = unique_names([getattr(f.items("nodes")[i], "name", None) for i in range(len(parents))])
+    trs: dict[int, NodeTRS] = {}
+
+    def node_trs(i: int) -> NodeTRS:
+        if i not in trs:
+            t, q, s = _rest_trs(f, i)
+            trs[i] = NodeTRS(names[i], t[None], q[None], s[None])
+        return trs[i]
+
+    for node, kind, keys, values, interp, label in channels:
+        if node not in members and not _is_above(node, members, parents):
+            continue
+        n = node_trs(node)
+        sampled = _sample(times, keys, values, interp, kind == "rotation", p, label)
+        setattr(n, kind, sampled)
+        n.animated = True
+    root = members[0]
+    above = []
+    i = int(parents[root])
+    while i >= 0:
+        above.append(i)
+        i = int(parents[i])
+    ancestors = [node_trs(i) for i in reversed(above)]
+    joints = [node_trs(i) for i in members]
+    position = {node: k for k, node in enumerate(members)}
+    jparents = [-1] + [position[int(parents[i])] for i in members[1:]]
+    units = _is_mocycle(f)
+    if units is not None:  # undo mocycle's writer: back to the motion's own units and axes
+        back = Rotation.from_quat(units["rotation"]).inv().as_quat()
+        ancestors.insert(0, NodeTRS("mocycle units", np.zeros((1, 3)), back[None],
+                                    np.full((1, 3), 1.0 / units["scale"])))
+    return motion_from_nodes(ancestors, joints, jparents, T, 1.0 / rate, p)
+
+
+def _is_above(node: int, members: list[int], parents: np.ndarray) -> bool:
+    """Whether ``node`` is an ancestor of the skeleton's root."""
+    i = int(parents[members[0]])
+    while i >= 0:
+        if i == node:
+            return True
+        i = int(parents[i])
+    return False
