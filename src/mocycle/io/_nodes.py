@@ -232,3 +232,21 @@ def skeleton_order(parents: np.ndarray, children: list[list[int]], chosen, path)
         order.append(i)
         stack += [c for c in reversed(children[i]) if c in members]
     return order
+
+
+def choose_take(names: list[str], take, path, noun: str, none_held: str) -> int | None:
+    """The index of the take (an animation stack, a glTF animation) called ``take`` (its name, or its index as
+    text) among ``names``; ``None`` when the file holds none and none was asked for, 0 when none was asked for.
+    ``noun``/``none_held`` word the one error line (``take`` / ``animation stack``)."""
+    if not names:
+        if take is not None:
+            raise MotionFileError(f"no {noun} named {take!r}: the file holds no {none_held}", path)
+        return None
+    if take is None:
+        return 0
+    text = str(take)
+    if text in names:
+        return names.index(text)
+    if text.isdigit() and int(text) < len(names):
+        return int(text)
+    raise MotionFileError(f"no {noun} named {text!r}; the file holds: {', '.join(names)}", path)

@@ -34,7 +34,7 @@ import numpy as np
 from ..errors import MocycleError, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
-from ._nodes import NodeTRS, motion_from_nodes, skeleton_order, unique_names
+from ._nodes import NodeTRS, choose_take, motion_from_nodes, skeleton_order, unique_names
 
 __all__ = ["DEFAULT_FPS", "fbx_takes", "read_fbx"]
 
@@ -79,19 +79,7 @@ def fbx_takes(path: str | os.PathLike) -> list[str]:
 
 
 def _choose(scene, take, path) -> int | None:
-    names = _stack_names(scene)
-    if not names:
-        if take is not None:
-            raise MotionFileError(f"no take named {take!r}: the file holds no animation stack", path)
-        return None
-    if take is None:
-        return 0
-    text = str(take)
-    if text in names:
-        return names.index(text)
-    if text.isdigit() and int(text) < len(names):
-        return int(text)
-    raise MotionFileError(f"no take named {text!r}; the file holds: {', '.join(names)}", path)
+    return choose_take(_stack_names(scene), take, path, "take", "animation stack")
 
 
 def _keys(struct_array) -> tuple[np.ndarray, np.ndarray]:

@@ -37,7 +37,7 @@ from scipy.spatial.transform import Rotation
 from ..errors import MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
-from ._nodes import NodeTRS, motion_from_nodes, skeleton_order, unique_names
+from ._nodes import NodeTRS, choose_take, motion_from_nodes, skeleton_order, unique_names
 
 __all__ = ["DEFAULT_FPS", "gltf_takes", "read_gltf"]
 
@@ -339,20 +339,8 @@ def gltf_takes(path: str | os.PathLike) -> list[str]:
 
 
 def _choose(f: _File, take) -> int | None:
-    anims = _animations(f)
-    if not anims:
-        if take is not None:
-            raise MotionFileError(f"no animation named {take!r}: the file holds no animation", f.path)
-        return None
-    names = _names(f)
-    if take is None:
-        return 0
-    text = str(take)
-    if text in names:
-        return names.index(text)
-    if text.isdigit() and int(text) < len(anims):
-        return int(text)
-    raise MotionFileError(f"no animation named {text!r}; the file holds: {', '.join(names)}", f.path)
+    names = _names(f) if _animations(f) else []
+    return choose_take(names, take, f.path, "animation", "animation")
 
 
 def _sample(times: np.ndarray, keys: np.ndarray, values: np.ndarray, interpolation: str, rotation: bool,
