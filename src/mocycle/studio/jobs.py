@@ -21,6 +21,9 @@ import numpy as np
 from ..errors import LoopRefused, MocycleError
 from .validate import Busy, Gone, NotFound
 
+#: jobs held before they are reached, cancelled ones included: at most this many times ``max_pending``
+LIVE_FACTOR = 4
+
 
 def held_bytes(obj, skip=(), _seen=None, _depth=0) -> int:
     """About the bytes ``obj`` holds: its numpy arrays and bytes, 32 per number in lists, through dicts, lists,
@@ -163,6 +166,9 @@ class Jobs:
             if self.max_pending is not None and waiting >= self.max_pending:
                 raise Busy(f"{waiting} jobs are waiting or running; at most {self.max_pending} "
                            "(wait for one to finish or cancel it)")
+            if self.max_pending is not None and len(self._live) >= LIVE_FACTOR * self.max_pending:
+                # cancelled jobs wait to be reached too: bounded all the same (submit and cancel in a loop)
+                raise Busy(f"{len(self._live)} jobs, some cancelled, are waiting to be reached; try again shortly")
             job = Job(id=f"{self._prefix}{next(self._ids)}", kind=kind)
             self._live[job.id] = job
         self._pool.submit(self._run, job, fn)
