@@ -157,6 +157,25 @@ def test_which_periodic_motion_from_the_list(walk):
         bpy.ops.mocycle.extract_cycle(which=7)
 
 
+def test_an_fbx_imported_by_blender_loops(walk, tmp_path):
+    """Blender's own FBX importer, then Extract Cycle: the action loops (issue 31: "import a BVH and an FBX,
+    extract a cycle")."""
+    path = tmp_path / "walk.fbx"
+    assert bpy.ops.export_scene.fbx(filepath=str(path), use_selection=False, bake_anim=True,
+                                    add_leaf_bones=False) == {"FINISHED"}
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob)
+    assert bpy.ops.import_scene.fbx(filepath=str(path)) == {"FINISHED"}
+    arm = next(ob for ob in bpy.data.objects if ob.type == "ARMATURE")
+    bpy.context.view_layer.objects.active = arm
+    arm.select_set(True)
+    assert arm.animation_data and arm.animation_data.action
+    assert bpy.ops.mocycle.extract_cycle() == {"FINISHED"}
+    f = facts(arm.animation_data.action)
+    assert f["period_frames"] == pytest.approx(FPS, rel=0.05)
+    check_loop(arm, arm.animation_data.action, f["period_frames"])
+
+
 def test_extract_cycle_lists_the_parts_and_loops_the_one_picked(scene, tmp_path):
     """A walk that turns mid-take (issue 28): the panel lists its parts; the part picked is the one looped."""
     from mocycle.datasets import synthetic_walk_turn_walk
