@@ -64,8 +64,10 @@ def test_the_page_under_its_csp(hostile, tmp_path):
         # a take that cannot be read: no exception, its own name, nothing of the walk left to play
         for name, words in (("notbvh.bvh", "cannot read this take"), ("passwd.bvh", "outside the served folder")):
             click_take(page, name)
+            # the status of the take before may still show for a moment (both failed): wait for this one's words
             until(page, f"document.getElementById('take-name').textContent === {json.dumps(name)} && "
-                        "document.getElementById('loop-status').dataset.state === 'failed'")
+                        "document.getElementById('loop-status').dataset.state === 'failed' && "
+                        f"document.getElementById('loop-status').textContent.includes({json.dumps(words)})")
             assert words in page.locator('[data-testid="loop-status"]').inner_text()
             assert page.evaluate("window.__studio.player.main === null && !window.__studio.viewer.figures.main")
             assert page.locator('[data-testid="loop-bvh"]').get_attribute("href") is None
