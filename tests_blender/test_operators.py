@@ -184,7 +184,8 @@ def test_extract_cycle_lists_the_parts_and_loops_the_one_picked(scene, tmp_path)
     assert bpy.ops.mocycle.extract_cycle() == {"FINISHED"}
     st = bpy.context.scene.mocycle
     kinds = [p.kind for p in st.parts if p.loops]  # between them a short transition may be listed, not looped
-    assert kinds == ["walk straight", "walk turning left", "walk straight"]
+    runs = [k for i, k in enumerate(kinds) if i == 0 or k != kinds[i - 1]]  # a straight walk may come in two parts
+    assert runs == ["walk straight", "walk turning left", "walk straight"], kinds
     assert all(p.reason for p in st.parts if not p.loops)
     assert "(walk" in st.last_message and "the steady part with the most cycles" in st.last_message
     arm.animation_data.action = bpy.data.actions["Turn"]
