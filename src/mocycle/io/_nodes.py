@@ -250,3 +250,16 @@ def choose_take(names: list[str], take, path, noun: str, none_held: str) -> int 
     if text.isdigit() and int(text) < len(names):
         return int(text)
     raise MotionFileError(f"no {noun} named {text!r}; the file holds: {', '.join(names)}", path)
+
+
+def member_nodes(members: list[int], parents, node_trs) -> tuple[list, list, list[int]]:
+    """The skeleton's nodes from a file's node tree: the nodes above its root (``node_trs`` of each, outermost
+    first), its joints' nodes (``members``, parents first) and each joint's parent among them (-1: the root)."""
+    above = []
+    i = int(parents[members[0]])
+    while i >= 0:
+        above.append(i)
+        i = int(parents[i])
+    position = {node: k for k, node in enumerate(members)}
+    return ([node_trs(i) for i in reversed(above)], [node_trs(i) for i in members],
+            [-1] + [position[int(parents[i])] for i in members[1:]])

@@ -34,7 +34,7 @@ import numpy as np
 from ..errors import MocycleError, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
-from ._nodes import NodeTRS, choose_take, motion_from_nodes, skeleton_order, unique_names
+from ._nodes import NodeTRS, choose_take, member_nodes, motion_from_nodes, skeleton_order, unique_names
 
 __all__ = ["DEFAULT_FPS", "fbx_takes", "read_fbx"]
 
@@ -233,13 +233,5 @@ def _read(pufbx, scene, p: Path, take, fps) -> Motion:
         trs[i] = node
         return node
 
-    above = []
-    i = int(parents[members[0]])
-    while i >= 0:
-        above.append(i)
-        i = int(parents[i])
-    ancestors = [node_trs(i) for i in reversed(above)]
-    joints = [node_trs(i) for i in members]
-    position = {node: k for k, node in enumerate(members)}
-    jparents = [-1] + [position[int(parents[i])] for i in members[1:]]
+    ancestors, joints, jparents = member_nodes(members, parents, node_trs)
     return motion_from_nodes(ancestors, joints, jparents, T, 1.0 / rate, p)

@@ -37,7 +37,7 @@ from scipy.spatial.transform import Rotation
 from ..errors import MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
-from ._nodes import NodeTRS, choose_take, motion_from_nodes, skeleton_order, unique_names
+from ._nodes import NodeTRS, choose_take, member_nodes, motion_from_nodes, skeleton_order, unique_names
 
 __all__ = ["DEFAULT_FPS", "gltf_takes", "read_gltf"]
 
@@ -530,16 +530,7 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
         sampled = _sample(times, keys, values, interp, kind == "rotation", p, label)
         setattr(n, kind, sampled)
         n.animated = True
-    root = members[0]
-    above = []
-    i = int(parents[root])
-    while i >= 0:
-        above.append(i)
-        i = int(parents[i])
-    ancestors = [node_trs(i) for i in reversed(above)]
-    joints = [node_trs(i) for i in members]
-    position = {node: k for k, node in enumerate(members)}
-    jparents = [-1] + [position[int(parents[i])] for i in members[1:]]
+    ancestors, joints, jparents = member_nodes(members, parents, node_trs)
     units = _is_mocycle(f)
     if units is not None:  # undo mocycle's writer: back to the motion's own units and axes
         back = Rotation.from_quat(units["rotation"]).inv().as_quat()
