@@ -33,7 +33,7 @@ def take(tmp_path):
 
 
 @pytest.mark.parametrize("args, code, message", [
-    (["blend", "{take}"], 2, "COMMAND must be one of info, phase, loop, swings, compress, stretch; got 'blend'"),
+    (["blend", "{take}"], 2, "COMMAND must be one of info, phase, loop, stretch, swings, compress; got 'blend'"),
     (["loop", "{take}", "--harmonic", "5"], 2, "No such option '--harmonic'"),
     (["loop", "{take}", "--harmonics", "0"], 2, "--harmonics must be 'auto' or a positive integer; got '0'"),
     (["stretch", "{take}"], 2, "Missing option '--factor'"),

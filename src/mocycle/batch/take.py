@@ -19,6 +19,7 @@ from pathlib import Path
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 from ..tasks.options import Options
+from ..tasks.spec import row_figures
 from ..text import json_text, path_hex, printable
 from .commands import COMMANDS, motion_targets, part_rows
 from .discover import Take
@@ -101,7 +102,7 @@ def process(job: Job, take: Take) -> dict:
             report = getattr(tasks, job.command).run(take.source, job.options)  # that task's module only
             row["facts"], row["seconds"] = dict(report.facts), report.seconds
             row["warnings"] = list(report.warnings)
-            row["figures"] = _figures(command, report.facts)
+            row["figures"] = row_figures(command.spec, report.facts)
             if job.command == "loop":  # a take cut into parts: a results row per part
                 row["parts"] = part_rows(command, report.facts)
             if job.command == "phase" and not report.facts["classes"]:
@@ -178,16 +179,6 @@ def _digest(path: Path) -> str:
 def _check_of(take: Take, path: Path) -> dict:
     """An output as its record lists it: its name after the take's stem, its size and its SHA-256."""
     return {"tail": _tail(take, path), "bytes": path.stat().st_size, "sha256": _digest(path)}
-
-
-def _figures(command, facts) -> dict:
-    out = {}
-    for name, get in command.figures.items():
-        try:
-            out[name] = get(facts)
-        except (KeyError, IndexError, TypeError):
-            out[name] = None
-    return out
 
 
 def _write_outputs(job: Job, command, take: Take, report, write, written: list[Path]) -> None:

@@ -17,10 +17,11 @@ import typer
 from .. import tasks
 from ..errors import MocycleError
 from ..tasks.options import MISSING, Flag, flag_of
+from ..tasks.spec import SPECS
 from .common import EXIT_USAGE, app, err, escape, friendly, out, print_json
 
-#: the commands batch runs (the ones that take one file)
-BATCH_COMMANDS = ("info", "phase", "loop", "swings", "compress", "stretch")
+#: the commands batch runs (the ones that take one file), as their specs say
+BATCH_COMMANDS = tuple(name for name, spec in SPECS.items() if spec.batch)
 
 
 def options_parser(command: str) -> click.Command:
@@ -57,7 +58,7 @@ def parse_command_line(args: list[str]):
 def batch(
     args: Annotated[list[str], typer.Argument(
         metavar="ARGS", show_default=False,
-        help="COMMAND INPUTS... [options of COMMAND]: COMMAND is info, phase, loop, swings, compress or stretch; "
+        help="COMMAND INPUTS... [options of COMMAND]: COMMAND is info, phase, loop, stretch, swings or compress; "
              "INPUTS are motion files (.bvh, .amc, .fbx, .glb, .gltf), folders "
              "(searched recursively) or glob patterns; then any flag of 'mocycle COMMAND' that sets an option "
              "of the task (e.g. --harmonics 5, --root motion, --factor 2).")],

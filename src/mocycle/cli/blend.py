@@ -8,57 +8,16 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import (
-    CLOSING_FRAME,
-    GLTF_SCALE,
-    GLTF_UP,
-    app,
-    check_motion_output,
-    check_output,
-    default,
-    escape,
-    flag,
-    friendly,
-    out,
-    print_json,
-    print_warnings,
-    timing_line,
-    write_motion,
-)
+from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line, write_motion
 
-B = tasks.blend.Options
-T = tasks.transition.Options
 PLOT_HELP = "Write a PNG: the most moving joint curves of the blend and of the inputs' cycles, phase-aligned."
 
 
-@app.command()
-@friendly
+@task_command("blend")
 def blend(
     paths: Annotated[list[Path], typer.Argument(help="Two or more .bvh (or .amc) takes on one skeleton.")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The blended loop as a .bvh or .glb file.")],
-    weights: Annotated[str | None, flag(B, "weights")] = default(B, "weights"),
-    root: Annotated[str, flag(B, "root")] = default(B, "root"),
-    cycles: Annotated[int, flag(B, "cycles")] = default(B, "cycles"),
-    method: Annotated[str, flag(B, "method")] = default(B, "method"),
-    model: Annotated[str, flag(B, "model")] = default(B, "model"),
-    harmonics: Annotated[str, flag(B, "harmonics")] = default(B, "harmonics"),
-    align: Annotated[bool, flag(B, "align")] = default(B, "align"),
-    joints: Annotated[str | None, flag(B, "joints")] = default(B, "joints"),
-    classes: Annotated[str, flag(B, "classes")] = default(B, "classes"),
-    which: Annotated[int | None, flag(B, "which")] = default(B, "which"),
-    pca: Annotated[str, flag(B, "pca")] = default(B, "pca"),
-    delay: Annotated[int, flag(B, "delay")] = default(B, "delay"),
-    min_periods: Annotated[float, flag(B, "min_periods")] = default(B, "min_periods"),
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help=PLOT_HELP)] = None,
-    amc_fps: Annotated[float, flag(B, "amc_fps")] = default(B, "amc_fps"),
-    take: Annotated[str | None, flag(B, "take")] = default(B, "take"),
-    force: Annotated[bool, flag(B, "force")] = default(B, "force"),
-    feet: Annotated[str, flag(B, "feet")] = default(B, "feet"),
-    foot_joints: Annotated[str | None, flag(B, "foot_joints")] = default(B, "foot_joints"),
-    closing_frame: Annotated[bool | None, CLOSING_FRAME] = None,
-    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
-    gltf_up: Annotated[str, GLTF_UP] = "auto",
+    *, options, output, as_json, force, closing_frame, gltf_scale, gltf_up,
 ):
     """Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).
 
@@ -67,11 +26,7 @@ def blend(
     Exit code 0 on success, 3 when a take holds no periodic motion or its cycle fails a loop check (see
     mocycle loop; --force uses it anyway), 1 for bad input, 2 for a bad option.
     """
-    check_motion_output(output, paths, force, "--output", gltf_scale, gltf_up)
     check_output(plot, paths, force, ".png", "--plot")
-    options = B(weights=weights, root=root, cycles=cycles, method=method, model=model, harmonics=harmonics,
-                align=align, joints=joints, classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods,
-                amc_fps=amc_fps, take=take, force=force, feet=feet, foot_joints=foot_joints)
     report = tasks.blend.run(paths, options)
     print_warnings(report)
     written = write_motion(report, "loop", output, gltf_scale, gltf_up, closing_frame)
@@ -107,39 +62,20 @@ def blend(
     seam = facts["seam"]
     out.print(f"  seam jump: pose {seam['seam_pose']:.3g}, velocity {seam['seam_velocity']:.3g} (× median step)")
     _print_feet(facts["feet"])
-    out.print(f"wrote {escape(output)}: {facts['frames_out']} frames ({cycles} cycle(s), root {root})", soft_wrap=True)
+    out.print(f"wrote {escape(output)}: {facts['frames_out']} frames ({options.cycles} cycle(s), root "
+              f"{options.root})", soft_wrap=True)
     if plot is not None:
         out.print(f"wrote {escape(plot)}", soft_wrap=True)
     out.print(timing_line(report))
 
 
-@app.command()
-@friendly
+@task_command("transition")
 def transition(
     first: Annotated[Path, typer.Argument(help="The take to start as (.bvh, .fbx, .glb, .gltf or .amc).")],
     second: Annotated[Path, typer.Argument(help="The take to end as, on the same skeleton.")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The transition as a .bvh or .glb file.")],
-    cycles: Annotated[int, flag(T, "cycles")] = default(T, "cycles"),
-    root: Annotated[str, flag(T, "root")] = default(T, "root"),
-    method: Annotated[str, flag(T, "method")] = default(T, "method"),
-    model: Annotated[str, flag(T, "model")] = default(T, "model"),
-    harmonics: Annotated[str, flag(T, "harmonics")] = default(T, "harmonics"),
-    joints: Annotated[str | None, flag(T, "joints")] = default(T, "joints"),
-    classes: Annotated[str, flag(T, "classes")] = default(T, "classes"),
-    which: Annotated[int | None, flag(T, "which")] = default(T, "which"),
-    pca: Annotated[str, flag(T, "pca")] = default(T, "pca"),
-    delay: Annotated[int, flag(T, "delay")] = default(T, "delay"),
-    min_periods: Annotated[float, flag(T, "min_periods")] = default(T, "min_periods"),
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves over the transition's phase, and the weight.")] = None,
-    amc_fps: Annotated[float, flag(T, "amc_fps")] = default(T, "amc_fps"),
-    take: Annotated[str | None, flag(T, "take")] = default(T, "take"),
-    force: Annotated[bool, flag(T, "force")] = default(T, "force"),
-    feet: Annotated[str, flag(T, "feet")] = default(T, "feet"),
-    foot_joints: Annotated[str | None, flag(T, "foot_joints")] = default(T, "foot_joints"),
-    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
-    gltf_up: Annotated[str, GLTF_UP] = "auto",
+    *, options, output, as_json, force, gltf_scale, gltf_up,
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
@@ -147,11 +83,7 @@ def transition(
     integrated at the blended period). Exit code 0 on success, 3 when a take holds no periodic motion or its
     cycle fails a loop check (see mocycle loop), 1 for bad input, 2 for a bad option.
     """
-    check_motion_output(output, [first, second], force, "--output", gltf_scale, gltf_up)
     check_output(plot, [first, second], force, ".png", "--plot")
-    options = T(cycles=cycles, root=root, method=method, model=model, harmonics=harmonics, joints=joints,
-                classes=classes, which=which, pca=pca, delay=delay, min_periods=min_periods, amc_fps=amc_fps, take=take,
-                force=force, feet=feet, foot_joints=foot_joints)
     report = tasks.transition.run([first, second], options)
     print_warnings(report)
     write_motion(report, "transition", output, gltf_scale, gltf_up)
@@ -160,12 +92,12 @@ def transition(
 
         tr = report.result
         plot_curves([("transition", tr.motion, tr.phase)], plot, weights=tr.weights, xlabel="phase (cycles)",
-                    title=f"transition {first.name} -> {second.name} over {cycles} cycle(s)")
+                    title=f"transition {first.name} -> {second.name} over {options.cycles} cycle(s)")
     facts = {"files": [str(first), str(second)], "output": str(output), **report.facts, "seconds": report.seconds}
     if as_json:
         print_json(facts)
         return
-    out.print(f"[bold]transition[/] {escape(first.name)} -> {escape(second.name)} over {cycles} cycle(s)",
+    out.print(f"[bold]transition[/] {escape(first.name)} -> {escape(second.name)} over {options.cycles} cycle(s)",
               soft_wrap=True)
     out.print(f"  period {facts['period_frames_start']:.2f} -> {facts['period_frames_end']:.2f} frames; "
               f"phase offset of the second {facts['phase_offset']:.3f} cycles")
@@ -173,7 +105,7 @@ def transition(
     out.print(f"  largest step {sm['step_local']:.3g} × its neighbours' median (inputs {sm['input_step_local']:.3g}); "
               f"largest velocity change {sm['velocity_local']:.3g} × (inputs {sm['input_velocity_local']:.3g})")
     _print_feet(facts["feet"])
-    out.print(f"wrote {escape(output)}: {facts['frames']} frames (root {root})", soft_wrap=True)
+    out.print(f"wrote {escape(output)}: {facts['frames']} frames (root {options.root})", soft_wrap=True)
     if plot is not None:
         out.print(f"wrote {escape(plot)}", soft_wrap=True)
     out.print(timing_line(report))

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import inspect
 import os
 import warnings
 from collections.abc import Callable, Mapping
@@ -21,31 +22,23 @@ from typer.core import TyperCommand, TyperGroup
 
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
-from ..tasks.options import MISSING, Choice, flag_of
+from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_of
+from ..tasks.spec import SPECS
 from ..text import json_text, printable
 
+#: the module of ``mocycle.cli`` that defines each task's command (the command is made from the task's spec)
+_TASK_MODULES = {"info": "info", "phase": "phase", "loop": "loop", "blend": "blend", "transition": "blend",
+                 "stretch": "stretch", "swings": "swings", "search": "swings", "edit": "swings",
+                 "compress": "keyframes", "decompress": "keyframes", "project": "keyframes"}
+
 #: sub-command -> (the module of ``mocycle.cli`` that defines it, the first paragraph of its help), in the
-#: order ``mocycle --help`` lists them.  tests/test_startup.py checks both against the commands themselves.
+#: order ``mocycle --help`` lists them: the tasks' from their specs, then the front end's own commands.
+#: tests/test_startup.py checks both against the commands themselves.
 COMMANDS = {
-    "info": ("info", "Frames, frame time, fps, duration, joints, channels, root travel and rotation ranges."),
+    "info": (_TASK_MODULES["info"], SPECS["info"].summary),
     "convert": ("convert", "Convert ASF/AMC, FBX or glTF to BVH or glTF (.glb), or rewrite a BVH (optionally a "
                            "frame range, another fps)."),
-    "phase": ("phase", "Find periodic motions and the phase of every frame (persistent cohomology)."),
-    "loop": ("loop", "Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH or "
-                     "glTF."),
-    "blend": ("blend", "Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination)."),
-    "transition": ("blend", "A motion that starts as the first take's cycle and ends as the second's (paper 001 "
-                            "§4.5, a homotopy)."),
-    "stretch": ("stretch", "Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down."),
-    "swings": ("swings", "Segment a take into joint swings and holds; report playback error and compressed size."),
-    "search": ("swings", "Rank the takes of a folder by how alike their swings are to an example (query by "
-                         "example)."),
-    "edit": ("swings", "Scale the angle or the duration of one swing of one joint and write the edited motion."),
-    "compress": ("keyframes", "Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report "
-                              "error and size."),
-    "decompress": ("keyframes", "Rebuild a take from its keyframes; the keyframes come back exactly (unless --feet "
-                                "lock)."),
-    "project": ("keyframes", "Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."),
+    **{name: (module, SPECS[name].summary) for name, module in _TASK_MODULES.items() if name != "info"},
     "batch": ("batch", "Run one command over many takes on dask.distributed; a row per take in "
                        "OUTDIR/results.csv and .json."),
     "studio": ("studio", "Review loops on a library of takes and author new motion on the spatial-keyframe plane, "
@@ -236,7 +229,7 @@ def main_options(
 
 
 
-# ------------------------------------------------------------ options derived from the task Options
+# ------------------------------------------------------------ commands made from the task specs
 def _field(options_cls, name: str) -> dataclasses.Field:
     for f in dataclasses.fields(options_cls):
         if f.name == name:
@@ -262,8 +255,95 @@ def default(options_cls, name: str):
     return ... if d is MISSING else d
 
 
-def as_flag_text(value) -> str:
-    return value if isinstance(value, str) else str(value)
+def cli_type(f: dataclasses.Field) -> object:
+    """The type the CLI parses an Options field's flag as: ``bool`` for an on/off field, ``int``/``float`` for
+    a plain number, else text (words such as ``auto`` or a list of joints); the Options check the value."""
+    check = f.metadata.get("check")
+    kind: type = str
+    if isinstance(check, Flag):
+        return bool
+    if isinstance(check, Integer) and not check.words:
+        kind = int
+    elif isinstance(check, Real) and not check.words:
+        kind = float
+    return kind | None if f.default is None else kind
+
+
+#: what :func:`task_command` hands a command besides its own parameters (keyword-only in its signature)
+GIVEN = ("options", "as_json", "force", "gltf_scale", "gltf_up", "closing_frame")
+
+
+def _parameter(name: str, annotation, default=inspect.Parameter.empty) -> inspect.Parameter:
+    return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation)
+
+
+def task_command(name: str, **aliases: tuple[str, ...]) -> Callable:
+    """Register ``mocycle <name>`` made from the task's spec (:data:`mocycle.tasks.spec.SPECS`).
+
+    The command function declares what is its own: its input arguments and its plots. This adds one option
+    per field of the task's ``Options`` (flag, help, type and default from the field; ``aliases``: more
+    flags of a field), one per output of the spec (``-o/--output`` ...; its suffixes checked before any work),
+    ``--json``, ``--force`` (when the Options have none) and, for a task that writes motion, ``--gltf-scale``,
+    ``--gltf-up`` and for a loop ``--closing-frame``. The function's keyword-only parameters name what of
+    these it wants (:data:`GIVEN`, and its outputs by flag: ``output``, ``playback``): ``options`` is the
+    task's Options, checked; ``force`` the Options' own when they have one."""
+    spec = SPECS[name]
+
+    def decorate(func: Callable) -> Callable:
+        summary = " ".join(inspect.cleandoc(func.__doc__ or "").split("\n\n")[0].split())
+        if summary != spec.summary:  # the help's first paragraph is the spec's (``mocycle --help`` lists it)
+            raise TypeError(f"{name}: the help begins {summary!r}, the spec says {spec.summary!r}")
+        own = inspect.signature(func, eval_str=True).parameters
+        wanted = [p.name for p in own.values() if p.kind is inspect.Parameter.KEYWORD_ONLY]
+        unknown = set(wanted) - {*GIVEN, *(o.flag[2:] for o in spec.outputs)}
+        if unknown:
+            raise TypeError(f"{func.__name__}: keyword-only parameters {sorted(unknown)} are not given by "
+                            f"task_command")
+        params = [p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in own.values() if p.name not in wanted]
+        options_cls = spec.options
+        fields = dataclasses.fields(options_cls)
+        for o in spec.outputs:
+            decls = (o.flag, "-o") if o.flag == "--output" else (o.flag,)
+            params.append(_parameter(o.flag[2:], Annotated[Path if o.required else Path | None,
+                                                           typer.Option(*decls, help=o.help)],
+                                     inspect.Parameter.empty if o.required else None))
+        params += [_parameter(f.name, Annotated[cli_type(f), flag(options_cls, f.name, *aliases.get(f.name, ()))],
+                              default(options_cls, f.name)) for f in fields]
+        params.append(_parameter("as_json", Annotated[bool, typer.Option("--json", help="Print JSON.")], False))
+        own_force = "force" not in {f.name for f in fields}
+        if own_force and (spec.outputs or any("plot" in p for p in own)):
+            params.append(_parameter("force", Annotated[bool, typer.Option("--force", help=FORCE_HELP)], False))
+        if spec.writes_motion():
+            if any(o.loop for o in spec.outputs):
+                params.append(_parameter("closing_frame", Annotated[bool | None, CLOSING_FRAME], None))
+            params += [_parameter("gltf_scale", Annotated[str, GLTF_SCALE], "auto"),
+                       _parameter("gltf_up", Annotated[str, GLTF_UP], "auto")]
+        params.sort(key=lambda p: p.default is not inspect.Parameter.empty)  # typer lists the required first
+
+        @wraps(func)
+        def command(**kwargs):
+            options = options_cls(**{f.name: kwargs.pop(f.name) for f in fields})
+            force = kwargs.get("force", False) if own_force else options.force
+            inputs = [v for key in spec.inputs for v in _listed(kwargs.get(key.lstrip("*")))]
+            for o in spec.outputs:
+                path = kwargs.get(o.flag[2:])
+                if o.writes == "motion":
+                    check_motion_output(path, inputs, force, o.flag, kwargs["gltf_scale"], kwargs["gltf_up"])
+                else:
+                    check_output(path, inputs, force, o.suffixes, o.flag)
+            given = {"options": options, "force": force, **kwargs}
+            return func(**{k: v for k, v in given.items() if k in own})
+
+        command.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]
+        command.__annotations__ = {p.name: p.annotation for p in params}
+        del command.__wrapped__  # typer reads the signature made here, not the function's
+        return app.command(name)(friendly(command))
+
+    return decorate
+
+
+def _listed(value) -> list:
+    return [] if value is None else list(value) if isinstance(value, (list, tuple)) else [value]
 
 
 def timing_line(report) -> str:
@@ -278,12 +358,6 @@ def print_json(facts: Mapping, indent: int | None = 2) -> None:
 
 
 # ------------------------------------------------------------ option parsing
-def check_suffix(path: Path | None, suffix: str, option: str = "-o") -> None:
-    """Refuse an output path without the expected suffix, before any work is done (nothing gets written)."""
-    if path is not None and path.suffix.lower() != suffix:
-        raise MocycleError(f"{path}: {option} must name a {suffix} file")
-
-
 def check_output(path: Path | None, inputs=(), force: bool = False, suffix: str | tuple[str, ...] | None = None,
                  option: str = "-o") -> None:
     """Refuse an output before any work is done: wrong suffix, a folder that is missing or not writable,

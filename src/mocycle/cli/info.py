@@ -8,21 +8,16 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import app, default, escape, flag, friendly, out, print_json, print_warnings
-
-O = tasks.info.Options
+from .common import escape, out, print_json, print_warnings, task_command
 
 
-@app.command()
-@friendly
+@task_command("info")
 def info(
     path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON instead of tables.")] = False,
-    amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
-    take: Annotated[str | None, flag(O, "take")] = default(O, "take"),
+    *, options, as_json,
 ):
     """Frames, frame time, fps, duration, joints, channels, root travel and rotation ranges."""
-    report = tasks.info.run(path, O(amc_fps=amc_fps, take=take))
+    report = tasks.info.run(path, options)
     print_warnings(report)
     facts = {**report.facts, "file": str(path), "seconds": report.seconds}
     if as_json:

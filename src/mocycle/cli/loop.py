@@ -10,61 +10,19 @@ import typer
 from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 from ..tasks.loop import METRIC_LABELS
-from .common import (
-    CLOSING_FRAME,
-    GLTF_SCALE,
-    GLTF_UP,
-    app,
-    check_motion_output,
-    check_output,
-    default,
-    escape,
-    flag,
-    friendly,
-    out,
-    print_json,
-    print_warnings,
-    timing_line,
-    write_motion,
-)
-
-O = tasks.loop.Options
+from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line, write_motion
 
 
-@app.command()
-@friendly
+@task_command("loop", which=("--parts", "--class"))
 def loop(
     path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The cycle as a .bvh or .glb file.")],
-    method: Annotated[str, flag(O, "method")] = default(O, "method"),
-    model: Annotated[str, flag(O, "model")] = default(O, "model"),
-    harmonics: Annotated[str, flag(O, "harmonics")] = default(O, "harmonics"),
-    root: Annotated[str, flag(O, "root")] = default(O, "root"),
-    frame_range: Annotated[str | None, flag(O, "frame_range")] = default(O, "frame_range"),
-    step: Annotated[int, flag(O, "step")] = default(O, "step"),
-    joints: Annotated[str | None, flag(O, "joints")] = default(O, "joints"),
-    cycles: Annotated[int, flag(O, "cycles")] = default(O, "cycles"),
-    classes: Annotated[str, flag(O, "classes")] = default(O, "classes"),
-    which: Annotated[str | None, flag(O, "which", "--parts", "--class")] = default(O, "which"),
-    pca: Annotated[str, flag(O, "pca")] = default(O, "pca"),
-    delay: Annotated[int, flag(O, "delay")] = default(O, "delay"),
-    min_periods: Annotated[float, flag(O, "min_periods")] = default(O, "min_periods"),
-    time_axis: Annotated[str, flag(O, "time_axis")] = default(O, "time_axis"),
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: PCA of input and cycle, phase, joint curves (with --class all: OUT.classK.png).")]
     = None,
-    amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
-    take: Annotated[str | None, flag(O, "take")] = default(O, "take"),
-    force: Annotated[bool, flag(O, "force")] = default(O, "force"),
-    feet: Annotated[str, flag(O, "feet")] = default(O, "feet"),
     feet_plot: Annotated[Path | None, typer.Option(
         help="Write a PNG of the contacts: each ankle and toe's height and speed over two cycles, before (dashed) "
              "and after locking (with --class all: OUT.classK.png).")] = None,
-    foot_joints: Annotated[str | None, flag(O, "foot_joints")] = default(O, "foot_joints"),
-    closing_frame: Annotated[bool | None, CLOSING_FRAME] = None,
-    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
-    gltf_up: Annotated[str, GLTF_UP] = "auto",
+    *, options, output, as_json, force, closing_frame, gltf_scale, gltf_up,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH or glTF.
 
@@ -74,13 +32,8 @@ def loop(
     Exit code 0 on success, 3 when the take holds no periodic motion or its cycle fails a loop check
     (the reason is printed; --force writes it anyway), 1 for bad input, 2 for a bad option.
     """
-    check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
     check_output(plot, [path], force, ".png", "--plot")
     check_output(feet_plot, [path], force, ".png", "--feet-plot")
-    options = O(method=method, model=model, harmonics=harmonics, root=root, frame_range=frame_range, step=step,
-                joints=joints, cycles=cycles, classes=classes, which=which, pca=pca, delay=delay,
-                min_periods=min_periods, time_axis=time_axis, amc_fps=amc_fps, take=take, force=force, feet=feet,
-                foot_joints=foot_joints)
     try:
         report = tasks.loop.run(path, options)
     except (NoPeriodicMotion, LoopRefused) as exc:
@@ -112,7 +65,8 @@ def loop(
 
             images.append(plot.with_suffix(f".{tag}.png") if tag else plot)
             plot_loop(report.motions["input"], cycle, images[-1],
-                      title=f"{path.name}: {method}{' ' + model if method == 'harmonic' else ''}")
+                      title=f"{path.name}: {options.method}"
+                      + (f" {options.model}" if options.method == "harmonic" else ""))
         facts.update(output=str(target), frames_out=written.n_frames, closing_frame=closing)
         shown.append(({"file": str(path), **facts, "seconds": report.seconds,
                        "metrics_seconds": report.timings_s["metrics"]}, images))

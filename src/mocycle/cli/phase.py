@@ -10,38 +10,22 @@ import typer
 from .. import tasks
 from .common import (
     EXIT_NOT_FOUND,
-    FORCE_HELP,
-    app,
     check_output,
-    default,
     err,
     escape,
-    flag,
-    friendly,
     out,
     print_json,
     print_warnings,
+    task_command,
     timing_line,
 )
 
-O = tasks.phase.Options
 
-
-@app.command()
-@friendly
+@task_command("phase")
 def phase(
     path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
-    classes: Annotated[str, flag(O, "classes")] = default(O, "classes"),
-    joints: Annotated[str | None, flag(O, "joints")] = default(O, "joints"),
-    pca: Annotated[str, flag(O, "pca")] = default(O, "pca"),
-    delay: Annotated[int, flag(O, "delay")] = default(O, "delay"),
-    min_periods: Annotated[float, flag(O, "min_periods")] = default(O, "min_periods"),
-    landmarks: Annotated[int, flag(O, "n_landmarks")] = default(O, "n_landmarks"),
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: diagram, phase per frame, PCA by phase.")] = None,
-    amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
-    take: Annotated[str | None, flag(O, "take")] = default(O, "take"),
-    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    *, options, as_json, force,
 ):
     """Find periodic motions and the phase of every frame (persistent cohomology).
 
@@ -49,8 +33,6 @@ def phase(
     (the reason is printed), 1 for bad input, 2 for a bad option.
     """
     check_output(plot, [path], force, ".png", "--plot")
-    options = O(classes=classes, joints=joints, pca=pca, delay=delay, min_periods=min_periods, n_landmarks=landmarks,
-                amc_fps=amc_fps, take=take)
     report = tasks.phase.run(path, options, keep_features=plot is not None)
     print_warnings(report)
     if plot is not None:

@@ -8,43 +8,15 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import (
-    GLTF_SCALE,
-    GLTF_UP,
-    app,
-    check_motion_output,
-    check_output,
-    default,
-    escape,
-    flag,
-    friendly,
-    out,
-    print_json,
-    print_warnings,
-    timing_line,
-    write_motion,
-)
-
-O = tasks.stretch.Options
+from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line, write_motion
 
 
-@app.command()
-@friendly
+@task_command("stretch")
 def stretch(
     path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
-    factor: Annotated[float, flag(O, "factor")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The .bvh or .glb file to write.")],
-    window: Annotated[str, flag(O, "window_frames")] = default(O, "window_frames"),
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves of the input and the stretched take in seconds.")] = None,
-    amc_fps: Annotated[float, flag(O, "amc_fps")] = default(O, "amc_fps"),
-    take: Annotated[str | None, flag(O, "take")] = default(O, "take"),
-    force: Annotated[bool, flag(O, "force")] = default(O, "force"),
-    feet: Annotated[str, flag(O, "feet")] = default(O, "feet"),
-    foot_joints: Annotated[str | None, flag(O, "foot_joints")] = default(O, "foot_joints"),
-    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
-    gltf_up: Annotated[str, GLTF_UP] = "auto",
+    *, options, output, as_json, force, gltf_scale, gltf_up,
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
 
@@ -56,17 +28,15 @@ def stretch(
     keeps its mean velocity. Exit code 3 when the take has no periodic motion
     (--force warps it whole anyway), 1 for bad input, 2 for a bad option.
     """
-    check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
     check_output(plot, [path], force, ".png", "--plot")
-    report = tasks.stretch.run(path, O(factor=factor, window_frames=window, amc_fps=amc_fps, take=take, force=force,
-                                       feet=feet, foot_joints=foot_joints))
+    report = tasks.stretch.run(path, options)
     print_warnings(report)
     write_motion(report, "stretched", output, gltf_scale, gltf_up)
     if plot is not None:
         from ..viz import plot_curves
 
         series = [("stretched", report.motions["stretched"], None), ("input", report.motions["input"], None)]
-        plot_curves(series, plot, title=f"{path.name} stretched × {factor:g}: cycles copied, not slowed down")
+        plot_curves(series, plot, title=f"{path.name} stretched × {options.factor:g}: cycles copied, not slowed down")
     facts = {**{k: v for k, v in report.facts.items() if k not in ("fps", "joints_per_group")},
              "seconds": report.seconds}
     if as_json:

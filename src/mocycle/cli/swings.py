@@ -9,61 +9,37 @@ import typer
 
 from .. import tasks
 from .common import (
-    FORCE_HELP,
-    GLTF_SCALE,
-    GLTF_UP,
-    app,
-    check_motion_output,
     check_output,
-    default,
     escape,
-    flag,
-    friendly,
     json_text,
     out,
     print_json,
     print_warnings,
+    task_command,
     timing_line,
     write_motion,
     write_text,
 )
 
-S = tasks.swings.Options
-Q = tasks.search.Options
-E = tasks.edit.Options
 _FACT_KEYS = ("joints", "n_swings", "segmentation_error", "per_angle_error_deg", "geodesic_error_deg",
               "compressed_bytes", "raw_float32_bytes")
 
 
-@app.command()
-@friendly
+@task_command("swings")
 def swings(
     path: Annotated[Path, typer.Argument(
         help="A motion file (.bvh, .fbx, .glb, .gltf, .amc), or a .mosw swings file to play back.")],
-    threshold: Annotated[float, flag(S, "threshold")] = default(S, "threshold"),
-    joints: Annotated[str | None, flag(S, "joints")] = default(S, "joints"),
-    output: Annotated[Path | None, typer.Option(
-        "-o", "--output", help="Write the swings: .json (records) or .mosw (compact binary file).")] = None,
-    playback_path: Annotated[Path | None, typer.Option(
-        "--playback", help="Write the motion rebuilt from the swings as .bvh or .glb.")] = None,
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: one row per joint, swings as numbered bars in time (the numbers edit --swing takes).")]
     = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    amc_fps: Annotated[float, flag(S, "amc_fps")] = default(S, "amc_fps"),
-    take: Annotated[str | None, flag(S, "take")] = default(S, "take"),
-    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
-    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
-    gltf_up: Annotated[str, GLTF_UP] = "auto",
+    *, options, output, playback, as_json, force, gltf_scale, gltf_up,
 ):
     """Segment a take into joint swings and holds; report playback error and compressed size.
 
     The table lists each joint's swing indices (0-based, in time order): what `mocycle edit --swing` takes.
     """
-    check_output(output, [path], force, (".json", ".mosw"), "--output")
-    check_motion_output(playback_path, [path], force, "--playback", gltf_scale, gltf_up)
     check_output(plot, [path], force, ".png", "--plot")
-    report = tasks.swings.run(path, S(threshold=threshold, joints=joints, amc_fps=amc_fps, take=take))
+    report = tasks.swings.run(path, options)
     print_warnings(report)
     seg, r = report.result, report.facts
     written = []
@@ -75,9 +51,9 @@ def swings(
         else:
             write_text(output, encode(seg), "swings file")
         written.append(f"{output} ({seg.n_swings} swings)")
-    if playback_path is not None:
-        write_motion(report, "playback", playback_path, gltf_scale, gltf_up)
-        written.append(f"{playback_path} (motion rebuilt from the swings)")
+    if playback is not None:
+        write_motion(report, "playback", playback, gltf_scale, gltf_up)
+        written.append(f"{playback} (motion rebuilt from the swings)")
     if plot is not None:
         from ..viz.swings import plot_swings
 
@@ -111,21 +87,13 @@ def swings(
     out.print(timing_line(report))
 
 
-@app.command()
-@friendly
+@task_command("search")
 def search(
     query: Annotated[Path, typer.Argument(help="The example take (.bvh, .fbx, .glb, .gltf or .amc).")],
     folder: Annotated[Path, typer.Argument(help="Folder of takes to search.")],
-    top: Annotated[int, flag(Q, "top")] = default(Q, "top"),
-    pattern: Annotated[str, flag(Q, "pattern")] = default(Q, "pattern"),
-    threshold: Annotated[float, flag(Q, "threshold")] = default(Q, "threshold"),
-    window: Annotated[float, flag(Q, "window_s")] = default(Q, "window_s"),
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    amc_fps: Annotated[float, flag(Q, "amc_fps")] = default(Q, "amc_fps"),
-    take: Annotated[str | None, flag(Q, "take")] = default(Q, "take"),
+    *, options, as_json,
 ):
     """Rank the takes of a folder by how alike their swings are to an example (query by example)."""
-    options = Q(top=top, pattern=pattern, threshold=threshold, window_s=window, amc_fps=amc_fps, take=take)
     report = tasks.search.run(query, folder, options)
     print_warnings(report)
     if as_json:
@@ -144,28 +112,12 @@ def search(
     out.print(timing_line(report))
 
 
-@app.command()
-@friendly
+@task_command("edit")
 def edit(
     path: Annotated[Path, typer.Argument(help="A motion file (.bvh, .fbx, .glb, .gltf or .amc).")],
-    joint: Annotated[str, flag(E, "joint")],
-    swing: Annotated[int, flag(E, "swing")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="Edited motion (.bvh or .glb).")],
-    angle_scale: Annotated[float, flag(E, "angle_scale")] = default(E, "angle_scale"),
-    duration_scale: Annotated[float, flag(E, "duration_scale")] = default(E, "duration_scale"),
-    threshold: Annotated[float, flag(E, "threshold")] = default(E, "threshold"),
-    joints: Annotated[str | None, flag(E, "joints")] = default(E, "joints"),
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
-    amc_fps: Annotated[float, flag(E, "amc_fps")] = default(E, "amc_fps"),
-    take: Annotated[str | None, flag(E, "take")] = default(E, "take"),
-    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
-    gltf_scale: Annotated[str, GLTF_SCALE] = "auto",
-    gltf_up: Annotated[str, GLTF_UP] = "auto",
+    *, options, output, as_json, gltf_scale, gltf_up,
 ):
     """Scale the angle or the duration of one swing of one joint and write the edited motion."""
-    check_motion_output(output, [path], force, "--output", gltf_scale, gltf_up)
-    options = E(joint=joint, swing=swing, angle_scale=angle_scale, duration_scale=duration_scale,
-                threshold=threshold, joints=joints, amc_fps=amc_fps, take=take)
     report = tasks.edit.run(path, options)
     print_warnings(report)
     write_motion(report, "edited", output, gltf_scale, gltf_up)
@@ -173,5 +125,6 @@ def edit(
     if as_json:
         print_json({**r, "output": str(output), "seconds": report.seconds})
     else:
-        out.print(f"{escape(joint)} swing {swing} (frames {r['start']}-{r['end']}, {r['angle_deg']:.1f} deg): "
-                  f"angle x{angle_scale:g}, duration x{duration_scale:g} -> {escape(output)}", soft_wrap=True)
+        o = options
+        out.print(f"{escape(o.joint)} swing {o.swing} (frames {r['start']}-{r['end']}, {r['angle_deg']:.1f} deg): "
+                  f"angle x{o.angle_scale:g}, duration x{o.duration_scale:g} -> {escape(output)}", soft_wrap=True)
