@@ -8,6 +8,7 @@ import bpy
 
 from mocycle import tasks
 from mocycle.errors import MocycleError
+from mocycle.tasks.spec import SPECS
 
 from . import props, rig
 
@@ -116,11 +117,14 @@ class _Task(bpy.types.Operator):
         return {"FINISHED"}
 
 
-def _task_operator(idname, label, description, options_cls, extra: dict):
+def _task_operator(task: str, idname: str, label: str, description: str, extra: dict, work):
+    """The operator of a task: a property per field of the task's ``Options`` (from its spec,
+    ``mocycle.tasks.spec.SPECS``) plus ``extra`` (what Blender itself supplies), and ``work``, which runs it."""
+    options_cls = SPECS[task].options
     annotations = {**props.annotations(options_cls), **extra}
     return type(f"MOCYCLE_OT_{idname}", (_Task,), {
         "bl_idname": f"mocycle.{idname}", "bl_label": label, "bl_description": description,
-        "__annotations__": annotations, "options_cls": options_cls})
+        "__annotations__": annotations, "options_cls": options_cls, "work": work})
 
 
 def _find_phase(self, context, arm):
@@ -130,7 +134,7 @@ def _find_phase(self, context, arm):
     if window:
         a, b = (int(x) for x in window.split(":"))
         motion = motion[a:b]
-    report = tasks.phase.run(motion, props.options_from(tasks.phase.Options, self, joints=_joints(self, arm)))
+    report = tasks.phase.run(motion, props.options_from(self.options_cls, self, joints=_joints(self, arm)))
     st = _state(context)
     st.periodic.clear()
     for c in report.facts["classes"]:
@@ -154,7 +158,7 @@ def _extract_cycle(self, context, arm):
     action = arm.animation_data.action
     first, last, window = _frame_range(self, action)
     motion = rig.to_motion(arm, action, (first, last))
-    options = props.options_from(tasks.loop.Options, self, frame_range=window, joints=_joints(self, arm),
+    options = props.options_from(self.options_cls, self, frame_range=window, joints=_joints(self, arm),
                                  which=None if self.which < 0 else self.which)
     report = tasks.loop.run(motion, options)
     _keep_parts(context, report.facts["parts"], first)
@@ -181,7 +185,7 @@ def _blend_cycles(self, context, arm):
     if len(actions) < 2:
         raise MocycleError("blend needs at least one other action (Other actions)")
     motions = [rig.to_motion(arm, a) for a in actions]
-    options = props.options_from(tasks.blend.Options, self, which=None if self.which < 0 else self.which)
+    options = props.options_from(self.options_cls, self, which=None if self.which < 0 else self.which)
     report = tasks.blend.run(motions, options)
     result = report.result
     new = rig.write_action(arm, report.motions["loop"], f"{action.name}_blend", rig.action_frames(action)[0],
@@ -202,7 +206,7 @@ def _transition(self, context, arm):
     if len(actions) != 2:
         raise MocycleError("transition needs exactly one other action (Other actions)")
     motions = [rig.to_motion(arm, a) for a in actions]
-    options = props.options_from(tasks.transition.Options, self, which=None if self.which < 0 else self.which)
+    options = props.options_from(self.options_cls, self, which=None if self.which < 0 else self.which)
     report = tasks.transition.run(motions, options)
     new = rig.write_action(arm, report.motions["transition"], f"{actions[0].name}_to_{actions[1].name}",
                            rig.action_frames(action)[0])
@@ -220,7 +224,7 @@ def _stretch(self, context, arm):
     action = arm.animation_data.action
     first, last = rig.action_frames(action)
     motion = rig.to_motion(arm, action, (first, last))
-    report = tasks.stretch.run(motion, props.options_from(tasks.stretch.Options, self))
+    report = tasks.stretch.run(motion, props.options_from(self.options_cls, self))
     new = rig.write_action(arm, report.motions["stretched"], f"{action.name}_stretched", first)
     _keep_facts(new, report)
     rig_assign(arm, new)
@@ -241,19 +245,18 @@ def rig_assign(arm, action) -> None:
 
 
 COMMON = props.COMMON
-FindPhase = _task_operator("find_phase", "Find Phase", "The periodic motions of the active action (period, "
-                           "number of periods, excitation), listed in the panel", tasks.phase.Options, COMMON)
-ExtractCycle = _task_operator("extract_cycle", "Extract Cycle", "The typical cycle of the active action as a new, "
-                              "looping action named <action>_cycle", tasks.loop.Options, {**COMMON, **props.WHICH})
-BlendCycles = _task_operator("blend_cycles", "Blend Cycles", "Blend the cycles of the active action and other "
-                             "actions (weights) into a new looping action", tasks.blend.Options,
-                             {**props.WHICH, **props.OTHER})
-Transition = _task_operator("transition", "Transition", "A new action that starts as the active action's cycle "
-                            "and ends as the other action's", tasks.transition.Options, {**props.WHICH, **props.OTHER})
-Stretch = _task_operator("stretch", "Stretch", "The active action lengthened by a factor (time-frequency warping "
-                         "of its periodic part) as a new action", tasks.stretch.Options, {})
-FindPhase.work, ExtractCycle.work, BlendCycles.work = _find_phase, _extract_cycle, _blend_cycles
-Transition.work, Stretch.work = _transition, _stretch
+FindPhase = _task_operator("phase", "find_phase", "Find Phase", "The periodic motions of the active action (period, "
+                           "number of periods, excitation), listed in the panel", COMMON, _find_phase)
+ExtractCycle = _task_operator("loop", "extract_cycle", "Extract Cycle", "The typical cycle of the active action as a "
+                              "new, looping action named <action>_cycle", {**COMMON, **props.WHICH}, _extract_cycle)
+BlendCycles = _task_operator("blend", "blend_cycles", "Blend Cycles", "Blend the cycles of the active action and "
+                             "other actions (weights) into a new looping action", {**props.WHICH, **props.OTHER},
+                             _blend_cycles)
+Transition = _task_operator("transition", "transition", "Transition", "A new action that starts as the active "
+                            "action's cycle and ends as the other action's", {**props.WHICH, **props.OTHER},
+                            _transition)
+Stretch = _task_operator("stretch", "stretch", "Stretch", "The active action lengthened by a factor (time-frequency "
+                         "warping of its periodic part) as a new action", {}, _stretch)
 
 
 CLASSES = (FindPhase, ExtractCycle, BlendCycles, Transition, Stretch)

@@ -14,7 +14,6 @@ from typing import Annotated
 import click
 import typer
 
-from .. import tasks
 from ..errors import MocycleError
 from ..tasks.options import MISSING, Flag, flag_of
 from ..tasks.spec import SPECS
@@ -28,7 +27,7 @@ def options_parser(command: str) -> click.Command:
     """A click command that reads INPUTS and the flags of ``tasks.<command>.Options`` (each field's flag,
     its help; on/off fields as flags, ``--no-X`` for the ones on by default)."""
     params: list[click.Parameter] = [click.Argument(["inputs"], nargs=-1)]
-    for f in dataclasses.fields(tasks.TASKS[command].Options):
+    for f in dataclasses.fields(SPECS[command].options):
         name = flag_of(f)
         if isinstance(f.metadata.get("check"), Flag):
             decl = f"{name}/--no-{name[2:]}" if f.default is True else name
@@ -49,7 +48,7 @@ def parse_command_line(args: list[str]):
     ctx = parser.make_context(parser.name, rest, resilient_parsing=False)
     given = {k: v for k, v in ctx.params.items() if k != "inputs"
              and ctx.get_parameter_source(k) == click.core.ParameterSource.COMMANDLINE}
-    options = tasks.TASKS[command].Options(**given)  # an OptionError names the flag (exit 2)
+    options = SPECS[command].options(**given)  # an OptionError names the flag (exit 2)
     return command, list(ctx.params["inputs"]), options
 
 

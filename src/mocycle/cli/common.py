@@ -277,7 +277,7 @@ def _parameter(name: str, annotation, default=inspect.Parameter.empty) -> inspec
     return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation)
 
 
-def task_command(name: str, **aliases: tuple[str, ...]) -> Callable:
+def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[str, ...]) -> Callable:
     """Register ``mocycle <name>`` made from the task's spec (:data:`mocycle.tasks.spec.SPECS`).
 
     The command function declares what is its own: its input arguments and its plots. This adds one option
@@ -286,7 +286,8 @@ def task_command(name: str, **aliases: tuple[str, ...]) -> Callable:
     ``--json``, ``--force`` (when the Options have none) and, for a task that writes motion, ``--gltf-scale``,
     ``--gltf-up`` and for a loop ``--closing-frame``. The function's keyword-only parameters name what of
     these it wants (:data:`GIVEN`, and its outputs by flag: ``output``, ``playback``): ``options`` is the
-    task's Options, checked; ``force`` the Options' own when they have one."""
+    task's Options, checked; ``force`` the Options' own when they have one. ``into``: the typer app
+    (``mocycle``'s by default)."""
     spec = SPECS[name]
 
     def decorate(func: Callable) -> Callable:
@@ -337,7 +338,7 @@ def task_command(name: str, **aliases: tuple[str, ...]) -> Callable:
         command.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]
         command.__annotations__ = {p.name: p.annotation for p in params}
         del command.__wrapped__  # typer reads the signature made here, not the function's
-        return app.command(name)(friendly(command))
+        return (into or app).command(name)(friendly(command))
 
     return decorate
 

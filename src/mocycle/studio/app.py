@@ -47,6 +47,7 @@ from starlette.staticfiles import StaticFiles
 from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from ..tasks import author
+from ..tasks.spec import SPECS
 from . import validate as v
 from .guard import MAX_BODY, Access, Guard
 from .jobs import Held, Jobs, held_bytes, release_memory
@@ -190,7 +191,7 @@ class Studio:
 
     # ------------------------------------------------------------ the authoring plane
     def plane(self, take: Take, params: dict) -> bytes:
-        fields = v.PLANE_FIELDS
+        fields = v.form_fields("project")
         o = tasks.project.Options(**params, amc_fps=self.amc_fps)
         key = repr((take.id, tuple(sorted((k, str(getattr(o, k))) for k in fields))))
         data = self._planes.peek(key)
@@ -351,8 +352,12 @@ async def list_takes(request):
 
 
 async def options(request):
-    return JSON({"loop": tasks.schema(tasks.loop.Options), "plane": tasks.schema(tasks.project.Options),
-                 "author": tasks.schema(author.Options)})
+    """The forms of the page, made from the tasks' specs: each form's schema (``tasks.schema``), and under
+    ``forms`` the fields the page shows (a spec's ``studio``), with ``cycles`` bounded by :data:`MAX_CYCLES`."""
+    forms = {"loop": "loop", "plane": "project", "author": "author"}
+    out = {form: tasks.schema(SPECS[task].options) for form, task in forms.items()}
+    out["loop"]["properties"]["cycles"]["maximum"] = v.MAX_CYCLES
+    return JSON({**out, "forms": {form: list(SPECS[task].studio) for form, task in forms.items()}})
 
 
 async def take_motion(request):

@@ -15,6 +15,7 @@ import math
 import re
 
 from ..errors import MocycleError
+from ..tasks.spec import SPECS
 
 
 class HTTPProblem(MocycleError):
@@ -46,12 +47,15 @@ class Busy(HTTPProblem):
 #: most keyframes a request may name; most samples a stroke may have (a 10-minute stroke at 120 Hz is 72,000)
 MAX_KEYFRAMES = 4096
 MAX_STROKE_POINTS = 100_000
-#: most cycles a loop job repeats (the page's form offers 1 to 20)
+#: most cycles a loop job repeats (the page's form offers 1 to this)
 MAX_CYCLES = 100
-#: the loop form's fields and the stroke's options (each checked again by the task's Options)
-LOOP_FIELDS = ("method", "model", "root", "feet", "cycles")
-STROKE_OPTIONS = ("plant", "feet")
-PLANE_FIELDS = ("projection", "select", "ratio", "seed_projection", "optimize")
+
+
+def form_fields(task: str) -> tuple[str, ...]:
+    """The fields of a task's form: what its spec names for the studio (each value is checked again by the
+    task's Options)."""
+    return SPECS[task].studio
+
 _ID = {"take": re.compile(r"t\d{1,9}"), "job": re.compile(r"j\d{1,9}"), "stroke": re.compile(r"s\d{1,9}")}
 
 
@@ -176,8 +180,8 @@ def _option_text(body: dict, fields) -> dict:
 def loop_request(body: dict) -> tuple[dict, bool]:
     """``POST /api/takes/{id}/loop``: the loop's options and ``force``; ``cycles`` at most :data:`MAX_CYCLES`
     (the studio's bound: the task's own is the output's length, found only after the cycle is made)."""
-    _known(body, (*LOOP_FIELDS, "force"))
-    options = _option_text(body, LOOP_FIELDS)
+    _known(body, (*form_fields("loop"), "force"))
+    options = _option_text(body, form_fields("loop"))
     if "cycles" in options:
         n = options["cycles"]
         if isinstance(n, str) and n.strip().isdigit() and len(n.strip()) < 6:
@@ -206,7 +210,7 @@ def relayout_request(body: dict, n_frames: int) -> tuple[list[int], list[list[fl
 def stroke_request(body: dict, n_frames: int, frame_time: float, max_frames: int) -> dict:
     """``POST /api/takes/{id}/strokes``: the stroke (as ``tasks.author`` takes it) and its options; the
     animation it makes (one frame per ``frame_time`` of its duration) must be at most ``max_frames``."""
-    _known(body, ("keyframes", "markers", "points", "times_s", *STROKE_OPTIONS))
+    _known(body, ("keyframes", "markers", "points", "times_s", *form_fields("author")))
     key, markers = _keyed_markers(body, n_frames)
     pts = points("points", _required(body, "points"), 1, MAX_STROKE_POINTS)
     times = [_number(f"times_s[{i}]", t) for i, t in
@@ -220,13 +224,13 @@ def stroke_request(body: dict, n_frames: int, frame_time: float, max_frames: int
         raise BadRequest(f"the stroke would make {frames} frames; at most {max_frames} "
                          f"({max_frames * frame_time:.0f} s at the take's frame rate)")
     return {"stroke": {"keyframes": key, "markers": markers, "points": pts, "times_s": times},
-            "options": _option_text(body, STROKE_OPTIONS)}
+            "options": _option_text(body, form_fields("author"))}
 
 
 def plane_query(query) -> dict:
     """``GET /api/takes/{id}/plane?...``: the plane's options as ``tasks.project.Options`` takes them."""
     query = {k: v for k, v in query.items() if k != "token"}  # a network server's token (see guard.py)
-    _known(query, PLANE_FIELDS)
+    _known(query, form_fields("project"))
     params = {k: v for k, v in query.items() if k != "optimize"}
     for name, value in params.items():
         if len(value) > 64:

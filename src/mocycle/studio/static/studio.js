@@ -188,15 +188,31 @@ async function runLoop() {
   } catch (e) { if (seq === S.loopSeq) { loopState("failed", e.message); S.player.setLoop(null); } }
 }
 
+// the loop form: one control per field the loop's spec names for the studio (schema.forms.loop), made from the
+// field's schema (a choice: a list; a whole number: a number box; on/off: a box to tick)
+function control(name, p, value) {
+  let el;
+  if (p.enum) {
+    el = document.createElement("select");
+    for (const v of p.enum) el.add(new Option(v, v, false, v === value));
+  } else if (p.type === "boolean") {
+    el = document.createElement("input"); el.type = "checkbox"; el.checked = !!value;
+  } else {
+    el = document.createElement("input"); el.type = p.type === "integer" ? "number" : "text";
+    if (p.minimum !== undefined) el.min = p.minimum;
+    if (p.maximum !== undefined) el.max = p.maximum;
+    el.value = value ?? "";
+  }
+  el.name = name; el.title = p.description;
+  return el;
+}
+
 function buildOptions(schema) {
-  const form = $("loop-options");
-  const defaults = { root: "motion", cycles: 3 };
-  for (const name of ["method", "model", "root", "feet"]) {
+  const defaults = { root: "motion", cycles: 3 };  // the studio shows loops moving on, three cycles long
+  for (const name of schema.forms.loop) {
     const p = schema.loop.properties[name];
-    const sel = document.createElement("select");
-    sel.name = name; sel.title = p.description;
-    for (const v of p.enum) sel.add(new Option(v, v, false, v === (defaults[name] ?? p.default)));
-    const label = document.createElement("label"); label.append(name + " ", sel);
+    const label = document.createElement("label");
+    label.append(name + " ", control(name, p, defaults[name] ?? p.default));
     $("loop-fields").appendChild(label);
   }
   const plane = schema.plane.properties;

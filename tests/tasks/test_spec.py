@@ -1,0 +1,125 @@
+"""One declaration per task (``mocycle.tasks.spec``): every front end is made from it, so a new option or output
+of a task reaches the CLI, batch and the studio without a second edit (Blender: ``tests_blender``)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+from typing import Annotated
+
+import pytest
+import typer
+from typer.testing import CliRunner
+
+from mocycle import tasks
+from mocycle.batch.commands import COMMANDS
+from mocycle.cli.batch import options_parser, parse_command_line
+from mocycle.cli.common import COMMANDS as CLI_COMMANDS
+from mocycle.cli.common import task_command
+from mocycle.tasks.options import Integer, option
+from mocycle.tasks.spec import SPECS
+
+pytest.importorskip("starlette")
+
+
+def test_every_task_has_a_spec_and_every_command_one_summary():
+    assert set(tasks.NAMES) <= set(SPECS)
+    for name, spec in SPECS.items():
+        assert dataclasses.is_dataclass(spec.options), name
+        if spec.cli:
+            assert CLI_COMMANDS[name][1] == spec.summary
+    assert set(COMMANDS) == {n for n, s in SPECS.items() if s.batch}
+
+
+@pytest.fixture
+def knob(monkeypatch):
+    """The loop task with one more option, as one edit of ``tasks/loop.py`` would declare it."""
+
+    @dataclasses.dataclass(frozen=True)
+    class Options(tasks.loop.Options):
+        extra_knob: int = option(3, "A new knob (a test's).", Integer(1, 9))
+
+    monkeypatch.setattr(tasks.loop, "Options", Options)
+    return Options
+
+
+def test_a_new_option_reaches_the_cli(knob, tmp_path):
+    app = typer.Typer()
+    seen = {}
+
+    @task_command("loop", into=app)
+    def loop(path: Annotated[Path, typer.Argument()], *, options, output):
+        """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH or glTF."""
+        seen.update(options=options, output=output)
+
+    take = tmp_path / "walk.bvh"
+    take.write_text("x")
+    result = CliRunner().invoke(app, [str(take), "-o", str(tmp_path / "out.bvh"), "--extra-knob", "5",
+                                      "--cycles", "2"])
+    assert result.exit_code == 0, result.output
+    assert seen["options"].extra_knob == 5 and seen["options"].cycles == 2
+    assert seen["output"] == tmp_path / "out.bvh"
+    bad = CliRunner().invoke(app, [str(take), "-o", str(tmp_path / "out.bvh"), "--extra-knob", "12"])
+    assert bad.exit_code == 2 and "--extra-knob" in bad.output  # the field's own check, named by its flag
+    wrong = CliRunner().invoke(app, [str(take), "-o", str(tmp_path / "out.mck")])
+    assert wrong.exit_code == 1 and ".bvh or .glb" in wrong.output  # the spec's suffixes, before any work
+
+
+def test_a_new_option_reaches_batch(knob):
+    assert "--extra-knob" in {o for p in options_parser("loop").params for o in p.opts}
+    command, inputs, options = parse_command_line(["loop", "a.bvh", "--extra-knob", "4"])
+    assert (command, inputs, options.extra_knob) == ("loop", ["a.bvh"], 4)
+
+
+def test_a_new_option_reaches_the_studio(knob, monkeypatch):
+    import asyncio
+
+    from mocycle.studio import validate
+    from mocycle.studio.app import options
+
+    # the form shows the option once the spec names it for the studio (that edit is the same line of the spec)
+    monkeypatch.setitem(SPECS, "loop", dataclasses.replace(SPECS["loop"], studio=(*SPECS["loop"].studio,
+                                                                                  "extra_knob")))
+    body = json.loads(asyncio.run(options(None)).body)
+    assert body["loop"]["properties"]["extra_knob"]["maximum"] == 9
+    assert "extra_knob" in body["forms"]["loop"]
+    assert validate.loop_request({"extra_knob": 4})[0] == {"extra_knob": 4}
+
+
+@pytest.mark.parametrize("name", [n for n, s in SPECS.items() if s.cli])
+def test_every_output_of_a_spec_is_a_cli_option(name):
+    from mocycle.cli import app
+
+    command = typer.main.get_command(app).commands[name]
+    flags = {o for p in command.params for o in p.opts}
+    for out in SPECS[name].outputs:
+        assert out.flag in flags
+    assert ("--gltf-scale" in flags) == SPECS[name].writes_motion()
+    assert ("--closing-frame" in flags) == any(o.loop for o in SPECS[name].outputs)
+
+
+def test_the_studio_forms_are_the_specs():
+    import asyncio
+
+    from mocycle.studio.app import options
+
+    body = json.loads(asyncio.run(options(None)).body)
+    assert body["forms"] == {"loop": list(SPECS["loop"].studio), "plane": list(SPECS["project"].studio),
+                             "author": list(SPECS["author"].studio)}
+    for form, fields in body["forms"].items():
+        assert set(fields) <= set(body[form]["properties"]), form
+
+
+def test_a_loop_output_names_one_file_per_part():
+    """Output.targets is how the CLI and batch name a report's files."""
+    from types import SimpleNamespace
+
+    out = SPECS["loop"].outputs[0]
+    report = SimpleNamespace(facts={"loops": [{"role": "loop.part1", "kind": "walk turning left"},
+                                              {"role": "loop.part3", "kind": "walk straight"}]},
+                             motions={"loop.part1": 1, "loop.part3": 2})
+    assert out.targets(report, Path("o/walk.bvh")) == {"loop.part1": Path("o/walk.part1-walk-turning-left.bvh"),
+                                                       "loop.part3": Path("o/walk.part3-walk-straight.bvh")}
+    assert SPECS["stretch"].outputs[0].targets(SimpleNamespace(facts={}, motions={}), Path("s.bvh")) == \
+        {"stretched": Path("s.bvh")}
