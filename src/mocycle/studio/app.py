@@ -47,6 +47,7 @@ from starlette.staticfiles import StaticFiles
 from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from ..tasks import author
+from ..tasks.report import Labelled
 from ..tasks.spec import SPECS
 from . import validate as v
 from .guard import MAX_BODY, Access, Guard
@@ -169,19 +170,12 @@ class Studio:
         fails its checks ends the job as ``refused``, see :class:`~.jobs.Jobs`)."""
         o = tasks.loop.Options(force=force, **options)  # an OptionError here is the caller's 400
 
-        def named(text: str) -> str:  # messages name the take as the library lists it, not as "take 0"
-            memory = "take 0: "  # how tasks name a motion given in memory
-            return f"{take.name}: {text[len(memory):]}" if text.startswith(memory) else text
-
-        def work(job):
-            try:
-                report = tasks.loop.run(take.motion(self.amc_fps), o)
-            except LoopRefused as exc:
-                raise LoopRefused(named(str(exc)), exc.failed) from None
+        def work(job):  # messages name the take as the library lists it
+            report = tasks.loop.run(Labelled(take.motion(self.amc_fps), take.name), o)
             f = report.facts
             view, view_facts = loop_view(report)
             return {"report": report, "view": view, "take": take, "facts": {
-                "loop": loop_summary(f), "options": o.to_dict(), "warnings": [named(w) for w in report.warnings],
+                "loop": loop_summary(f), "options": o.to_dict(), "warnings": list(report.warnings),
                 "failed_checks": f["failed_checks"], "forced": bool(f["failed_checks"]),
                 "frames_out": f["frames_out"], "phase": take_phase(report), "excitation": strip_excitation(report),
                 "parts": strip_parts(report),

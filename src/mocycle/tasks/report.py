@@ -18,7 +18,7 @@ from ..threads import limited
 if TYPE_CHECKING:
     from ..motion import Motion
 
-__all__ = ["Recorder", "Report", "is_motion", "load", "label_of"]
+__all__ = ["Labelled", "Recorder", "Report", "is_motion", "label_of", "load"]
 
 
 @dataclass(frozen=True)
@@ -107,9 +107,19 @@ class _Part:
         return False
 
 
+class Labelled(NamedTuple):
+    """A motion in memory and how messages name it (a front end's name for the take, e.g. its file name):
+    a task input like the motion itself, whose errors and warnings begin ``<label>:`` instead of ``take 0:``."""
+
+    motion: Motion
+    label: str
+
+
 def is_motion(item) -> bool:
-    """True for a :class:`~mocycle.motion.Motion`, without importing :mod:`mocycle.motion` (and numpy): when
-    that module is not loaded yet, no object can be a Motion."""
+    """True for a :class:`~mocycle.motion.Motion` (or a :class:`Labelled` one), without importing
+    :mod:`mocycle.motion` (and numpy): when that module is not loaded yet, no object can be a Motion."""
+    if isinstance(item, Labelled):
+        return True
     motion = sys.modules.get("mocycle.motion")
     return motion is not None and isinstance(item, motion.Motion)
 
@@ -117,6 +127,8 @@ def is_motion(item) -> bool:
 def load(item: Motion | str | os.PathLike, amc_fps: float = AMC_FPS, take: str | None = None) -> Motion:
     """A task input: a :class:`Motion` as is, or a motion file read (``amc_fps``: AMC files only; ``take``: the
     animation of a glTF or FBX file)."""
+    if isinstance(item, Labelled):
+        return item.motion
     if is_motion(item):
         return item
     from ..io import read_motion
@@ -125,5 +137,8 @@ def load(item: Motion | str | os.PathLike, amc_fps: float = AMC_FPS, take: str |
 
 
 def label_of(item, k: int = 0) -> str:
-    """How messages name an input: its path, or ``take k`` for a motion in memory."""
+    """How messages name an input: its path, its label (:class:`Labelled`), or ``take k`` for a motion in
+    memory."""
+    if isinstance(item, Labelled):
+        return item.label
     return f"take {k}" if is_motion(item) else str(Path(item)) if not isinstance(item, str) else item
