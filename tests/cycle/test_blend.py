@@ -14,7 +14,7 @@ from mocycle.cycle.blend import (
     transition,
     transition_smoothness,
 )
-from mocycle.cycle.extract import metric_features
+from mocycle.cycle.metric_rows import metric_features
 from mocycle.cycle.metrics import template_error
 from mocycle.datasets import humanoid_skeleton, synthetic_walk
 from mocycle.errors import MocycleError

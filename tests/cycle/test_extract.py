@@ -5,7 +5,7 @@ from scipy.spatial.transform import Rotation
 
 from conftest import shared_path
 from mocycle.cycle import extract_cycle, loop_metrics
-from mocycle.cycle.extract import metric_features
+from mocycle.cycle.metric_rows import metric_features
 from mocycle.cycle.metrics import template_error
 from mocycle.datasets import synthetic_nonperiodic, synthetic_still, synthetic_walk
 from mocycle.errors import MocycleError, MocycleWarning, NoPeriodicMotion
@@ -134,7 +134,7 @@ def test_loop_blocks_are_the_inplace_motions_features_and_travel_path():
     own, and every motion of the cycle has the same rotations apart from the travel joint's heading."""
     from dataclasses import replace
 
-    from mocycle.cycle.extract import loop_blocks
+    from mocycle.cycle.metric_rows import loop_blocks
 
     walk = synthetic_walk(n_frames=300, fps=60, seed=4).motion
     cycle = extract_cycle(walk)

@@ -2,7 +2,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from mocycle.cycle import extract_cycle
-from mocycle.cycle.extract import metric_features
+from mocycle.cycle.metric_rows import metric_features
 from mocycle.cycle.metrics import foot_points, foot_sliding, jerk_ratio, loop_metrics, template_error
 from mocycle.cycle.seam import calmest_start, seam_ratios
 from mocycle.datasets import synthetic_still, synthetic_walk
