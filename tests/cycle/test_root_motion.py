@@ -95,7 +95,7 @@ def test_drifting_path_is_the_inverse_of_the_in_place_path():
     from mocycle.datasets import synthetic_circle_walk
 
     cycle = extract_cycle(synthetic_circle_walk(n_frames=300, turn_per_cycle_deg=60.0, noise_deg=0.5).motion)
-    assert np.abs(drifting_L(cycle.space.up, cycle._inplace_L(), cycle.drift) - cycle.L).max() < 1e-9
+    assert np.abs(drifting_L(cycle.space.up, cycle.inplace_L(), cycle.drift) - cycle.L).max() < 1e-9
 
 
 def test_repeat_path_is_the_path_of_the_repeated_cycle_bit_for_bit(straight):

@@ -138,8 +138,6 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     else:
         cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion))
     path, drift = space.bend(cycle.L, cycle.drift, space.heading_trend(L[:, 3], axis.period_frames)[0])
-    bent = replace(cycle, L=path, drift=drift)
-    bent._projected = cycle._projected  # the same P: the same projection
-    cycle = bent
+    cycle = cycle.on_path(path, drift)  # the same P: the same rotation matrices
     cycle.seconds = time.perf_counter() - t0
     return cycle

@@ -106,13 +106,11 @@ def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
 
 
 def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, periodic: PeriodicMotion,
-                   model: str = "M1", n_harmonics: int | str = "auto", reference: np.ndarray | None = None,
-                   *, calmest: bool | None = None) -> Cycle:
+                   model: str = "M1", n_harmonics: int | str = "auto", *, calmest: bool = False) -> Cycle:
     """Fit ``P`` periodically and ``L`` with a linear term on ``axis``, sample one period at ``N`` frames.
 
-    With ``calmest`` (default: when a ``reference`` is given, the input's mean rotation per joint ``(J, 4)``,
-    whose value changes nothing) the cycle starts at its calmest point, chosen to a tenth of a frame;
-    without, at phase 0 of the axis.
+    With ``calmest`` the cycle starts at its calmest point, chosen to a tenth of a frame; without, at phase 0
+    of the axis.
     """
     _check_choice(model, MODELS, "model")
     frames = axis.frames()
@@ -146,7 +144,7 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
         return fit_l.predict(at) if linear else fit_l.predict(at) + np.outer(at, drift)
 
     x0 = float(np.floor(x[0]))
-    if calmest or (calmest is None and reference is not None):  # start at the calmest step, between frames too
+    if calmest:  # start at the calmest step, between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
         trial = Cycle(space=space, P=fit_p.predict(fine), L=path(fine), drift=drift,
                       method="harmonic", model=model, n_harmonics=K, axis=axis, positions=np.zeros(0),
@@ -156,14 +154,13 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
         # the cycle's frames are trial samples start, start + 10, ... (one period on, where they pass its end:
         # the periodic block and its projection are the same there): taken, not fitted and projected again
         rows = (start + SUBFRAMES * np.arange(N)) % (SUBFRAMES * N)
-        P, projected = trial.P[rows], trial._rotations()[rows]
+        P, projected = trial.P[rows], trial.rotation_matrices()[rows]
     else:
         P, projected = fit_p.predict(x0 + np.arange(N) / N), None
     xs = x0 + np.arange(N) / N
-    cycle = Cycle(space=space, P=P, L=path(xs), drift=drift, method="harmonic", model=model,
-                  n_harmonics=K, axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic, regression=fit_p)
-    cycle._projected = projected
-    return cycle
+    return Cycle(space=space, P=P, L=path(xs), drift=drift, method="harmonic", model=model, n_harmonics=K,
+                 axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic, regression=fit_p,
+                 projected=projected)
 
 
 def short_drift(L: np.ndarray, axis: TimeAxis, n_harmonics: int = DRIFT_HARMONICS) -> np.ndarray:

@@ -168,26 +168,31 @@ class MetricRows:
                                  for r in range(0, M, self.BLOCK)) / M))
 
 
-def loop_blocks(cycle: Cycle, reference: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def loop_blocks(cycle: Cycle) -> tuple[np.ndarray, np.ndarray]:
     """What the seam of a cycle is judged on: its in-place rotations as :func:`metric_features` ``(N, 9J)``
-    and the world path of its travel joint ``(N, 3)``.
+    and the world path of its travel joint ``(N, 3)`` (both read-only).
 
     Made from the decoded rotation matrices directly (the numbers of ``metric_features`` and
     ``world_positions`` of ``cycle.motion("inplace")`` within rounding, without building the motion or
-    running forward kinematics of every joint), and kept on the cycle: the metrics and the checks ask
-    for the same blocks.  ``reference`` changes nothing (see :func:`metric_features`)."""
-    if cycle._blocks is None:
-        space = cycle.space
-        joints = _rotation_joints(space.skeleton)
-        if not joints:
-            raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
-        L = cycle._inplace_L()
-        R = cycle._rotations()  # local rotations; the travel joint's without its heading, which is put in below
-        travel = space.heading_rotations(L) @ R[:, space.travel]
-        every = len(joints) == space.n_joints
-        C = (R if every else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
-        if space.travel in joints:
-            at = space.travel if every else joints.index(space.travel)
-            C[:, 9 * at:9 * at + 9] = travel.reshape(-1, 9) / np.sqrt(2.0)
-        cycle._blocks = (C, space.travel_path(R, space.translations(cycle.P, L), travel))
-    return cycle._blocks
+    running forward kinematics of every joint), and kept with the cycle (:meth:`Cycle.cache`): the
+    metrics and the checks ask for the same blocks."""
+    return cycle.cache("loop blocks", _loop_blocks)
+
+
+def _loop_blocks(cycle: Cycle) -> tuple[np.ndarray, np.ndarray]:
+    space = cycle.space
+    joints = _rotation_joints(space.skeleton)
+    if not joints:
+        raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
+    L = cycle.inplace_L()
+    R = cycle.rotation_matrices()  # local rotations; the travel joint's without its heading, put in below
+    travel = space.heading_rotations(L) @ R[:, space.travel]
+    every = len(joints) == space.n_joints
+    C = (R if every else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
+    if space.travel in joints:
+        at = space.travel if every else joints.index(space.travel)
+        C[:, 9 * at:9 * at + 9] = travel.reshape(-1, 9) / np.sqrt(2.0)
+    path = space.travel_path(R, space.translations(cycle.P, L), travel)
+    C.setflags(write=False)
+    path.setflags(write=False)
+    return C, path

@@ -7,7 +7,9 @@ with the root in place or moving on, and repeats seamlessly.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from collections.abc import Callable, Hashable
+from dataclasses import InitVar, dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -36,6 +38,11 @@ class Cycle:
     vertical.  A vertical component (a take whose root rises or sinks slowly: capture drift, a ramp)
     is taken out of ``drift`` and of ``L`` on construction, so the root's height is periodic and
     ``repeat(20, root="motion")`` neither floats nor sinks.
+
+    The cycle keeps what it derives from its arrays (:meth:`cache`): every motion of it (:meth:`repeat`,
+    :meth:`motion`) is decoded once per ``(count, root)`` and the same Motion returned after that, so the
+    metrics, the feet and the output of one loop share them.  Its arrays are not to be changed in place;
+    ``dataclasses.replace`` makes a cycle with caches of its own.
     """
 
     space: CycleSpace
@@ -50,11 +57,13 @@ class Cycle:
     periodic: PeriodicMotion
     regression: HarmonicRegression | None = field(default=None, repr=False)
     seconds: float = 0.0
-    #: :func:`loop_blocks` of this cycle and ``space.project(P)``, once made (not copied by ``dataclasses.replace``)
-    _blocks: tuple | None = field(default=None, init=False, repr=False, compare=False)
-    _projected: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
+    #: ``space.project(P)`` ``(N, J, 3, 3)`` when the maker has it (rows of a finer sampling of the same fit):
+    #: kept as :meth:`rotation_matrices`.  Not a field: ``dataclasses.replace`` does not pass it on.
+    projected: InitVar[np.ndarray | None] = None
+    #: the values of :meth:`cache` (a fresh dict for each cycle, ``dataclasses.replace``'s too)
+    _kept: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
-    def __post_init__(self):
+    def __post_init__(self, projected: np.ndarray | None):
         up = self.space.up
         rise = float(self.drift[:3] @ up)
         if rise != 0.0:  # level the drift: only horizontal travel and the turn about the vertical remain
@@ -63,22 +72,50 @@ class Cycle:
             self.L[:, :3] -= ramp * (rise * up)
             self.drift = self.drift.copy()
             self.drift[:3] -= rise * up
+        if projected is not None:
+            if projected.shape != (self.n_frames, self.space.n_joints, 3, 3):
+                raise ValueError(f"projected has shape {projected.shape}; the cycle's rotation matrices are "
+                                 f"{(self.n_frames, self.space.n_joints, 3, 3)}")
+            self._kept["rotations"] = _read_only(projected)
 
     def __getstate__(self) -> dict:
-        """Pickled without the caches ``_blocks`` and ``_projected`` (made again from ``P`` when asked for)."""
-        return {**self.__dict__, "_blocks": None, "_projected": None}
+        """Pickled without what :meth:`cache` keeps (made again from the arrays when asked for)."""
+        return {**self.__dict__, "_kept": {}}
+
+    def cache(self, key: Hashable, make: Callable[[Cycle], Any] | None = None) -> Any:
+        """A value derived from this cycle, made by ``make(cycle)`` on the first call with ``key`` and kept with
+        the cycle after that; with no ``make``, the kept value or ``None`` (as :meth:`Motion.cache`).
+
+        Arrays are kept read-only and Motions are shared: copy where the caller changes them, and never hand
+        a kept Motion over (:meth:`Motion.hand_over`).  The keys in use: ``"rotations"``
+        (:meth:`rotation_matrices`), ``"inplace L"`` (:meth:`inplace_L`), ``("repeat", count, root)``
+        (:meth:`repeat`), ``"loop blocks"`` (:func:`~mocycle.cycle.metric_rows.loop_blocks`).
+
+        Examples
+        --------
+        >>> from mocycle.cycle import extract_cycle
+        >>> from mocycle.datasets import synthetic_walk
+        >>> cycle = extract_cycle(synthetic_walk(n_frames=300).motion)
+        >>> cycle.repeat(2, root="motion") is cycle.repeat(2, root="motion"), cycle.cache(("repeat", 3, "motion"))
+        (True, None)
+        """
+        kept = self._kept
+        if key not in kept:
+            if make is None:
+                return None
+            kept[key] = make(self)
+        return kept[key]
 
     @property
     def n_frames(self) -> int:
         return self.P.shape[0]
 
-    def _rotations(self, count: int = 1) -> np.ndarray:
-        """``space.project(P)`` ``(N, J, 3, 3)``, made once, repeated ``count`` times: every motion of the
-        cycle (in place, moving on, repeated, the seam's blocks) has these rotations, only the travel joint's
-        heading differs."""
-        if self._projected is None:
-            self._projected = self.space.project(self.P)
-        return self._projected if count == 1 else np.tile(self._projected, (count, 1, 1, 1))
+    def rotation_matrices(self, count: int = 1) -> np.ndarray:
+        """``space.project(P)`` ``(N, J, 3, 3)`` (read-only), made once, repeated ``count`` times (a new array):
+        every motion of the cycle (in place, moving on, repeated, the seam's blocks) has these local rotations,
+        only the travel joint's heading differs (here it has none)."""
+        R = self.cache("rotations", lambda cycle: _read_only(cycle.space.project(cycle.P)))
+        return R if count == 1 else np.tile(R, (count, 1, 1, 1))
 
     @property
     def period_frames(self) -> float:
@@ -100,6 +137,11 @@ class Cycle:
         L = self.L[idx] + np.outer(np.arange(N) + k >= N, self.drift)
         return replace(self, P=self.P[idx], L=L, positions=np.mod(self.positions - k, N))
 
+    def on_path(self, L: np.ndarray, drift: np.ndarray) -> Cycle:
+        """The same poses on the path ``L`` ``(N, 4)`` moving on by ``drift`` ``(4,)``: a new cycle that keeps
+        this one's rotation matrices (the path does not change them), none of its motions."""
+        return replace(self, L=L, drift=drift, projected=self.cache("rotations"))
+
     def _next_repeat(self, L: np.ndarray, times: int = 1) -> np.ndarray:
         """Rows of ``L`` as they are ``times`` repeats later: the rigid motion of one cycle (the turn about the
         vertical through the first frame's position, then the travel) applied ``times`` times."""
@@ -111,11 +153,14 @@ class Cycle:
             out[:, 3] += self.drift[3]
         return out
 
-    def _inplace_L(self) -> np.ndarray:
-        """``L (N, 4)`` walking on the spot: the path straightened (each step turned back by the turn spread
-        evenly over the cycle, so a turning walk's steps line up as a straight walk's) and its travel and turn
-        taken out along a ramp.  Position and velocity both wrap seamlessly; a straight walk's path is only
-        ramped.  :func:`drifting_L` is the inverse."""
+    def inplace_L(self) -> np.ndarray:
+        """``L (N, 4)`` walking on the spot (read-only, made once): the path straightened (each step turned back
+        by the turn spread evenly over the cycle, so a turning walk's steps line up as a straight walk's) and
+        its travel and turn taken out along a ramp.  Position and velocity both wrap seamlessly; a straight
+        walk's path is only ramped.  :func:`drifting_L` is the inverse."""
+        return self.cache("inplace L", lambda cycle: _read_only(cycle._make_inplace_L()))
+
+    def _make_inplace_L(self) -> np.ndarray:
         N = self.n_frames
         ramp = np.arange(N) / N
         full = np.vstack([self.L, self._next_repeat(self.L[:1])])  # the next repeat's first frame closes it
@@ -128,22 +173,29 @@ class Cycle:
         return out
 
     def motion(self, root: str = "inplace") -> Motion:
-        """The cycle as a Motion; ``root="inplace"`` walks on the spot, ``"motion"`` moves on by ``drift``."""
-        _check_choice(root, ROOT_MODES, "root")
-        return self.space.decode(self.P, self._inplace_L() if root == "inplace" else self.L, self._rotations())
+        """The cycle as a Motion; ``root="inplace"`` walks on the spot, ``"motion"`` moves on by ``drift``
+        (``repeat(1, root)``: the same Motion)."""
+        return self.repeat(1, root)
 
     def repeat(self, count: int, root: str = "inplace") -> Motion:
-        """The cycle ``count`` times, seamlessly; with ``root="motion"`` each repeat starts where the last ends."""
+        """The cycle ``count`` times, seamlessly; with ``root="motion"`` each repeat starts where the last ends.
+
+        Decoded on the first call with ``(count, root)`` and kept with the cycle (:meth:`cache`): later calls
+        return the same Motion."""
         _check_choice(root, ROOT_MODES, "root")
         count = _validate.integer("count", count, 1)
+        return self.cache(("repeat", count, root), lambda cycle: cycle._decode(count, root))
+
+    def _decode(self, count: int, root: str) -> Motion:
         check_frames(count * self.n_frames, self.space.skeleton.n_joints,
                      f"{count} cycles of {self.n_frames} frames")
-        return self.space.decode(np.tile(self.P, (count, 1)), self._repeat_L(count, root), self._rotations(count))
+        P = self.P if count == 1 else np.tile(self.P, (count, 1))
+        return self.space.decode(P, self._repeat_L(count, root), self.rotation_matrices(count))
 
     def _repeat_L(self, count: int, root: str) -> np.ndarray:
-        """``L (count * N, 4)`` of :meth:`repeat`."""
+        """``L (count * N, 4)`` of :meth:`repeat` (a new array)."""
         if root == "inplace":
-            return np.tile(self._inplace_L(), (count, 1))
+            return np.tile(self.inplace_L(), (count, 1))
         Ls = [self.L]
         for _ in range(count - 1):  # each repeat is the last one moved rigidly: a turning walk walks a circle
             Ls.append(self._next_repeat(Ls[-1]))
@@ -158,7 +210,7 @@ class Cycle:
         count = _validate.integer("count", count, 1)
         space = self.space
         L = self._repeat_L(count, root)
-        R = np.tile(self._rotations()[:, space.travel], (count, 1, 1))
+        R = np.tile(self.rotation_matrices()[:, space.travel], (count, 1, 1))
         R = space.heading_rotations(L) @ R
         q = continuous_quats(matrix_quats(R[:, None]), inplace=True)  # decode
         q /= vector_norms(q, keepdims=True)  # Motion's own normalisation
@@ -189,7 +241,7 @@ def _step_turns(up: np.ndarray, turn: float, n: int) -> np.ndarray:
 
 def drifting_L(up: np.ndarray, inplace: np.ndarray, drift: np.ndarray) -> np.ndarray:
     """The cycle's ``L (N, 4)`` that moves on by ``drift (4,)`` (travel in the file's frame, turn in rad) and
-    walks on the spot as ``inplace (N, 4)``: the inverse of ``Cycle._inplace_L``.  The straight travel ``s``
+    walks on the spot as ``inplace (N, 4)``: the inverse of :meth:`Cycle.inplace_L`.  The straight travel ``s``
     that, bent by the turn, ends at ``drift[:3]`` solves ``mean_k(R_k) s = drift - sum_k R_k (step_k)``."""
     N = inplace.shape[0]
     R = _step_turns(up, drift[3], N)
@@ -205,3 +257,8 @@ def drifting_L(up: np.ndarray, inplace: np.ndarray, drift: np.ndarray) -> np.nda
 
 def _check_choice(value, choices, name):
     _validate.choice(name, value, choices)
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    array.setflags(write=False)
+    return array
