@@ -18,18 +18,17 @@ if TYPE_CHECKING:
     from .result import Cycle
 
 
-def metric_features(motion: Motion, reference: np.ndarray | None = None, rows: slice = slice(None)) -> np.ndarray:
+def metric_features(motion: Motion, *, rows: slice = slice(None)) -> np.ndarray:
     """``(T, 9J)`` the space the loop metrics are measured in: every joint's rotation matrix (its 9 entries,
     :func:`~mocycle.features.pose_matrix` ``rotmat``) divided by √2.
 
     The distance between two poses is then, per joint, ``||R1 - R2||_F / √2 = 2 sin(θ/2)`` for a relative
     rotation of ``θ``: about ``θ`` in radians for small angles (0.5 % short at 20°, 4 % at 60°), and, unlike
     a rotation vector, continuous for a joint that turns a full circle every cycle (no wrap at ±π); it is
-    the same wrap-free space the cycle is regressed in (:class:`~mocycle.cycle.representation.CycleSpace`).
-    ``reference`` (``(J, 4)``, the input's mean rotation per joint, as the callers pass it) changes no
-    distance in this space and is accepted for the callers' sake only; values are not relative to it.
-    ``rows``: only these frames (a slice), without copying the motion.  Computed block by block of frames:
-    the same numbers as ``pose_matrix(motion, rep="rotmat", root="drop")[0] / √2``.
+    the same wrap-free space the cycle is regressed in (:class:`~mocycle.cycle.representation.CycleSpace`),
+    and no reference pose moves a distance in it.  ``rows``: only these frames (a slice), without copying
+    the motion.  Computed block by block of frames: the same numbers as
+    ``pose_matrix(motion, rep="rotmat", root="drop")[0] / √2``.
     """
     joints = _rotation_joints(motion.skeleton)
     if not joints:

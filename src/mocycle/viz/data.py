@@ -63,7 +63,7 @@ def loop_plot_data(motion, cycle, n_joints: int = 3) -> dict:
 
     ref = mean_rotations(motion.rotations)
     inplace = cycle.motion("inplace")
-    Y, C = metric_features(motion, ref), metric_features(inplace, ref)  # the metrics' wrap-free space
+    Y, C = metric_features(motion), metric_features(inplace)  # the metrics' wrap-free space
     frames = cycle.axis.frames()
     if Y.shape[1] >= 2:
         pca = PCA(n_components=2).fit(Y[frames])
