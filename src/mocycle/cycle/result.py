@@ -181,7 +181,7 @@ class Cycle:
         """The cycle ``count`` times, seamlessly; with ``root="motion"`` each repeat starts where the last ends.
 
         Decoded on the first call with ``(count, root)`` and kept with the cycle (:meth:`cache`): later calls
-        return the same Motion."""
+        return the same Motion, and its ``count * N`` frames live as long as the cycle does."""
         _check_choice(root, ROOT_MODES, "root")
         count = _validate.integer("count", count, 1)
         return self.cache(("repeat", count, root), lambda cycle: cycle._decode(count, root))
