@@ -6,7 +6,7 @@ import pytest
 import mocycle.cycle.extract as extract_module
 from mocycle.cycle import extract_cycle, loop_metrics
 from mocycle.cycle.checks import _lag_differences, best_cut_error, loop_checks, moving_columns
-from mocycle.cycle.extract import MetricRows, metric_features
+from mocycle.cycle.metric_rows import MetricRows, metric_features
 from mocycle.cycle.representation import CycleSpace
 from mocycle.datasets import synthetic_walk
 from mocycle.motion import Motion

@@ -91,11 +91,11 @@ def test_a_turning_walk_loops_in_place_without_a_seam(turn_deg):
 
 
 def test_drifting_path_is_the_inverse_of_the_in_place_path():
-    from mocycle.cycle.extract import drifting_L
+    from mocycle.cycle.result import drifting_L
     from mocycle.datasets import synthetic_circle_walk
 
     cycle = extract_cycle(synthetic_circle_walk(n_frames=300, turn_per_cycle_deg=60.0, noise_deg=0.5).motion)
-    assert np.abs(drifting_L(cycle.space.up, cycle._inplace_L(), cycle.drift) - cycle.L).max() < 1e-9
+    assert np.abs(drifting_L(cycle.space.up, cycle.inplace_L(), cycle.drift) - cycle.L).max() < 1e-9
 
 
 def test_repeat_path_is_the_path_of_the_repeated_cycle_bit_for_bit(straight):

@@ -1,10 +1,14 @@
 """Seamless typical cycles from a take: harmonic regression (M1/M2/M3), centroids, cut; loop metrics."""
 
 from .blend import BlendedCycle, Transition, blend_cycles, transition
-from .extract import METHODS, ROOT_MODES, Cycle, centroid_cycle, cut_cycle, cycle_phase, extract_cycle, harmonic_cycle
+from .centroid import centroid_cycle
+from .cut import cut_cycle
+from .extract import METHODS, cycle_phase, extract_cycle
 from .harmonic import MODELS, HarmonicRegression, harmonic_basis
+from .harmonic_fit import harmonic_cycle
 from .metrics import loop_metrics
 from .representation import CycleSpace
+from .result import ROOT_MODES, Cycle
 from .timeaxis import TIME_AXES, TimeAxis, time_axis
 
 __all__ = [

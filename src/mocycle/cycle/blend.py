@@ -64,8 +64,10 @@ from ..motion import Motion, Skeleton
 from ..rotations import axis_rotations, nearest_rotations
 from ..threads import limit_threads
 from .checks import check_loop
-from .extract import ROOT_MODES, Cycle, drifting_L, extract_cycle, loop_blocks, metric_features
+from .extract import extract_cycle
+from .metric_rows import loop_blocks, metric_features
 from .representation import CycleSpace
+from .result import ROOT_MODES, Cycle, drifting_L
 from .seam import LOCAL, calmest_start, seam_ratios
 from .timeaxis import TimeAxis
 
@@ -585,7 +587,7 @@ def _local_ratios(x: np.ndarray, periodic: bool) -> float:
 
 def transition_smoothness(tr: Transition) -> dict[str, float]:
     """Whether a transition jumps anywhere: its largest pose step and velocity change (in the loop metrics'
-    rotation-matrix space, :func:`~mocycle.cycle.extract.metric_features`) over the median of the 8 nearest
+    rotation-matrix space, :func:`~mocycle.cycle.metric_rows.metric_features`) over the median of the 8 nearest
     (``step_local``, ``velocity_local``) and over the median of all (``step_ratio``, ``velocity_ratio``); the
     same for the two input loops (``input_*``)."""
     def ratios(m: Motion, periodic: bool) -> dict[str, float]:

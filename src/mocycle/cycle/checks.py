@@ -40,8 +40,9 @@ import numpy as np
 from ..errors import LoopRefused, MocycleWarning
 from ..motion import Motion
 from ..phase.period import autocorrelation_period, autocorrelation_period_of_blocks
-from .extract import Cycle, MetricRows, loop_blocks
+from .metric_rows import MetricRows, loop_blocks
 from .metrics import template_error
+from .result import Cycle
 from .seam import seam_ratios
 
 MAX_FIT_RATIO = 2.0   # template error over the best plain cut's
@@ -69,7 +70,7 @@ def _plain_cut_error(Y: np.ndarray, period: float, differences: dict | None = No
     """Template error of the best plain cut of ``Y (M, D)`` with a lag within :data:`CUT_SPAN` of ``period``.
 
     The cut is frames ``a .. a+lag-1`` between the two windows (a fifth of a period wide) that are most
-    alike ``lag`` frames apart, as :func:`~mocycle.cycle.extract.cut_cycle` picks them, without its
+    alike ``lag`` frames apart, as :func:`~mocycle.cycle.cut.cut_cycle` picks them, without its
     cross-fade.  Returns ``(error, lag)``; NaN error when the frames hold no such pair.  ``differences``:
     lag -> :func:`_lag_differences`, filled and reused across calls on the same ``Y`` (two period estimates
     close together search the same lags).
@@ -125,8 +126,8 @@ def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = 
     """``(template error of the best plain cut, its length in frames)`` on the cycle's longest excited
     region: the better of cuts near the cycle's period and near the region's own autocorrelation period
     (paper 004 eq. 1 on the pose features; independent of the phase).  ``reference`` changes nothing
-    (:func:`~mocycle.cycle.extract.metric_features`); ``features``: the region's metric features when the
-    caller has them, an array or a :class:`~mocycle.cycle.extract.MetricRows` (its still columns may be left
+    (:func:`~mocycle.cycle.metric_rows.metric_features`); ``features``: the region's metric features when the
+    caller has them, an array or a :class:`~mocycle.cycle.metric_rows.MetricRows` (its still columns may be left
     out: :func:`moving_columns`); by default they are made block by block as they are read."""
     s, e = max(cycle.axis.regions, key=lambda r: r[1] - r[0])
     Y = MetricRows(motion, slice(s, e)) if features is None else features

@@ -2,7 +2,7 @@
 
 All pose errors are measured in one space for every method: each joint's
 rotation matrix, its 9 entries divided by √2 (``(T, 9J)``;
-:func:`~mocycle.cycle.extract.metric_features`).  Per joint the distance is
+:func:`~mocycle.cycle.metric_rows.metric_features`).  Per joint the distance is
 ``2 sin(θ/2)`` for a relative rotation of ``θ``: radians for small angles
 (0.5 % short at 20°), and continuous for a joint that turns a full circle
 every cycle, where a rotation vector would wrap at ±π and call a correct
@@ -44,7 +44,8 @@ from ..axes import vertical_axis
 from ..errors import MocycleError
 from ..motion import Motion
 from .differences import FORWARD_3, HALF, central_acceleration, central_velocity, forward_jerk
-from .extract import Cycle, MetricRows, loop_blocks
+from .metric_rows import MetricRows, loop_blocks
+from .result import Cycle
 from .seam import seam_ratios
 
 CONTACT_HEIGHT = 0.02  # of the body height

@@ -49,7 +49,7 @@ def loop_plot_data(motion, cycle, n_joints: int = 3) -> dict:
     -------
     dict with ``input_xy`` ``(T, 2)`` and ``cycle_xy`` ``(N + 1, 2)`` (closed): the input's poses and the
     cycle in the 2-D PCA of the excited input frames (in the loop metrics' rotation-matrix space,
-    :func:`~mocycle.cycle.extract.metric_features`); ``frames`` ``(M,)``: the excited frames;
+    :func:`~mocycle.cycle.metric_rows.metric_features`); ``frames`` ``(M,)``: the excited frames;
     ``input_phase`` ``(M,)``: where each falls in the cycle (cycles); ``coords`` ``(T,)``: the circular
     coordinate (``None`` for a blend); ``axis_phase`` ``(M,)``: the time axis mod 1; ``regions``;
     ``curves``: the ``n_joints`` most moving rotation-vector components about the mean pose, each with its
@@ -57,13 +57,13 @@ def loop_plot_data(motion, cycle, n_joints: int = 3) -> dict:
     ``positions`` ``(M,)`` (cycle frames); ``n_frames``, ``n_periods``, ``period_frames``, ``method``,
     ``model``, ``axis_method``.
     """
-    from ..cycle.extract import metric_features
+    from ..cycle.metric_rows import metric_features
     from ..features import pose_matrix
     from ..rotations import mean_rotations
 
     ref = mean_rotations(motion.rotations)
     inplace = cycle.motion("inplace")
-    Y, C = metric_features(motion, ref), metric_features(inplace, ref)  # the metrics' wrap-free space
+    Y, C = metric_features(motion), metric_features(inplace)  # the metrics' wrap-free space
     frames = cycle.axis.frames()
     if Y.shape[1] >= 2:
         pca = PCA(n_components=2).fit(Y[frames])
