@@ -8,6 +8,7 @@ import bpy
 
 from mocycle import tasks
 from mocycle.errors import MocycleError
+from mocycle.tasks.clips import closing_frame
 from mocycle.tasks.spec import SPECS
 
 from . import props, rig
@@ -88,12 +89,6 @@ def _keep_facts(action, report) -> None:
     action["mocycle"] = json.dumps({"task": report.task, **report.facts}, default=str)
 
 
-def _wrap(result, cycles: int, root: str):
-    """The pose after the last frame of ``cycles`` repeats: the loop's first pose (moved on with the root)."""
-    n = result.n_frames
-    return result.repeat(cycles + 1, root=root)[cycles * n:cycles * n + 1]
-
-
 class _Task(bpy.types.Operator):
     """Shared run/report of the operators; subclasses implement ``work(context, arm) -> str``."""
 
@@ -163,8 +158,8 @@ def _extract_cycle(self, context, arm):
     report = tasks.loop.run(motion, options)
     _keep_parts(context, report.facts["parts"], first)
     cycle, loop = report.result, report.motions["loop"]
-    new = rig.write_action(arm, loop, f"{action.name}_cycle", first, wrap=_wrap(cycle, options.cycles, options.root),
-                           travel=options.root == "motion")
+    new = rig.write_action(arm, loop, f"{action.name}_cycle", first,
+                           wrap=closing_frame(cycle, options.cycles, options.root), travel=options.root == "motion")
     _keep_facts(new, report)
     rig_assign(arm, new)
     f = report.facts
@@ -189,7 +184,7 @@ def _blend_cycles(self, context, arm):
     report = tasks.blend.run(motions, options)
     result = report.result
     new = rig.write_action(arm, report.motions["loop"], f"{action.name}_blend", rig.action_frames(action)[0],
-                           wrap=_wrap(result, options.cycles, options.root), travel=options.root == "motion")
+                           wrap=closing_frame(result, options.cycles, options.root), travel=options.root == "motion")
     _keep_facts(new, report)
     rig_assign(arm, new)
     f = report.facts

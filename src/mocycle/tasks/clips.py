@@ -17,18 +17,24 @@ from pathlib import Path
 from ..clip import Clip
 from ..motion import Motion, concatenate
 
-__all__ = ["LOOP_TASKS", "clip_of", "closed_loop", "cycle_of", "for_output"]
+__all__ = ["LOOP_TASKS", "clip_of", "closed_loop", "closing_frame", "cycle_of", "for_output"]
 
 #: the tasks whose output motion is a seamless loop (clip ``<name>_loop``)
 LOOP_TASKS = ("loop", "blend")
 
 
+def closing_frame(cycle, cycles: int, root: str) -> Motion:
+    """The pose after the last frame of ``cycles`` repeats (one frame): the loop's first pose, moved on by
+    ``cycles`` cycles' travel and turn with ``root="motion"``."""
+    n = cycle.n_frames * cycles
+    return cycle.repeat(cycles + 1, root=root)[n:n + 1]
+
+
 def closed_loop(cycle, cycles: int, root: str, repeated: Motion | None = None) -> Motion:
-    """``cycle.repeat(cycles, root)`` plus its closing frame: frame 0 of the next repeat (``cycles * N + 1``
-    frames).  ``repeated``: the repeat already made."""
+    """``cycle.repeat(cycles, root)`` plus its :func:`closing_frame` (``cycles * N + 1`` frames).
+    ``repeated``: the repeat already made."""
     repeated = cycle.repeat(cycles, root=root) if repeated is None else repeated
-    n = repeated.n_frames
-    return concatenate([repeated, cycle.repeat(cycles + 1, root=root)[n:n + 1]])
+    return concatenate([repeated, closing_frame(cycle, cycles, root)])
 
 
 def cycle_of(report, role: str):
