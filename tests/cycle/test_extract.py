@@ -98,22 +98,22 @@ def test_few_periods_warn_with_the_count():
 
 def test_bad_options_are_rejected_with_the_limit(walk):
     with pytest.raises(MocycleError, match="K must be <= 29"):
-        extract_cycle(walk.motion, n_harmonics=40)
+        extract_cycle(walk.motion, harmonics=40)
     with pytest.raises(MocycleError, match="method must be one of harmonic, centroid, cut"):
         extract_cycle(walk.motion, method="fourier")
     with pytest.raises(MocycleError, match="model must be one of M1, M2, M3"):
         extract_cycle(walk.motion, model="M9")
     with pytest.raises(MocycleError, match="class 3 does not exist"):
         extract_cycle(walk.motion, which=3)
-    with pytest.raises(MocycleError, match="phase_step must be a positive integer"):
-        extract_cycle(walk.motion, phase_step=0)
+    with pytest.raises(MocycleError, match="step must be a positive integer"):
+        extract_cycle(walk.motion, step=0)
     with pytest.raises(MocycleError, match="needs a Motion"):
         extract_cycle("walk.bvh")
 
 
 def test_phase_on_every_other_frame_gives_the_same_cycle(walk, clean_walk):
     full = extract_cycle(walk.motion)
-    half = extract_cycle(walk.motion, phase_step=2)
+    half = extract_cycle(walk.motion, step=2)
     assert abs(half.period_frames - full.period_frames) < 0.5 and half.n_frames == full.n_frames
     assert _error_to_truth(half, clean_walk) < 1.2 * _error_to_truth(full, clean_walk) + 1e-3
 

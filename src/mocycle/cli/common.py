@@ -12,7 +12,7 @@ import inspect
 import os
 import warnings
 from collections.abc import Callable, Mapping
-from functools import cache, wraps
+from functools import wraps
 from pathlib import Path
 from typing import Annotated
 
@@ -137,18 +137,14 @@ EXIT_USAGE = 2  # a bad option value (typer/click use 2 for usage errors too)
 EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion, or its cycle is not a loop
 
 
-@cache
 def flags(command: str | None = None) -> dict[str, str]:
     """Parameter names of the library -> the CLI flag that sets them (every task option, a few library names);
     ``command``: the task whose own flags win where two tasks name one parameter differently (``loop``'s
-    ``which`` is ``--part``, ``blend``'s ``--class``)."""
-    from ..tasks import TASKS
-
-    names = {f.name: flag_of(f) for task in TASKS.values() for f in dataclasses.fields(task.Options)}
-    if command in TASKS:
-        names.update({f.name: flag_of(f) for f in dataclasses.fields(TASKS[command].Options)})
-    names.update({"n_harmonics": "--harmonics", "time_axis_method": "--time", "phase_step": "--step",
-                  "n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles",
+    ``which`` is ``--part``, ``blend``'s ``--class``). Asked only when an option is refused."""
+    names = {f.name: flag_of(f) for spec in SPECS.values() if spec.cli for f in dataclasses.fields(spec.options)}
+    if command in SPECS:
+        names.update({f.name: flag_of(f) for f in dataclasses.fields(SPECS[command].options)})
+    names.update({"n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles",
                   "window": "--window", "gltf_scale": "--gltf-scale", "gltf_up": "--gltf-up"})
     return names
 

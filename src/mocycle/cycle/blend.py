@@ -421,7 +421,7 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     """Paper 001 §4.5: the convex combination of the takes' cycles, a new loop.
 
     ``takes``: Motions (their cycle is extracted with ``extract_cycle(**extract_options)``, e.g.
-    ``method``, ``model``, ``n_harmonics``) or :class:`Cycle` objects, all on one skeleton; ``weights``:
+    ``method``, ``model``, ``harmonics``) or :class:`Cycle` objects, all on one skeleton; ``weights``:
     one per take, ``>= 0``, normalised to sum 1 (default equal); ``align``: search each take's phase offset
     against the first (off: every loop is read from its own frame 0); ``roll``: start the blend at its
     calmest pose, as :func:`extract_cycle` does (off: at the first cycle's frame 0); ``labels``: names for

@@ -25,7 +25,8 @@ from .metric_rows import loop_blocks, metric_features
 from .representation import CycleSpace
 from .result import Cycle, _check_choice
 from .seam import calmest_start
-from .timeaxis import TIME_AXES, time_axis
+from .timeaxis import TIME_AXES
+from .timeaxis import time_axis as make_time_axis
 
 #: Above this size (bytes) the M1 harmonic fit reads the pose rows ``P`` of :meth:`CycleSpace.encode` as it
 #: goes (:meth:`CycleSpace.encode_rows`: each of its three passes makes them again) instead of holding them.
@@ -62,32 +63,32 @@ def _phase_at_full_rate(result: PhaseResult, step: int, n_frames: int) -> PhaseR
 
 def cycle_phase(motion: Motion, *, joints: str | Iterable[str] | None = None, classes: int | str = "auto",
                 pca: int | str | None = "auto", delay: int = 2, min_periods: float = MIN_PERIODS,
-                phase_step: int = 1) -> PhaseResult:
+                step: int = 1) -> PhaseResult:
     """:func:`~mocycle.phase.find_phase` as the cycle extraction calls it, optionally on every
-    ``phase_step``-th frame only (the thesis plugin's subsampling), brought back to every frame."""
-    phase_step = _validate.integer("phase_step", phase_step, 1)
+    ``step``-th frame only (the thesis plugin's subsampling), brought back to every frame."""
+    step = _validate.integer("step", step, 1)
     options = dict(classes=classes, joints=joints, pca=pca, delay=delay, min_periods=min_periods)
-    if phase_step > 1:
-        return _phase_at_full_rate(find_phase(motion[::phase_step], **options), phase_step, motion.n_frames)
+    if step > 1:
+        return _phase_at_full_rate(find_phase(motion[::step], **options), step, motion.n_frames)
     return find_phase(motion, **options)
 
 
 @limit_threads
-def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n_harmonics: int | str = "auto",
-                  time_axis_method: str = "smooth", *, joints: str | Iterable[str] | None = None,
+def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", harmonics: int | str = "auto",
+                  time_axis: str = "smooth", *, joints: str | Iterable[str] | None = None,
                   classes: int | str = "auto", which: int | None = None, pca: int | str | None = "auto",
                   delay: int = 2, min_periods: float = MIN_PERIODS, phase: PhaseResult | None = None,
-                  phase_step: int = 1) -> Cycle:
+                  step: int = 1) -> Cycle:
     """One seamless cycle of ``motion``.
 
     ``method``: ``harmonic`` | ``centroid`` | ``cut``; ``model``: M1 | M2 | M3 (harmonic only);
-    ``n_harmonics``: K or ``"auto"`` (20, capped by the frames); ``time_axis_method``: see
+    ``harmonics``: K or ``"auto"`` (20, capped by the frames); ``time_axis``: see
     :mod:`~mocycle.cycle.timeaxis`.  The phase options go to :func:`~mocycle.phase.find_phase`:
     ``joints`` (the joints the *phase* is found on; every joint is looped; default the whole body, then
     legs, then arms), ``classes`` (how many periodic motions to look for), ``pca``, ``delay`` and
     ``min_periods``; ``which``: the periodic motion to loop (0-based; default the one covering most frames);
     ``phase``: a :class:`PhaseResult` already computed for this motion (skips :func:`find_phase`);
-    ``phase_step``: find the phase on every ``phase_step``-th frame only (the cycle is still built from
+    ``step``: find the phase on every ``step``-th frame only (the cycle is still built from
     every frame at the capture's rate).
     Raises :class:`NoPeriodicMotion` when the take has none; warns below 1.5 periods.
 
@@ -111,14 +112,14 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     if not isinstance(motion, Motion):
         raise MocycleError(f"extract_cycle needs a Motion; got {type(motion).__name__}")
     _check_choice(method, METHODS, "method")
-    _check_choice(time_axis_method, TIME_AXES, "time_axis_method")
+    _check_choice(time_axis, TIME_AXES, "time_axis")
     if method == "harmonic":
         _check_choice(model, MODELS, "model")
     if phase is None:
         phase = cycle_phase(motion, joints=joints, classes=classes, pca=pca, delay=delay, min_periods=min_periods,
-                            phase_step=phase_step)
+                            step=step)
     periodic = choose_periodic(phase, which)
-    axis = time_axis(periodic, time_axis_method)
+    axis = make_time_axis(periodic, time_axis)
     if axis.n_periods < FEW_PERIODS:
         warnings.warn(f"only {axis.n_periods:.2f} periods found (fewer than {FEW_PERIODS}); the cycle rests on "
                       f"little evidence", MocycleWarning, stacklevel=2)
@@ -131,7 +132,7 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", n
     Q = space.straighten(L, axis.period_frames)
     # The cut's wrap is its seam; the others have none, so they start at the calmest point.
     if method == "harmonic":
-        cycle = harmonic_cycle(space, P, Q, axis, periodic, model, n_harmonics, calmest=True)
+        cycle = harmonic_cycle(space, P, Q, axis, periodic, model, harmonics, calmest=True)
     elif method == "centroid":
         cycle = centroid_cycle(space, P, Q, axis, periodic)
         cycle = cycle.rolled(calmest_start(*loop_blocks(cycle)))

@@ -78,7 +78,7 @@ def _period_average(u: np.ndarray, period: float) -> np.ndarray:
 
 def time_axis(periodic: PeriodicMotion, method: str = "smooth") -> TimeAxis:
     """The time axis of one periodic motion found by :func:`mocycle.phase.find_phase`."""
-    _validate.choice("time_axis_method", method, TIME_AXES)
+    _validate.choice("time_axis", method, TIME_AXES)
     period = float(periodic.period_frames)
     if not (np.isfinite(period) and period > 1):
         raise MocycleError(f"the periodic motion has no usable period ({period:.4g} frames)")

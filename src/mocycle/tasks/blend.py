@@ -64,7 +64,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     with Recorder() as rec:
         motions = [load(t, o.amc_fps, o.take) for t in takes]
         result = blend_cycles(motions, o.weights, align=o.align, labels=[label_of(t, k) for k, t in enumerate(takes)],
-                              method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force,
+                              method=o.method, model=o.model, harmonics=o.harmonics, force=o.force,
                               **phase_options(o))
         with rec.part("feet"):
             cleaned, feet_facts, _ = clean_feet(result.cycle, o.feet, o.root, o.foot_joints, reference=motions)

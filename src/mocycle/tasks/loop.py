@@ -214,7 +214,7 @@ def _jobs(motion, acts, plan: str, o: Options, rec, start: int) -> list[tuple]:
         part = parts[loopable[0]] if plan == "single" else None
         with rec.part("cycle"):
             try:
-                phase = cycle_phase(motion, phase_step=o.step, joints=o.joints, classes=o.classes, pca=o.pca,
+                phase = cycle_phase(motion, step=o.step, joints=o.joints, classes=o.classes, pca=o.pca,
                                     delay=o.delay, min_periods=o.min_periods)
             except NoPeriodicMotion as exc:
                 if part is None:
@@ -350,8 +350,8 @@ def _loop_one(motion, phase, k, o, label, offset, part, rec):
     from .feet import clean_feet
 
     with rec.part("cycle"):
-        fitted = extract_cycle(motion, method=o.method, model=o.model, n_harmonics=o.harmonics,
-                               time_axis_method=o.time_axis, which=k, phase=phase)
+        fitted = extract_cycle(motion, method=o.method, model=o.model, harmonics=o.harmonics,
+                               time_axis=o.time_axis, which=k, phase=phase)
     with rec.part("metrics"):
         # the metrics and checks judge the fitted cycle against the take (locking changes the legs on
         # purpose); the feet block says what locking did

@@ -37,7 +37,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     with Recorder() as rec:
         a, b = (load(t, o.amc_fps, o.take) for t in takes)
         result = transition(a, b, o.cycles, root=o.root, labels=[label_of(t, k) for k, t in enumerate(takes)],
-                            method=o.method, model=o.model, n_harmonics=o.harmonics, force=o.force,
+                            method=o.method, model=o.model, harmonics=o.harmonics, force=o.force,
                             **phase_options(o))
         facts = {**result.to_dict(), "root": o.root, "smoothness": transition_smoothness(result)}
         with rec.part("feet"):
