@@ -13,9 +13,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .io import AMC_FPS
+from .io import AMC_FPS, write
 from .io import read as _read
-from .io import write
 
 __all__ = ["read", "write"]
 

@@ -19,8 +19,9 @@ suffix     holds                                       :func:`read` returns / :f
 
 ``write`` also writes any result that has a ``to_dict()`` (cycles, phases, reports) as
 ``.json``.  io imports no algorithm: a ``.mck`` file is decoded here (:func:`.mck.decode`) and made into the
-take it holds by :func:`mocycle.read` (:mod:`mocycle.files`), which sits above io and the keyframe package.  :func:`read_motion` is :func:`read` for the files that hold a motion
-(``.bvh``, ``.amc``, ``.glb``, ``.gltf``, ``.fbx``), which is what the commands that take a motion use.
+take it holds by :func:`mocycle.read` (:mod:`mocycle.files`), which sits above io and the keyframe package.
+:func:`read_motion` is :func:`read` for the files that hold a motion (``.bvh``, ``.amc``, ``.glb``, ``.gltf``,
+``.fbx``), which is what the commands that take a motion use.
 glTF and FBX files may hold several animations (takes): ``take`` names one (:func:`takes` lists them).
 """
 
