@@ -3,7 +3,7 @@
     python benchmarks/feet.py [--quick] [--data DIR] [--bend DEG]
 
 Per take: a harmonic M1 cycle with its root motion (``extract_cycle`` as
-``mocycle loop`` runs it), then :func:`mocycle.contacts.lock_cycle`.  Printed,
+``mocycle loop`` runs it), then :func:`mocycle.cycle.lock_cycle`.  Printed,
 input vs output:
 
 * skate (units/s, :func:`mocycle.contacts.skate`) of the input's excited
@@ -45,10 +45,10 @@ from pathlib import Path
 
 import numpy as np
 
-from mocycle.contacts import detect_contacts, largest_leg_step, lock_cycle, lock_feet, ranges
+from mocycle.contacts import detect_contacts, largest_leg_step, lock_feet, ranges
 from mocycle.contacts import skate as skate_measure
 from mocycle.contacts.skate import leg_joints
-from mocycle.cycle import extract_cycle
+from mocycle.cycle import extract_cycle, lock_cycle
 from mocycle.errors import MocycleError
 from mocycle.io import read
 from mocycle.tasks import loop as loop_task

@@ -29,13 +29,14 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "src"))
+sys.path.insert(1, str(REPO / "tests"))  # the browser harness the studio tests use: tests/studio_harness.py
 
 import mocycle.cycle.extract as extract_module  # noqa: E402
 from mocycle import write  # noqa: E402
 from mocycle.datasets import synthetic_nonperiodic, synthetic_walk  # noqa: E402
 from mocycle.phase import find_phase  # noqa: E402
 from mocycle.studio.app import create_app  # noqa: E402
-from mocycle.studio.testing import chromium, served, watch_console  # noqa: E402
+from studio_harness import chromium, served, watch_console  # noqa: E402
 
 READY = "window.__studio && window.__studio.ready"
 

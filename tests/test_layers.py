@@ -34,16 +34,26 @@ def test_swings_records_import_neither_swings_nor_codecs():
     assert not [m for m in loaded if m.startswith(("mocycle.swings", "mocycle.io.mosw", "mocycle.io.swings_json"))]
 
 
-def test_old_names_still_resolve():
+def test_the_keyframe_codec_names_no_algorithm():
     import mocycle.io.mck as mck
-    from mocycle.keyframes import Compressed, compress, read_compressed
     from mocycle.swings import Segmentation, segment
     from mocycle.swings.segment import Segmentation as SegmentationToo
 
-    assert (mck.Compressed, mck.compress, mck.read_compressed) == (Compressed, compress, read_compressed)
+    for name in ("Compressed", "compress", "read_compressed", "decompress"):
+        assert not hasattr(mck, name), name  # the take and its algorithm are mocycle.keyframes'
     assert Segmentation is SegmentationToo and segment.__module__ == "mocycle.swings.segment"
-    with pytest.raises(AttributeError):
-        mck.decompress  # noqa: B018
+
+
+def test_a_keyframe_file_is_read_above_io(tmp_path):
+    import mocycle
+    from mocycle.errors import MotionFileError
+    from mocycle.io import read
+    from mocycle.keyframes import Compressed, compress
+
+    path = mocycle.write(compress(synthetic_walk(n_frames=60).motion, count=4), tmp_path / "a.mck")
+    assert isinstance(mocycle.read(path), Compressed)
+    with pytest.raises(MotionFileError, match="mocycle.read"):
+        read(path)
 
 
 def test_a_read_segmentation_writes_back_in_a_fresh_process(tmp_path):

@@ -15,7 +15,7 @@ import pytest
 
 from mocycle.cycle import blend_cycles, extract_cycle, transition
 from mocycle.datasets import synthetic_walk
-from mocycle.io.mck import compress
+from mocycle.keyframes import compress
 from mocycle.motion import Motion
 from mocycle.phase import find_phase
 from mocycle.swings import segment

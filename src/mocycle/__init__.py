@@ -12,7 +12,7 @@ from .errors import MocycleError, MocycleWarning, MotionFileError
 
 # The rest is imported on first use (PEP 562), so that ``import mocycle.cli`` stays cheap and the command
 # line can take Ctrl-C cleanly from its first moment.
-_LAZY = {"delay_embed": "features", "pose_matrix": "features", "read": "io", "write": "io", "EndSite": "motion",
+_LAZY = {"delay_embed": "features", "pose_matrix": "features", "read": "files", "write": "files", "EndSite": "motion",
          "Motion": "motion", "Skeleton": "motion"}
 
 

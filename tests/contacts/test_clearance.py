@@ -1,9 +1,9 @@
 import numpy as np
 
-from mocycle.contacts import body_height, find_feet, lock_cycle
+from mocycle.contacts import body_height, find_feet
 from mocycle.contacts.clearance import MAX_CLEARANCE, SWING_SPEED, swing_clearance
 from mocycle.contacts.detect import heights_and_speeds, local_floor
-from mocycle.cycle import extract_cycle
+from mocycle.cycle import extract_cycle, lock_cycle
 from mocycle.datasets import synthetic_still
 from mocycle.motion import Motion
 from tests.contacts.test_contacts import _planted_walk

@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from mocycle.contacts import detect_contacts, find_feet, largest_leg_step, lock_cycle, lock_feet, ranges, skate
-from mocycle.cycle import extract_cycle
+from mocycle.contacts import detect_contacts, find_feet, largest_leg_step, lock_feet, ranges, skate
+from mocycle.cycle import extract_cycle, lock_cycle
 from mocycle.datasets import synthetic_still, synthetic_walk
 from mocycle.motion import Motion
 

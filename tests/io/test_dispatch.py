@@ -11,7 +11,7 @@ import mocycle
 from mocycle.datasets import synthetic_walk
 from mocycle.errors import MotionFileError
 from mocycle.io import READ_SUFFIXES, read_motion
-from mocycle.io.mck import Compressed, compress
+from mocycle.keyframes import Compressed, compress
 from mocycle.swings import Segmentation, segment
 
 

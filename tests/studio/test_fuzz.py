@@ -19,7 +19,7 @@ from mocycle.datasets import synthetic_walk  # noqa: E402
 from mocycle.studio.app import Limits, create_app  # noqa: E402
 from mocycle.studio.jobs import LIVE_FACTOR  # noqa: E402
 from mocycle.studio.payload import unpack  # noqa: E402
-from mocycle.studio.testing import api_client  # noqa: E402
+from studio_harness import api_client  # noqa: E402
 
 EXAMPLES = int(os.environ.get("MOCYCLE_STUDIO_FUZZ_EXAMPLES", "100"))
 LIMITS = Limits(max_jobs_kept=4, max_strokes=4, max_pending=3)

@@ -21,7 +21,7 @@ pytest.importorskip("httpx")
 from mocycle.studio import app as app_module  # noqa: E402
 from mocycle.studio.app import Limits, create_app  # noqa: E402
 from mocycle.studio.payload import unpack  # noqa: E402
-from mocycle.studio.testing import api_client  # noqa: E402
+from studio_harness import api_client  # noqa: E402
 
 
 def wait(client, job_id, timeout=120.0):

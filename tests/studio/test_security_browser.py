@@ -15,7 +15,7 @@ pytest.importorskip("uvicorn")
 pytest.importorskip("playwright")
 
 from mocycle.studio.app import create_app  # noqa: E402
-from mocycle.studio.testing import CHROMIUM, chromium, served, watch_console  # noqa: E402
+from studio_harness import CHROMIUM, chromium, served, watch_console  # noqa: E402
 
 if not os.path.exists(CHROMIUM):
     pytest.skip(f"{CHROMIUM} is absent (make chromium installs Debian's chromium)", allow_module_level=True)

@@ -14,7 +14,7 @@ pytest.importorskip("httpx")
 from mocycle.io.bvh import parse_bvh  # noqa: E402
 from mocycle.studio.app import create_app  # noqa: E402
 from mocycle.studio.payload import pack, unpack  # noqa: E402
-from mocycle.studio.testing import api_client  # noqa: E402
+from studio_harness import api_client  # noqa: E402
 
 
 def wait(client, job, timeout=120.0):

@@ -22,7 +22,7 @@ from mocycle import read  # noqa: E402
 from mocycle.io.bvh import parse_bvh  # noqa: E402
 from mocycle.keyframes import BackProjection, joint_weights, pose_distance_matrix  # noqa: E402
 from mocycle.studio.app import create_app  # noqa: E402
-from mocycle.studio.testing import CHROMIUM, chromium, served, watch_console  # noqa: E402
+from studio_harness import CHROMIUM, chromium, served, watch_console  # noqa: E402
 
 if not os.path.exists(CHROMIUM):
     pytest.skip(f"{CHROMIUM} is absent (make chromium installs Debian's chromium)", allow_module_level=True)

@@ -26,7 +26,7 @@ pytest.importorskip("httpx")
 
 from mocycle.studio.app import create_app  # noqa: E402
 from mocycle.studio.payload import unpack  # noqa: E402
-from mocycle.studio.testing import api_client  # noqa: E402
+from studio_harness import api_client  # noqa: E402
 
 REFUSED_FRAMES = 500
 
@@ -117,7 +117,7 @@ def test_the_page_shows_a_refused_loop_as_refused(refused_library, tmp_path):
     shows the loop marked FORCED and downloads it as ``limp_loop.forced.bvh``."""
     pytest.importorskip("uvicorn")
     pytest.importorskip("playwright")
-    from mocycle.studio.testing import CHROMIUM, chromium, served, watch_console
+    from studio_harness import CHROMIUM, chromium, served, watch_console
 
     if not os.path.exists(CHROMIUM):
         pytest.skip(f"{CHROMIUM} is absent (make chromium installs Debian's chromium)")

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 from collections import Counter
 from pathlib import Path
 
@@ -61,8 +60,3 @@ def write_results(outdir: Path, command: str, options: dict, rows: list[dict], r
     data = {"command": command, "options": options, "summary": summary(rows), "run": run, "takes": rows}
     return (atomic_write(outdir / "results.csv", csv_text(command, rows)),
             atomic_write(outdir / "results.json", json_text(data, indent=1)))
-
-
-def read_rows(path: Path) -> list[dict]:
-    """The rows of a ``results.json``."""
-    return json.loads(Path(path).read_text(encoding="utf-8"))["takes"]

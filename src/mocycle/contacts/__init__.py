@@ -1,6 +1,9 @@
-"""Feet that stay planted: foot joints of any rig, contact detection, foot locking, the skate measure."""
+"""Feet that stay planted: foot joints of any rig, contact detection, foot locking, the skate measure.
 
-from .cycle import lock_cycle
+Below :mod:`mocycle.cycle`, which imports it (loops locked across their seam: :func:`mocycle.cycle.lock_cycle`);
+nothing here knows of cycles.
+"""
+
 from .detect import Contacts, detect_contacts, ranges
 from .feet import Foot, body_height, find_feet, up_axis
 from .lock import lock_feet
@@ -8,4 +11,4 @@ from .plant import floor_height, foot_points, plant_lowest_foot
 from .skate import largest_leg_step, skate
 
 __all__ = ["Contacts", "Foot", "body_height", "detect_contacts", "find_feet", "floor_height", "foot_points",
-           "largest_leg_step", "lock_cycle", "lock_feet", "plant_lowest_foot", "ranges", "skate", "up_axis"]
+           "largest_leg_step", "lock_feet", "plant_lowest_foot", "ranges", "skate", "up_axis"]

@@ -41,6 +41,7 @@ import numpy as np
 from scipy.linalg import solve_circulant
 
 from ..axes import vertical_axis
+from ..contacts.skate import skate
 from ..errors import MocycleError
 from ..motion import Motion
 from .differences import FORWARD_3, HALF, central_acceleration, central_velocity, forward_jerk
@@ -278,8 +279,6 @@ def foot_sliding(motion: Motion, up: np.ndarray | None = None, positions: np.nda
 
 
 def _skate(motion: Motion, up: np.ndarray, positions: np.ndarray | None = None) -> float:
-    from ..contacts.skate import skate
-
     try:
         return skate(motion, up=up, positions=positions)
     except MocycleError:  # no feet found by name

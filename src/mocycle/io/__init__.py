@@ -12,13 +12,16 @@ suffix     holds                                       :func:`read` returns / :f
 ``.fbx``   a motion in an FBX file (:mod:`.fbx`)       :class:`~mocycle.motion.Motion` (read only)
 ``.amc``   a CMU motion, skeleton in an ``.asf``       :class:`~mocycle.motion.Motion` (read only)
 ``.mck``   a keyframe-compressed take (:mod:`.mck`)    :class:`~mocycle.keyframes.Compressed`
+                                                       (read by :func:`mocycle.read`)
 ``.mosw``  joint swings, compact (:mod:`.mosw`)        :class:`~mocycle.swings.Segmentation`
 ``.json``  joint swings as JSON records                :class:`~mocycle.swings.Segmentation`
 =========  ==========================================  =======================================
 
 ``write`` also writes any result that has a ``to_dict()`` (cycles, phases, reports) as
-``.json``.  :func:`read_motion` is :func:`read` for the files that hold a motion
-(``.bvh``, ``.amc``, ``.glb``, ``.gltf``, ``.fbx``), which is what the commands that take a motion use.
+``.json``.  io imports no algorithm: a ``.mck`` file is decoded here (:func:`.mck.decode`) and made into the
+take it holds by :func:`mocycle.read` (:mod:`mocycle.files`), which sits above io and the keyframe package.
+:func:`read_motion` is :func:`read` for the files that hold a motion (``.bvh``, ``.amc``, ``.glb``, ``.gltf``,
+``.fbx``), which is what the commands that take a motion use.
 glTF and FBX files may hold several animations (takes): ``take`` names one (:func:`takes` lists them).
 """
 
@@ -129,22 +132,23 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: 
 
     Parameters
     ----------
-    path : a ``.bvh``, ``.amc``, ``.glb``, ``.gltf``, ``.fbx``, ``.mck``, ``.mosw`` or swings ``.json`` file.
+    path : a ``.bvh``, ``.amc``, ``.glb``, ``.gltf``, ``.fbx``, ``.mosw`` or swings ``.json`` file (a ``.mck``
+        file: :func:`mocycle.read`).
     asf, fps : for ``.amc`` files only (see :func:`read_motion`).
     take, sample_fps : for ``.glb``, ``.gltf`` and ``.fbx`` files (see :func:`read_motion`).
 
     Returns
     -------
-    Motion, Compressed or Segmentation
+    Motion or Segmentation
         A :class:`Motion` for ``.bvh``/``.amc``/``.glb``/``.gltf``/``.fbx``, a
-        :class:`~mocycle.keyframes.Compressed` take for ``.mck`` (``.decompress()`` gives the motion), a
         :class:`~mocycle.swings.Segmentation` for ``.mosw`` and swings ``.json`` (``mocycle.swings.playback``
         gives the motion).
 
     Raises
     ------
     MotionFileError
-        Unknown suffix or a folder (the message lists the known suffixes), or a damaged file.
+        Unknown suffix or a folder (the message lists the known suffixes), a ``.mck`` file (read by
+        :func:`mocycle.read`), or a damaged file.
 
     Examples
     --------
@@ -166,9 +170,8 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: 
     if suffix in MOTION_SUFFIXES:
         return read_motion(p, asf=asf, fps=fps, take=take, sample_fps=sample_fps)
     if suffix == ".mck":
-        from .mck import read_compressed
-
-        return read_compressed(p)
+        raise MotionFileError("holds a keyframe-compressed take, which io does not build: read it with "
+                              "mocycle.read or mocycle.keyframes.read_compressed", p)
     if suffix == ".mosw":
         from .mosw import read_swings
 

@@ -14,7 +14,8 @@ and time, scheme, selection, projection, array shapes) followed by the arrays:
 
 The keyframes come back exactly (same rotations, same translations).  The take itself, how it is
 made and how its frames are rebuilt, is :mod:`mocycle.keyframes.compressed`'s (:func:`compress`,
-:class:`Compressed`, :func:`read_compressed`); this module only encodes and decodes.
+:class:`Compressed`, :func:`read_compressed`); this module only encodes and decodes, and imports nothing
+from there (io sits below every algorithm).
 """
 
 from __future__ import annotations
@@ -213,16 +214,3 @@ def write_bytes(path: str | os.PathLike, data: bytes) -> Path:
     except OSError as exc:
         raise MotionFileError(f"cannot write file ({exc.strerror or exc})", path) from None
 
-
-# Kept for the code that imported them from here (``mocycle.read``'s ``.mck`` branch among them): the take and
-# the algorithm are mocycle.keyframes.compressed's, resolved when first asked for.  New code imports them from
-# mocycle.keyframes.
-_MOVED = ("Compressed", "compress", "read_compressed")
-
-
-def __getattr__(name: str):
-    if name in _MOVED:
-        from ..keyframes import compressed as moved
-
-        return getattr(moved, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -35,8 +35,9 @@ The scale is taken late in the class's lifetime (paper 001 §4.3), and the
 number of classes can be read from the barcode (a gap between long bars and
 the rest), with the reason recorded.
 
-:class:`CohomologyFit` is the algorithm; :class:`~mocycle.phase.transformer.CircularCoordinates` (also
-importable from here) is the same as a scikit-learn transformer.  ``find_phase`` uses the former, so that
+:class:`CohomologyFit` is the algorithm; :class:`~mocycle.phase.transformer.CircularCoordinates` (import it
+from there or from :mod:`mocycle.phase`; this module does not name it) is the same as a scikit-learn
+transformer.  ``find_phase`` uses the former, so that
 finding a phase loads neither scikit-learn nor ripser's Python wrapper (which imports scikit-learn): about a
 second of start-up (``docs/performance.md``).
 """
@@ -58,14 +59,6 @@ MIN_FRAMES = 20
 #: Up to this many rows the greedy permutation measures every pair at once (2 MB), then only picks (faster
 #: than 120 matrix-vector products below about 500 rows, slower above).
 FULL_MATRIX_ROWS = 512
-
-
-def __getattr__(name: str):
-    if name == "CircularCoordinates":  # the scikit-learn transformer, imported with scikit-learn on first use
-        from .transformer import CircularCoordinates
-
-        return CircularCoordinates
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def rips_h1(dist: np.ndarray, prime: int) -> tuple[np.ndarray, list[np.ndarray]]:

@@ -15,6 +15,7 @@ nothing deeper; :func:`schema` describes an Options class for forms and flags.
 from __future__ import annotations
 
 import importlib
+from typing import TYPE_CHECKING
 
 from .fields import AMC_FPS, SWING_THRESHOLD
 from .options import Options, option, schema
@@ -24,6 +25,13 @@ from .report import Report
 #: that a front end pays only for the task it runs (``docs/performance.md``)
 NAMES = ("info", "phase", "loop", "blend", "transition", "stretch", "swings", "search", "edit", "compress",
          "decompress", "project")
+
+if TYPE_CHECKING:  # what __getattr__ gives, for IDEs and type checkers; at run time each loads on first use
+    from types import ModuleType
+
+    from . import blend, compress, decompress, edit, info, loop, phase, project, search, stretch, swings, transition
+
+    TASKS: dict[str, ModuleType]
 
 
 def __getattr__(name: str):

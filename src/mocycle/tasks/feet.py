@@ -20,7 +20,8 @@ def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=N
     takes) the cycle was made from, whose swing clearance the locked feet keep.  ``before``: the cycle
     repeated twice with its root motion, and ``skate_before`` its skate on the same feet, when the caller has
     measured them (``loop_metrics`` does: its ``skate``)."""
-    from ..contacts import find_feet, largest_leg_step, lock_cycle
+    from ..contacts import find_feet, largest_leg_step
+    from ..cycle.feet import lock_cycle
 
     if mode == "auto":
         try:

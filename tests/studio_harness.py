@@ -1,5 +1,7 @@
 """Drive the studio in Debian's chromium through Playwright, the studio served on a free port in a thread: what the
-tests, the screenshots and the latency benchmark share (Playwright and uvicorn are imported when used)."""
+tests, the screenshots and the latency benchmark (``benchmarks/studio.py``) share (Playwright and uvicorn are
+imported when used).  A test helper, so not in the installed package: ``from studio_harness import ...``
+(``tests`` is on pytest's path, as for ``helpers`` and ``fuzzing``)."""
 
 from __future__ import annotations
 

@@ -11,6 +11,9 @@ cleaned loop is frame 0 moved on by exactly the travel per cycle, the held
 feet of consecutive cycles are exactly one travel apart, and the in-place
 loop (the travel taken out at a constant rate) slides a held foot back at
 exactly the treadmill speed.
+
+It lives with the cycle it cleans, above :mod:`mocycle.contacts`, whose detection and locking it uses: the
+contacts package knows nothing of cycles.
 """
 
 from __future__ import annotations
@@ -20,13 +23,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..cycle.extract import Cycle
+from ..contacts.clearance import swing_clearance
+from ..contacts.detect import Contacts, detect_contacts
+from ..contacts.feet import Foot, chain_joints, chain_transforms, find_feet, leg_joints
+from ..contacts.lock import BLEND_SECONDS, REACH, lock_feet
 from ..motion import Motion
 from ..rotations import axis_rotations
-from .clearance import swing_clearance
-from .detect import Contacts, detect_contacts
-from .feet import Foot, chain_joints, chain_transforms, find_feet, leg_joints
-from .lock import BLEND_SECONDS, REACH, lock_feet
+from .result import Cycle
 
 
 def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend: float = BLEND_SECONDS,
