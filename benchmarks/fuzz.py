@@ -66,7 +66,7 @@ def _targets():
     from mocycle.io.bvh import format_bvh, parse_bvh
     from mocycle.io.mck import MAGIC as MCK
     from mocycle.io.mosw import MAGIC as MOSW
-    from mocycle.io.swings_json import parse_swings_json
+    from mocycle.io.swings_json import parse_swings_json, swings_document
     from mocycle.keyframes import Compressed, compress
     from mocycle.swings import decode, encode, playback, segment
 
@@ -132,7 +132,7 @@ def _targets():
         if fbx_dir and Path(fbx_dir).is_dir() else []
     return {"bvh": (bvh, bvh_seeds, None), "asf": (asf, [ASF.encode()], None), "amc": (amc, [AMC.encode()], None),
             "mck": (mck, mck_seeds, MCK), "mosw": (mosw, [encode(segment(walk))], MOSW),
-            "json": (swings_json, [json.dumps(segment(walk[:40]).to_dict()).encode()], None),
+            "json": (swings_json, [json.dumps(swings_document(segment(walk[:40]))).encode()], None),
             "glb": (from_file(".glb", glb_reader), glb_seeds, None),
             "fbx": (from_file(".fbx", fbx_reader), fbx_seeds, None)}
 

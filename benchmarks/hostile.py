@@ -37,9 +37,9 @@ def build(folder: Path) -> None:
 
     from mocycle.datasets import synthetic_walk
     from mocycle.io import write
+    from mocycle.io.bvh import skeleton_text
     from mocycle.io.mck import MAGIC as MCK
     from mocycle.io.mosw import MAGIC as MOSW
-    from mocycle.io.mosw import skeleton_text
     from mocycle.keyframes import compress
     from mocycle.motion import Skeleton
 

@@ -11,6 +11,7 @@ import mocycle
 from mocycle.datasets import synthetic_walk
 from mocycle.errors import MotionFileError
 from mocycle.io import READ_SUFFIXES, read_motion
+from mocycle.io.swings_json import swings_document
 from mocycle.keyframes import Compressed, compress
 from mocycle.swings import Segmentation, segment
 
@@ -45,7 +46,7 @@ def test_swings_round_trip(tmp_path, walk, suffix):
 def test_swings_json_is_what_the_cli_writes(tmp_path, walk):
     seg = segment(walk)
     path = mocycle.write(seg, tmp_path / "w.json")
-    assert json.loads(path.read_text()) == json.loads(json.dumps(seg.to_dict(), indent=1))
+    assert json.loads(path.read_text()) == json.loads(json.dumps(swings_document(seg), indent=1))
 
 
 def test_result_with_to_dict_written_as_json(tmp_path):

@@ -50,7 +50,7 @@ def test_swings_mosw_round_trip_and_table(walk_file, tmp_path):
 
 
 @pytest.mark.parametrize("args, word, code", [(["--threshold", "3"], "--threshold must be a number in [0, 2]", 2),
-                                              (["-o", "x.txt"], ".json or .mosw", 1),
+                                              (["-o", "x.txt"], ".mosw or .json", 1),
                                               (["--joints", "Tail"], "Tail", 1)])
 def test_swings_bad_options(walk_file, args, word, code):
     r = runner.invoke(app, ["swings", str(walk_file), *args])

@@ -7,8 +7,9 @@ from helpers import tiny_skeleton
 from mocycle.datasets import synthetic_walk
 from mocycle.errors import MocycleError
 from mocycle.io import read
+from mocycle.io.swings_json import segmentation_from_dict, swings_document
 from mocycle.motion import Motion
-from mocycle.swings import PAPER_WINDOW_S, Segmentation, choose_joints, segment
+from mocycle.swings import PAPER_WINDOW_S, choose_joints, segment
 from mocycle.swings.segment import angular_velocity, grow_swings, swing_error, unit_axes, window_frames
 
 AXIS = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
@@ -123,11 +124,11 @@ def test_records_and_dict_round_trip():
     assert kinds == {"swing", "hold"}
     sw = next(r for r in rows if r["kind"] == "swing")
     assert sw["joint"] == "Left Up Leg" and sw["end_s"] > sw["start_s"]
-    back = Segmentation.from_dict(seg.to_dict())
+    back = segmentation_from_dict(swings_document(seg))
     assert back.swings == seg.swings and back.holds == seg.holds and back.joints == seg.joints
     assert back.skeleton.same_as(seg.skeleton)
     with pytest.raises(MocycleError, match="swings JSON"):
-        Segmentation.from_dict({"frames": 3})
+        segmentation_from_dict({"frames": 3})
 
 
 def test_real_bandai_walk_segments_major_bones():

@@ -44,10 +44,11 @@ def swings(
     seg, r = report.result, report.facts
     written = []
     if output is not None:
+        from ..io.swings_json import swings_document
         from ..swings import encode
 
         if output.suffix.lower() == ".json":
-            write_text(output, json_text(seg.to_dict(), indent=1), "swings")
+            write_text(output, json_text(swings_document(seg), indent=1), "swings")
         else:
             write_text(output, encode(seg), "swings file")
         written.append(f"{output} ({seg.n_swings} swings)")

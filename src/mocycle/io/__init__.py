@@ -255,7 +255,13 @@ def write(obj, path: str | os.PathLike, *, clip=None, gltf_scale: float | str = 
         from .mosw import write_swings
 
         return write_swings(obj, p)
+    if suffix == ".json" and fits.get(type(obj)) == (".mosw", ".json"):  # a Segmentation: the swings document
+        from .swings_json import swings_document
+
+        document = swings_document(obj)
+    else:
+        document = obj.to_dict()
     try:
-        return atomic_write(p, json.dumps(obj.to_dict(), indent=1))
+        return atomic_write(p, json.dumps(document, indent=1))
     except OSError as exc:
         raise MotionFileError(f"cannot write file ({exc.strerror or exc})", p) from None

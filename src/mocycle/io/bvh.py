@@ -616,3 +616,9 @@ def write_bvh(motion: Motion, path: str | os.PathLike) -> Path:
         return atomic_write(path, bvh_chunks(motion))
     except OSError as exc:
         raise MotionFileError(f"cannot write file ({exc.strerror or exc})", path) from None
+
+
+def skeleton_text(skeleton: Skeleton) -> str:
+    """The BVH text of the skeleton's rest pose (one frame), which :func:`parse_bvh` reads back (the swings
+    files keep their skeleton so)."""
+    return format_bvh(Motion.rest(skeleton, 1))

@@ -30,9 +30,9 @@ from numpy.typing import ArrayLike
 from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
-from ..segmentation import MAX_SKELETON_BYTES, Segmentation, checked_segmentation, skeleton_text
+from ..segmentation import MAX_SKELETON_BYTES, Segmentation, checked_segmentation
 from .atomic import atomic_write
-from .bvh import bvh_size, parse_bvh
+from .bvh import bvh_size, parse_bvh, skeleton_text
 from .inflate import Inflater
 
 MAGIC = b"MOSW\x01"
