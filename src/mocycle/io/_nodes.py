@@ -110,14 +110,13 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     """
     T, J = int(n_frames), len(joints)
     check_frames(T, J, "the animation", path)
-    parents = np.asarray(parents, dtype=np.int64)
-    if J == 0 or parents.shape != (J,) or parents[0] != -1 or np.any(parents[1:] < 0) \
-            or np.any(parents[1:] >= np.arange(1, J)):
+    up = np.asarray(parents, dtype=np.int64)  # checked as an array, used as one
+    if J == 0 or up.shape != (J,) or up[0] != -1 or np.any(up[1:] < 0) or np.any(up[1:] >= np.arange(1, J)):
         raise MotionFileError("the skeleton's joints are not in parents-first order under one root", path)
     check_trs(ancestors + joints, path)
 
     children = np.zeros(J, dtype=int)
-    np.add.at(children, parents[1:], 1)
+    np.add.at(children, up[1:], 1)
     sites = [j for j in range(1, J) if leaves_as_sites and children[j] == 0 and not joints[j].animated]
     keep = [j for j in range(J) if j not in set(sites)]
     new_index = {j: k for k, j in enumerate(keep)}
@@ -128,7 +127,7 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     varying = np.zeros(J, dtype=bool)
     scaled_above = np.zeros(J, dtype=bool)  # some node above the joint has an animated scale
     for j in range(J):
-        p = parents[j]
+        p = up[j]
         scaled_above[j] = scale_moves if p < 0 else (scaled_above[p] or len(joints[p].scale) > 1)
         varying[j] = len(joints[j].translation) > 1 or scaled_above[j] or (j == 0 and anc_moves)
     K = len(keep)
@@ -145,12 +144,12 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
         world = np.empty((n, J, 4, 4))
         for j in range(J):
             local = _matrices(joints[j], rows, n)
-            world[:, j] = (top if parents[j] < 0 else world[:, parents[j]]) @ local
+            world[:, j] = (top if up[j] < 0 else world[:, up[j]]) @ local
         rot = _rotation_part(world[:, :, :3, :3].reshape(-1, 3, 3)).reshape(n, J, 3, 3)
         pos = world[:, :, :3, 3]
         r_locals = np.empty((n, K, 3, 3))
         for j in range(J):
-            p = parents[j]
+            p = up[j]
             if p < 0:
                 r_local, t_local = rot[:, j], pos[:, j]
             else:
@@ -181,12 +180,12 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     for k, t in tracks.items():
         offsets[k] = t[0]
     names = [joints[j].name for j in keep]
-    kparents = [-1] + [new_index[int(parents[j])] for j in keep[1:]]
+    kparents = [-1] + [new_index[int(up[j])] for j in keep[1:]]
     channels = [_MOVING if k in tracks else _TURNING for k in range(K)]
-    end_sites = tuple(EndSite(parent=new_index[int(parents[j])], offset=tuple(float(v) for v in site_offsets[j]),
+    end_sites = tuple(EndSite(parent=new_index[int(up[j])], offset=_vec3(site_offsets[j]),
                               name=joints[j].name) for j in sites)
     try:
-        skeleton = Skeleton(tuple(names), kparents, offsets, tuple(channels), end_sites)
+        skeleton = Skeleton(tuple(names), np.asarray(kparents), offsets, tuple(channels), end_sites)
         return Motion(skeleton, rotations, static, frame_time, tracks=tracks, copy=False)
     except MocycleError as exc:
         raise MotionFileError(str(exc), path) from None
@@ -219,7 +218,7 @@ def skeleton_order(parents: np.ndarray, children: list[list[int]], chosen, path)
         members.add(root)
         chains[root] = ancestors(root)
     for i in list(members):  # nodes between a joint and its nearest joint above are joints too
-        between = []
+        between: list[int] = []
         for a in chains[i]:
             if a in members:
                 members.update(between)
@@ -263,3 +262,8 @@ def member_nodes(members: list[int], parents, node_trs) -> tuple[list, list, lis
     position = {node: k for k, node in enumerate(members)}
     return ([node_trs(i) for i in reversed(above)], [node_trs(i) for i in members],
             [-1] + [position[int(parents[i])] for i in members[1:]])
+
+
+def _vec3(v) -> tuple[float, float, float]:
+    x, y, z = (float(c) for c in v)
+    return x, y, z

@@ -176,15 +176,15 @@ def _read(pufbx, scene, p: Path, take, fps) -> Motion:
 
     stack = _choose(scene, take, p)
     baked_nodes = {}
-    rate = fps
+    rate: float | None = fps
     start = end = 0.0
     if stack is not None:
         anim = scene.anim_stacks[stack].anim
         baked = pufbx.bake_anim(scene, anim, resample_rate=fps or DEFAULT_FPS)
         for b in baked.modified_nodes:
-            i = by_typed.get(b.typed_id)
-            if i is not None:
-                baked_nodes[i] = (_keys(b.translation_keys), _keys(b.rotation_keys), _keys(b.scale_keys))
+            at = by_typed.get(b.typed_id)
+            if at is not None:
+                baked_nodes[at] = (_keys(b.translation_keys), _keys(b.rotation_keys), _keys(b.scale_keys))
         all_times = [k[0] for trs in baked_nodes.values() for k in trs]
         if all_times:
             times_all = np.concatenate(all_times)
@@ -197,16 +197,17 @@ def _read(pufbx, scene, p: Path, take, fps) -> Motion:
                     baked = pufbx.bake_anim(scene, anim, resample_rate=rate)
                     baked_nodes = {}
                     for b in baked.modified_nodes:
-                        i = by_typed.get(b.typed_id)
-                        if i is not None:
-                            baked_nodes[i] = (_keys(b.translation_keys), _keys(b.rotation_keys),
-                                              _keys(b.scale_keys))
+                        at = by_typed.get(b.typed_id)
+                        if at is not None:
+                            baked_nodes[at] = (_keys(b.translation_keys), _keys(b.rotation_keys),
+                                               _keys(b.scale_keys))
         stack_begin, stack_end = float(scene.anim_stacks[stack].time_begin), float(scene.anim_stacks[stack].time_end)
         if np.isfinite(stack_begin) and np.isfinite(stack_end) and stack_end > stack_begin:
             start, end = stack_begin, stack_end
     rate = float(rate or DEFAULT_FPS)
-    if frame_time_problem(1.0 / rate):
-        raise MotionFileError(frame_time_problem(1.0 / rate), p)
+    problem = frame_time_problem(1.0 / rate)
+    if problem:
+        raise MotionFileError(problem, p)
     if not (end - start < 1e9):
         raise MotionFileError(f"the animation spans {end - start:g} s", p)
     T = check_frames(int(round((end - start) * rate)) + 1, len(members), "the animation", p)

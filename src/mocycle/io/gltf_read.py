@@ -505,8 +505,9 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
     members = _skeleton_nodes(f, parents, animated)
     if channels:
         start, end, rate = _frame_rate([c[2] for c in channels], fps)
-        if frame_time_problem(1.0 / rate):
-            raise MotionFileError(frame_time_problem(1.0 / rate), p)
+        problem = frame_time_problem(1.0 / rate)
+        if problem:
+            raise MotionFileError(problem, p)
         if not end - start < 1e9:
             raise MotionFileError(f"the animation spans {end - start:g} s", p)
         T = check_frames(int(round((end - start) * rate)) + 1, len(members), "the animation", p)
