@@ -39,6 +39,7 @@ def click_take(page, name):
                   f"r.querySelector('.name').textContent === {json.dumps(name)}).click()")
 
 
+@pytest.mark.browser
 def test_the_page_under_its_csp(hostile, tmp_path):
     app = create_app([hostile])
     studio = app.state.studio

@@ -64,6 +64,7 @@ def test_bad_inputs(tmp_path, folder):
         idx.query(folder / "set_run_s1.bvh", top=0)
 
 
+@pytest.mark.slow
 def test_real_bandai_precision_at_5_beats_chance():
     files = shared_files("bandai")
     if len(files) < 45:
