@@ -25,3 +25,14 @@ ONE_STEP_PROJECTIONS = ("pca", "mds", "isomap", "lle", "force", "tsne")
 #: two-step 2-D projections (their keyframes are placed by a one-step projection first).
 TWO_STEP_PROJECTIONS = ("rbfp", "lamp")
 PROJECTIONS = ONE_STEP_PROJECTIONS + TWO_STEP_PROJECTIONS
+
+# The names of the cycle methods (paper 001 and the KTH thesis), one home: the algorithms (:mod:`mocycle.cycle`)
+# and the task options read them from here.
+#: how a cycle is extracted; :mod:`mocycle.cycle.extract`.
+CYCLE_METHODS = ("harmonic", "centroid", "cut")
+#: harmonic regression models; :mod:`mocycle.cycle.harmonic`.
+HARMONIC_MODELS = ("M1", "M2", "M3")
+#: a loop's root: walks on the spot (facing kept) or moves on; :mod:`mocycle.cycle.result`.
+ROOT_MODES = ("inplace", "motion")
+#: phase to time; :mod:`mocycle.cycle.timeaxis`.
+TIME_AXES = ("smooth", "rank", "gmm", "line")

@@ -23,7 +23,7 @@ from typer.core import TyperCommand, TyperGroup
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_of
-from ..tasks.spec import SPECS
+from ..tasks.spec import MOTION_SUFFIXES, SPECS
 from ..text import json_text, printable
 
 #: the module of ``mocycle.cli`` that defines each task's command (the command is made from the task's spec)
@@ -421,8 +421,8 @@ def write_text(path: Path, text: str | bytes, what: str = "file") -> Path:
 
 
 # ------------------------------------------------------------ motion outputs (.bvh or .glb)
-#: the files a command that writes motion writes
-MOTION_OUTPUTS = (".bvh", ".glb")
+#: the files a command that writes motion writes (the task specs')
+MOTION_OUTPUTS = MOTION_SUFFIXES
 GLTF_SCALE = typer.Option(
     "--gltf-scale", metavar="<auto|m|cm|mm|in|cmu|METRES>",
     help=".glb outputs: metres per motion unit, a unit name, or auto (the unit that makes the body about 1.7 m).")

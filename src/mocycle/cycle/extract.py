@@ -12,7 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..motion import Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
@@ -32,7 +32,7 @@ from .timeaxis import time_axis as make_time_axis
 #: goes (:meth:`CycleSpace.encode_rows`: each of its three passes makes them again) instead of holding them.
 LAZY_P_BYTES = 1 << 26
 
-METHODS = ("harmonic", "centroid", "cut")
+METHODS = defaults.CYCLE_METHODS
 FEW_PERIODS = 1.5        # fewer periods than this: warn
 
 

@@ -25,10 +25,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError
 
-MODELS = ("M1", "M2", "M3")
+MODELS = defaults.HARMONIC_MODELS
 #: DOFs per batch of M1's normal equations: a 100-joint rig's (D, 41, 41) at once is 10 MB of temporaries
 _SOLVE_BLOCK = 64
 WEIGHT_LIMIT = 1e8  # alpha, gamma are clipped here: a DOF whose derivatives fit perfectly stays solvable

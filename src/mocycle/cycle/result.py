@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .. import _validate
+from .. import _validate, defaults
 from ..limits import check_frames
 from ..motion import Motion
 from ..phase.analysis import PeriodicMotion
@@ -23,7 +23,7 @@ from .harmonic import HarmonicRegression
 from .representation import CycleSpace
 from .timeaxis import TimeAxis
 
-ROOT_MODES = ("inplace", "motion")
+ROOT_MODES = defaults.ROOT_MODES
 
 
 @dataclass(kw_only=True)

@@ -22,12 +22,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError
 from ..phase.analysis import PeriodicMotion
 from ..phase.period import gmm_cdf_remap, rank_uniform, unwrap_phase
 
-TIME_AXES = ("smooth", "rank", "gmm", "line")
+TIME_AXES = defaults.TIME_AXES
 
 
 @dataclass(frozen=True, kw_only=True)

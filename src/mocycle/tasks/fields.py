@@ -4,16 +4,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..defaults import AMC_FPS, MIN_PERIODS, SWING_THRESHOLD
+from ..defaults import AMC_FPS, CYCLE_METHODS, HARMONIC_MODELS, MIN_PERIODS, ROOT_MODES, SWING_THRESHOLD
 from .options import Choice, Flag, Integer, Options, Real, Text, option
 
 __all__ = ["AMC_FPS", "CycleOptions", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay",
            "feet", "foot_joints", "force_cycle", "harmonics", "joints", "method", "min_periods", "model", "pca",
            "phase_joints", "root", "swing_joints", "take", "threshold", "which"]
 
-METHODS = ("harmonic", "centroid", "cut")
-MODELS = ("M1", "M2", "M3")
-ROOTS = ("inplace", "motion")
+METHODS = CYCLE_METHODS
+MODELS = HARMONIC_MODELS
+ROOTS = ROOT_MODES
 
 
 def amc_fps():

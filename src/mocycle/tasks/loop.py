@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..defaults import TIME_AXES
 from ..errors import LoopRefused, NoPeriodicMotion, OptionError
 from . import fields
 from .options import Choice, Flag, Integer, option
-from .options import Options as _Options
 from .report import Recorder, Report, label_of, load
 
 #: the loop metrics (``facts["metrics"]``): key -> (label, unit)
@@ -26,8 +26,6 @@ METRIC_LABELS = {
     "skate": ("foot skate, cycle (as fitted)", "units/s"),
     "input_skate": ("foot skate, input", "units/s"),
 }
-
-TIME_AXES = ("smooth", "rank", "gmm", "line")
 
 
 def parse_range(text: str | None, n_frames: int) -> tuple[int, int]:
@@ -62,36 +60,27 @@ _range_text.schema = lambda: {"anyOf": [{"type": "string", "pattern": r"^-?\d*:-
 
 
 @dataclass(frozen=True)
-class Options(_Options):
-    """Options of ``loop``."""
+class Options(fields.CycleOptions):
+    """Options of ``loop``: how the take's cycle is found (:class:`~mocycle.tasks.fields.CycleOptions`, with the
+    loop's own words for a few), which part is looped, and how the loop is written."""
 
     method: str = fields.method("harmonic (regression), centroid (paper 001) or cut (baseline).")
     model: str = fields.model("Harmonic model: M1 (FGLS-weighted positions, velocities, accelerations), M2 "
                               "(positions only; velocity/acceleration off), M3 (unweighted).")
-    harmonics: int | str = fields.harmonics()
-    root: str = fields.root("inplace", "inplace (walks on the spot, facing kept) or motion (moves on).")
-    frame_range: str | None = option(None, "Use frames START:STOP of the take.", _range_text, flag="--range")
-    step: int = option(1, "Find the phase on every STEP-th frame (faster on long takes).", Integer(1))
-    joints: str | None = fields.phase_joints()
-    cycles: int = fields.cycles(1, "Repeat the cycle this many times in the output.")
-    classes: int | str = fields.classes()
     which: int | str | None = option(
         None, "Which part of the take to loop (0-based, as listed; default: the steady part with the most cycles), or "
               "'all': one file per part that loops, named OUT.part<k>-<kind>.bvh (kind: walk-straight, "
               "walk-turning-left, run-..., arms, periodic). --class is the old name.",
         Integer(0, words={"all": "all"}, optional=True), flag="--part")
-    pca: int | str | None = fields.pca()
-    delay: int = fields.delay()
-    min_periods: float = fields.min_periods()
-    time_axis: str = option("smooth", "Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) "
-                                      "or line.", Choice(TIME_AXES), flag="--time")
-    amc_fps: float = fields.amc_fps()
-    take: str | None = fields.take()
     force: bool = option(False, "Write the cycle even when it fails a loop check (longer than the take, fits much "
                                 "worse than a plain cut, seam jumps); a warning names the check. It also lets an "
                                 "output replace an input file.", Flag())
-    feet: str = fields.feet()
-    foot_joints: str | None = fields.foot_joints()
+    root: str = fields.root("inplace", "inplace (walks on the spot, facing kept) or motion (moves on).")
+    frame_range: str | None = option(None, "Use frames START:STOP of the take.", _range_text, flag="--range")
+    step: int = option(1, "Find the phase on every STEP-th frame (faster on long takes).", Integer(1))
+    cycles: int = fields.cycles(1, "Repeat the cycle this many times in the output.")
+    time_axis: str = option("smooth", "Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) "
+                                      "or line.", Choice(TIME_AXES), flag="--time")
 
 
 #: A loop's cycle more than this share off the stride period (the landings of each foot) is not written.
