@@ -21,7 +21,7 @@ to 10 000 frames, the 500-frame take).
 Tools and the parameters chosen for them:
 
 * mocycle: ``CircularCoordinates(n_landmarks=120, prime=47, n_classes=1,
-  min_cycles=None)`` (the raw coordinate is always kept); and, when it exists,
+  min_periods=None)`` (the raw coordinate is always kept); and, when it exists,
   ``mocycle.phase.find_phase(motion)`` (features + coordinates + periods).
 * DREiMac: ``CircularCoords(X, n_landmarks=120, prime=47)`` and
   ``get_coordinates(perc=0.5, cocycle_idx=0)`` (its defaults; the same
@@ -98,7 +98,7 @@ def run_mocycle(X: np.ndarray) -> np.ndarray:
     from mocycle.phase import CircularCoordinates
 
     est = CircularCoordinates(n_landmarks=N_LANDMARKS, prime=PRIME, scale="auto", n_classes=1,
-                              min_cycles=None).fit(X)
+                              min_periods=None).fit(X)
     if est.coords_.shape[1] == 0:
         raise Skipped(f"no class: {est.reason_}")
     return est.coords_[:, 0]

@@ -475,7 +475,7 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
                            weights=weights)
         try:
             estimator = CohomologyFit(n_landmarks=n_landmarks, scale=scale, n_classes=classes,
-                                      min_cycles=float(min_periods)).fit(X)
+                                      min_periods=float(min_periods)).fit(X)
         except MocycleError as exc:  # e.g. no prime lifts the class to Z: the next joint selection may do
             tries.append((label, f"the analysis failed ({exc})"))
             continue

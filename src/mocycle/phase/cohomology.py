@@ -21,7 +21,7 @@ chosen H1 class:
    total: ripser may return "walk + run" and "run" for a walk-then-run take,
    the reduced basis is "walk" and "run" (paper 001 §7 suggests such
    combinations of coclasses);
-5. a class must wind at least ``min_cycles`` times over the take (rows are
+5. a class must wind at least ``min_periods`` times over the take (rows are
    frames in time order) to count as a periodic motion: a single loop in a
    non-periodic take winds about once.  When no class does, but several wind
    about once each, their signed sum is tried: a gait whose cycles do not
@@ -493,7 +493,7 @@ class CohomologyFit:
         late in the lifetime works best).
     min_ratio : death/birth a bar needs to count as long ("auto").
     max_classes : at most this many classes with ``"auto"``.
-    min_cycles : net windings over the frames a coordinate needs to count as a
+    min_periods : net windings over the frames a coordinate needs to count as a
         periodic motion (rows of X must be frames in time order); ``None``
         keeps every chosen class.
 
@@ -509,7 +509,7 @@ class CohomologyFit:
 
     def __init__(self, n_landmarks: int = 120, prime: int = 47, scale: str | float = "auto",
                  n_classes: int | str = 1, scale_fraction: float = 0.75, min_ratio: float = 1.5,
-                 max_classes: int = 5, min_cycles: float | None = 1.25):
+                 max_classes: int = 5, min_periods: float | None = 1.25):
         self.n_landmarks = n_landmarks
         self.prime = prime
         self.scale = scale
@@ -517,7 +517,7 @@ class CohomologyFit:
         self.scale_fraction = scale_fraction
         self.min_ratio = min_ratio
         self.max_classes = max_classes
-        self.min_cycles = min_cycles
+        self.min_periods = min_periods
 
     # -- validation ----------------------------------------------------------
     def _check_X(self, X) -> np.ndarray:
@@ -588,10 +588,10 @@ class CohomologyFit:
     def _join_single_loops(self, raw: np.ndarray, X: np.ndarray) -> tuple[np.ndarray, str]:
         """The basis with the signed sum of classes that wind about once each appended, if it is
         periodic (module notes), and a note saying so ('' when nothing was joined)."""
-        if self.min_cycles is None or raw.shape[1] < 2:
+        if self.min_periods is None or raw.shape[1] < 2:
             return self.basis_, ""
         nets = _wrap(np.diff(raw @ self.basis_, axis=0)).sum(axis=0)
-        if np.any(np.abs(nets) >= self.min_cycles):
+        if np.any(np.abs(nets) >= self.min_periods):
             return self.basis_, ""
         single = np.flatnonzero(np.abs(nets) >= 0.5)
         if single.size < 2:
@@ -600,7 +600,7 @@ class CohomologyFit:
         cycles = abs(_wrap(np.diff(raw @ total)).sum())
         period = autocorrelation_period(X)
         expected = X.shape[0] / period if np.isfinite(period) else np.nan
-        if cycles >= self.min_cycles and abs(cycles / expected - 1) <= 0.25:
+        if cycles >= self.min_periods and abs(cycles / expected - 1) <= 0.25:
             note = (f"; {single.size} classes that wind about once each were joined into one that "
                     f"winds {cycles:.2f} times (the autocorrelation expects {expected:.2f})")
             return np.c_[self.basis_, total], note
@@ -616,9 +616,9 @@ class CohomologyFit:
             main = max(members, key=lambda i: classes[i].persistence)
             c = classes[main]
             sign = -1.0 if net < 0 else 1.0
-            if self.min_cycles is not None and abs(net) < self.min_cycles:
+            if self.min_periods is not None and abs(net) < self.min_periods:
                 notes.append(f"; the class of bar [{c.birth:.3g}, {c.death:.3g}) winds only {abs(net):.2f} "
-                             f"times over the take (< {self.min_cycles:g}), so it is not a periodic motion")
+                             f"times over the take (< {self.min_periods:g}), so it is not a periodic motion")
                 continue
             keep.append(k)
             out.append(CircleCoordinate(c.bar, c.birth, c.death, tuple(int(v) for v in self.basis_[:, k]),
