@@ -28,12 +28,21 @@ that still works on a part of 1.2 cycles where the circular coordinate winds abo
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .axes import vertical_axis
+from .contacts import body_height, find_feet, up_axis
+from .contacts.detect import heights_and_speeds, local_floor
+from .contacts.feet import chain_joints, chain_positions
 from .errors import MocycleError, NoPeriodicMotion
+from .features import HeadingFrame, pose_matrix
 from .motion import Motion
+from .phase import find_phase
+from .phase.analysis import PERIOD_AGREEMENT, PeriodicMotion
+from .phase.period import autocorrelation_period, moving_average, repetition_distance
+from .rotations import mean_rotations, quat_angles
 
 #: A step (landing to the other foot's landing) lasts at least / at most this long, seconds.
 MIN_STEP_S, MAX_STEP_S = 0.15, 1.2
@@ -165,9 +174,6 @@ def find_landings(motion: Motion) -> Landings | None:
     only, no speeds: a foot that glides on the floor (a retargeted or synthetic take, a fitted loop) still
     lands where it comes down, and feet that stay down while the legs sway make no landing.  The floor of
     each joint is its lowest level nearby (:func:`~mocycle.contacts.detect.local_floor`)."""
-    from .contacts import body_height, find_feet, up_axis
-    from .contacts.detect import heights_and_speeds, local_floor
-    from .contacts.feet import chain_joints, chain_positions
 
     try:
         feet = find_feet(motion.skeleton)
@@ -234,7 +240,6 @@ def stride_periods(landings: Landings, fps: float, start: int = 0, stop: int | N
 # ------------------------------------------------------------------------------------------- segmentation
 def heading_degrees(motion: Motion) -> np.ndarray:
     """The hips' (travel joint's) heading ``(T,)`` in degrees, unwrapped, positive turning left about up."""
-    from .features import HeadingFrame
 
     frame = HeadingFrame.fit(motion)
     _, psi = frame.tilt(motion)
@@ -243,14 +248,12 @@ def heading_degrees(motion: Motion) -> np.ndarray:
 
 
 def _body_height(motion: Motion) -> float:
-    from .contacts import body_height, up_axis
 
     return float(body_height(motion, up_axis(motion)))
 
 
 def _horizontal_path(motion: Motion) -> np.ndarray:
     """The travel joint's world position ``(T, 3)`` with its vertical component removed."""
-    from .axes import vertical_axis
 
     up = vertical_axis(motion)
     p = motion.joint_path(motion.travel_joint)
@@ -415,7 +418,6 @@ def _one_step_part(motion: Motion, chain, landings: Landings, heading, path, bod
 
 def _leg_features(motion: Motion, start: int, stop: int) -> np.ndarray | None:
     """The legs' rotation vectors ``(stop - start, D)`` (no root, not normalised), ``None`` without legs."""
-    from .features import pose_matrix
 
     try:
         X, _ = pose_matrix(motion[start:stop], rep="expmap", root="drop", joints="legs", normalize=False,
@@ -629,7 +631,6 @@ def _lead(motion, start, stop, when):
 
 def _rotation_spread(motion: Motion) -> np.ndarray:
     """Each joint's rotation spread ``(J,)`` in degrees: the RMS angle of its rotations from their mean."""
-    from .rotations import mean_rotations, quat_angles
 
     q = motion.rotations
     mean = mean_rotations(q)
@@ -664,8 +665,6 @@ def _repeating_region(piece: Motion, joints, min_periods: float) -> tuple[int, i
     autocorrelation (paper 004), the frames where the take is like itself one period later
     (:func:`~mocycle.phase.period.repetition_distance` under a half) and moves (at least a fifth of its
     largest local speed), their longest run.  ``None`` when it holds fewer than ``min_periods`` periods."""
-    from .features import pose_matrix
-    from .phase.period import autocorrelation_period, moving_average, repetition_distance
 
     X, _ = pose_matrix(piece, rep="expmap", root="drop", joints=joints, normalize=False, weights=None)
     V = np.diff(X, axis=0)
@@ -700,8 +699,6 @@ def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float):
     """``(limbs, kind, PeriodicMotion, (start, stop))`` of the motion repeating in ``piece`` (frames of the
     piece; the PeriodicMotion is on those frames): the arm joints that move first (a wave beside standing
     legs), where they repeat, then the whole body; ``None`` when nothing repeats."""
-    from .phase import find_phase
-    from .phase.analysis import PERIOD_AGREEMENT
 
     moving = _moving_arm_joints(piece.skeleton, spread) if _legs_still(piece.skeleton, spread) else []
     tries = [(moving, "arms")] if moving else []
@@ -737,7 +734,6 @@ def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float):
 
 def _rebased(pm, a: int, b: int):
     """``pm`` on its frames ``a .. b-1`` only (frame ``a`` first)."""
-    from dataclasses import replace
 
     regions = [(max(s, a) - a, min(e, b) - a) for s, e in pm.excitation if min(e, b) > max(s, a)]
     return replace(pm, coords=pm.coords[a:b], unwrapped=pm.unwrapped[a:b], excitation=regions)
@@ -746,7 +742,6 @@ def _rebased(pm, a: int, b: int):
 def line_periodic(x: np.ndarray, period: float, frame_time: float, source: str, joints_used: str, reason: str):
     """A :class:`~mocycle.phase.analysis.PeriodicMotion` whose time is ``x`` ``(n,)`` (cycles; a line: one
     tempo) over all its frames, with the period estimator that made it named."""
-    from .phase.analysis import PeriodicMotion
 
     x = np.asarray(x, dtype=np.float64)
     n = x.size

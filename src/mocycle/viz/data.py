@@ -10,7 +10,10 @@ from __future__ import annotations
 import numpy as np
 from sklearn.decomposition import PCA
 
+from ..cycle.metric_rows import metric_features
 from ..errors import MocycleError
+from ..features import pose_matrix
+from ..rotations import mean_rotations
 
 
 def _xy(X: np.ndarray, fit_rows: np.ndarray | None = None) -> tuple[np.ndarray, PCA | None]:
@@ -57,10 +60,6 @@ def loop_plot_data(motion, cycle, n_joints: int = 3) -> dict:
     ``positions`` ``(M,)`` (cycle frames); ``n_frames``, ``n_periods``, ``period_frames``, ``method``,
     ``model``, ``axis_method``.
     """
-    from ..cycle.metric_rows import metric_features
-    from ..features import pose_matrix
-    from ..rotations import mean_rotations
-
     ref = mean_rotations(motion.rotations)
     inplace = cycle.motion("inplace")
     Y, C = metric_features(motion), metric_features(inplace)  # the metrics' wrap-free space
@@ -144,9 +143,6 @@ def curves_plot_data(series, n_joints: int = 3) -> dict:
     ``series``: one dict per motion with ``label``, ``x`` ``(T,)`` and ``degrees`` ``(T, n_joints)``: the
     rotation from the first motion's mean pose (quaternion log, degrees).
     """
-    from ..features import pose_matrix
-    from ..rotations import mean_rotations
-
     first = series[0][1]
     ref = mean_rotations(first.rotations)
     names = pose_matrix(first[:1], rep="quatlog", root="drop", reference=ref)[1].columns
