@@ -198,7 +198,9 @@ function control(name, p, value) {
   } else if (p.type === "boolean") {
     el = document.createElement("input"); el.type = "checkbox"; el.checked = !!value;
   } else {
-    el = document.createElement("input"); el.type = p.type === "integer" ? "number" : "text";
+    el = document.createElement("input");
+    el.type = p.type === "integer" || p.type === "number" ? "number" : "text";
+    if (p.type === "number") el.step = "any";
     if (p.minimum !== undefined) el.min = p.minimum;
     if (p.maximum !== undefined) el.max = p.maximum;
     el.value = value ?? "";
@@ -207,27 +209,35 @@ function control(name, p, value) {
   return el;
 }
 
-function buildOptions(schema) {
-  const defaults = { root: "motion", cycles: 3 };  // the studio shows loops moving on, three cycles long
-  for (const name of schema.forms.loop) {
-    const p = schema.loop.properties[name];
+// the studio's own starting values where they differ from the task's defaults: loops moving on, three cycles
+// long; a plane with more keyframes than the thesis' 3 %, optimised
+const STUDIO_DEFAULTS = { loop: { root: "motion", cycles: 3 }, plane: { ratio: 0.05, optimize: true } };
+
+function buildForm(schema, form, box) {
+  for (const name of schema.forms[form]) {
+    const p = schema[form].properties[name];
     const label = document.createElement("label");
-    label.append(name + " ", control(name, p, defaults[name] ?? p.default));
-    $("loop-fields").appendChild(label);
+    label.append(name.replace("_", " ") + " ", control(name, p, STUDIO_DEFAULTS[form]?.[name] ?? p.default));
+    $(box).appendChild(label);
   }
-  const plane = schema.plane.properties;
-  for (const name of ["projection", "select"]) {
-    const sel = $(`plane-${name}`);
-    for (const v of plane[name].enum) sel.add(new Option(v, v, false, v === plane[name].default));
-    sel.title = plane[name].description;
-  }
+}
+
+function buildOptions(schema) {
+  buildForm(schema, "loop", "loop-fields");
+  buildForm(schema, "plane", "plane-fields");
+}
+
+// the plane form's fields as the plane's query (on/off fields as 1 or 0)
+function planeQuery() {
+  const q = new URLSearchParams();
+  for (const el of $("plane-form").querySelectorAll("[name]")) q.set(el.name, el.type === "checkbox" ? (el.checked ? "1" : "0") : el.value);
+  return q;
 }
 
 // ---------------------------------------------------------------- authoring plane
 async function loadPlane() {
   const id = S.take;
-  const q = new URLSearchParams({ projection: $("plane-projection").value, select: $("plane-select").value,
-                                  ratio: $("plane-ratio").value, optimize: $("plane-optimize").checked ? "1" : "0" });
+  const q = planeQuery();
   $("plane-status").textContent = "projecting…";
   try {
     const plane = await fetchPayload(`/api/takes/${id}/plane?${q}`);
@@ -276,7 +286,7 @@ async function relayout() {
   if (previous) json(`/api/jobs/${previous}`, undefined, "DELETE").catch(() => {});
   $("relayout-progress").value = 0; $("relayout-box").classList.add("busy");
   try {
-    const job = await json(`/api/takes/${id}/relayout`, { keyframes: S.keys, markers: S.markers, optimize: $("plane-optimize").checked });
+    const job = await json(`/api/takes/${id}/relayout`, { keyframes: S.keys, markers: S.markers, optimize: $("plane-form").elements.optimize.checked });
     S.relayoutJob = job.id;
     const j = await waitJob(job, (s) => { if (S.relayoutJob === job.id) $("relayout-progress").value = s.progress; });
     if (S.relayoutJob !== job.id || S.take !== id) return;  // a newer drag took over (its box stays)
