@@ -123,3 +123,39 @@ def test_a_loop_output_names_one_file_per_part():
                                                        "loop.part3": Path("o/walk.part3-walk-straight.bvh")}
     assert SPECS["stretch"].outputs[0].targets(SimpleNamespace(facts={}, motions={}), Path("s.bvh")) == \
         {"stretched": Path("s.bvh")}
+
+
+def _reports(tmp_path) -> dict:
+    """One report of every task on generated takes (the optional facts asked for where a task has them)."""
+    import mocycle
+    from mocycle.datasets import synthetic_walk
+
+    walk = mocycle.write(synthetic_walk(n_frames=240).motion, tmp_path / "walk.bvh")
+    other = mocycle.write(synthetic_walk(n_frames=240, period_s=0.8, seed=1).motion, tmp_path / "other.bvh")
+    compressed = tasks.compress.run(walk)
+    compressed.result.save(tmp_path / "walk.mck")
+    return {"info": [tasks.info.run(walk)], "phase": [tasks.phase.run(walk)],
+            "loop": [tasks.loop.run(walk), tasks.loop.run(walk, tasks.loop.Options(which="all", root="motion"))],
+            "blend": [tasks.blend.run([walk, other])], "transition": [tasks.transition.run([walk, other])],
+            "stretch": [tasks.stretch.run(walk, tasks.stretch.Options(factor=1.5))],
+            "swings": [tasks.swings.run(walk)], "search": [tasks.search.run(walk, tmp_path)],
+            "edit": [tasks.edit.run(walk, tasks.edit.Options(joint="LeftUpLeg", swing=0, angle_scale=1.2))],
+            "compress": [compressed], "decompress": [tasks.decompress.run(tmp_path / "walk.mck")],
+            "project": [tasks.project.run(walk), tasks.project.run(walk, tasks.project.Options(optimize=True))]}
+
+
+def test_every_report_has_the_facts_its_spec_declares(tmp_path):
+    """A task's facts have one shape, the spec's: every declared key, and no other but the optional ones."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        reports = _reports(tmp_path)
+    for name, runs in reports.items():
+        spec = SPECS[name]
+        for report in runs:
+            keys = set(report.facts)
+            assert set(spec.facts) <= keys, f"{name}: missing {sorted(set(spec.facts) - keys)}"
+            assert keys <= {*spec.facts, *spec.optional_facts}, \
+                f"{name}: undeclared {sorted(keys - {*spec.facts, *spec.optional_facts})}"
+    assert "stress_optimized" in reports["project"][1].facts

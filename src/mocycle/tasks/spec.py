@@ -73,6 +73,9 @@ class Spec:
     batch : ``mocycle batch`` runs it (it takes one file).
     studio : the fields of its ``Options`` the studio's forms show (the others keep their defaults).
     cli : it is a ``mocycle`` command.
+    facts : the keys every report of the task has in ``facts`` (its shape; ``tests/tasks/test_spec.py``
+        runs each task and checks), and ``optional_facts`` the few it adds only when asked (the optimised
+        projection, the takes of a glTF or FBX file).
     """
 
     name: str
@@ -84,6 +87,8 @@ class Spec:
     batch: bool = False
     studio: tuple[str, ...] = ()
     cli: bool = True
+    facts: tuple[str, ...] = ()
+    optional_facts: tuple[str, ...] = ()
 
     @property
     def module(self):
@@ -135,13 +140,19 @@ SPECS: dict[str, Spec] = {s.name: s for s in (
     Spec("info", "Frames, frame time, fps, duration, joints, channels, root travel and rotation ranges.",
          figures={"frames": lambda f: f["frames"], "fps": lambda f: f["fps"], "duration_s": lambda f: f["duration_s"],
                   "joints": lambda f: f["joints"], "root_displacement": lambda f: f["root_displacement"]},
-         imports=("mocycle.tasks.info", "mocycle.io.bvh"), batch=True),
+         imports=("mocycle.tasks.info", "mocycle.io.bvh"), batch=True,
+         facts=("channels", "duration_s", "end_sites", "fps", "frame_time", "frames", "joints", "root_displacement",
+                "root_end", "root_path_length", "root_start", "rotation_range_deg", "rotation_spread_deg",
+                "travel_joint"),
+         optional_facts=("takes", "take")),
     Spec("phase", "Find periodic motions and the phase of every frame (persistent cohomology).",
          figures={"frames": lambda f: f["frames"], "fps": lambda f: f["fps"], "classes": lambda f: len(f["classes"]),
                   "period_frames": lambda f: _first_class(f, "period_frames"),
                   "periods": lambda f: _first_class(f, "n_periods"),
                   "autocorrelation_period_frames": lambda f: f["autocorrelation_period_frames"]},
-         imports=("mocycle.tasks.phase", "mocycle.phase", "pyRipser"), batch=True),
+         imports=("mocycle.tasks.phase", "mocycle.phase", "pyRipser"), batch=True,
+         facts=("autocorrelation_period_frames", "classes", "fps", "frames", "joints_used", "legs_period_frames",
+                "reason")),
     Spec("loop", "Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH or glTF.",
          outputs=(_motion("loop", "The cycle as a .bvh or .glb file.", loop=True),),
          figures={"part": lambda f: _loop(f)["part"], "kind": lambda f: _loop(f)["kind"],
@@ -153,18 +164,31 @@ SPECS: dict[str, Spec] = {s.name: s for s in (
                   "seam_velocity": lambda f: _loop(f)["metrics"]["seam_velocity"], "foot_skate": _skate},
          imports=("mocycle.tasks.loop", "mocycle.activities", "mocycle.phase", "pyRipser", "mocycle.cycle",
                   "mocycle.cycle.checks", "mocycle.tasks.feet", "mocycle.contacts"),
-         batch=True, studio=("method", "model", "root", "feet", "cycles")),
+         batch=True, studio=("method", "model", "root", "feet", "cycles"),
+         facts=("class", "cycle_frames", "cycles", "excitation", "excited_regions", "failed_checks", "feet",
+                "first_frame", "fps", "frames", "frames_in", "frames_out", "half_cycle_doubled", "harmonics",
+                "joints_used", "kind", "legs_period_frames", "loops", "method", "metrics", "model", "n_periods",
+                "not_looped", "part", "parts", "period_candidates", "period_frames", "period_reason",
+                "period_source", "reason", "role", "root", "speed", "status", "time_axis", "travel_per_cycle",
+                "turn_per_cycle_deg")),
     Spec("blend", "Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).",
-         inputs=("*paths",), outputs=(_motion("loop", "The blended loop as a .bvh or .glb file.", loop=True),)),
+         inputs=("*paths",), outputs=(_motion("loop", "The blended loop as a .bvh or .glb file.", loop=True),),
+         facts=("cycle_frames", "cycles", "feet", "frames_out", "heading_offsets_deg", "input_periods_frames",
+                "input_seams", "period_frames", "phase_offsets", "root", "seam", "start_phase", "travel_per_cycle",
+                "turn_per_cycle_deg", "weights")),
     Spec("transition", "A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, "
                        "a homotopy).",
-         inputs=("first", "second"), outputs=(_motion("transition", "The transition as a .bvh or .glb file."),)),
+         inputs=("first", "second"), outputs=(_motion("transition", "The transition as a .bvh or .glb file."),),
+         facts=("cycles", "feet", "frames", "input_periods_frames", "period_frames_end", "period_frames_start",
+                "phase_offset", "root", "smoothness")),
     Spec("stretch", "Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.",
          outputs=(_motion("stretched", "The .bvh or .glb file to write."),),
          figures={"factor": lambda f: f["factor"], "frames_in": lambda f: f["frames_in"],
                   "frames_out": lambda f: f["frames_out"], "periodic_regions": lambda f: len(f["periodic_regions"])},
          imports=("mocycle.tasks.stretch", "mocycle.warp", "mocycle.phase", "pyRipser", "mocycle.cycle",
-                  "mocycle.tasks.feet", "mocycle.contacts", "scipy.ndimage"), batch=True),
+                  "mocycle.tasks.feet", "mocycle.contacts", "scipy.ndimage"), batch=True,
+         facts=("cycles", "factor", "feet", "forced", "fps", "frames_in", "frames_out", "joints_per_group",
+                "periodic_regions", "periodic_regions_out", "trend_curves", "windows")),
     Spec("swings", "Segment a take into joint swings and holds; report playback error and compressed size.",
          outputs=(Output("result", "swings", (".mosw", ".json"), required=False,
                          help="Write the swings: .json (records) or .mosw (compact binary file)."),
@@ -174,11 +198,16 @@ SPECS: dict[str, Spec] = {s.name: s for s in (
                   "per_angle_error_deg": lambda f: f["per_angle_error_deg"],
                   "compressed_bytes": lambda f: f["compressed_bytes"], "ratio_bvh": lambda f: f["ratio_bvh"]},
          imports=("mocycle.tasks.swings", "mocycle.swings", "mocycle.io.mosw", "scipy.optimize", "scipy.ndimage"),
-         batch=True),
+         batch=True,
+         facts=("compressed_bytes", "fps", "frames", "geodesic_error_deg", "joints", "n_swings",
+                "per_angle_error_deg", "per_joint", "ratio_bvh", "ratio_raw", "raw_float32_bytes",
+                "segmentation_error", "threshold")),
     Spec("search", "Rank the takes of a folder by how alike their swings are to an example (query by example).",
-         inputs=("query", "folder")),
+         inputs=("query", "folder"),
+         facts=("indexed", "query", "results")),
     Spec("edit", "Scale the angle or the duration of one swing of one joint and write the edited motion.",
-         outputs=(_motion("edited", "Edited motion (.bvh or .glb)."),)),
+         outputs=(_motion("edited", "Edited motion (.bvh or .glb)."),),
+         facts=("angle_deg", "angle_scale", "duration_scale", "end", "joint", "start", "swing")),
     Spec("compress", "Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error "
                      "and size.",
          outputs=(Output("result", "compressed", (".mck",), help="The .mck file to write."),),
@@ -187,11 +216,17 @@ SPECS: dict[str, Spec] = {s.name: s for s in (
                   "error_per_frame_per_joint": lambda f: f["error_per_frame_per_joint"],
                   "compressed_bytes": lambda f: f["compressed_bytes"], "real_ratio": lambda f: f["real_ratio"]},
          imports=("mocycle.tasks.compress", "mocycle.keyframes", "mocycle.phase", "pyRipser", "mocycle.io.mck",
-                  "scipy.optimize"), batch=True),
+                  "scipy.optimize"), batch=True,
+         facts=("bvh_bytes", "compressed_bytes", "error_per_frame_per_joint", "formula_ratio", "frames",
+                "keyframe_ratio", "keyframes", "keyframes_set_by", "keys_per_period", "period_frames", "ratio",
+                "real_ratio")),
     Spec("decompress", "Rebuild a take from its keyframes; the keyframes come back exactly (unless --feet lock).",
-         outputs=(_motion("motion", "The .bvh or .glb file to write."),)),
+         outputs=(_motion("motion", "The .bvh or .glb file to write."),),
+         facts=("feet", "frames", "keyframes", "keyframes_exact", "scheme")),
     Spec("project", "Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take.",
-         studio=("projection", "select", "ratio", "seed_projection", "optimize")),
+         studio=("projection", "select", "ratio", "seed_projection", "optimize"),
+         facts=("frames", "keyframes", "points", "projection", "select", "stress"),
+         optional_facts=("points_optimized", "stress_optimized")),
     Spec("author", "A new motion from a stroke drawn on a take's spatial-keyframe plane (thesis chapter 5).",
          inputs=(), studio=("plant", "feet"), cli=False),
 )}
