@@ -9,7 +9,6 @@ does not import dask (only :func:`run_batch` does).
 from __future__ import annotations
 
 import os
-import re
 import tempfile
 import time
 from collections.abc import Callable
@@ -134,7 +133,7 @@ def check_collisions(job: Job, takes: list[Take]) -> None:
     for name in RESULTS_FILES:
         claim(job.outdir / name, f"the batch's {name}")
     patterns = []
-    every_class = job.command == "loop" and getattr(job.options, "which", None) == "all"
+    output = COMMANDS[job.command].output
     for take in takes:
         if take.problem is not None:
             continue
@@ -143,11 +142,9 @@ def check_collisions(job: Job, takes: list[Take]) -> None:
         if job.suffix:
             target = take.output(job.outdir, job.suffix)
             claim(target, f"the output of {rel}")
-            if every_class:  # <stem>.part<K>-<kind><suffix> (.class<K>), K unknown until the take runs
-                stem = os.path.normcase(str(target.with_suffix("")))
-                patterns.append((re.compile(re.escape(stem) + r"\.(class\d+|part\d+-[a-z-]+)"
-                                            + re.escape(os.path.normcase(job.suffix)) + r"\Z"),
-                                 f"the outputs of {rel} (--part all)"))
+            every = output.every_target(target, job.options)  # --part all: one file per part, parts unknown yet
+            if every is not None:
+                patterns.append((every, f"the outputs of {rel} (--part all)"))
     found = [(path, whats) for path, whats in claims.items() if len(whats) > 1]
     for pattern, what in patterns:
         found += [(path, [what, *whats]) for path, whats in claims.items() if pattern.match(path)]

@@ -167,6 +167,11 @@ def run(take, options: Options | None = None) -> Report:
     return rec.report("loop", facts, motions, cycles if everything else cycles[0], extras)
 
 
+#: every :func:`output_tag` of a loop with ``--part all``, as a regular expression (batch claims those names
+#: before any take has run, when the parts are not known yet)
+TAG_PATTERN = r"class\d+|part\d+-[a-z-]+"
+
+
 def output_tag(facts) -> str | None:
     """What a loop's output name adds before its suffix (``OUT.<tag>.bvh``), from its figures: ``None`` for the
     one loop (``role`` ``loop``), ``part1-walk-turning-left`` for a part, ``class0`` for a periodic motion of

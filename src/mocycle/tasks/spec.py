@@ -18,6 +18,8 @@ This module is light: it imports no task module (``mocycle --help`` lists the co
 from __future__ import annotations
 
 import importlib
+import os
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -49,6 +51,17 @@ class Output:
     help: str = ""
     required: bool = True
     loop: bool = False
+
+    def every_target(self, path: Path, options) -> re.Pattern | None:
+        """For a loop with ``--part all`` (``options.which == "all"``), the names its files may have beside
+        ``path`` (``OUT.part<k>-<kind>.bvh``, ``OUT.class<k>.bvh``: :data:`mocycle.tasks.loop.TAG_PATTERN`),
+        as one pattern on the normalised path; ``None`` when the output is the one file ``path``."""
+        if not (self.loop and getattr(options, "which", None) == "all"):
+            return None
+        from .loop import TAG_PATTERN
+
+        stem = os.path.normcase(str(path.with_suffix("")))
+        return re.compile(re.escape(stem) + rf"\.({TAG_PATTERN})" + re.escape(os.path.normcase(path.suffix)) + r"\Z")
 
     def targets(self, report, path: Path) -> dict[str, Path]:
         """The report's things this output writes, by role, and where: ``{role: path}``; for a loop, one file
