@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line, write_motion
+from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line
 
 PLOT_HELP = "Write a PNG: the most moving joint curves of the blend and of the inputs' cycles, phase-aligned."
 
@@ -17,7 +17,7 @@ PLOT_HELP = "Write a PNG: the most moving joint curves of the blend and of the i
 def blend(
     paths: Annotated[list[Path], typer.Argument(help="Two or more .bvh (or .amc) takes on one skeleton.")],
     plot: Annotated[Path | None, typer.Option(help=PLOT_HELP)] = None,
-    *, options, output, as_json, force, closing_frame, gltf_scale, gltf_up,
+    *, options, output, as_json, force, write,
 ):
     """Blend the cycles of several takes into one new loop (paper 001 §4.5: a convex combination).
 
@@ -29,7 +29,7 @@ def blend(
     check_output(plot, paths, force, ".png", "--plot")
     report = tasks.blend.run(paths, options)
     print_warnings(report)
-    written = write_motion(report, "loop", output, gltf_scale, gltf_up, closing_frame)
+    written = write(report)["loop"][1]
     result = report.result
     if plot is not None:
         import numpy as np
@@ -75,7 +75,7 @@ def transition(
     second: Annotated[Path, typer.Argument(help="The take to end as, on the same skeleton.")],
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves over the transition's phase, and the weight.")] = None,
-    *, options, output, as_json, force, gltf_scale, gltf_up,
+    *, options, output, as_json, force, write,
 ):
     """A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, a homotopy).
 
@@ -86,7 +86,7 @@ def transition(
     check_output(plot, [first, second], force, ".png", "--plot")
     report = tasks.transition.run([first, second], options)
     print_warnings(report)
-    write_motion(report, "transition", output, gltf_scale, gltf_up)
+    write(report)
     if plot is not None:
         from ..viz import plot_curves
 

@@ -266,7 +266,42 @@ def cli_type(f: dataclasses.Field) -> object:
 
 
 #: what :func:`task_command` hands a command besides its own parameters (keyword-only in its signature)
-GIVEN = ("options", "as_json", "force", "gltf_scale", "gltf_up", "closing_frame")
+GIVEN = ("options", "as_json", "force", "gltf_scale", "gltf_up", "closing_frame", "write")
+
+
+@dataclasses.dataclass(frozen=True)
+class Writer:
+    """Writes a report's outputs where the command line put them, as the task's spec declares them (what
+    :func:`task_command` gives a command as ``write``): ``write(report)`` writes the ``--output`` one,
+    ``write(report, "--playback")`` another; each returns ``{role: (path, what was written)}``."""
+
+    outputs: tuple  # the spec's Output declarations
+    paths: Mapping[str, Path | None]  # flag -> the path given
+    gltf_scale: str = "auto"
+    gltf_up: str = "auto"
+    closing_frame: bool | None = None
+
+    def __call__(self, report, flag: str = "--output") -> dict[str, tuple[Path, object]]:
+        output = next(o for o in self.outputs if o.flag == flag)
+        path = self.paths.get(flag)
+        if path is None:
+            return {}
+        if output.writes == "motion":
+            return {role: (target, write_motion(report, role, target, self.gltf_scale, self.gltf_up,
+                                                self.closing_frame if output.loop else None))
+                    for role, target in output.targets(report, path).items()}
+        thing = report.result
+        if output.writes == "compressed":
+            thing.save(path)
+        elif path.suffix.lower() == ".json":  # swings: the JSON document or the compact file
+            from ..io.swings_json import swings_document
+
+            write_text(path, json_text(swings_document(thing), indent=1), "swings")
+        else:
+            from ..swings import encode
+
+            write_text(path, encode(thing), "swings file")
+        return {output.role: (path, thing)}
 
 
 def _parameter(name: str, annotation, default=inspect.Parameter.empty) -> inspect.Parameter:
@@ -282,7 +317,8 @@ def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[st
     ``--json``, ``--force`` (when the Options have none) and, for a task that writes motion, ``--gltf-scale``,
     ``--gltf-up`` and for a loop ``--closing-frame``. The function's keyword-only parameters name what of
     these it wants (:data:`GIVEN`, and its outputs by flag: ``output``, ``playback``): ``options`` is the
-    task's Options, checked; ``force`` the Options' own when they have one. ``into``: the typer app
+    task's Options, checked; ``force`` the Options' own when they have one; ``write`` a :class:`Writer` that
+    writes the report's outputs as the spec declares them. ``into``: the typer app
     (``mocycle``'s by default)."""
     spec = SPECS[name]
 
@@ -328,7 +364,9 @@ def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[st
                     check_motion_output(path, inputs, force, o.flag, kwargs["gltf_scale"], kwargs["gltf_up"])
                 else:
                     check_output(path, inputs, force, o.suffixes, o.flag)
-            given = {"options": options, "force": force, **kwargs}
+            write = Writer(spec.outputs, {o.flag: kwargs.get(o.flag[2:]) for o in spec.outputs},
+                           kwargs.get("gltf_scale", "auto"), kwargs.get("gltf_up", "auto"), kwargs.get("closing_frame"))
+            given = {"options": options, "force": force, "write": write, **kwargs}
             return func(**{k: v for k, v in given.items() if k in own})
 
         command.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]

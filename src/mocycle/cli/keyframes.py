@@ -8,13 +8,13 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line, write_motion
+from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line
 
 
 @task_command("compress")
 def compress(
     path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
-    *, options, output, as_json,
+    *, options, output, as_json, write,
 ):
     """Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error and size.
 
@@ -23,7 +23,7 @@ def compress(
     """
     report = tasks.compress.run(path, options)
     print_warnings(report)
-    report.result.save(output)
+    write(report)
     r = report.facts
     facts = {k: r[k] for k in ("frames", "keyframes", "ratio", "period_frames", "keys_per_period", "keyframes_set_by",
                                "error_per_frame_per_joint", "compressed_bytes", "bvh_bytes")}
@@ -54,12 +54,12 @@ def compress(
 @task_command("decompress")
 def decompress(
     path: Annotated[Path, typer.Argument(help="A .mck file written by 'mocycle compress'.")],
-    *, options, output, as_json, gltf_scale, gltf_up,
+    *, options, output, as_json, write,
 ):
     """Rebuild a take from its keyframes; the keyframes come back exactly (unless --feet lock)."""
     report = tasks.decompress.run(path, options)
     print_warnings(report)
-    write_motion(report, "motion", output, gltf_scale, gltf_up)
+    write(report)
     r = report.facts
     if as_json:
         print_json({**r, "seconds": report.seconds})

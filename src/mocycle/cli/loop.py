@@ -10,7 +10,7 @@ import typer
 from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 from ..tasks.loop import METRIC_LABELS
-from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line, write_motion
+from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line
 
 
 @task_command("loop", which=("--parts", "--class"))
@@ -22,7 +22,7 @@ def loop(
     feet_plot: Annotated[Path | None, typer.Option(
         help="Write a PNG of the contacts: each ankle and toe's height and speed over two cycles, before (dashed) "
              "and after locking (with --class all: OUT.classK.png).")] = None,
-    *, options, output, as_json, force, closing_frame, gltf_scale, gltf_up,
+    *, options, as_json, force, write,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH or glTF.
 
@@ -48,12 +48,12 @@ def loop(
         raise MocycleError("--feet-plot needs locked feet (--feet lock, or auto with --root motion)")
     print_warnings(report)
     cycles_made = report.result if everything else [report.result]
+    files = write(report)  # every cycle was made and checked before writing; one file per loop (OUT.part<k>-...)
     shown = []
-    for facts, cycle in zip(loops, cycles_made, strict=True):  # every cycle was made and checked before writing
+    for facts, cycle in zip(loops, cycles_made, strict=True):
         role = facts["role"]
         tag = tasks.loop.output_tag(facts)
-        target = tasks.loop.output_path(output, facts)
-        written = write_motion(report, role, target, gltf_scale, gltf_up, closing_frame)
+        target, written = files[role]
         closing = report.motions[role].n_frames != written.n_frames
         images = []
         if feet_plot is not None:

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line, write_motion
+from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line
 
 
 @task_command("stretch")
@@ -16,7 +16,7 @@ def stretch(
     path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: the most moving joint curves of the input and the stretched take in seconds.")] = None,
-    *, options, output, as_json, force, gltf_scale, gltf_up,
+    *, options, output, as_json, force, write,
 ):
     """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.
 
@@ -31,7 +31,7 @@ def stretch(
     check_output(plot, [path], force, ".png", "--plot")
     report = tasks.stretch.run(path, options)
     print_warnings(report)
-    write_motion(report, "stretched", output, gltf_scale, gltf_up)
+    write(report)
     if plot is not None:
         from ..viz import plot_curves
 

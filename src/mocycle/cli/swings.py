@@ -11,14 +11,11 @@ from .. import tasks
 from .common import (
     check_output,
     escape,
-    json_text,
     out,
     print_json,
     print_warnings,
     task_command,
     timing_line,
-    write_motion,
-    write_text,
 )
 
 _FACT_KEYS = ("joints", "n_swings", "segmentation_error", "per_angle_error_deg", "geodesic_error_deg",
@@ -32,7 +29,7 @@ def swings(
     plot: Annotated[Path | None, typer.Option(
         help="Write a PNG: one row per joint, swings as numbered bars in time (the numbers edit --swing takes).")]
     = None,
-    *, options, output, playback, as_json, force, gltf_scale, gltf_up,
+    *, options, output, playback, as_json, force, write,
 ):
     """Segment a take into joint swings and holds; report playback error and compressed size.
 
@@ -43,17 +40,9 @@ def swings(
     print_warnings(report)
     seg, r = report.result, report.facts
     written = []
-    if output is not None:
-        from ..io.swings_json import swings_document
-        from ..swings import encode
-
-        if output.suffix.lower() == ".json":
-            write_text(output, json_text(swings_document(seg), indent=1), "swings")
-        else:
-            write_text(output, encode(seg), "swings file")
+    if write(report):
         written.append(f"{output} ({seg.n_swings} swings)")
-    if playback is not None:
-        write_motion(report, "playback", playback, gltf_scale, gltf_up)
+    if write(report, "--playback"):
         written.append(f"{playback} (motion rebuilt from the swings)")
     if plot is not None:
         from ..viz.swings import plot_swings
@@ -116,12 +105,12 @@ def search(
 @task_command("edit")
 def edit(
     path: Annotated[Path, typer.Argument(help="A motion file (.bvh, .fbx, .glb, .gltf or .amc).")],
-    *, options, output, as_json, gltf_scale, gltf_up,
+    *, options, output, as_json, write,
 ):
     """Scale the angle or the duration of one swing of one joint and write the edited motion."""
     report = tasks.edit.run(path, options)
     print_warnings(report)
-    write_motion(report, "edited", output, gltf_scale, gltf_up)
+    write(report)
     r = report.facts
     if as_json:
         print_json({**r, "output": str(output), "seconds": report.seconds})
