@@ -66,6 +66,33 @@ def test_a_new_option_reaches_the_cli(knob, tmp_path):
     assert wrong.exit_code == 1 and ".bvh or .glb" in wrong.output  # the spec's suffixes, before any work
 
 
+def test_a_new_output_reaches_the_cli(monkeypatch, tmp_path):
+    """An output added to a spec is a CLI option, checked before any work and written by ``write``."""
+    from mocycle.datasets import synthetic_walk
+    from mocycle.io import read_bvh, write
+    from mocycle.tasks.spec import Output
+
+    extra = Output("input", "motion", (".bvh", ".glb"), flag="--input-copy", required=False, help="The take read.")
+    monkeypatch.setitem(SPECS, "stretch", dataclasses.replace(SPECS["stretch"],
+                                                              outputs=(*SPECS["stretch"].outputs, extra)))
+    app = typer.Typer()
+
+    @task_command("stretch", into=app)
+    def stretch(path: Annotated[Path, typer.Argument()], *, options, write):
+        """Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down."""
+        report = tasks.stretch.run(path, options)
+        write(report)
+        write(report, "--input-copy")
+
+    take = write(synthetic_walk(n_frames=180).motion, tmp_path / "walk.bvh")
+    args = [str(take), "--factor", "1.5", "-o", str(tmp_path / "long.bvh")]
+    wrong = CliRunner().invoke(app, [*args, "--input-copy", str(tmp_path / "copy.txt")])
+    assert wrong.exit_code == 1 and "--input-copy" in wrong.output and not (tmp_path / "long.bvh").exists()
+    result = CliRunner().invoke(app, [*args, "--input-copy", str(tmp_path / "copy.bvh")])
+    assert result.exit_code == 0, result.output
+    assert read_bvh(tmp_path / "copy.bvh").n_frames == 180 and read_bvh(tmp_path / "long.bvh").n_frames == 270
+
+
 def test_a_new_option_reaches_batch(knob):
     assert "--extra-knob" in {o for p in options_parser("loop").params for o in p.opts}
     command, inputs, options = parse_command_line(["loop", "a.bvh", "--extra-knob", "4"])

@@ -328,7 +328,7 @@ def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[st
             raise TypeError(f"{name}: the help begins {summary!r}, the spec says {spec.summary!r}")
         own = inspect.signature(func, eval_str=True).parameters
         wanted = [p.name for p in own.values() if p.kind is inspect.Parameter.KEYWORD_ONLY]
-        unknown = set(wanted) - {*GIVEN, *(o.flag[2:] for o in spec.outputs)}
+        unknown = set(wanted) - {*GIVEN, *(_name(o.flag) for o in spec.outputs)}
         if unknown:
             raise TypeError(f"{func.__name__}: keyword-only parameters {sorted(unknown)} are not given by "
                             f"task_command")
@@ -337,7 +337,7 @@ def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[st
         fields = dataclasses.fields(options_cls)
         for o in spec.outputs:
             decls = (o.flag, "-o") if o.flag == "--output" else (o.flag,)
-            params.append(_parameter(o.flag[2:], Annotated[Path if o.required else Path | None,
+            params.append(_parameter(_name(o.flag), Annotated[Path if o.required else Path | None,
                                                            typer.Option(*decls, help=o.help)],
                                      inspect.Parameter.empty if o.required else None))
         params += [_parameter(f.name, Annotated[cli_type(f), flag(options_cls, f.name, *aliases.get(f.name, ()))],
@@ -359,12 +359,12 @@ def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[st
             force = kwargs.get("force", False) if own_force else options.force
             inputs = [v for key in spec.inputs for v in _listed(kwargs.get(key.lstrip("*")))]
             for o in spec.outputs:
-                path = kwargs.get(o.flag[2:])
+                path = kwargs.get(_name(o.flag))
                 if o.writes == "motion":
                     check_motion_output(path, inputs, force, o.flag, kwargs["gltf_scale"], kwargs["gltf_up"])
                 else:
                     check_output(path, inputs, force, o.suffixes, o.flag)
-            write = Writer(spec.outputs, {o.flag: kwargs.get(o.flag[2:]) for o in spec.outputs},
+            write = Writer(spec.outputs, {o.flag: kwargs.get(_name(o.flag)) for o in spec.outputs},
                            kwargs.get("gltf_scale", "auto"), kwargs.get("gltf_up", "auto"), kwargs.get("closing_frame"))
             given = {"options": options, "force": force, "write": write, **kwargs}
             return func(**{k: v for k, v in given.items() if k in own})
@@ -375,6 +375,11 @@ def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[st
         return (into or app).command(name)(friendly(command))
 
     return decorate
+
+
+def _name(flag: str) -> str:
+    """The parameter a flag fills (``--input-copy`` -> ``input_copy``)."""
+    return flag.lstrip("-").replace("-", "_")
 
 
 def _listed(value) -> list:
