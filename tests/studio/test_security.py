@@ -230,6 +230,7 @@ def test_strokes_are_evicted_least_recently_used_and_a_gone_one_is_410(hostile, 
         assert 1 <= len(s) < 6 and s.bytes <= budget
 
 
+@pytest.mark.slow  # 18 s of load: make test runs it, make check does not
 def test_sixty_jobs_and_strokes_keep_what_is_held_bounded(hostile, walk):
     """A studio under load: 60 loop jobs and 60 strokes; what it holds stays at its limits."""
     limits = Limits(max_jobs_kept=5, max_strokes=5)
