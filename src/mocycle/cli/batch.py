@@ -15,7 +15,7 @@ import click
 import typer
 
 from ..errors import MocycleError
-from ..tasks.options import MISSING, Flag, flag_of
+from ..tasks.options import MISSING, Flag, flag_declaration
 from ..tasks.spec import SPECS
 from .common import EXIT_USAGE, app, err, escape, friendly, out, print_json
 
@@ -28,12 +28,11 @@ def options_parser(command: str) -> click.Command:
     its help; on/off fields as flags, ``--no-X`` for the ones on by default)."""
     params: list[click.Parameter] = [click.Argument(["inputs"], nargs=-1)]
     for f in dataclasses.fields(SPECS[command].options):
-        name = flag_of(f)
+        decls, help = [flag_declaration(f), f.name], f.metadata["help"]
         if isinstance(f.metadata.get("check"), Flag):
-            decl = f"{name}/--no-{name[2:]}" if f.default is True else name
-            params.append(click.Option([decl, f.name], is_flag=True, default=f.default, help=f.metadata["help"]))
+            params.append(click.Option(decls, is_flag=True, default=f.default, help=help))
         else:
-            params.append(click.Option([name, f.name], required=f.default is MISSING, help=f.metadata["help"]))
+            params.append(click.Option(decls, required=f.default is MISSING, help=help))
     return click.Command(f"mocycle batch {command}", params=params, add_help_option=False)
 
 

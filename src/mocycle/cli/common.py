@@ -22,7 +22,7 @@ from typer.core import TyperCommand, TyperGroup
 
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
-from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_of
+from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_declaration, flag_of
 from ..tasks.spec import MOTION_SUFFIXES, SPECS
 from ..text import json_text, printable
 
@@ -236,9 +236,7 @@ def _field(options_cls, name: str) -> dataclasses.Field:
 def flag(options_cls, name: str, *short: str, **kwargs) -> typer.models.OptionInfo:
     """The typer option of an Options field: its flag (plus short names) and its help line."""
     f = _field(options_cls, name)
-    names = flag_of(f)
-    if f.default is True:  # a flag that is on by default also gets its --no- form
-        names = f"{names}/--no-{names[2:]}"
+    names = flag_declaration(f)
     check = f.metadata.get("check")
     if isinstance(check, Choice) and "metavar" not in kwargs:  # --method <harmonic|centroid|cut>
         kwargs["metavar"] = f"<{'|'.join(check.choices)}>"
@@ -464,8 +462,6 @@ def write_text(path: Path, text: str | bytes, what: str = "file") -> Path:
 
 
 # ------------------------------------------------------------ motion outputs (.bvh or .glb)
-#: the files a command that writes motion writes (the task specs')
-MOTION_OUTPUTS = MOTION_SUFFIXES
 GLTF_SCALE = typer.Option(
     "--gltf-scale", metavar="<auto|m|cm|mm|in|cmu|METRES>",
     help=".glb outputs: metres per motion unit, a unit name, or auto (the unit that makes the body about 1.7 m).")
@@ -484,7 +480,7 @@ def check_motion_output(path: Path | None, inputs=(), force: bool = False, optio
 
     from ..io.gltf import check_options
 
-    check_output(path, inputs, force, MOTION_OUTPUTS, option)
+    check_output(path, inputs, force, MOTION_SUFFIXES, option)
     check_options(gltf_scale, gltf_up)
     if path is not None and path.suffix.lower() == ".glb" and importlib.util.find_spec("pygltflib") is None:
         raise MocycleError(f"{path}: writing .glb files needs pygltflib: pip install 'mocycle[gltf]'")

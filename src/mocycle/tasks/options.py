@@ -166,6 +166,13 @@ def flag_of(f: dataclasses.Field) -> str:
     return f.metadata.get("flag") or "--" + f.name.replace("_", "-")
 
 
+def flag_declaration(f: dataclasses.Field) -> str:
+    """The CLI declaration of a field's flag: :func:`flag_of`, with its ``--no-`` form for an on/off field that
+    is on by default (``--align/--no-align``)."""
+    name = flag_of(f)
+    return f"{name}/--no-{name[2:]}" if f.default is True else name
+
+
 def _json_default(value):
     if isinstance(value, float) and not math.isfinite(value):
         return None
