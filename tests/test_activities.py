@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from mocycle import tasks
 from mocycle.activities import segment_activities, short_period
 from mocycle.cli import app
 from mocycle.datasets import (
@@ -81,7 +80,7 @@ def test_the_default_loop_is_one_part_and_says_which_and_why(tmp_path):
     chosen = facts["loops"][0]
     assert "the steady part with the most cycles" in facts["reason"] and chosen["part"] is not None
     assert chosen["period_frames"] == facts["period_frames"]  # the old flat figures are the chosen loop's
-    assert [p["kind"] for p in facts["parts"]] == ["walk straight", "walk turning left", "walk straight"]
+    assert [p["kind"] for p in facts["parts"] if p["loop"]] == ["walk straight", "walk turning left", "walk straight"]
     most = max(p["n_periods"] for p in facts["parts"])
     assert facts["parts"][chosen["part"]]["n_periods"] == most
 
@@ -150,22 +149,21 @@ def test_no_prime_lifting_the_class_falls_back_to_the_next_joints(monkeypatch):
 
 def test_a_loop_off_the_strides_or_the_takes_turn_is_refused():
     """The stride and turn checks: a cycle fitted at a wrong period (a phase that runs 30 % slow) fails both."""
+    from dataclasses import replace
+
     from mocycle.activities import line_periodic
     from mocycle.cycle import extract_cycle
-    from mocycle.phase.analysis import PhaseResult
-    from mocycle.tasks.loop import _activity_checks
+    from mocycle.cycle.parts import part_checks, part_phase
 
     take = synthetic_walk_turn_walk(turn_deg=90.0, seed=6)
     motion = take.motion
-    (_, b, c) = [s for s in take.segments if s[0].startswith("turning")][0]
-    piece = motion[b:c]
-    wrong = 1.3 * float(np.nanmedian(take.period_frames))
+    acts = segment_activities(motion)
+    k, right = [(k, p) for k, p in enumerate(acts.parts) if p.kind == "walk turning left"][0]
+    piece = motion[right.start:right.stop]
+    wrong = 1.3 * right.period_frames
     pm = line_periodic(np.arange(piece.n_frames) / wrong, wrong, motion.frame_time, "test", "legs", "a wrong period")
-    phase = PhaseResult(classes=[pm], barcode=np.zeros((0, 2)), reason="", autocorrelation_period_frames=np.nan,
-                        n_frames=piece.n_frames, frame_time=motion.frame_time)
-    cycle = extract_cycle(piece, phase=phase)
-    failed = {f.name for f in _activity_checks(piece, cycle, None, b)}
+    cycle = extract_cycle(piece, phase=part_phase(replace(right, periodic=pm, period_frames=wrong)))
+    failed = {f.name for f in part_checks(motion, acts, right, cycle)}
     assert "stride" in failed
-    right = [p for p in segment_activities(motion).parts if p.kind == "walk turning left"][0]
-    good = extract_cycle(motion[right.start:right.stop], phase=tasks.loop._part_phase(right))
-    assert _activity_checks(motion[right.start:right.stop], good, right, right.start) == []
+    good = extract_cycle(piece, phase=part_phase(right))
+    assert part_checks(motion, acts, right, good) == []

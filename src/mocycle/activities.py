@@ -32,15 +32,16 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from . import _validate
 from .axes import vertical_axis
 from .contacts import body_height, find_feet, up_axis
 from .contacts.detect import heights_and_speeds, local_floor
 from .contacts.feet import chain_joints, chain_positions
+from .defaults import MIN_PERIODS
 from .errors import MocycleError, NoPeriodicMotion
 from .features import HeadingFrame, pose_matrix
 from .motion import Motion
-from .phase import find_phase
-from .phase.analysis import PERIOD_AGREEMENT, PeriodicMotion
+from .phase.analysis import PERIOD_AGREEMENT, PeriodicMotion, PhaseResult, find_phase_every
 from .phase.period import autocorrelation_period, moving_average, repetition_distance
 from .rotations import mean_rotations, quat_angles
 
@@ -54,12 +55,22 @@ STEP_RATIO = 1.6
 UNLIKE = 0.5
 #: ... and a take of one step (two landings) must be more alike still, its evidence being the shorter.
 UNLIKE_ONE_STEP = 0.2
-#: A stride turning by more than this many degrees is a turning stride.
+#: The hips turning by more than this many degrees per stride (over one stride about a frame) are turning.
 TURN_DEG = 15.0
+#: A turn's core, the frames a turning part holds, turns at least this share of the turn's fastest rate; the
+#: frames of the turn slower than that (its start and end) are a transition of their own when they last a
+#: quarter of a stride or more, part of the straight walk beside them when less.
+TURN_CORE_SHARE = 0.5
 #: Consecutive strides whose periods differ by more than this share are different activities.
 TEMPO_CHANGE = 0.2
-#: Faster than this many body heights per second is a run (people switch from walking to running at about
-#: 2 m/s, 1.1-1.2 body heights per second).
+#: A stride whose feet are both off the floor for at least this share of its frames has a flight phase: a run.
+FLIGHT_SHARE = 0.05
+#: A stride with both feet on the floor for at least this share of its frames (and no flight) is a walk: walking
+#: keeps a foot down at every instant and both at each hand-over (double support; 20-55 % of a stride on the
+#: shared walks as the landings' heights see it, 0-8 % on their runs).
+DOUBLE_SUPPORT_SHARE = 0.12
+#: Where the feet cannot tell (neither flight nor double support), faster than this many body heights per second
+#: is a run (people switch from walking to running at about 2 m/s, 1.1-1.2 body heights per second).
 RUN_SPEED = 1.25
 #: Frames without gait shorter than this many seconds are transitions, not looked at for another motion.
 MIN_OTHER_S = 1.0
@@ -67,6 +78,9 @@ MIN_OTHER_S = 1.0
 MOVING_SHARE = 0.25
 #: The body stands when its joints' mean rotation spread is under this many degrees.
 STILL_DEG = 4.0
+#: A motion without gait (arms, the whole body) must be seen to repeat: at least this many periods, so that it is
+#: compared with itself a whole period later (a raised and lowered hand winds once, a wave many times).
+MIN_REPEATS = 2.0
 
 
 @dataclass(kw_only=True)
@@ -141,6 +155,8 @@ class Activities:
     frame_time: float
     feet: bool
     reason: str
+    #: the foot landings the parts were cut by (found once: the loop checks read them again), or None
+    landings: Landings | None = field(default=None, repr=False)
 
     def loopable(self) -> list[Activity]:
         return [p for p in self.parts if p.loop]
@@ -261,48 +277,140 @@ def _horizontal_path(motion: Motion) -> np.ndarray:
 
 
 def _stride_figures(chain, landings, heading, path, fps):
-    """Per stride of a chain (landing k to landing k+2, the same foot): period (frames), turn (deg), speed
-    (units/s)."""
+    """Per stride of a chain (landing k to landing k+2, the same foot) ``(n, 5)``: period (frames), turn (deg),
+    speed (units/s), flight and double support (the shares of its frames with no foot and with both feet on
+    the floor, :attr:`Landings.down`)."""
     f = landings.frames[chain]
     out = []
     for k in range(f.size - 2):
         a, b = int(f[k]), int(f[k + 2])
         speed = float(np.linalg.norm(path[b] - path[a])) * fps / (b - a)
-        out.append((float(b - a), float(heading[b] - heading[a]), speed))
+        down = landings.down[a:b]
+        out.append((float(b - a), float(heading[b] - heading[a]), speed, float(np.mean(down == 0)),
+                    float(np.mean(down >= 2))))
     return np.asarray(out)
 
 
-def _step_kinds(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
-    """Each step's kind and stride period: step i lies in strides i-1 and i (those that exist).
+def gait_of(flight: float, double: float, speed: float, body: float) -> str:
+    """``"walk"`` or ``"run"``, told by the feet: a flight phase (:data:`FLIGHT_SHARE`) is a run, double support
+    (:data:`DOUBLE_SUPPORT_SHARE`) a walk; only where the feet show neither does the speed decide
+    (:data:`RUN_SPEED` body heights per second)."""
+    if flight >= FLIGHT_SHARE:
+        return "run"
+    if double >= DOUBLE_SUPPORT_SHARE:
+        return "walk"
+    return "run" if speed > RUN_SPEED * body else "walk"
 
-    A step turns when its strides turn by more than :data:`TURN_DEG` (the core of a turn), or by more than
-    :data:`TURN_EDGE_DEG` the same way next to such steps (a turn's gentle start and end); a straight walk's
-    steps stay under both (on the shared walks 95 % under 6 degrees, all under 11)."""
-    n_steps = strides.shape[0] + 1
-    turns, periods, gaits = [], [], []
-    for i in range(n_steps):
+
+def _step_gaits(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
+    """Each step's gait (:func:`gait_of`) and stride period: step i lies in strides i-1 and i (those that
+    exist).  Which way a step turns is decided later, frame by frame (:func:`_turn_runs`)."""
+    out = []
+    for i in range(strides.shape[0] + 1):
         rows = strides[max(0, i - 1): i + 1]
-        periods.append(float(rows[:, 0].mean()))
-        turns.append(float(rows[:, 1].mean()))
-        gaits.append("run" if rows[:, 2].mean() > RUN_SPEED * body else "walk")
-    way = [0 if abs(t) <= TURN_DEG else int(np.sign(t)) for t in turns]
-    grown = True
-    while grown:  # a turn's edges: neighbours turning the same way by more than TURN_EDGE_DEG
-        grown = False
-        for i in range(n_steps):
-            if way[i] == 0 and abs(turns[i]) > TURN_EDGE_DEG:
-                sign = int(np.sign(turns[i]))
-                if (i > 0 and way[i - 1] == sign) or (i + 1 < n_steps and way[i + 1] == sign):
-                    way[i], grown = sign, True
-    names = {0: "straight", 1: "turning left", -1: "turning right"}
-    return [(f"{g} {names[w]}", p) for g, w, p in zip(gaits, way, periods, strict=True)]
+        out.append((gait_of(rows[:, 3].mean(), rows[:, 4].mean(), rows[:, 2].mean(), body), float(rows[:, 0].mean())))
+    return out
 
 
-def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activities:
+def stride_rate(heading: np.ndarray, period: float, start: int, stop: int) -> np.ndarray:
+    """The hips' turning rate ``(stop - start,)`` in degrees per stride: the heading's change over one stride
+    (``period`` frames) about each frame, where the hips' sway within a stride cancels; near the take's ends the
+    stride is the first or last one inside it."""
+    T = heading.size
+    span = min(max(2, int(round(period))), T - 1)
+    t = np.arange(start, stop)
+    lo = np.clip(t - span // 2, 0, T - 1 - span)
+    return (heading[lo + span] - heading[lo]) * (period / span)
+
+
+def _turn_runs(rate: np.ndarray, period: float, least: float) -> list[tuple[int, int, int]]:
+    """A gait part's frames as runs ``(start, stop, way)`` by the hips' turning rate ``rate`` (deg per stride):
+    ``way`` 0 straight (under :data:`TURN_DEG`), +1 / -1 a turn's core to the left / right (at least
+    :data:`TURN_CORE_SHARE` of that turn's fastest rate), 2 a turn's slow start or end (a transition).  A core
+    shorter than ``least`` frames (the cycles a loop needs) grows into its turn's slower frames, evenly on both
+    sides, as far as they turn by more than :data:`TURN_DEG`: a sharp turn of a stride and a half is still a
+    turn to loop.  Runs shorter than a quarter of a stride take the way of their longer neighbour."""
+    n = rate.size
+    way = np.where(np.abs(rate) >= TURN_DEG, np.sign(rate), 0).astype(np.int8)
+    label = np.zeros(n, dtype=np.int8)
+    for a, b, w in _value_runs(way):
+        if w == 0:
+            continue
+        r = np.abs(rate[a:b])
+        core = np.flatnonzero(r >= max(TURN_DEG, TURN_CORE_SHARE * float(r.max())))
+        c0, c1 = a + int(core[0]), a + int(core[-1]) + 1
+        while c1 - c0 < least and (c0 > a or c1 < b):  # the slower side first: the core stays centred
+            if c0 > a and (c1 >= b or abs(rate[c0 - 1]) >= abs(rate[c1])):
+                c0 -= 1
+            else:
+                c1 += 1
+        label[a:b] = 2
+        label[c0:c1] = w
+    short = max(1, int(round(period / 4)))
+    runs = _value_runs(label)
+    while len(runs) > 1:
+        k = min(range(len(runs)), key=lambda i: runs[i][1] - runs[i][0])
+        a, b, _ = runs[k]
+        if b - a >= short:
+            break
+        nbrs = [runs[i] for i in (k - 1, k + 1) if 0 <= i < len(runs)]
+        label[a:b] = max(nbrs, key=lambda r: r[1] - r[0])[2]
+        runs = _value_runs(label)
+    return runs
+
+
+def _value_runs(values: np.ndarray) -> list[tuple[int, int, int]]:
+    """Runs ``(start, stop, value)`` of equal values of an integer array, in order."""
+    values = np.asarray(values)
+    if values.size == 0:
+        return []
+    edges = np.flatnonzero(values[1:] != values[:-1]) + 1
+    starts = np.concatenate([[0], edges])
+    stops = np.concatenate([edges, [values.size]])
+    return [(int(a), int(b), int(values[a])) for a, b in zip(starts, stops, strict=True)]
+
+
+#: A turn's core grows to at least this many strides when the turn lasts that long (:func:`_turn_runs`): the
+#: default ``min_periods`` (1.2) with room for a stride phase fitted a little longer than the landings say.
+TURN_LEAST = 1.3
+
+
+def _split_turns(part: Activity, heading: np.ndarray, path: np.ndarray, fps: float) -> list[Activity]:
+    """A gait part (``kind`` ``"walk"`` or ``"run"``) cut where the hips start and stop turning
+    (:func:`_turn_runs`): straight parts, turning parts that hold the turn's core only, and the turn's slow
+    start and end as transitions."""
+    gait = part.kind
+    names = {0: f"{gait} straight", 1: f"{gait} turning left", -1: f"{gait} turning right", 2: "transition"}
+    runs = _turn_runs(stride_rate(heading, part.period_frames, part.start, part.stop), part.period_frames,
+                      np.ceil(TURN_LEAST * part.period_frames))
+    out = []
+    for k, (a, b, way) in enumerate(runs):
+        a, b = part.start + a, part.start + b
+        own = {side: [f for f in frames if a <= f < b] for side, frames in part.landings.items()}
+        reason = ""
+        if way == 2:
+            when = "start" if k + 1 < len(runs) and runs[k + 1][2] in (1, -1) else "end"
+            reason = f"the turn's {when}: the hips turn slower than {TURN_CORE_SHARE:.0%} of the turn's fastest"
+        out.append(Activity(start=a, stop=b, kind=names[way], limbs="legs" if way != 2 else "none",
+                            period_frames=part.period_frames,
+                            speed=float(np.linalg.norm(path[b - 1] - path[a])) * fps / max(b - 1 - a, 1),
+                            turn_deg=float(heading[b - 1] - heading[a]),
+                            landings={side: v for side, v in own.items() if v}, reason=reason))
+    return out
+
+
+def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, joints=None, step: int = 1,
+                       **phase_options) -> Activities:
     """Cut ``motion`` into steady parts (module notes); ``min_periods``: cycles a part needs to be looped.
 
-    Without feet found by name the whole take is one part of kind ``"periodic"`` on every joint (the phase
-    decides).
+    ``joints``, ``step`` and ``phase_options`` (``classes``, ``pca``, ``delay``, ``n_landmarks``) are
+    :func:`~mocycle.phase.find_phase`'s, used inside the parts without gait (``joints``: the joints those parts'
+    periodic motion is found on, instead of the moving arm joints or the whole body; ``step``: the phase found
+    on every ``step``-th frame).  Gait parts take their phase from the landings, or, when ``joints`` are given,
+    from the cohomology of those joints inside the part.  Without feet found by name, the whole take is looked
+    at as frames without gait (arms, then the whole body, region by region).  Every part that loops (``loop``)
+    holds at least ``min_periods`` cycles of its own ``periodic`` phase, and a part without gait at least
+    :data:`MIN_REPEATS`.
 
     Examples
     --------
@@ -312,16 +420,24 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activitie
     [('walk straight', 0, 300, 60)]
     """
     T, fps = motion.n_frames, motion.fps
+    min_periods = _validate.real("min_periods", min_periods, 1.0)
+    if joints is not None:
+        motion.skeleton.select(joints)  # a joint the rig lacks is the caller's mistake: said once, here
+    options = {"joints": joints, "step": step, **phase_options}
     landings = find_landings(motion)
     if landings is None:
-        whole = Activity(start=0, stop=T, kind="periodic", limbs="all", loop=True,
-                         reason="the rig's feet were not found by name: the whole take is one part")
-        return Activities(parts=[whole], n_frames=T, frame_time=motion.frame_time, feet=False, reason=whole.reason)
+        parts = _other(motion, 0, T, min_periods, False, options)
+        _decide(parts, min_periods)
+        return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=False,
+                          reason="the rig's feet were not found by name: the take is looked at without gait; "
+                                 + _listing(parts), landings=None)
     heading = heading_degrees(motion)
     path = _horizontal_path(motion)
     body = _body_height(motion)
     parts: list[Activity] = []
+    stepped = []  # the landings of the gait chains: a stride phase is a line through these only
     for chain in _gait_chains(landings, fps, least=2):
+        stepped.append(chain)
         a, b = int(landings.frames[chain[0]]), int(landings.frames[chain[-1]])
         if _legs_still(motion.skeleton, _rotation_spread(motion[a:b + 1])):
             continue  # contacts that flicker while the legs stand are no steps
@@ -331,7 +447,7 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activitie
                 parts.append(short)
             continue
         strides = _stride_figures(chain, landings, heading, path, fps)
-        kinds = _step_kinds(strides, body)
+        kinds = _step_gaits(strides, body)
         f = landings.frames[chain]
         i = 0
         while i < len(kinds):
@@ -346,38 +462,98 @@ def segment_activities(motion: Motion, *, min_periods: float = 1.2) -> Activitie
     parts = [p for p in parts if _legs_repeat_in(motion, p)]
     parts.sort(key=lambda p: p.start)
     _reach(parts, landings, T)
-    _turn_borders(parts, heading)
-    parts = _fill(motion, parts, landings, min_periods)
+    parts = [q for p in parts for q in (_split_turns(p, heading, path, fps) if " " not in p.kind else [p])]
+    parts = _fill(motion, parts, landings, min_periods, options)
+    keep = np.sort(np.concatenate(stepped)) if stepped else np.zeros(0, dtype=np.intp)
+    steps = Landings(landings.frames[keep], landings.foot[keep], landings.sides, landings.down)
     for p in parts:
-        if p.gait:
-            p.loop = bool(p.n_periods >= min_periods)
-            if p.loop and sum(map(len, p.landings.values())) < 3:  # one step: the legs' self-similarity
-                x = (np.arange(p.start, p.stop) - p.start) / p.period_frames
-                p.periodic = line_periodic(x, p.period_frames, motion.frame_time, "legs self-similarity", "legs",
-                                           f"the legs' self-similarity: the take holds one step, its legs are "
-                                           f"most alike {p.period_frames:.2f} frames apart")
-            elif p.loop:
-                x, period = stride_phase(p, landings.frames, landings.foot, p.start, p.stop)
-                legs, why = legs_check(motion, p.start, p.stop, period)
-                n = sum(map(len, p.landings.values()))
-                if np.isfinite(legs):  # a landing seen early or late: the legs' own repeat decides the period
-                    x = (x - x[0]) * period / legs + x[0]
-                    p.periodic = line_periodic(x, legs, motion.frame_time, "legs self-similarity", "legs",
-                                               f"the legs' self-similarity: {why} (the {n} landings said "
-                                               f"{period:.2f})")
-                    p.period_frames = legs
-                else:
-                    p.periodic = line_periodic(x, period, motion.frame_time, "strides", "legs",
-                                               f"the strides: landings of each foot {period:.2f} frames apart "
-                                               f"(a line through {n} landings; {why})")
-                    p.period_frames = period
+        if p.gait and p.n_periods >= min_periods:
+            if joints is None:
+                _gait_phase(motion, p, steps)
             else:
-                p.reason = (f"{p.kind} for only {p.n_periods:.1f} stride(s): too short for a loop "
-                            f"(at least {min_periods:g} wanted)")
-                p.kind = "transition" if len(parts) > 1 else p.kind
+                _asked_phase(motion, p, min_periods, options)
+    _decide(parts, min_periods)
+    return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True, reason=_listing(parts),
+                      landings=landings)
+
+
+def _listing(parts: list[Activity]) -> str:
     kinds = ", ".join(f"{p.kind} {p.start}-{p.stop}" for p in parts)
-    return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True,
-                      reason=f"{len(parts)} part(s): {kinds}" if parts else "no part")
+    return f"{len(parts)} part(s): {kinds}" if parts else "no part"
+
+
+def _gait_phase(motion: Motion, p: Activity, landings: Landings) -> None:
+    """A gait part's phase (``periodic``) and period: a line through the landings of its steps (``landings``:
+    those of the gait chains, not a foot that comes down beside them; :func:`stride_phase`),
+    its period checked by the legs' self-similarity (:func:`legs_check`); for one step, the legs' own."""
+    try:
+        x, period = stride_phase(p, landings.frames, landings.foot, p.start, p.stop)
+    except MocycleError:  # fewer than three landings near: one step, the legs' self-similarity
+        x = (np.arange(p.start, p.stop) - p.start) / p.period_frames
+        p.periodic = line_periodic(x, p.period_frames, motion.frame_time, "legs self-similarity", "legs",
+                                   f"the legs' self-similarity: the part holds one step, its legs are most "
+                                   f"alike {p.period_frames:.2f} frames apart")
+        return
+    legs, why = legs_check(motion, p.start, p.stop, period)
+    step = p.period_frames / 2.0
+    n = int(np.count_nonzero((landings.frames >= p.start - step) & (landings.frames <= p.stop + step)))
+    if np.isfinite(legs):  # a landing seen early or late: the legs' own repeat decides the period
+        x = (x - x[0]) * period / legs + x[0]
+        p.periodic = line_periodic(x, legs, motion.frame_time, "legs self-similarity", "legs",
+                                   f"the legs' self-similarity: {why} (the {n} landings said {period:.2f})")
+        p.period_frames = legs
+    else:
+        p.periodic = line_periodic(x, period, motion.frame_time, "strides", "legs",
+                                   f"the strides: landings of each foot {period:.2f} frames apart (a line through "
+                                   f"{n} landings; {why})")
+        p.period_frames = period
+
+
+def _asked_phase(motion: Motion, p: Activity, min_periods: float, options: dict) -> None:
+    """A gait part's phase found as asked (``options["joints"]``): the cohomology of the part's frames on those
+    joints (:func:`~mocycle.phase.find_phase`), the periodic motion covering most of them; the loop checks then
+    hold it against the strides."""
+    options = dict(options)
+    step = int(options.pop("step", 1) or 1)
+    try:
+        found = find_phase_every(motion[p.start:p.stop], step, min_periods=min_periods, **options).classes
+    except MocycleError as exc:
+        found, why = [], str(exc)
+    else:
+        why = "no periodic motion found on the joints asked"
+    if not found:
+        p.periodic = None
+        p.reason = f"{p.kind}: {why}"
+        return
+    p.periodic = max(found, key=lambda c: len(c.frames()))  # on the part's frames; it winds in its excitation
+    p.period_frames = p.periodic.period_frames
+
+
+def _decide(parts: list[Activity], min_periods: float) -> None:
+    """Which parts loop, the same rule for every kind: a phase of its own, at least ``min_periods`` cycles of it
+    (:data:`MIN_REPEATS` without gait: seen to repeat) and so a period shorter than the part; the reason in
+    plain words for every part that does not."""
+    for p in parts:
+        if p.kind in ("gesture", "standing", "transition") and not p.gait:
+            p.loop = False
+            continue
+        least = min_periods if p.gait else max(min_periods, MIN_REPEATS)
+        n = p.n_periods
+        p.loop = bool(p.periodic is not None and np.isfinite(n) and n >= least)
+        if p.loop:
+            if p.gait:
+                p.reason = ""
+            continue
+        if p.gait:
+            if np.isfinite(n):
+                p.reason = (f"{p.kind} for only {n:.1f} stride(s): too short for a loop (at least {least:g} "
+                            f"wanted)")
+            p.kind = "transition" if len(parts) > 1 else p.kind
+        elif np.isfinite(n):
+            p.reason = (f"{p.kind}: only {n:.1f} periods of {p.period_frames:.1f} frames: it is not seen to repeat "
+                        f"(at least {least:g} wanted)")
+            p.kind = "gesture"
+        p.periodic = None
 
 
 def _gait_part(kind, f, chain, i, j, landings, strides, heading, path, fps) -> Activity:
@@ -407,7 +583,8 @@ def _one_step_part(motion: Motion, chain, landings: Landings, heading, path, bod
     turn = float(heading[hi - 1] - heading[lo])
     per_stride = turn / (hi - 1 - lo) * period
     way = "straight" if abs(per_stride) <= TURN_DEG else ("turning left" if per_stride > 0 else "turning right")
-    gait = "run" if speed > RUN_SPEED * body else "walk"
+    down = landings.down[lo:hi]
+    gait = gait_of(float(np.mean(down == 0)), float(np.mean(down >= 2)), speed, body)
     own = {}
     for k in chain:
         own.setdefault(landings.sides[landings.foot[k]], []).append(int(landings.frames[k]))
@@ -481,16 +658,16 @@ def legs_check(motion: Motion, start: int, stop: int, period: float) -> tuple[fl
                          f"{at:.2f} at the landings' {period:.2f})")
 
 
-def stride_reference(motion: Motion, landings: Landings, start: int, stop: int) -> tuple[float, int]:
-    """The stride period over frames ``start .. stop`` that a loop is checked against: the median stride of the
-    landings there, or the legs' own when they overrule it (:func:`legs_check`); and the number of strides
-    measured (0: NaN, no ruler)."""
+def stride_reference(motion: Motion, landings: Landings, start: int, stop: int) -> tuple[list[float], int]:
+    """The stride periods over frames ``start .. stop`` that a loop may be held to: the median stride of the
+    landings there, and the legs' own period when they overrule it (:func:`legs_check`: a landing seen early or
+    late); and the number of strides measured (0: no ruler, an empty list)."""
     strides = stride_periods(landings, motion.fps, start, stop)
     if not strides:
-        return float("nan"), 0
+        return [], 0
     median = float(np.median(strides))
     legs, _ = legs_check(motion, start, stop, median)
-    return (legs if np.isfinite(legs) else median), len(strides)
+    return [median] + ([legs] if np.isfinite(legs) else []), len(strides)
 
 
 def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[float, float]:
@@ -521,43 +698,6 @@ def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[f
     return best, float(d[i])
 
 
-def _turn_borders(parts: list[Activity], heading: np.ndarray) -> None:
-    """Move each border between a straight and a turning part of one gait to where the turn is half made: the
-    frame nearest the landing (within a stride) where the hips' turn over the stride centred on it crosses half
-    the turning part's largest.  A step is judged by the strides it lies in, which reach half a stride
-    beyond it, so a turning part found from its steps starts and ends about half a stride early and late; the
-    turn's half-way rate is where it begins and ends as a viewer sees it."""
-    T = heading.size
-    for a, b in zip(parts, parts[1:], strict=False):
-        if a.stop != b.start or not (a.gait and b.gait) or a.kind.split()[0] != b.kind.split()[0]:
-            continue
-        turning = [p for p in (a, b) if "turning" in p.kind]
-        if len(turning) != 1:
-            continue
-        turn = turning[0]
-        P = int(round(turn.period_frames))
-        half = P // 2
-        if P < 4 or turn.n_frames <= P:
-            continue
-        t = np.arange(half, T - half)
-        rate = np.full(T, np.nan)
-        rate[t] = heading[t + half] - heading[t - half]           # degrees per stride, centred on each frame
-        inside = np.abs(rate[turn.start:turn.stop])
-        if not np.isfinite(inside).any():
-            continue
-        level = 0.5 * np.nanmax(inside)
-        lo, hi = max(a.start + 1, b.start - P), min(b.stop - 1, b.start + P)
-        window = np.abs(rate[lo:hi + 1])
-        turning_side = window >= level
-        if not np.isfinite(window).all() or turning_side.all() or not turning_side.any():
-            continue
-        # the crossing nearest the landing, on the side of the straight part
-        flips = np.flatnonzero(turning_side[1:] != turning_side[:-1]) + lo + 1
-        border = int(flips[np.argmin(np.abs(flips - b.start))])
-        if a.start < border < b.stop and min(border - a.start, b.stop - border) >= half:
-            a.stop = b.start = border
-
-
 def _reach(parts: list[Activity], landings: Landings, T: int) -> None:
     """Let each gait part reach up to one step before its first and after its last landing (the take starts or
     ends mid-stride), short of its neighbours; a gap smaller than a step between two parts is split."""
@@ -575,25 +715,32 @@ def _reach(parts: list[Activity], landings: Landings, T: int) -> None:
             p.stop = int(np.ceil(p.stop + step))
 
 
-def _fill(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float) -> list[Activity]:
+def _fill(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float,
+          options: dict) -> list[Activity]:
     """The parts with the frames between them (and before the first, after the last) as parts of their own."""
     T = motion.n_frames
     out, at = [], 0
     for p in [*parts, None]:
         stop = T if p is None else p.start
         if stop > at:
-            out.extend(_other(motion, at, stop, min_periods, gait_near=bool(parts)))
+            out.extend(_other(motion, at, stop, min_periods, bool(parts), options))
         if p is not None:
             out.append(p)
             at = p.stop
     return out
 
 
-def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near: bool) -> list[Activity]:
+def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near: bool, options: dict,
+           when: str = "") -> list[Activity]:
     """Frames ``start .. stop-1`` without gait: an arms part, a periodic part, a gesture, standing or a short
-    transition between gait parts."""
+    transition between gait parts.  What lies before and after a repeating region is looked at again the same
+    way (a wave, then a dance step), so that every repeating motion without gait is a part of its own.
+    ``when``: ``"before"``/``"after"`` for the frames beside a repeating region."""
     n = stop - start
     if n < MIN_OTHER_S * motion.fps:
+        if when:
+            return [Activity(start=start, stop=stop, kind="gesture", limbs="none",
+                             reason=f"the movement {when} the repeating part: it happens once")]
         kind = "transition" if gait_near else "gesture"
         why = "between activities" if gait_near else "in the whole take"
         return [Activity(start=start, stop=stop, kind=kind, limbs="none",
@@ -603,7 +750,7 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
     if float(np.sort(spread)[-min(3, spread.size)]) < STILL_DEG:  # fewer than three joints move
         return [Activity(start=start, stop=stop, kind="standing", limbs="none",
                          reason="the actor stands: nothing moves enough to loop")]
-    found = _periodic_in(piece, spread, min_periods)
+    found = _periodic_in(piece, spread, min_periods, options)
     if found is not None:  # what repeats must move: noise while the actor stands still after a gesture does not
         a, b = found[3]
         if float(_rotation_spread(piece[a:b]).max()) < STILL_DEG:
@@ -615,18 +762,13 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
     limbs, kind, pm, (s, e) = found
     out = []
     if s > 0:
-        out.extend(_lead(motion, start, start + s, "before"))
+        out.extend(_other(motion, start, start + s, min_periods, gait_near, options, "before"))
     out.append(Activity(start=start + s, stop=start + e, kind=kind, limbs=limbs, period_frames=pm.period_frames,
                         loop=True, periodic=pm, legs_still=still,
-                        reason=f"{kind}: {pm.n_periods:.1f} periods of {pm.period_frames:.1f} frames"))
+                        reason=f"{kind}: {(e - s) / pm.period_frames:.1f} periods of {pm.period_frames:.1f} frames"))
     if e < n:
-        out.extend(_lead(motion, start + e, stop, "after"))
+        out.extend(_other(motion, start + e, stop, min_periods, gait_near, options, "after"))
     return out
-
-
-def _lead(motion, start, stop, when):
-    return [Activity(start=start, stop=stop, kind="gesture", limbs="none",
-                     reason=f"the movement {when} the repeating part: it happens once")]
 
 
 def _rotation_spread(motion: Motion) -> np.ndarray:
@@ -659,12 +801,12 @@ def _legs_still(skeleton, spread: np.ndarray) -> bool:
     return not legs or float(spread[legs].max()) < 2 * STILL_DEG
 
 
-def _repeating_region(piece: Motion, joints, min_periods: float) -> tuple[int, int, float] | None:
+def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, float] | None:
     """Where ``joints`` repeat in ``piece``: ``(start, stop, period)`` from the velocity of their rotations
     (a wave's hand swings back and forth while the arm's raise and fall happen once): the period by windowed
     autocorrelation (paper 004), the frames where the take is like itself one period later
     (:func:`~mocycle.phase.period.repetition_distance` under a half) and moves (at least a fifth of its
-    largest local speed), their longest run.  ``None`` when it holds fewer than ``min_periods`` periods."""
+    largest local speed), their longest run.  ``None`` when it holds fewer than ``least`` periods."""
 
     X, _ = pose_matrix(piece, rep="expmap", root="drop", joints=joints, normalize=False, weights=None)
     V = np.diff(X, axis=0)
@@ -684,7 +826,7 @@ def _repeating_region(piece: Motion, joints, min_periods: float) -> tuple[int, i
         return None
     s, e = max(runs, key=lambda r: r[1] - r[0])
     s, e = max(0, s - w // 2), min(piece.n_frames, e + 1 + w // 2)
-    if (e - s) < min_periods * P:
+    if (e - s) < least * P:
         return None
     return s, e, float(P)
 
@@ -695,25 +837,32 @@ def _true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
 
 
-def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float):
+def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float, options: dict):
     """``(limbs, kind, PeriodicMotion, (start, stop))`` of the motion repeating in ``piece`` (frames of the
     piece; the PeriodicMotion is on those frames): the arm joints that move first (a wave beside standing
-    legs), where they repeat, then the whole body; ``None`` when nothing repeats."""
-
-    moving = _moving_arm_joints(piece.skeleton, spread) if _legs_still(piece.skeleton, spread) else []
-    tries = [(moving, "arms")] if moving else []
-    tries.append((None, "periodic"))
+    legs), where they repeat, then the whole body (or the joints of ``options["joints"]``); ``None`` when nothing
+    repeats.  ``options``: :func:`~mocycle.phase.find_phase`'s, and ``step``."""
+    options = dict(options)
+    step = int(options.pop("step", 1) or 1)
+    chosen = options.pop("joints", None)
+    if chosen is not None:
+        tries = [(chosen, "periodic")]
+    else:
+        moving = _moving_arm_joints(piece.skeleton, spread) if _legs_still(piece.skeleton, spread) else []
+        tries = [(moving, "arms")] if moving else []
+        tries.append((None, "periodic"))
+    least = max(min_periods, MIN_REPEATS)
     for joints, kind in tries:
-        region = _repeating_region(piece, joints, min_periods)
+        region = _repeating_region(piece, joints, least)
         if region is None:
-            if joints is not None:
+            if joints is not None and chosen is None:
                 continue
-            region = (0, piece.n_frames, float("nan"))  # the whole body: the cohomology finds where it repeats
+            region = (0, piece.n_frames, float("nan"))  # the cohomology finds where it repeats
         s, e, acf = region
         sub = piece[s:e]
-        limbs = ",".join(joints) if joints else "all"
+        limbs = joints if isinstance(joints, str) else ",".join(joints) if joints else "all"
         try:
-            result = find_phase(sub, joints=joints, min_periods=min_periods)
+            result = find_phase_every(sub, step, joints=joints, min_periods=least, **options)
             classes = result.classes
         except (NoPeriodicMotion, MocycleError):
             classes = []
@@ -725,7 +874,7 @@ def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float):
         if not np.isfinite(acf) or joints is None:
             continue  # the whole body needs the cohomology's word; an arm that swings on its own, the autocorrelation's
         x = np.arange(e - s, dtype=np.float64) / acf
-        why = (f"the autocorrelation of the {'moving arm joints' if joints else 'body'}' velocities: "
+        why = (f"the autocorrelation of the {'moving arm joints' if kind == 'arms' else 'joints'}' velocities: "
                f"{acf:.2f} frames" + (f" (the cohomology's {', '.join(f'{c.period_frames:.2f}' for c in classes)} "
                                       f"disagree)" if classes else " (the cohomology found no class)"))
         return limbs, kind, line_periodic(x, acf, piece.frame_time, "autocorrelation", limbs, why), (s, e)
@@ -772,3 +921,44 @@ def stride_phase(part: Activity, landings_frames: np.ndarray, landings_foot: np.
         raise MocycleError(f"the landings of frames {start}-{stop} give no stride period")
     t = np.arange(start, stop, dtype=np.float64)
     return (t - t0) / P, float(P)
+
+
+# ------------------------------------------------------------------------------------------- what to say
+def nothing_to_loop(acts: Activities) -> str:
+    """Why nothing in the take loops, in plain words."""
+    if not acts.parts:
+        return "no repeating motion found in the take"
+    if len(acts.parts) == 1 and acts.parts[0].n_frames * acts.frame_time < MIN_OTHER_S:
+        return acts.parts[0].reason  # a take too short to be looked at: its part says so
+    kinds = {p.kind for p in acts.parts}
+    if kinds == {"standing"}:
+        return "no repeating motion: the actor stands still"
+    gait = [p for p in acts.parts if p.gait or p.landings]
+    if gait and not any(p.loop for p in acts.parts):
+        longest = max(gait, key=lambda p: p.n_periods if np.isfinite(p.n_periods) else 0.0)
+        return (f"no steady part repeats long enough to loop: the longest ({longest.kind or 'steps'}, frames "
+                f"{longest.start}-{longest.stop}) holds {longest.n_periods:.1f} strides")
+    if kinds <= {"gesture", "standing", "transition"}:
+        return "no repeating motion: the take does one gesture, it does not repeat"
+    return "no repeating motion found: the body moves, but nothing in it repeats"
+
+
+def parts_phase(acts: Activities) -> PhaseResult:
+    """The take's periodic motions as ``mocycle phase`` reports them: one per part that loops, its phase on the
+    take's frames (NaN outside the part) and its excitation in take frames: the same parts ``mocycle loop``
+    loops."""
+    T = acts.n_frames
+    classes = []
+    for p in acts.loopable():
+        pm = p.periodic
+        coords, unwrapped = np.full(T, np.nan), np.full(T, np.nan)
+        coords[p.start:p.stop], unwrapped[p.start:p.stop] = pm.coords, pm.unwrapped
+        classes.append(replace(pm, coords=coords, unwrapped=unwrapped,
+                               excitation=[(s + p.start, e + p.start) for s, e in pm.excitation],
+                               n_periods=float(p.n_periods)))
+    reason = _listing(acts.parts) if classes else nothing_to_loop(acts)
+    legs = [c.legs_period_frames for c in classes if np.isfinite(c.legs_period_frames)]
+    return PhaseResult(classes=classes, barcode=np.zeros((0, 2)), reason=reason,
+                       autocorrelation_period_frames=float("nan"), n_frames=T, frame_time=acts.frame_time,
+                       joints_used=", ".join(dict.fromkeys(c.joints_used for c in classes)) or "none",
+                       legs_period_frames=legs[0] if legs else float("nan"))

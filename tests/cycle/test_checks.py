@@ -9,7 +9,7 @@ from scipy.spatial.transform import Rotation
 from typer.testing import CliRunner
 
 import mocycle.cli.blend  # noqa: F401  (registers the commands)
-import mocycle.cycle.extract as extract_module
+import mocycle.phase.analysis as analysis
 from conftest import shared_path
 from mocycle.cli import app
 from mocycle.cycle import extract_cycle, loop_metrics
@@ -102,7 +102,7 @@ def test_a_jumping_seam_is_refused(walk):
 
 def test_loop_cli_refuses_with_exit_3_and_force_writes(tmp_path, walk, wrong_phase, monkeypatch):
     src = write(walk, tmp_path / "walk.bvh")
-    monkeypatch.setattr(extract_module, "find_phase", lambda *a, **k: wrong_phase)
+    monkeypatch.setattr(analysis, "find_phase", lambda *a, **k: wrong_phase)
     out = tmp_path / "cycle.bvh"
     # by default the walk's strides overrule the phase's period (issue 28): a loop at the strides' period
     result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--json"])
@@ -115,13 +115,13 @@ def test_loop_cli_refuses_with_exit_3_and_force_writes(tmp_path, walk, wrong_pha
     result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--force", "--json", "--joints", "legs"])
     assert result.exit_code == 0 and out.exists()
     assert "warning:" in result.output and "--force" in result.output
-    tr = runner.invoke(app, ["transition", str(src), str(src), "-o", str(tmp_path / "t.bvh")])
+    tr = runner.invoke(app, ["transition", str(src), str(src), "-o", str(tmp_path / "t.bvh"), "--joints", "legs"])
     assert tr.exit_code == 3 and "not a loop" in tr.output and not (tmp_path / "t.bvh").exists()
 
 
 def test_blend_refuses_a_take_whose_cycle_is_not_a_loop(walk, wrong_phase, monkeypatch):
     good = extract_cycle(walk)
-    monkeypatch.setattr(extract_module, "find_phase", lambda *a, **k: wrong_phase)
+    monkeypatch.setattr(analysis, "find_phase", lambda *a, **k: wrong_phase)
     with pytest.raises(LoopRefused, match="bad take: not a loop"):
         blend_cycles([good, walk], labels=["good", "bad take"])
     with pytest.warns(MocycleWarning, match="bad take: kept although"):

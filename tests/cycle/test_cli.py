@@ -48,13 +48,13 @@ def test_no_periodic_motion_exits_3_and_writes_nothing(tmp_path):
     as_json = runner.invoke(app, ["loop", str(src), "-o", str(out), "--json"])
     facts = json.loads(as_json.stdout)  # a refused take prints its JSON too: status, reason, the technical why
     assert as_json.exit_code == 3 and facts["status"] == "no-periodic-motion" and facts["loops"] == []
-    assert "H1 bar" in facts["detail"] and facts["parts"][0]["kind"] == "standing"
+    assert [p["kind"] for p in facts["parts"]] == ["standing"] and facts["not_looped"][0]["reason"]
 
 
 def test_bad_options_exit_2_with_one_message(tmp_path):
     src = _walk(tmp_path, 200)
-    cases = [  # a bad value exits 2 (usage); too many harmonics for this take is found on the take: 1
-        (["--harmonics", "80"], "K must be <=", 1),
+    cases = [  # a bad value exits 2 (usage); too many harmonics for the take's one part is that part's failure: 3
+        (["--harmonics", "80"], "K must be <=", 3),
         (["--harmonics", "many"], "--harmonics must be", 2),
         (["--model", "M7"], "--model must be one of", 2),
         (["--method", "spline"], "--method must be one of harmonic, centroid, cut", 2),
@@ -102,6 +102,7 @@ def test_loop_part_all_writes_one_file_per_part(tmp_path):
         assert f["joints_used"] == "legs" and f["period_source"] in f["period_candidates"]
     text = runner.invoke(app, ["loop", str(src), "-o", str(out), "--class", "1"])  # --class: the old name
     assert text.exit_code == 0 and "part 1 (run straight" in text.output and out.exists()
+    assert "--class is deprecated" in text.stderr and "--part" in text.stderr
     for bad in ("two", "-1", "9"):
         refused = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.bvh"), "--part", bad])
         assert refused.exit_code == 2 and "--part" in refused.stderr  # a bad option value: usage error
@@ -114,8 +115,10 @@ def test_loop_takes_the_phase_options_and_reports_the_period_decision(tmp_path):
                                  "--joints", "legs", "--classes", "1", "--min-periods", "1.5"])
     assert result.exit_code == 0, result.output
     facts = json.loads(result.stdout)
+    # the phase asked for: the cohomology on the legs inside the walk's one part, not its strides
     assert facts["joints_used"] == "legs" and abs(facts["legs_period_frames"] - 60) < 1.5
     assert facts["half_cycle_doubled"] is False and "cohomology" in facts["period_candidates"]
+    assert [p["kind"] for p in facts["parts"]] == ["walk straight"] and facts["part"] == 0
     for bad, message in ((["--min-periods", "0.5"], "--min-periods"), (["--delay", "-1"], "--delay")):
         refused = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.bvh"), *bad])
         assert refused.exit_code == 2 and message in refused.stderr  # a bad option value: usage error

@@ -93,7 +93,7 @@ def test_cli_phase_exit_codes(tmp_path):
     assert result.exit_code == 3 and "no periodic motion found" in result.stderr
     short = write_bvh(synthetic_walk(n_frames=15).motion, tmp_path / "short.bvh")
     result = runner.invoke(app, ["phase", str(short)])  # valid but too short for a phase: nothing periodic
-    assert result.exit_code == 3 and "at least" in result.stderr
+    assert result.exit_code == 3 and "too short" in result.stderr
     walk = write_bvh(synthetic_walk(n_frames=300).motion, tmp_path / "walk.bvh")
     for bad, code in ((["--classes", "zero"], 2), (["--pca", "-3"], 2), (["--delay", "-1"], 2),
                       (["--joints", "Tail"], 1)):

@@ -15,7 +15,7 @@ import pytest
 from typer.testing import CliRunner
 
 import mocycle.cli.report  # noqa: F401  (registers the command)
-import mocycle.cycle.extract as extract_module
+import mocycle.cycle.parts as parts_module
 from mocycle import write
 from mocycle.cli import app
 from mocycle.datasets import synthetic_walk
@@ -39,15 +39,13 @@ def refused_library(tmp_path_factory):
     write(synthetic_walk(n_frames=240).motion, folder / "walk.bvh")
     write(synthetic_walk(n_frames=REFUSED_FRAMES, noise_deg=1.0, seed=1).motion, folder / "limp.bvh")
     wrong = find_phase(synthetic_walk(n_frames=REFUSED_FRAMES, period_s=1.5, noise_deg=1.0, seed=4).motion)
-    real = extract_module.find_phase
+    real = parts_module.part_phase
 
-    def phase(motion, *args, **kwargs):
-        return wrong if motion.n_frames == REFUSED_FRAMES else real(motion, *args, **kwargs)
+    def phase(part):  # the limp is one part, its whole 500 frames: its phase is the wrong one
+        return wrong if part.n_frames == REFUSED_FRAMES else real(part)
 
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(extract_module, "find_phase", phase)
-        # the walk's strides would overrule that phase's period (issue 28): here the wrong phase must stand
-        mp.setattr("mocycle.tasks.loop._off_strides", lambda phase, part: False)
+        mp.setattr(parts_module, "part_phase", phase)
         yield folder
 
 

@@ -15,7 +15,7 @@ import click
 import typer
 
 from ..errors import MocycleError
-from ..tasks.options import MISSING, Flag, flag_declaration
+from ..tasks.options import MISSING, Flag, flag_declaration, old_flag_warning
 from ..tasks.spec import SPECS
 from .common import EXIT_USAGE, app, err, escape, friendly, out, print_json
 
@@ -33,6 +33,8 @@ def options_parser(command: str) -> click.Command:
             params.append(click.Option(decls, is_flag=True, default=f.default, help=help))
         else:
             params.append(click.Option(decls, required=f.default is MISSING, help=help))
+            params += [click.Option([old, f"{f.name}__{old.strip('-')}"], hidden=True)
+                       for old in f.metadata.get("old_flags", ())]
     return click.Command(f"mocycle batch {command}", params=params, add_help_option=False)
 
 
@@ -45,8 +47,14 @@ def parse_command_line(args: list[str]):
     command, rest = args[0], list(args[1:])
     parser = options_parser(command)
     ctx = parser.make_context(parser.name, rest, resilient_parsing=False)
-    given = {k: v for k, v in ctx.params.items() if k != "inputs"
+    given = {k: v for k, v in ctx.params.items() if k != "inputs" and "__" not in k
              and ctx.get_parameter_source(k) == click.core.ParameterSource.COMMANDLINE}
+    for f in dataclasses.fields(SPECS[command].options):
+        for old in f.metadata.get("old_flags", ()):
+            value = ctx.params.get(f"{f.name}__{old.strip('-')}")
+            if value is not None:
+                err.print(f"[yellow]warning:[/] {escape(old_flag_warning(f, old))}", markup=True, soft_wrap=True)
+                given.setdefault(f.name, value)
     options = SPECS[command].options(**given)  # an OptionError names the flag (exit 2)
     return command, list(ctx.params["inputs"]), options
 

@@ -21,8 +21,8 @@ import typer.main
 from typer.core import TyperCommand, TyperGroup
 
 from .. import __version__
-from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
-from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_declaration, flag_of
+from ..errors import LoopRefused, MocycleError, MocycleWarning, NoPeriodicMotion, OptionError
+from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_declaration, flag_of, old_flag_warning
 from ..tasks.spec import MOTION_SUFFIXES, SPECS
 from ..text import json_text, printable
 
@@ -306,12 +306,13 @@ def _parameter(name: str, annotation, default=inspect.Parameter.empty) -> inspec
     return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation)
 
 
-def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[str, ...]) -> Callable:
+def task_command(name: str, into: typer.Typer | None = None) -> Callable:
     """Register ``mocycle <name>`` made from the task's spec (:data:`mocycle.tasks.spec.SPECS`).
 
     The command function declares what is its own: its input arguments and its plots. This adds one option
-    per field of the task's ``Options`` (flag, help, type and default from the field; ``aliases``: more
-    flags of a field), one per output of the spec (``-o/--output`` ...; its suffixes checked before any work),
+    per field of the task's ``Options`` (flag, help, type and default from the field; its ``old_flags`` as
+    hidden options read with a deprecation warning), one per output of the spec (``-o/--output`` ...; its
+    suffixes checked before any work),
     ``--json``, ``--force`` (when the Options have none) and, for a task that writes motion, ``--gltf-scale``,
     ``--gltf-up`` and for a loop ``--closing-frame``. The function's keyword-only parameters name what of
     these it wants (:data:`GIVEN`, and its outputs by flag: ``output``, ``playback``): ``options`` is the
@@ -338,8 +339,11 @@ def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[st
             params.append(_parameter(_name(o.flag), Annotated[Path if o.required else Path | None,
                                                            typer.Option(*decls, help=o.help)],
                                      inspect.Parameter.empty if o.required else None))
-        params += [_parameter(f.name, Annotated[cli_type(f), flag(options_cls, f.name, *aliases.get(f.name, ()))],
-                              default(options_cls, f.name)) for f in fields]
+        params += [_parameter(f.name, Annotated[cli_type(f), flag(options_cls, f.name)], default(options_cls, f.name))
+                   for f in fields]
+        olds = [(f, old, f"{f.name}__{old.strip('-').replace('-', '_')}") for f in fields
+                for old in f.metadata.get("old_flags", ())]
+        params += [_parameter(key, Annotated[str | None, typer.Option(old, hidden=True)], None) for _, old, key in olds]
         params.append(_parameter("as_json", Annotated[bool, typer.Option("--json", help="Print JSON.")], False))
         own_force = "force" not in {f.name for f in fields}
         if own_force and (spec.outputs or any("plot" in p for p in own)):
@@ -353,6 +357,12 @@ def task_command(name: str, into: typer.Typer | None = None, **aliases: tuple[st
 
         @wraps(func)
         def command(**kwargs):
+            for f, old, key in olds:
+                value = kwargs.pop(key)
+                if value is not None:
+                    warnings.warn(old_flag_warning(f, old), MocycleWarning, stacklevel=2)
+                    if kwargs[f.name] == default(options_cls, f.name):
+                        kwargs[f.name] = value
             options = options_cls(**{f.name: kwargs.pop(f.name) for f in fields})
             force = kwargs.get("force", False) if own_force else options.force
             inputs = [v for key in spec.inputs for v in _listed(kwargs.get(key.lstrip("*")))]

@@ -13,15 +13,15 @@ from ..tasks.loop import METRIC_LABELS
 from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line
 
 
-@task_command("loop", which=("--parts", "--class"))
+@task_command("loop")
 def loop(
     path: Annotated[Path, typer.Argument(help="A motion file: .bvh, .fbx, .glb, .gltf, or .amc (its .asf beside it).")],
     plot: Annotated[Path | None, typer.Option(
-        help="Write a PNG: PCA of input and cycle, phase, joint curves (with --class all: OUT.classK.png).")]
+        help="Write a PNG: PCA of input and cycle, phase, joint curves (with --part all: OUT.part<k>-<kind>.png).")]
     = None,
     feet_plot: Annotated[Path | None, typer.Option(
         help="Write a PNG of the contacts: each ankle and toe's height and speed over two cycles, before (dashed) "
-             "and after locking (with --class all: OUT.classK.png).")] = None,
+             "and after locking (with --part all: OUT.part<k>-<kind>.png).")] = None,
     *, options, as_json, force, write,
 ):
     """Extract one seamless typical cycle (frame N would equal frame 0) and write it as BVH or glTF.
@@ -114,8 +114,7 @@ def _print_loop(facts: dict) -> None:
     from rich.table import Table
 
     kind = facts["method"] + (f" {facts['model']}, K = {facts['harmonics']}" if facts["method"] == "harmonic" else "")
-    where = f"part {facts['part']} ({facts['kind']}, frames {facts['frames'][0]}-{facts['frames'][1]})" \
-        if facts.get("part") is not None else f"class {facts['class']}"
+    where = f"part {facts['part']} ({facts['kind']}, frames {facts['frames'][0]}-{facts['frames'][1]})"
     out.print(f"[bold]{escape(facts['file'])}[/]: {facts['frames_in']} frames at {facts['fps']:.6g} fps")
     out.print(f"  {where}: {facts['n_periods']:.2f} periods of {facts['period_frames']:.2f} frames "
               f"(time axis: {facts['time_axis']}, {facts['excited_regions']} excited region(s): "

@@ -27,10 +27,13 @@ def phase(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG: diagram, phase per frame, PCA by phase.")] = None,
     *, options, as_json, force,
 ):
-    """Find periodic motions and the phase of every frame (persistent cohomology).
+    """Find the steady parts of a take and the periodic motion and phase of each part that repeats.
 
-    Exit code 0 when at least one periodic motion is found, 3 when none is
-    (the reason is printed), 1 for bad input, 2 for a bad option.
+    The parts are the ones mocycle loop lists and loops: walks, turns and runs (their phase from the feet's
+    landings), arms and other repeating motion (persistent cohomology inside the part), gestures, standing.
+
+    Exit code 0 when at least one part repeats, 3 when none does (the reason is printed), 1 for bad input, 2 for
+    a bad option.
     """
     check_output(plot, [path], force, ".png", "--plot")
     report = tasks.phase.run(path, options, keep_features=plot is not None)
@@ -56,21 +59,20 @@ def _print_phase(path: Path, report) -> None:
 
     facts = report.facts
     out.print(f"[bold]{escape(path)}[/]: {facts['frames']} frames at {facts['fps']:.6g} fps")
-    table = Table(title="periodic motions (H1 classes)")
-    for col in ("class", "bar [birth, death)", "period frames", "period s", "periods", "excitation frames"):
-        table.add_column(col, justify="right" if col != "excitation frames" else "left")
-    for k, c in enumerate(facts["classes"]):
-        table.add_row(str(k), f"[{c['birth']:.3g}, {c['death']:.3g})", f"{c['period_frames']:.2f}",
-                      f"{c['period_s']:.3f}", f"{c['n_periods']:.2f}",
-                      ", ".join(f"{s}-{e}" for s, e in c["excitation"]))
+    parts = facts["parts"]
+    if len(parts) > 1:
+        out.print(f"  {len(parts)} parts: " + "; ".join(f"{k} {escape(p['kind'])} {p['frames'][0]}-{p['frames'][1]}"
+                                                       for k, p in enumerate(parts)), soft_wrap=True)
+    table = Table(title="periodic motions, one per part that repeats")
+    for col in ("part", "kind", "frames", "period frames", "period s", "periods", "period from"):
+        table.add_column(col, justify="left" if col in ("kind", "period from") else "right")
+    for c in facts["classes"]:
+        table.add_row(str(c["part"]), escape(c["kind"]), f"{c['frames'][0]}-{c['frames'][1]}",
+                      f"{c['period_frames']:.2f}", f"{c['period_s']:.3f}", f"{c['n_periods']:.2f}",
+                      escape(c["period_source"]))
     if facts["classes"]:
         out.print(table)
-    acf = facts["autocorrelation_period_frames"]
-    out.print(f"  autocorrelation period (cross-check): {'none' if acf is None else f'{acf:.2f} frames'}")
-    legs = facts["legs_period_frames"]
-    out.print(f"  legs' autocorrelation period: {'none' if legs is None else f'{legs:.2f} frames'}; "
-              f"joints used: {escape(facts['joints_used'])}", soft_wrap=True)
-    for k, c in enumerate(facts["classes"]):
-        out.print(f"  class {k} period: {escape(c['period_reason'])}", soft_wrap=True)
+    for c in facts["classes"]:
+        out.print(f"  part {c['part']} period: {escape(c['period_reason'])}", soft_wrap=True)
     out.print(f"  why: {escape(facts['reason'])}", soft_wrap=True)
     out.print(timing_line(report))

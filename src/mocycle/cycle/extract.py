@@ -8,14 +8,11 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Iterable
-from dataclasses import replace
 
-import numpy as np
-
-from .. import _validate, defaults
+from .. import defaults
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..motion import Motion
-from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase
+from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase_every
 from ..threads import limit_threads
 from .centroid import centroid_cycle
 from .cut import cut_cycle
@@ -47,30 +44,13 @@ def choose_periodic(result: PhaseResult, which: int | None = None) -> PeriodicMo
     return result.classes[which]
 
 
-def _phase_at_full_rate(result: PhaseResult, step: int, n_frames: int) -> PhaseResult:
-    """A phase found on every ``step``-th frame, brought back to all ``n_frames`` frames (the unwrapped
-    coordinate interpolated linearly; excitation regions and periods scaled by ``step``)."""
-    frames = np.arange(n_frames)
-    classes = []
-    for c in result.classes:
-        unwrapped = np.interp(frames, np.arange(c.unwrapped.size) * step, c.unwrapped)
-        excitation = [(s * step, min(n_frames, (e - 1) * step + 1)) for s, e in c.excitation]
-        classes.append(replace(c, coords=np.mod(unwrapped, 1.0), unwrapped=unwrapped, excitation=excitation,
-                               period_frames=c.period_frames * step, frame_time=c.frame_time / step))
-    return replace(result, classes=classes, n_frames=n_frames, frame_time=result.frame_time / step,
-                   autocorrelation_period_frames=result.autocorrelation_period_frames * step)
-
-
 def cycle_phase(motion: Motion, *, joints: str | Iterable[str] | None = None, classes: int | str = "auto",
                 pca: int | str | None = "auto", delay: int = 2, min_periods: float = MIN_PERIODS,
                 step: int = 1) -> PhaseResult:
     """:func:`~mocycle.phase.find_phase` as the cycle extraction calls it, optionally on every
     ``step``-th frame only (the thesis plugin's subsampling), brought back to every frame."""
-    step = _validate.integer("step", step, 1)
-    options = dict(classes=classes, joints=joints, pca=pca, delay=delay, min_periods=min_periods)
-    if step > 1:
-        return _phase_at_full_rate(find_phase(motion[::step], **options), step, motion.n_frames)
-    return find_phase(motion, **options)
+    return find_phase_every(motion, step, classes=classes, joints=joints, pca=pca, delay=delay,
+                            min_periods=min_periods)
 
 
 @limit_threads

@@ -537,3 +537,23 @@ def _doubt(checked: list[PeriodicMotion], acf: float, legs: float, X: np.ndarray
         return (f"; the take is not like itself one found period ({found:.2f} frames) later (self-similarity "
                 f"{unlike:.2f} > {UNLIKE:g})")
     return ""
+
+
+def find_phase_every(motion: Motion, step: int = 1, **options) -> PhaseResult:
+    """:func:`find_phase` on every ``step``-th frame only (the thesis plugin's subsampling), brought back to
+    every frame: the unwrapped coordinate interpolated linearly, excitation regions and periods scaled by
+    ``step``.  ``options``: :func:`find_phase`'s."""
+    step = _validate.integer("step", step, 1)
+    if step == 1:
+        return find_phase(motion, **options)
+    result = find_phase(motion[::step], **options)
+    n_frames = motion.n_frames
+    frames = np.arange(n_frames)
+    classes = []
+    for c in result.classes:
+        unwrapped = np.interp(frames, np.arange(c.unwrapped.size) * step, c.unwrapped)
+        excitation = [(s * step, min(n_frames, (e - 1) * step + 1)) for s, e in c.excitation]
+        classes.append(replace(c, coords=np.mod(unwrapped, 1.0), unwrapped=unwrapped, excitation=excitation,
+                               period_frames=c.period_frames * step, frame_time=c.frame_time / step))
+    return replace(result, classes=classes, n_frames=n_frames, frame_time=result.frame_time / step,
+                   autocorrelation_period_frames=result.autocorrelation_period_frames * step)

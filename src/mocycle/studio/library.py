@@ -107,7 +107,7 @@ def loop_summary(loop: dict) -> dict:
     checks (``failed_checks``, the ones ``tasks.loop`` refuses it for without ``force``); ``refusal``: why."""
     m = loop.get("metrics", {})
     failed = loop.get("failed_checks", [])
-    return {"class": loop["class"], "part": loop.get("part"), "kind": loop.get("kind"), "frames": loop.get("frames"),
+    return {"part": loop["part"], "kind": loop.get("kind"), "frames": loop.get("frames"),
             "period_frames": loop["period_frames"],
             "period_s": loop["period_frames"] / loop["fps"], "cycle_frames": loop["cycle_frames"],
             "seam_pose": m.get("seam_pose"), "seam_velocity": m.get("seam_velocity"),

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 from ..errors import OptionError
 from . import fields
-from .fields import phase_options
+from .fields import take_cycles
 from .options import Flag, option
 from .report import Recorder, Report, label_of, load
 
@@ -63,9 +63,10 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
         check_weights(o.weights, len(takes))  # refuse bad weights before the (slower) extraction
     with Recorder() as rec:
         motions = [load(t, o.amc_fps, o.take) for t in takes]
-        result = blend_cycles(motions, o.weights, align=o.align, labels=[label_of(t, k) for k, t in enumerate(takes)],
-                              method=o.method, model=o.model, harmonics=o.harmonics, force=o.force,
-                              **phase_options(o))
+        labels = [label_of(t, k) for k, t in enumerate(takes)]
+        with rec.part("cycle"):
+            cycles = take_cycles(motions, labels, o)
+        result = blend_cycles(cycles, o.weights, align=o.align, labels=labels, force=o.force)
         with rec.part("feet"):
             cleaned, feet_facts, _ = clean_feet(result.cycle, o.feet, o.root, o.foot_joints, reference=motions)
         result = dataclasses.replace(result, cycle=cleaned)

@@ -9,7 +9,7 @@ from .options import Choice, Flag, Integer, Options, Real, Text, option
 
 __all__ = ["AMC_FPS", "CycleOptions", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay",
            "feet", "foot_joints", "force_cycle", "harmonics", "joints", "method", "min_periods", "model", "pca",
-           "phase_joints", "root", "swing_joints", "take", "threshold", "which"]
+           "phase_joints", "root", "take_cycles", "swing_joints", "take", "threshold", "which"]
 
 METHODS = CYCLE_METHODS
 MODELS = HARMONIC_MODELS
@@ -71,9 +71,10 @@ def min_periods():
                                "warning.", Real(1.0))
 
 
-def which(help: str = "Which periodic motion of each take to use (0-based; default: the one covering most "
-                      "frames).", words: tuple[str, ...] = ()):
-    return option(None, help, Integer(0, words={w: w for w in words}, optional=True), flag="--class")
+def which(help: str = "Which part of each take to use: its number in the parts mocycle loop lists (0-based; "
+                      "default: the steady part with the most cycles that loops).", words: tuple[str, ...] = ()):
+    return option(None, help, Integer(0, words={w: w for w in words}, optional=True), flag="--part",
+                  old_flags=("--class",))
 
 
 def joints(help: str = "Joints to use: names, glob patterns or groups (legs, arms, spine), comma-separated."):
@@ -90,10 +91,16 @@ def force_cycle():
                   Flag())
 
 
-def phase_options(options) -> dict:
-    """The phase options of an Options object as keyword arguments of ``extract_cycle``/``blend_cycles``."""
-    return {"joints": options.joints, "classes": options.classes, "which": options.which, "pca": options.pca,
-            "delay": options.delay, "min_periods": options.min_periods}
+def take_cycles(motions, labels, options) -> list:
+    """Each take's cycle as ``blend`` and ``transition`` use it: the loop of one of its steady parts
+    (:func:`~mocycle.cycle.parts.part_cycle`: ``options.which``, by default the part with the most cycles that
+    loops), the same loop ``mocycle loop`` writes.  A take that does not loop raises with its label."""
+    from ..cycle.parts import part_cycle
+
+    return [part_cycle(m, which=options.which, method=options.method, model=options.model,
+                       harmonics=options.harmonics, force=options.force, label=label, joints=options.joints,
+                       classes=options.classes, pca=options.pca, delay=options.delay,
+                       min_periods=options.min_periods) for m, label in zip(motions, labels, strict=True)]
 
 
 def feet(help: str | None = None):

@@ -125,14 +125,21 @@ class Text:
 Constraint = Callable[[str, object], object]
 
 
-def option(default=MISSING, help: str = "", check: Constraint | None = None, *, flag: str | None = None):
+def option(default=MISSING, help: str = "", check: Constraint | None = None, *, flag: str | None = None,
+           old_flags: tuple[str, ...] = ()):
     """A dataclass field of an Options class.
 
     ``help``: one line for ``--help``, tooltips and forms; ``check``: the constraint (:class:`Choice`,
     :class:`Integer`, :class:`Real`, :class:`Flag`, :class:`Text` or any ``f(name, value) -> value``);
-    ``flag``: the CLI flag when it is not ``--`` + the field name with dashes.
+    ``flag``: the CLI flag when it is not ``--`` + the field name with dashes; ``old_flags``: former names of
+    the flag, still read, each with a warning that it is deprecated (:func:`old_flag_warning`).
     """
-    return field(default=default, metadata={"help": help, "check": check, "flag": flag})
+    return field(default=default, metadata={"help": help, "check": check, "flag": flag, "old_flags": old_flags})
+
+
+def old_flag_warning(f: dataclasses.Field, old: str) -> str:
+    """What a front end says when a field is set by one of its ``old_flags``."""
+    return f"{old} is deprecated: it is read as {flag_of(f)}, which says the same (use {flag_of(f)})"
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from .report import Recorder, Report, load
 
 LABELS = {
     "frames": ("frames", ""), "fps": ("frame rate", "fps"),
-    "classes": ("periodic motions (H1 classes)", ""),
+    "classes": ("periodic motions, one per part that loops", ""),
     "autocorrelation_period_frames": ("autocorrelation period (cross-check)", "frames"),
     "reason": ("why", ""),
 }
@@ -37,16 +37,26 @@ class Options(_Options):
 
 
 def run(take, options: Options | None = None, *, keep_features: bool = False) -> Report:
-    """Find the periodic motions of one take; ``facts["classes"]`` is empty when there is none (with the
-    reason in ``facts["reason"]``). ``keep_features``: keep the point cloud in ``result.features`` (the phase
-    plot needs it)."""
-    from ..phase import find_phase
+    """The take's steady parts and the periodic motion of each part that loops (the parts ``loop`` loops:
+    :func:`~mocycle.activities.segment_activities`, the phase options used inside the parts): one entry of
+    ``facts["classes"]`` per such part, with ``part`` (its index in ``facts["parts"]``), ``kind`` and its
+    frames; empty when none loops (``facts["reason"]`` says why).  ``keep_features``: keep the take's point
+    cloud in ``result.features`` (the phase plot needs it)."""
+    from ..activities import parts_phase, segment_activities
+    from ..phase.analysis import phase_features
 
     options = options or Options()
     with Recorder() as rec:
         motion = load(take, options.amc_fps, options.take)
-        result = find_phase(motion, classes=options.classes, joints=options.joints, pca=options.pca,
-                            delay=options.delay, min_periods=options.min_periods, n_landmarks=options.n_landmarks,
-                            keep_features=keep_features)
+        acts = segment_activities(motion, min_periods=options.min_periods, joints=options.joints,
+                                  classes=options.classes, pca=options.pca, delay=options.delay,
+                                  n_landmarks=options.n_landmarks)
+        result = parts_phase(acts)
+        if keep_features:
+            result.features = phase_features(motion, joints=options.joints, pca=options.pca)
         facts = {k: v for k, v in result.to_dict().items() if k != "seconds"}
+        looping = [k for k, p in enumerate(acts.parts) if p.loop]
+        for k, c in zip(looping, facts["classes"], strict=True):
+            c.update(part=k, kind=acts.parts[k].kind, frames=[acts.parts[k].start, acts.parts[k].stop])
+        facts["parts"] = [p.to_dict() for p in acts.parts]
     return rec.report("phase", facts, {"motion": motion}, result)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from ..errors import OptionError
 from . import fields
-from .fields import phase_options
+from .fields import take_cycles
 from .report import Recorder, Report, label_of, load
 
 LABELS = {
@@ -35,10 +35,10 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     if len(takes) != 2:
         raise OptionError("takes", f"must be two takes (first, second); got {len(takes)}")
     with Recorder() as rec:
-        a, b = (load(t, o.amc_fps, o.take) for t in takes)
-        result = transition(a, b, o.cycles, root=o.root, labels=[label_of(t, k) for k, t in enumerate(takes)],
-                            method=o.method, model=o.model, harmonics=o.harmonics, force=o.force,
-                            **phase_options(o))
+        labels = [label_of(t, k) for k, t in enumerate(takes)]
+        with rec.part("cycle"):
+            a, b = take_cycles([load(t, o.amc_fps, o.take) for t in takes], labels, o)
+        result = transition(a, b, o.cycles, root=o.root, labels=labels, force=o.force)
         facts = {**result.to_dict(), "root": o.root, "smoothness": transition_smoothness(result)}
         with rec.part("feet"):
             written, facts["feet"] = lock_motion(result.motion, o.feet, o.foot_joints, o.root == "motion")
