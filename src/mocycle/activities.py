@@ -1,29 +1,35 @@
 """Steady activities of a take: where it walks straight, turns, runs, waves or stands, before anything is looped.
 
-A take that changes what it does (walk, turn, walk; walk then wave) has no one cycle: a loop fitted over all
-of it averages the parts into a motion the actor never made.  :func:`segment_activities` cuts the take into
-parts that each do one thing, from evidence that does not depend on the phase:
+A take that changes what it does (walk, turn, walk; walk then wave; a whole capture session) has no one
+cycle: a loop fitted over all of it averages the parts into a motion the actor never made.
+:func:`segment_activities` cuts the take into parts that each do one thing, from evidence that does not
+depend on the phase; every loop is then made from one part's frames only (:mod:`mocycle.cycle.parts`).
 
-1. **Foot landings** (:func:`~mocycle.contacts.detect_contacts`): a landing is the start of a foot's contact.
-   Landings that alternate between the feet, each step between :data:`MIN_STEP_S` and :data:`MAX_STEP_S`
-   seconds, are *gait*; the frames between a foot's landing and its next landing are one **stride**, the
-   gait's full cycle (two steps) measured without any phase.
-2. **Each stride's figures**: its period (frames), its turn (the hips' heading, :class:`~mocycle.features.
-   HeadingFrame`, one stride apart: at the same point of the gait, so the hips' sway within a stride cancels),
-   its speed (the travel joint's horizontal distance over its time) and its flight (the share of its frames
-   with no foot on the floor: a run has some, a walk none).
-3. **Steps of one kind** make a part: each step (half a stride) is *straight* or *turning left/right* (its
-   strides turn by more than :data:`TURN_DEG` degrees) and *walk* or *run*; consecutive steps of the same kind
-   whose stride periods agree within :data:`TEMPO_CHANGE` are one part.  A part's first and last frames reach
-   at most one step beyond its first and last landing (the take starts or ends mid-stride).
-4. **The frames between gait parts** (the legs stand, or move without alternating landings) are looked at
-   limb by limb: the arm joints that move are tried for a periodic motion first (a wave), then the whole body
-   (:func:`~mocycle.phase.find_phase`); what holds no repeating motion is a **gesture** (the body moves) or
-   **standing** (it barely does), never looped.
+1. **Foot landings** (:func:`find_landings`): where a lifted foot comes down.  Landings that alternate between
+   the feet, each step between :data:`MIN_STEP_S` and :data:`MAX_STEP_S` seconds, are *gait*; the frames
+   between a foot's landing and its next landing are one **stride**, the gait's full cycle (two steps)
+   measured without any phase.
+2. **Each stride's figures**: its period (frames), its speed (the travel joint's horizontal distance over its
+   time), its flight and its double support (the shares of its frames with no foot and with both feet on the
+   floor).  A step is a *run* when its strides have a flight phase, a *walk* when they have double support,
+   and only where the feet show neither does the speed decide (:func:`gait_of`).
+3. **Steps of one gait and tempo** make a part: consecutive steps of the same gait whose stride periods stay
+   within :data:`TEMPO_CHANGE` of the part's median so far.  A part reaches up to a step beyond its first
+   and last landing (the take starts or ends mid-stride) while its legs still repeat the stride.
+4. **Turns** (:func:`_turn_runs`): within a gait part, the hips' turning rate over one stride about each frame
+   (their sway within a stride cancels) cuts it into straight parts, turning parts that hold the turn's core
+   (at least :data:`TURN_CORE_SHARE` of its fastest rate, grown to :data:`TURN_LEAST` strides when the turn
+   lasts that long) and the turn's slower start and end as transitions.
+5. **The frames between gait parts** (the legs stand, or move without alternating landings) are looked at
+   for a repeating motion (:func:`_periodic_in`): the moving arm joints first where the legs stand (a wave),
+   the whole body first where they move (a dance step), region by region, so that several such motions are
+   parts of their own; what holds no repeating motion is a **gesture** (the body moves) or **standing**
+   (it barely does), never looped.  A rig whose feet are not found by name is looked at the same way.
 
-A part is worth a loop when it holds at least ``min_periods`` cycles.  Gait parts carry their **stride
-phase** (:func:`stride_phase`): time in cycles through a line fitted to the landings, the period estimator
-that still works on a part of 1.2 cycles where the circular coordinate winds about once.
+A part is worth a loop when it holds at least ``min_periods`` cycles of its own phase, and a part without
+gait at least :data:`MIN_REPEATS` (it must be seen to repeat).  Gait parts carry their **stride phase**
+(:func:`stride_phase`): time in cycles through a line fitted to the landings, the period estimator that still
+works on a part of 1.2 cycles where the circular coordinate winds about once.
 """
 
 from __future__ import annotations
@@ -61,7 +67,8 @@ TURN_DEG = 15.0
 #: frames of the turn slower than that (its start and end) are a transition of their own when they last a
 #: quarter of a stride or more, part of the straight walk beside them when less.
 TURN_CORE_SHARE = 0.5
-#: Consecutive strides whose periods differ by more than this share are different activities.
+#: A step whose stride period differs by more than this share from the median of its part so far starts
+#: another part (a tempo that drifts step by step is caught as surely as one that jumps).
 TEMPO_CHANGE = 0.2
 #: A stride whose feet are both off the floor for at least this share of its frames has a flight phase: a run.
 FLIGHT_SHARE = 0.05
@@ -453,7 +460,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
         while i < len(kinds):
             j = i + 1
             while j < len(kinds) and kinds[j][0] == kinds[i][0] and \
-                    abs(kinds[j][1] / kinds[j - 1][1] - 1) <= TEMPO_CHANGE:
+                    abs(kinds[j][1] / float(np.median([k[1] for k in kinds[i:j]])) - 1) <= TEMPO_CHANGE:
                 j += 1
             # steps i .. j-1: landings f[i] .. f[j]
             parts.append(_gait_part(kinds[i][0], f, chain, i, j, landings, strides, heading, path, fps))
@@ -461,7 +468,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     # steps that land in turn but whose legs do not repeat a stride later (a wander, a stumble) are no gait
     parts = [p for p in parts if _legs_repeat_in(motion, p)]
     parts.sort(key=lambda p: p.start)
-    _reach(parts, landings, T)
+    _reach(motion, parts, T)
     parts = [q for p in parts for q in (_split_turns(p, heading, path, fps) if " " not in p.kind else [p])]
     parts = _fill(motion, parts, landings, min_periods, options)
     keep = np.sort(np.concatenate(stepped)) if stepped else np.zeros(0, dtype=np.intp)
@@ -698,9 +705,11 @@ def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[f
     return best, float(d[i])
 
 
-def _reach(parts: list[Activity], landings: Landings, T: int) -> None:
+def _reach(motion: Motion, parts: list[Activity], T: int) -> None:
     """Let each gait part reach up to one step before its first and after its last landing (the take starts or
-    ends mid-stride), short of its neighbours; a gap smaller than a step between two parts is split."""
+    ends mid-stride; up to a stride at the take's ends), short of its neighbours and only as far as its legs
+    still repeat the stride (:func:`_repeating_reach`: where the gait stops or blends into another motion, the
+    part stops); a gap smaller than a step between two parts is split."""
     for k, p in enumerate(parts):
         step = p.period_frames / 2.0
         lo = parts[k - 1].stop if k > 0 else 0
@@ -708,11 +717,42 @@ def _reach(parts: list[Activity], landings: Landings, T: int) -> None:
             mid = (lo + p.start) // 2
             parts[k - 1].stop, p.start = mid, mid
         else:  # at the take's start a foot may be mid-swing: up to a stride
-            p.start = max(lo, int(np.floor(p.start - (2 * step if k == 0 else step))))
+            want = max(lo, int(np.floor(p.start - (2 * step if k == 0 else step))))
+            p.start = _repeating_reach(motion, p, want, p.start)
         if k + 1 == len(parts):
-            p.stop = min(T, int(np.ceil(p.stop + 2 * step)))
+            want = min(T, int(np.ceil(p.stop + 2 * step)))
+            p.stop = _repeating_reach(motion, p, want, p.stop)
         elif parts[k + 1].start - p.stop >= step:
-            p.stop = int(np.ceil(p.stop + step))
+            p.stop = _repeating_reach(motion, p, int(np.ceil(p.stop + step)), p.stop)
+
+
+def _repeating_reach(motion: Motion, part: Activity, want: int, edge: int) -> int:
+    """How far towards ``want`` (a frame before the part's first landing or after its last, ``edge``) the
+    part's legs still repeat its stride: the first frame from ``edge`` at which the legs are unlike their pose
+    a stride before (after, going back) by :data:`UNLIKE` or more (over 3 frames; unlikeness against the
+    legs' spread over the stride next to the edge, as :func:`_unlike` measures it) ends the reach."""
+    lag = int(round(part.period_frames))
+    if want == edge or lag < 2:
+        return want
+    forward = want > edge
+    lo, hi = (edge - lag, want) if forward else (want, edge + lag)
+    lo, hi = max(0, lo), min(motion.n_frames, hi)
+    X = _leg_features(motion, lo, hi)
+    if X is None or X.shape[0] <= lag:
+        return want
+    ref = X[edge - lo - lag: edge - lo] if forward else X[edge - lo: edge - lo + lag]
+    var = float(ref.var(axis=0).sum())
+    if not var > 0:
+        return want
+    d = ((X[lag:] - X[:-lag]) ** 2).sum(axis=1) / (2.0 * var)   # frame t + lag against frame t (relative to lo)
+    d = moving_average(d, 3)
+    if forward:  # frames edge .. want-1 against a stride before
+        run = d[edge - lo - lag:]
+        bad = np.flatnonzero(run >= UNLIKE)
+        return edge + int(bad[0]) if bad.size else want
+    run = d[: edge - lo][::-1]  # frames edge-1 .. want against a stride after, going back
+    bad = np.flatnonzero(run >= UNLIKE)
+    return edge - int(bad[0]) if bad.size else want
 
 
 def _fill(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float,
@@ -805,8 +845,9 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
     """Where ``joints`` repeat in ``piece``: ``(start, stop, period)`` from the velocity of their rotations
     (a wave's hand swings back and forth while the arm's raise and fall happen once): the period by windowed
     autocorrelation (paper 004), the frames where the take is like itself one period later
-    (:func:`~mocycle.phase.period.repetition_distance` under a half) and moves (at least a fifth of its
-    largest local speed), their longest run.  ``None`` when it holds fewer than ``least`` periods."""
+    (:func:`~mocycle.phase.period.repetition_distance` under a half) and moves (at least a fifth of the largest
+    local speed among those frames: a big gesture beside a small wave does not hide it), their longest run.
+    ``None`` when it holds fewer than ``least`` periods."""
 
     X, _ = pose_matrix(piece, rep="expmap", root="drop", joints=joints, normalize=False, weights=None)
     V = np.diff(X, axis=0)
@@ -819,13 +860,15 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
     w = max(3, int(round(P)))
     alike = repetition_distance(V, P, smooth=w) < 0.5
     energy = moving_average((V ** 2).sum(axis=1), w)
-    busy = energy > 0.2 * energy.max()
+    if not alike.any():
+        return None
+    busy = energy > 0.2 * energy[alike].max()  # a fifth of the repeating motion's own speed: not a gesture's
     good = alike & busy
     runs = _true_runs(good)
     if not runs:
         return None
     s, e = max(runs, key=lambda r: r[1] - r[0])
-    s, e = max(0, s - w // 2), min(piece.n_frames, e + 1 + w // 2)
+    e = min(piece.n_frames, e + 1)  # velocities: frame e + 1 ends the last one (the smoothing already reaches w/2 out)
     if (e - s) < least * P:
         return None
     return s, e, float(P)
@@ -839,18 +882,19 @@ def _true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float, options: dict):
     """``(limbs, kind, PeriodicMotion, (start, stop))`` of the motion repeating in ``piece`` (frames of the
-    piece; the PeriodicMotion is on those frames): the arm joints that move first (a wave beside standing
-    legs), where they repeat, then the whole body (or the joints of ``options["joints"]``); ``None`` when nothing
-    repeats.  ``options``: :func:`~mocycle.phase.find_phase`'s, and ``step``."""
+    piece; the PeriodicMotion is on those frames): the arm joints that move and the whole body, the arms first
+    where the legs stand (a wave), the body first where they move (a dance step; the arms then, for a wave
+    among other movements), or the joints of ``options["joints"]``; ``None`` when nothing repeats.
+    ``options``: :func:`~mocycle.phase.find_phase`'s, and ``step``."""
     options = dict(options)
     step = int(options.pop("step", 1) or 1)
     chosen = options.pop("joints", None)
     if chosen is not None:
         tries = [(chosen, "periodic")]
-    else:
-        moving = _moving_arm_joints(piece.skeleton, spread) if _legs_still(piece.skeleton, spread) else []
-        tries = [(moving, "arms")] if moving else []
-        tries.append((None, "periodic"))
+    else:  # the arms first where the legs stand (a wave), the whole body first where they move (a dance)
+        moving = _moving_arm_joints(piece.skeleton, spread)
+        arms = [(moving, "arms")] if moving else []
+        tries = arms + [(None, "periodic")] if _legs_still(piece.skeleton, spread) else [(None, "periodic")] + arms
     least = max(min_periods, MIN_REPEATS)
     for joints, kind in tries:
         region = _repeating_region(piece, joints, least)

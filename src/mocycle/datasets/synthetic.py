@@ -37,6 +37,7 @@ __all__ = [
     "synthetic_circle_walk",
     "synthetic_half_cycle_trap",
     "synthetic_still",
+    "synthetic_sway",
     "synthetic_walk",
     "synthetic_walk_then_run",
     "synthetic_walk_then_wave",
@@ -87,7 +88,7 @@ _IX = {n: i for i, n in enumerate(_NAMES)}
 _AXIS = {"X": 0, "Y": 1, "Z": 2}
 #: Segment labels of steady periodic activities (see :attr:`SyntheticTake.steady_parts`).
 STEADY_KINDS = frozenset({"walk", "run", "symmetric walk", "straight", "turning left", "turning right",
-                          "wave"})
+                          "wave", "sway"})
 #: Standing height of the Hips joint in the rest pose (cm); toes then touch y = 0.
 STAND_HEIGHT = 97.0
 
@@ -991,3 +992,55 @@ def synthetic_walk_then_wave(walk_s: float = 4.0, stop_s: float = 0.8, wave_s: f
             f"seed {seed}")
     return SyntheticTake(Motion(skel, q, None, 1.0 / fps, root_positions=root), phase, unwrapped, period,
                          segments, desc, chan, np.zeros(T))
+
+
+def synthetic_sway(n_frames: int = 480, fps: float = 60.0, period_s: float = 1.2, noise_deg: float = 0.3,
+                   seed: int = 0) -> SyntheticTake:
+    """A dance step on the spot: the whole body repeats while the legs move but no foot lands in turn.
+
+    Every ``period_s`` seconds the knees bend and straighten (a bounce, 30 degrees at the knee; the
+    trunk nods, the shoulders shrug and the elbows bend with it), the hips roll 6 degrees to one side and back
+    to the other, the trunk counters half of it, both arms swing 30 degrees forward and back in turn and the
+    trunk turns a little with them; the root goes down with the bounce so that the lower foot stays on the
+    floor (no foot lifts more than about 2 % of the body height: no landing, no gait).  ``noise_deg``: Gaussian
+    noise on every rotation channel (degrees).
+
+    Truth: ``segments`` ``[("sway", 0, n_frames)]``; ``phase``/``unwrapped_phase`` count periods from frame 0;
+    ``period_frames`` ``period_s * fps``; ``heading_deg`` zeros.
+    """
+    n_frames, fps = _check(n_frames, fps)
+    period_s = _validate.positive("period_s", period_s)
+    if not np.isfinite(noise_deg) or noise_deg < 0:
+        raise MocycleError(f"noise_deg must be >= 0; got {noise_deg!r}")
+    u = np.arange(n_frames) / (period_s * fps)
+    bounce = 0.5 * (1.0 - np.cos(2.0 * np.pi * u))                  # one bend a period, in [0, 1]
+    roll = 6.0 * np.sin(2.0 * np.pi * u)
+    swing = np.sin(2.0 * np.pi * u)
+    a = np.zeros((n_frames, len(_NAMES), 3))
+    a[:, _IX["Hips"], 2] = roll
+    a[:, _IX["Spine"], 2] = -0.5 * roll
+    for j, share in (("Spine1", 0.3), ("Spine2", 0.3), ("Neck", 0.2), ("Head", 0.2)):  # the trunk and head nod
+        a[:, _IX[j], 0] = 8.0 * share * bounce
+        a[:, _IX[j], 1] = 10.0 * share * swing                   # and turn a little with the arms
+    for side, sign in (("Left", 1.0), ("Right", -1.0)):
+        a[:, _IX[f"{side}UpLeg"], 0] = -15.0 * bounce
+        a[:, _IX[f"{side}UpLeg"], 2] = sign * 2.0 - roll            # the legs stay vertical as the hips roll
+        a[:, _IX[f"{side}Leg"], 0] = 30.0 * bounce
+        a[:, _IX[f"{side}Foot"], 0] = -15.0 * bounce
+        a[:, _IX[f"{side}Shoulder"], 2] = sign * 8.0 * bounce
+        a[:, _IX[f"{side}Arm"], 2] = sign * -75.0
+        a[:, _IX[f"{side}Arm"], 1] = sign * 30.0 * swing
+        a[:, _IX[f"{side}ForeArm"], 1] = -sign * (20.0 + 25.0 * bounce)
+        a[:, _IX[f"{side}Hand"], 0] = 15.0 * swing
+    skel = humanoid_skeleton()
+    chan = _channels(skel, a)
+    if noise_deg > 0:
+        chan += _rng(seed).normal(0.0, noise_deg, size=chan.shape)
+    q = _quats_from_channels(skel, chan)
+    root = np.zeros((n_frames, 3))
+    root[:, 1] = _floor_height(skel, q)
+    unwrapped = u.copy()
+    desc = (f"synthetic sway (a dance step on the spot): {n_frames} frames at {fps:g} fps, period {period_s:g} s, "
+            f"noise {noise_deg:g} deg, seed {seed}")
+    return SyntheticTake(Motion(skel, q, None, 1.0 / fps, root_positions=root), unwrapped % 1.0, unwrapped,
+                         np.full(n_frames, period_s * fps), [("sway", 0, n_frames)], desc, chan, np.zeros(n_frames))
