@@ -78,7 +78,7 @@ def scene(extension):
     sc = bpy.context.scene
     sc.render.fps, sc.render.fps_base = 30, 1.0
     sc.frame_set(1)
-    sc.mocycle.periodic.clear()
+    sc.mocycle.parts.clear()
     sc.mocycle.last_task = ""
     return sc
 

@@ -93,10 +93,11 @@ def addon_fcurves(arm, action):
 def test_find_phase(walk):
     assert bpy.ops.mocycle.find_phase() == {"FINISHED"}
     st = bpy.context.scene.mocycle
-    assert len(st.periodic) >= 1 and st.periodic_index == -1  # nothing picked yet
-    assert st.periodic[0].period_frames == pytest.approx(FPS, rel=0.03)
-    assert st.periodic[0].n_periods == pytest.approx(8, abs=0.5)
-    assert st.last_task == "find_phase" and "periodic motion" in st.last_message
+    assert len(st.parts) >= 1 and st.part_index == -1  # nothing picked yet
+    looping = [p for p in st.parts if p.loops]
+    assert looping[0].period_frames == pytest.approx(FPS, rel=0.03)
+    assert looping[0].n_periods == pytest.approx(8, abs=0.5)
+    assert st.last_task == "find_phase" and "repeat" in st.last_message
 
 
 def test_extract_cycle_loops(walk):
@@ -149,11 +150,11 @@ def test_extract_cycle_options_reach_the_task(walk):
     assert facts(walk.animation_data.action)["method"] == "centroid"
 
 
-def test_which_periodic_motion_from_the_list(walk):
+def test_which_part_from_the_list(walk):
     bpy.ops.mocycle.find_phase()
     assert bpy.ops.mocycle.extract_cycle(which=0) == {"FINISHED"}
-    assert facts(walk.animation_data.action)["class"] == 0
-    with pytest.raises((RuntimeError, TypeError), match="which|class|periodic|repeat"):
+    assert facts(walk.animation_data.action)["part"] == 0
+    with pytest.raises((RuntimeError, TypeError), match="which|part"):
         bpy.ops.mocycle.extract_cycle(which=7)
 
 

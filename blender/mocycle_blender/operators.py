@@ -130,21 +130,17 @@ def _find_phase(self, context, arm):
         a, b = (int(x) for x in window.split(":"))
         motion = motion[a:b]
     report = tasks.phase.run(motion, props.options_from(self.options_cls, self, joints=_joints(self, arm)))
-    st = _state(context)
-    st.periodic.clear()
-    for c in report.facts["classes"]:
-        item = st.periodic.add()
-        item.period_frames, item.period_s, item.n_periods = c["period_frames"], c["period_s"], c["n_periods"]
-        item.excitation = ", ".join(f"{s + first}-{e + first - 1}" for s, e in c["excitation"])
-    st.periodic_index = -1  # none picked: the task's own choice (the one covering most frames) until a click
+    _keep_parts(context, report.facts["parts"], first)
     self._warnings = report.warnings
-    if not st.periodic:
-        message = f"{action.name}: no periodic motion ({report.facts['reason']})"
+    found = report.facts["classes"]
+    if not found:
+        message = f"{action.name}: no part repeats ({report.facts['reason']})"
         _record(context, "find_phase", action, message=message)
         return message
-    best = report.facts["classes"][0]
-    message = (f"{action.name}: {len(st.periodic)} periodic motion(s); first: period "
-               f"{best['period_frames']:.1f} frames ({best['period_s']:.2f} s), {best['n_periods']:.1f} periods")
+    best = max(found, key=lambda c: c["n_periods"])
+    message = (f"{action.name}: {len(report.facts['parts'])} part(s), {len(found)} repeat; the longest, part "
+               f"{best['part']} ({best['kind']}): period {best['period_frames']:.1f} frames "
+               f"({best['period_s']:.2f} s), {best['n_periods']:.1f} cycles")
     _record(context, "find_phase", action, period=best["period_frames"], message=message)
     return message
 
@@ -240,8 +236,8 @@ def rig_assign(arm, action) -> None:
 
 
 COMMON = props.COMMON
-FindPhase = _task_operator("phase", "find_phase", "Find Phase", "The periodic motions of the active action (period, "
-                           "number of periods, excitation), listed in the panel", COMMON, _find_phase)
+FindPhase = _task_operator("phase", "find_phase", "Find Phase", "The steady parts of the active action and the period "
+                           "of each part that repeats, listed in the panel", COMMON, _find_phase)
 ExtractCycle = _task_operator("loop", "extract_cycle", "Extract Cycle", "The typical cycle of the active action as a "
                               "new, looping action named <action>_cycle", {**COMMON, **props.WHICH}, _extract_cycle)
 BlendCycles = _task_operator("blend", "blend_cycles", "Blend Cycles", "Blend the cycles of the active action and "

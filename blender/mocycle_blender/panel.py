@@ -1,5 +1,5 @@
-"""The sidebar panel (3D view, tab "mocycle"): the options of each task, the periodic motions found, the last
-result. Each button runs its operator with the panel's settings."""
+"""The sidebar panel (3D view, tab "mocycle"): the options of each task, the parts found, the last result.
+Each button runs its operator with the panel's settings."""
 
 from __future__ import annotations
 
@@ -12,12 +12,6 @@ from . import props
 #: options drawn under "Advanced" (the thesis' options 16-24); the rest are always shown
 ADVANCED = {"classes", "pca", "delay", "min_periods", "n_landmarks", "time_axis", "harmonics", "force",
             "foot_joints", "align", "window_frames"}
-
-
-class MOCYCLE_UL_periodic(bpy.types.UIList):
-    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
-        layout.label(text=f"{index}: {item.period_frames:.1f} fr ({item.period_s:.2f} s) × {item.n_periods:.1f}"
-                          f"  [{item.excitation}]")
 
 
 class MOCYCLE_UL_parts(bpy.types.UIList):
@@ -36,9 +30,7 @@ def _button(layout, idname, text, group, options_cls, st, extra=()):
     op = layout.operator(idname, text=text)
     props.copy_options(options_cls, group, op)
     for k in extra:
-        if k == "which":
-            op.which = st.periodic_index if 0 <= st.periodic_index < len(st.periodic) else -1
-        elif k == "part":  # Extract Cycle's which is a part of the action (the list its last run filled)
+        if k == "which":  # a part of the action (the list Find Phase or Extract Cycle filled last)
             op.which = st.part_index if 0 <= st.part_index < len(st.parts) else -1
         elif k == "other":
             op.other = st.other_action.name if st.other_action else ""
@@ -75,18 +67,16 @@ class MOCYCLE_PT_panel(bpy.types.Panel):
         box.prop(st, "selected_bones", text="Phase on selected bones (Pose Mode)")
 
         box = layout.box()
-        box.label(text="Periodic motions")
+        box.label(text="Parts")
         _options(box, st.phase, tasks.phase.Options, advanced=False)
         _button(box, "mocycle.find_phase", "Find Phase", st.phase, tasks.phase.Options, st, common)
-        if len(st.periodic):
-            box.template_list("MOCYCLE_UL_periodic", "", st, "periodic", st, "periodic_index", rows=2)
+        if len(st.parts):  # the steady parts Find Phase or Extract Cycle found: pick one, the buttons below use it
+            box.template_list("MOCYCLE_UL_parts", "", st, "parts", st, "part_index", rows=3)
 
         box = layout.box()
         box.label(text="Cycle")
         _options(box, st.loop, tasks.loop.Options, advanced=False)
-        _button(box, "mocycle.extract_cycle", "Extract Cycle", st.loop, tasks.loop.Options, st, common + ("part",))
-        if len(st.parts):  # the steady parts the last Extract Cycle found: pick one, Extract Cycle loops it
-            box.template_list("MOCYCLE_UL_parts", "", st, "parts", st, "part_index", rows=3)
+        _button(box, "mocycle.extract_cycle", "Extract Cycle", st.loop, tasks.loop.Options, st, common + ("which",))
 
         box = layout.box()
         box.label(text="Blend / Transition")
@@ -136,4 +126,4 @@ class MOCYCLE_PT_advanced(bpy.types.Panel):
             _options(box, group, cls, advanced=True)
 
 
-CLASSES = (MOCYCLE_UL_periodic, MOCYCLE_UL_parts, MOCYCLE_PT_panel, MOCYCLE_PT_advanced)
+CLASSES = (MOCYCLE_UL_parts, MOCYCLE_PT_panel, MOCYCLE_PT_advanced)

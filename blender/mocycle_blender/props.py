@@ -16,7 +16,7 @@ from bpy.props import (
 from mocycle import tasks
 
 #: fields the add-on fills from Blender itself: the frame range from frame numbers, the phase joints from the
-#: Pose Mode selection, the periodic motion from the list ``find_phase`` made; AMC input never reaches it
+#: Pose Mode selection, the part from the list ``find_phase`` or ``extract_cycle`` made; AMC input never reaches it
 FROM_BLENDER = {"amc_fps", "frame_range", "joints", "which"}
 #: a value for fields the task requires (no default)
 REQUIRED_DEFAULTS = {"factor": 1.5}
@@ -86,9 +86,9 @@ COMMON = {
         name="Selected bones", default=True,
         description="In Pose Mode, find the phase on the selected bones only (all bones are animated)"),
 }
-WHICH = {"which": IntProperty(name="Periodic motion", default=-1, min=-1,
-                              description="Which periodic motion (0-based, from Find Phase; -1: the one "
-                                          "covering most frames)")}
+WHICH = {"which": IntProperty(name="Part", default=-1, min=-1,
+                              description="Which part of the action (0-based, as the panel lists them after Find "
+                                          "Phase or Extract Cycle; -1: the steady part with the most cycles)")}
 OTHER = {"other": StringProperty(name="Other actions", description="Names of the other action(s), "
                                  "comma-separated (the active action comes first)")}
 
@@ -97,15 +97,6 @@ LoopSettings = _group("MOCYCLE_PG_loop", tasks.loop.Options)
 BlendSettings = _group("MOCYCLE_PG_blend", tasks.blend.Options)
 TransitionSettings = _group("MOCYCLE_PG_transition", tasks.transition.Options)
 StretchSettings = _group("MOCYCLE_PG_stretch", tasks.stretch.Options)
-
-
-class MOCYCLE_PG_periodic(bpy.types.PropertyGroup):
-    """One periodic motion found by ``find_phase``."""
-
-    period_frames: FloatProperty(name="Period (frames)")
-    period_s: FloatProperty(name="Period (s)")
-    n_periods: FloatProperty(name="Periods")
-    excitation: StringProperty(name="Excitation (frames)")
 
 
 class MOCYCLE_PG_part(bpy.types.PropertyGroup):
@@ -130,8 +121,6 @@ MOCYCLE_PG_state = type("MOCYCLE_PG_state", (bpy.types.PropertyGroup,), {"__anno
     "other_action": PointerProperty(type=bpy.types.Action, name="Other action",
                                     description="The second action of Blend and Transition"),
     "other_weight": FloatProperty(name="Weight of the other", default=0.5, min=0.0, max=1.0),
-    "periodic": CollectionProperty(type=MOCYCLE_PG_periodic),
-    "periodic_index": IntProperty(name="Periodic motion", default=-1),
     "parts": CollectionProperty(type=MOCYCLE_PG_part),
     "part_index": IntProperty(name="Part", default=-1),
     "last_task": StringProperty(),
@@ -143,5 +132,5 @@ MOCYCLE_PG_state = type("MOCYCLE_PG_state", (bpy.types.PropertyGroup,), {"__anno
 }})
 
 
-CLASSES = (PhaseSettings, LoopSettings, BlendSettings, TransitionSettings, StretchSettings, MOCYCLE_PG_periodic,
+CLASSES = (PhaseSettings, LoopSettings, BlendSettings, TransitionSettings, StretchSettings,
            MOCYCLE_PG_part, MOCYCLE_PG_state)
