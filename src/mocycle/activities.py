@@ -319,6 +319,31 @@ def _step_gaits(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
     return out
 
 
+#: Where the strides of a straight gait change, over three strides before against three after, by more than
+#: this share in period or in speed, the gait changes (another take, another style): a part ends at that
+#: landing.  Steady strides vary by a few per cent in both.
+STRIDE_PERIOD_STEP, STRIDE_SPEED_STEP = 0.08, 0.15
+
+
+def _gait_changes(strides: np.ndarray) -> set[int]:
+    """The landings (indices into a chain's landings; a part boundary there starts a new part at that step)
+    where a straight gait changes tempo or speed (:data:`STRIDE_PERIOD_STEP`, :data:`STRIDE_SPEED_STEP`): the
+    medians of up to three strides ending at the landing and three starting there differ; of neighbouring
+    candidates, the landing where they differ most.  Turning strides are left out: a turn slows a walk, and
+    the turn's own borders are cut by :func:`_turn_runs`."""
+    n = strides.shape[0]
+    score = np.zeros(n + 2)
+    for b in range(2, n):  # strides k <= b - 2 end by landing b; strides k >= b start there
+        before, after = strides[max(0, b - 4): b - 1], strides[b: b + 3]
+        if before.shape[0] < 2 or after.shape[0] < 2 or \
+                np.abs(np.concatenate([before[:, 1], after[:, 1]])).max() > TURN_DEG:
+            continue
+        (p0, v0), (p1, v1) = np.median(before[:, [0, 2]], axis=0), np.median(after[:, [0, 2]], axis=0)
+        change = max(abs(p1 / p0 - 1) / STRIDE_PERIOD_STEP, abs(v1 / v0 - 1) / STRIDE_SPEED_STEP if v0 > 0 else 0)
+        score[b] = change if change > 1.0 else 0.0
+    return {b for b in range(2, n) if score[b] > 0 and score[b] >= score[b - 1] and score[b] > score[b + 1]}
+
+
 def stride_rate(heading: np.ndarray, period: float, start: int, stop: int) -> np.ndarray:
     """The hips' turning rate ``(stop - start,)`` in degrees per stride: the heading's change over one stride
     (``period`` frames) about each frame, where the hips' sway within a stride cancels; near the take's ends the
@@ -455,11 +480,12 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
             continue
         strides = _stride_figures(chain, landings, heading, path, fps)
         kinds = _step_gaits(strides, body)
+        cuts = _gait_changes(strides)
         f = landings.frames[chain]
         i = 0
         while i < len(kinds):
             j = i + 1
-            while j < len(kinds) and kinds[j][0] == kinds[i][0] and \
+            while j < len(kinds) and kinds[j][0] == kinds[i][0] and j not in cuts and \
                     abs(kinds[j][1] / float(np.median([k[1] for k in kinds[i:j]])) - 1) <= TEMPO_CHANGE:
                 j += 1
             # steps i .. j-1: landings f[i] .. f[j]

@@ -528,8 +528,9 @@ def synthetic_still(n_frames: int = 300, fps: float = 60.0, noise_deg: float = 0
 
 
 def synthetic_gesture(n_frames: int = 240, fps: float = 60.0, noise_deg: float = 0.5,
-                      seed: int = 0) -> SyntheticTake:
-    """A one-off gesture: standing with the arms down, both hands raised above the head once and lowered.
+                      seed: int = 0, hand: str = "both") -> SyntheticTake:
+    """A one-off gesture: standing with the arms down, the hands (``hand``: ``"both"``, ``"left"`` or
+    ``"right"``) raised above the head once and lowered.
 
     The raise takes the middle 40 % of the take (up, a short hold, down, smoothstep ramps); the rest is
     standing still with Gaussian angle noise (``noise_deg``).  Nothing repeats: a take that stretching
@@ -538,6 +539,8 @@ def synthetic_gesture(n_frames: int = 240, fps: float = 60.0, noise_deg: float =
     n_frames, fps = _check(n_frames, fps)
     if not np.isfinite(noise_deg) or noise_deg < 0:
         raise MocycleError(f"noise_deg must be >= 0; got {noise_deg!r}")
+    if hand not in _HANDS:
+        raise MocycleError(f"hand must be 'left', 'right' or 'both'; got {hand!r}")
     skel = humanoid_skeleton()
     t = np.arange(n_frames) / max(n_frames - 1, 1)
     a, b = 0.3, 0.7                                    # the gesture's span (fractions of the take)
@@ -546,8 +549,9 @@ def synthetic_gesture(n_frames: int = 240, fps: float = 60.0, noise_deg: float =
     lift = _smoothstep(np.minimum(up, down))           # 0 standing, 1 hands above the head
     ang = np.zeros((n_frames, skel.n_joints, 3))
     for side, sign in (("Left", 1.0), ("Right", -1.0)):
-        ang[:, _IX[f"{side}Arm"], _AXIS["Z"]] = sign * (-75.0 + 160.0 * lift)
-        ang[:, _IX[f"{side}ForeArm"], _AXIS["Y"]] = -sign * (15.0 + 20.0 * np.sin(np.pi * lift))
+        raised = lift if side in _HANDS[hand] else np.zeros(n_frames)
+        ang[:, _IX[f"{side}Arm"], _AXIS["Z"]] = sign * (-75.0 + 160.0 * raised)
+        ang[:, _IX[f"{side}ForeArm"], _AXIS["Y"]] = -sign * (15.0 + 20.0 * np.sin(np.pi * raised))
     ang[:, _IX["Spine1"], _AXIS["X"]] = -4.0 * lift   # a slight lean back with the hands up
     if noise_deg > 0:
         ang += np.random.default_rng(seed).normal(0.0, noise_deg, size=ang.shape)
@@ -557,7 +561,7 @@ def synthetic_gesture(n_frames: int = 240, fps: float = 60.0, noise_deg: float =
     i, j = int(round(a * (n_frames - 1))), int(round(b * (n_frames - 1))) + 1
     return SyntheticTake(Motion(skel, q, None, 1.0 / fps, root_positions=root), nan, nan.copy(), nan.copy(),
                          [("still", 0, i), ("gesture", i, j), ("still", j, n_frames)],
-                         f"synthetic gesture (both hands raised once): {n_frames} frames at {fps:g} fps, "
+                         f"synthetic gesture ({hand} hand(s) raised once): {n_frames} frames at {fps:g} fps, "
                          f"noise {noise_deg:g} deg, seed {seed}", chan)
 
 
