@@ -506,8 +506,36 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
             else:
                 _asked_phase(motion, p, min_periods, options)
     _decide(parts, min_periods)
+    parts = _second_look(motion, parts, min_periods, options)
     return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True, reason=_listing(parts),
                       landings=landings)
+
+
+def _second_look(motion: Motion, parts: list[Activity], min_periods: float, options: dict) -> list[Activity]:
+    """Frames where steps were seen but no gait part loops (landings missed on a rig whose feet slide, a
+    stumble) looked at again as frames without gait (:func:`_other`): each run of neighbouring parts that do
+    not loop, holding steps and lasting :data:`MIN_OTHER_S` or more, is replaced by what that finds when it
+    finds a motion that repeats there; otherwise the parts stay as they were."""
+    out: list[Activity] = []
+    k = 0
+    while k < len(parts):
+        j = k
+        while j < len(parts) and not parts[j].loop:
+            j += 1
+        if j == k:
+            out.append(parts[k])
+            k += 1
+            continue
+        run = parts[k:j]
+        a, b = run[0].start, run[-1].stop
+        if any(p.landings for p in run) and (b - a) * motion.frame_time >= MIN_OTHER_S:
+            again = _other(motion, a, b, min_periods, True, options)
+            _decide(again, min_periods)
+            if any(p.loop for p in again):
+                run = again
+        out.extend(run)
+        k = j
+    return out
 
 
 def _listing(parts: list[Activity]) -> str:
@@ -672,20 +700,23 @@ def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
     return _unlike(X, lag) < (UNLIKE if overlap >= lag else UNLIKE_ONE_STEP)
 
 
-#: The legs' self-similar period overrules the landings' when it is this far off and at least twice as alike.
-LEGS_OVERRULE = 0.05
+#: The legs' self-similar period overrules the landings' when it is this far off and the legs are at least
+#: LEGS_BETTER times as unlike at the landings' period as at their own (a landing seen early or late skews a
+#: line through a few landings; the legs' repeat is measured on every frame).
+LEGS_OVERRULE, LEGS_BETTER = 0.02, 1.5
 
 
 def legs_check(motion: Motion, start: int, stop: int, period: float) -> tuple[float, str]:
     """The landings' ``period`` checked by the legs over frames ``start .. stop-1``: ``(NaN, why)`` when the
     legs agree (or cannot tell), ``(their period, why)`` when they are most alike more than
-    :data:`LEGS_OVERRULE` away from it and at least twice as alike there (a landing detected early or late)."""
+    :data:`LEGS_OVERRULE` away from it and :data:`LEGS_BETTER` times as alike there (a landing detected early or
+    late)."""
     legs, unlike = short_period(motion, period, start, stop)
     at = legs_repeat(motion, start, stop, period)
     if not np.isfinite(legs) or abs(legs / period - 1) <= LEGS_OVERRULE:
         return float("nan"), (f"the legs agree ({legs:.2f} frames)" if np.isfinite(legs) else
                               "the legs cannot tell")
-    if not (np.isfinite(at) and unlike < 0.5 * at):
+    if not (np.isfinite(at) and LEGS_BETTER * unlike < at):
         return float("nan"), f"the legs' {legs:.2f} frames are not clearly better"
     return float(legs), (f"the legs are most alike {legs:.2f} frames apart (unlikeness {unlike:.2f} against "
                          f"{at:.2f} at the landings' {period:.2f})")
