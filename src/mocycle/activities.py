@@ -319,28 +319,39 @@ def _step_gaits(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
     return out
 
 
-#: Where the strides of a straight gait change, over three strides before against three after, by more than
-#: this share in period or in speed, the gait changes (another take, another style): a part ends at that
-#: landing.  Steady strides vary by a few per cent in both.
-STRIDE_PERIOD_STEP, STRIDE_SPEED_STEP = 0.08, 0.15
+#: How much the strides of a straight gait may change, over three strides before a landing against three after,
+#: and still be one gait: in period and speed (shares) and in flight and double support (shares of a stride),
+#: each as the scale of its change.  Where the root of the sum of the squared scaled changes passes
+#: GAIT_CHANGE and is STEADY_SIDES times the spread within either side (a step between two steady gaits, as
+#: where one take meets the next, not the ramp of a walk that starts from standing), the gait changes there.
+STRIDE_STEPS = {"period": 0.08, "speed": 0.15, "flight": 0.12, "double support": 0.15}
+GAIT_CHANGE, STEADY_SIDES = 1.25, 3.0
 
 
 def _gait_changes(strides: np.ndarray) -> set[int]:
     """The landings (indices into a chain's landings; a part boundary there starts a new part at that step)
-    where a straight gait changes tempo or speed (:data:`STRIDE_PERIOD_STEP`, :data:`STRIDE_SPEED_STEP`): the
+    where a straight gait changes (:data:`STRIDE_STEPS`, :data:`GAIT_CHANGE`, :data:`STEADY_SIDES`): the
     medians of up to three strides ending at the landing and three starting there differ; of neighbouring
     candidates, the landing where they differ most.  Turning strides are left out: a turn slows a walk, and
     the turn's own borders are cut by :func:`_turn_runs`."""
     n = strides.shape[0]
+    scale = np.array([STRIDE_STEPS["period"], STRIDE_STEPS["speed"], STRIDE_STEPS["flight"],
+                      STRIDE_STEPS["double support"]])
     score = np.zeros(n + 2)
     for b in range(2, n):  # strides k <= b - 2 end by landing b; strides k >= b start there
         before, after = strides[max(0, b - 4): b - 1], strides[b: b + 3]
         if before.shape[0] < 2 or after.shape[0] < 2 or \
                 np.abs(np.concatenate([before[:, 1], after[:, 1]])).max() > TURN_DEG:
             continue
-        (p0, v0), (p1, v1) = np.median(before[:, [0, 2]], axis=0), np.median(after[:, [0, 2]], axis=0)
-        change = max(abs(p1 / p0 - 1) / STRIDE_PERIOD_STEP, abs(v1 / v0 - 1) / STRIDE_SPEED_STEP if v0 > 0 else 0)
-        score[b] = change if change > 1.0 else 0.0
+        fb, fa = before[:, [0, 2, 3, 4]], after[:, [0, 2, 3, 4]]
+        m0 = np.median(fb, axis=0)
+        if not (m0[0] > 0 and m0[1] > 0):
+            continue
+        unit = np.array([m0[0], m0[1], 1.0, 1.0]) * scale  # period and speed relative, the shares absolute
+        change, within_b, within_a = (float(np.sqrt(np.sum((d / unit) ** 2))) for d in
+                                      (np.median(fa, axis=0) - m0, np.ptp(fb, axis=0) / 2, np.ptp(fa, axis=0) / 2))
+        within = max(within_b, within_a)
+        score[b] = change if change > GAIT_CHANGE and change > STEADY_SIDES * within else 0.0
     return {b for b in range(2, n) if score[b] > 0 and score[b] >= score[b - 1] and score[b] > score[b + 1]}
 
 
@@ -490,7 +501,8 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
                 j += 1
             # steps i .. j-1: landings f[i] .. f[j]
             parts.append(_gait_part(kinds[i][0], f, chain, i, j, landings, strides, heading, path, fps))
-            i = j
+            # where the gait changes, the step across the change belongs to neither part (a blend of the two)
+            i = j + 1 if j in cuts and j + 2 < len(kinds) else j
     # steps that land in turn but whose legs do not repeat a stride later (a wander, a stumble) are no gait
     parts = [p for p in parts if _legs_repeat_in(motion, p)]
     parts.sort(key=lambda p: p.start)
