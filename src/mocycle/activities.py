@@ -348,8 +348,10 @@ def _gait_changes(strides: np.ndarray) -> set[int]:
         if not (m0[0] > 0 and m0[1] > 0):
             continue
         unit = np.array([m0[0], m0[1], 1.0, 1.0]) * scale  # period and speed relative, the shares absolute
+        m1 = np.median(fa, axis=0)  # spread: the median deviation, blind to the one stride a blend may spoil
         change, within_b, within_a = (float(np.sqrt(np.sum((d / unit) ** 2))) for d in
-                                      (np.median(fa, axis=0) - m0, np.ptp(fb, axis=0) / 2, np.ptp(fa, axis=0) / 2))
+                                      (m1 - m0, np.median(np.abs(fb - m0), axis=0),
+                                       np.median(np.abs(fa - m1), axis=0)))
         within = max(within_b, within_a)
         score[b] = change if change > GAIT_CHANGE and change > STEADY_SIDES * within else 0.0
     return {b for b in range(2, n) if score[b] > 0 and score[b] >= score[b - 1] and score[b] > score[b + 1]}
