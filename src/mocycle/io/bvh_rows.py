@@ -1,7 +1,7 @@
 """The frame rows of a long BVH file parsed fast: polars' CSV reader, a chunk of lines at a time.
 
 Text numbers are most of a BVH read.  ``np.loadtxt`` parses about 45 MB/s; polars' CSV reader (the optional
-extra ``mocycle[fast]``) about 250 MB/s on one thread, to the same float64 values bit for bit (both round
+extra ``mocycle[fast]``) about 200 MB/s on one thread, to the same float64 values bit for bit (both round
 correctly; ``docs/performance.md`` has the figures and the other parsers measured).  :func:`row_chunks` cuts
 the motion block at line ends into pieces of :data:`CHUNK_BYTES`, and parses the next piece in a helper thread
 (polars releases the GIL) while the caller converts the one before, so reading takes about the parse alone.
