@@ -18,7 +18,7 @@ import pytest
 import mocycle
 
 FORBIDDEN = ("typer", "rich", "click", "matplotlib", "dask", "distributed", "starlette", "uvicorn", "bpy",
-             "pygltflib")
+             "pygltflib", "polars")
 REQUIRED = ("numpy", "scipy", "sklearn", "ripser", "threadpoolctl", "joblib")
 CORE = ["mocycle", "mocycle.errors", "mocycle.io", "mocycle.io.mck", "mocycle.io.mosw", "mocycle.motion",
         "mocycle.rotations", "mocycle.axes", "mocycle.features", "mocycle.datasets", "mocycle.phase",

@@ -93,6 +93,39 @@ def test_resample_keeps_frames_at_shared_times_and_interpolates_between():
     assert np.isclose((a.inv() * mid).magnitude(), (mid.inv() * b).magnitude(), atol=1e-9)
 
 
+@pytest.mark.parametrize("frame_time", [0.0333333, 1 / 30, 0.033333])
+@pytest.mark.parametrize("n_frames, fps, expected", [(273, 60, 545), (108_000, 120, 431_997), (108_000, 25, 90_000),
+                                                       (3, 120, 9), (108_001, 10, 36_001)])
+def test_resample_counts_frames_exactly_at_any_length(frame_time, n_frames, fps, expected):
+    """A file's frame time is rounded (0.0333333 s): the count is the 30 fps take's, however long the take
+    (a tolerance that grew with the take gave 432,000 frames for 3,600 s at 120 fps)."""
+    m = random_motion(n_frames).replace(frame_time=frame_time)
+    up = m.resample(fps)
+    assert up.n_frames == expected
+    step = 30 / fps
+    if step.is_integer() or (1 / step).is_integer():  # shared frames are the old frames
+        k = max(1, round(1 / step))
+        shared = up.rotations[::k] if step < 1 else up.rotations
+        old = m.rotations if step < 1 else m.rotations[::round(step)]
+        assert max_angle(shared[:len(old)], old[:len(shared)]) < 1e-9
+    assert max_angle(up.rotations[-1:], m.rotations[-1:]) < 1e-9 or (n_frames - 1) * fps % 30
+
+
+def test_frame_time_fraction_recognises_rounded_rates_only():
+    from fractions import Fraction
+
+    from mocycle.motion import frame_time_fraction
+
+    assert frame_time_fraction(0.0333333) == Fraction(1, 30)
+    assert frame_time_fraction(0.016667) == Fraction(1, 60)  # iClone's five digits
+    assert frame_time_fraction(0.0083333) == Fraction(1, 120)  # CMU's
+    assert frame_time_fraction(0.0333667) == Fraction(1001, 30000)  # NTSC 29.97
+    assert frame_time_fraction(1 / 30) == Fraction(1, 30)
+    assert frame_time_fraction(0.01) == Fraction(1, 100)
+    assert frame_time_fraction(0.0123456789) == Fraction("0.0123456789")  # no whole rate: the decimal
+    assert frame_time_fraction(2.5) == Fraction(5, 2)
+
+
 def test_concatenate_checks_skeleton():
     m = random_motion(10)
     both = concatenate([m, m])

@@ -666,22 +666,26 @@ class Motion:
     def resample(self, fps: float) -> Motion:
         """Resample to ``fps`` frames per second over the same duration.
 
-        Rotations are interpolated by slerp, translations linearly.  The first
-        frame is kept; the last new frame is the old last frame when the new frame time divides the duration
-        (within 1e-5 of a frame per frame: file frame times are rounded, e.g. ``0.0333333``), else the last
-        new frame before it.  273 frames at 30 fps give 545 at 60 fps.
+        Rotations are interpolated by slerp, translations linearly.  The first frame is kept; the last new
+        frame is the old last frame when the new frame time divides the duration, else the last new frame
+        before it.  The frame time is taken as the rate it was rounded from (:func:`frame_time_fraction`: a
+        file's ``0.0333333`` is 1/30 s), so the count is exact at any length: 273 frames at 30 fps give 545
+        at 60 fps, 108,000 give 431,997 at 120 fps, and every fourth new frame is an old one.
         """
+        from fractions import Fraction
+
         fps = _validate.positive("fps", fps)
         if frame_time_problem(1.0 / fps):
             raise MocycleError(f"fps must be a positive number within [1e-4, 1e6]; got {fps:g}")
         new_dt = 1.0 / fps
         if self.n_frames == 1:
             return self.replace(frame_time=new_dt)
-        old_t = np.arange(self.n_frames) * self.frame_time
-        steps = self.duration / new_dt
-        n_new = check_frames(np.floor(steps + max(1e-9, 1e-5 * steps)) + 1, self.n_joints,
+        # old frames per new frame, exactly: the new frames fall at k * step in old frames
+        step = 1 / (Fraction(repr(float(fps))) * frame_time_fraction(self.frame_time))
+        n_new = check_frames((self.n_frames - 1) // step + 1, self.n_joints,
                              f"resampling {self.n_frames} frames to {fps:g} fps")
-        new_t = np.minimum(np.arange(n_new) * new_dt, old_t[-1])
+        old_t = np.arange(self.n_frames, dtype=np.float64)
+        new_t = np.minimum(np.arange(n_new) * float(step), old_t[-1])
         rot = np.empty((n_new, self.n_joints, 4))
         for j in range(self.n_joints):
             rot[:, j] = Slerp(old_t, Rotation.from_quat(self.rotations[:, j]))(new_t).as_quat()
@@ -695,6 +699,29 @@ class Motion:
         q = np.zeros((n_frames, skeleton.n_joints, 4))
         q[..., 3] = 1.0
         return cls(skeleton, q, None, frame_time)
+
+
+def frame_time_fraction(frame_time: float):
+    """The frame time (s) as the exact fraction it was rounded from: ``1/N`` or NTSC's ``1001/(1000 N)`` s for
+    the whole rate ``N`` nearest to it when that lies within half a unit of the last digit of its shortest
+    decimal, or rounds to the same float (``0.0333333`` -> 1/30, ``0.016667`` -> 1/60, ``0.0333667`` ->
+    1001/30000, ``1 / 60`` -> 1/60), else the decimal itself (``0.0123456789``).  A ``fractions.Fraction``.
+    """
+    import math
+    from decimal import Decimal
+    from fractions import Fraction
+
+    x = float(frame_time)
+    text = Decimal(repr(x))
+    value = Fraction(text)
+    exponent = text.as_tuple().exponent
+    half = max(Fraction(1, 2) * Fraction(10) ** (exponent if isinstance(exponent, int) else 0),
+               Fraction(math.ulp(x)) / 2)
+    for ntsc in (Fraction(1), Fraction(1001, 1000)):
+        rate = round(ntsc / value)
+        if rate >= 1 and abs(ntsc / rate - value) <= half:
+            return ntsc / rate
+    return value
 
 
 def concatenate(motions: Sequence[Motion]) -> Motion:

@@ -28,9 +28,9 @@ from .errors import MocycleError
 __all__ = ["ENV", "LIBRARY_VARIABLES", "limit_threads", "limited", "pin_environment", "threads"]
 
 ENV = "MOCYCLE_THREADS"
-#: the variables BLAS and OpenMP builds read when they load
+#: the variables BLAS and OpenMP builds read when they load (and polars, which parses long BVH files)
 LIBRARY_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-                     "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+                     "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS", "POLARS_MAX_THREADS")
 
 _inside = threading.local()
 

@@ -46,3 +46,19 @@ def test_failed_write_leaves_no_temporary_file(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         atomic_write(tmp_path / "c.bvh", "data")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_folder_is_listed_once_however_many_outputs_go_there(tmp_path, monkeypatch):
+    """Writing n outputs into one folder lists it once (not n times: quadratic in n), and each target's
+    leftovers from that listing still go at its own first write."""
+    from mocycle.io import atomic
+
+    for k in range(3):
+        (tmp_path / f".out{k}.bvh.4194399.x1y2.tmp").write_text("partial")
+    listed = []
+    scandir = os.scandir
+    monkeypatch.setattr(atomic.os, "scandir", lambda folder: listed.append(folder) or scandir(folder))
+    for k in range(50):
+        atomic_write(tmp_path / f"out{k}.bvh", "new")
+    assert len(listed) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"out{k}.bvh" for k in range(50))

@@ -123,7 +123,7 @@ def test_round_trip_shared_files(path, tmp_path):
 def test_read_in_blocks_is_the_motion_of_its_channels(tmp_path, monkeypatch, block):
     """read_bvh normalises and sign-flips block by block (and skips Motion's own pass): bit for bit what
     Motion makes of euler_to_quats' quaternions, with sign flips inside and across blocks."""
-    from mocycle.io import bvh
+    from mocycle.io import bvh_channels
     from mocycle.motion import Motion
     from mocycle.rotations import euler_to_quats
 
@@ -136,7 +136,7 @@ def test_read_in_blocks_is_the_motion_of_its_channels(tmp_path, monkeypatch, blo
     text = format_bvh(m).split("Frame Time:")[0] + f"Frame Time: {m.frame_time!r}\n"
     path = tmp_path / "flips.bvh"
     path.write_text(text + "\n".join(" ".join(repr(float(v)) for v in row) for row in values) + "\n")
-    monkeypatch.setattr(bvh, "BLOCK_FRAMES", block)
+    monkeypatch.setattr(bvh_channels, "BLOCK_FRAMES", block)
     read = read_bvh(path)
 
     quats = np.empty_like(m.rotations)

@@ -27,13 +27,13 @@ glTF and FBX files may hold several animations (takes): ``take`` names one (:fun
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 from pathlib import Path
 
 from ..errors import MotionFileError
 from ..motion import Motion
+from ..text import indented_json
 from .asfamc import AMC_FPS, read_amc, read_asf, read_asfamc
 from .atomic import atomic_write
 from .bvh import parse_bvh, read_bvh, write_bvh
@@ -262,6 +262,6 @@ def write(obj, path: str | os.PathLike, *, clip=None, gltf_scale: float | str = 
     else:
         document = obj.to_dict()
     try:
-        return atomic_write(p, json.dumps(document, indent=1))
+        return atomic_write(p, indented_json(document, indent=1))  # json.dumps' text, at C speed
     except OSError as exc:
         raise MotionFileError(f"cannot write file ({exc.strerror or exc})", p) from None

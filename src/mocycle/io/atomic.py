@@ -5,18 +5,26 @@ the process lives to see (an exception, Ctrl-C, SIGTERM handled by the CLI).  A 
 (SIGKILL, power loss) leaves it behind: the next write to the same target removes such leftovers of
 processes that no longer run (:func:`clean_stale`).  Readers never take them for takes (they end in
 ``.tmp``).
+
+A process lists a folder's leftovers once, at its first write there, not at every write: writing ``n``
+outputs into one folder costs one listing, not ``n`` listings of a folder that grows to ``n`` files.  The
+leftovers of a run killed while this process runs are the next process's to remove.
 """
 
 from __future__ import annotations
 
 import os
 import tempfile
+import threading
 import time
 from collections.abc import Iterable
 from pathlib import Path
 
 #: A leftover temporary file without a process id in its name counts as stale after this many seconds.
 STALE_AFTER_S = 3600.0
+
+_leftovers: dict[str, list[str]] = {}  # per folder (absolute) listed by this process: the names of its leftovers
+_lock = threading.Lock()  # batch's threaded workers write side by side
 
 
 def _file_mode(path: Path) -> int:
@@ -71,29 +79,53 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def _folder_leftovers(folder: Path) -> list[str]:
+    """The names in ``folder`` that look like leftovers (``.<name>...tmp``), listed once per process."""
+    key = os.path.abspath(folder)
+    names = _leftovers.get(key)
+    if names is None:
+        try:
+            with os.scandir(folder) as entries:
+                names = [e.name for e in entries if e.name.startswith(".") and e.name.endswith(".tmp")]
+        except OSError:
+            names = []
+        _leftovers[key] = names
+    return names
+
+
 def clean_stale(path: str | os.PathLike) -> list[Path]:
     """Remove the temporary files a killed write to ``path`` left behind; returns the ones removed.
 
     ``.<name>.<pid>.<random>.tmp`` goes when process ``pid`` no longer runs; an older
-    ``.<name>.<random>.tmp`` (no process id) when it is older than :data:`STALE_AFTER_S`.
+    ``.<name>.<random>.tmp`` (no process id) when it is older than :data:`STALE_AFTER_S`.  The folder is
+    listed at this process's first write there (:func:`_folder_leftovers`); later calls look only at what
+    that listing found.
     """
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
     prefix = f".{path.name}."
-    removed = []
-    try:
-        candidates = [p for p in folder.iterdir() if p.name.startswith(prefix) and p.name.endswith(".tmp")]
-    except OSError:
-        return removed
-    now = time.time()
-    for p in candidates:
-        middle = p.name[len(prefix):-len(".tmp")]
-        pid_text = middle.split(".", 1)[0] if "." in middle else ""
-        try:
-            stale = (not _alive(int(pid_text))) if pid_text.isdigit() else now - p.stat().st_mtime > STALE_AFTER_S
-            if stale:
-                p.unlink()
-                removed.append(p)
-        except OSError:
-            continue
+    removed: list[Path] = []
+    with _lock:
+        names = _folder_leftovers(folder)
+        mine = [n for n in names if n.startswith(prefix)]
+        if not mine:
+            return removed
+        now = time.time()
+        for name in mine:
+            p = folder / name
+            middle = name[len(prefix):-len(".tmp")]
+            pid_text = middle.split(".", 1)[0] if "." in middle else ""
+            try:
+                if pid_text.isdigit():
+                    stale = not _alive(int(pid_text))
+                else:
+                    stale = now - p.stat().st_mtime > STALE_AFTER_S
+                if stale:
+                    p.unlink()
+                    removed.append(p)
+                    names.remove(name)
+            except FileNotFoundError:
+                names.remove(name)
+            except OSError:
+                continue
     return removed

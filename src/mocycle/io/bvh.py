@@ -12,15 +12,17 @@ Writing keeps each joint's channel order and the End Sites, writes the exact
 frame time and Euler angles that are continuous in time, and replaces the
 target file in one step (never a half-written file).
 
-:func:`read_bvh` reads the hierarchy line by line, then hands the file to numpy's C ``loadtxt`` (the
-floor for text numbers) and turns the channels into quaternions a block of frames at a time, so a read
-takes about 1.2 times ``loadtxt`` of the same numbers and peaks at about 3.3 times the float64 channel
-array (``docs/performance.md``).  When anything is off (a warning, an error, a line ``loadtxt`` cannot
-take), the whole file is parsed again the careful way (:func:`parse_bvh`), which says what is wrong where.
+:func:`read_bvh` reads the hierarchy line by line, then the frame rows: a long file's by polars' CSV reader
+a chunk at a time in a helper thread when the extra ``mocycle[fast]`` is installed (:mod:`.bvh_rows`), others
+by numpy's C ``loadtxt``; the rows become quaternions as they come (:mod:`.bvh_channels`), so a read takes
+about the parse alone with polars and 1.1-1.2 times ``loadtxt`` without (``docs/performance.md``).  When
+anything is off (a warning, an error, a line the parser cannot take), the whole file is parsed again the
+careful way (:func:`parse_bvh`), which says what is wrong where.
 """
 
 from __future__ import annotations
 
+import contextlib
 import io
 import math
 import os
@@ -33,15 +35,13 @@ import numpy as np
 from ..errors import MocycleError, MocycleWarning, MotionFileError
 from ..limits import MAX_MAGNITUDE, check_frames, frame_time_problem
 from ..motion import POSITION_CHANNELS, ROTATION_CHANNELS, EndSite, Motion, Skeleton
-from ..rotations import continuous_euler_blocks, euler_quat_components
+from ..rotations import continuous_euler_blocks
+from . import bvh_rows
 from .atomic import atomic_write
+from .bvh_channels import ChannelConverter
+from .bvh_channels import channel_layout as _channel_layout
 
 _CHANNEL_NAMES = {c.lower(): c for c in ROTATION_CHANNELS + POSITION_CHANNELS}
-
-
-#: frames converted to quaternions at a time (keeps the temporaries small and in cache: 128 frames were
-#: fastest on the CMU and 100-joint iClone takes; 1024 is 1.5x slower)
-BLOCK_FRAMES = 128
 
 
 def read_bvh(path: str | os.PathLike) -> Motion:
@@ -53,18 +53,19 @@ def read_bvh(path: str | os.PathLike) -> Motion:
             return parse_bvh(p.read_bytes(), path=p)
     except OSError as exc:
         raise MotionFileError(f"cannot read file ({exc.strerror or exc})", p) from None
-    skel, frames, frame_time, values = fast
-    quats, static, tracks = _arrays_from_channels(skel, values)
-    del values, fast  # the channel array goes before the motion is made: lower peak memory
+    skel, frame_time, (quats, static, tracks) = fast
     return _motion(skel, quats, static, tracks, frame_time, p)
 
 
 def _read_plain(p: Path):
-    """A well-formed file read fast: the hierarchy from its lines, the frame rows by ``np.loadtxt(path)``.
+    """A well-formed file read fast: the hierarchy from its lines, the frame rows by polars a chunk at a time
+    (:mod:`.bvh_rows`, for long files when polars is installed) or by ``np.loadtxt(path)``, converted as they
+    come (:class:`~.bvh_channels.ChannelConverter`).
 
-    Returns (skeleton, Frames: count, frame time, (T, C) values), or ``None`` when the file needs the careful
-    parse: a header error or warning, no channels, a row ``loadtxt`` refuses, or a value that is not finite
-    or beyond ``MAX_MAGNITUDE``.  The rows' count may differ from ``Frames:`` (the caller warns).
+    Returns (skeleton, frame time, (quaternions, constant translations, tracks)), or ``None`` when the file
+    needs the careful parse: a header error or warning, no channels, a row ``loadtxt`` refuses, or a value
+    that is not finite or beyond ``MAX_MAGNITUDE``.  When the rows' count differs from ``Frames:`` the rows
+    win, with a warning.
     """
     head = []
     with open(p, "rb") as fh:
@@ -83,19 +84,51 @@ def _read_plain(p: Path):
             return None
     if caught or skel.n_channels == 0:
         return None
+    converter = None
+    if frames and data_start == len(head):  # the data's first byte is where the header's lines end
+        converter = _read_chunks(p, sum(map(len, head)), skel, frames)
+    if converter is None:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")  # "input contained no data" and the like: the careful parse
+                values = np.loadtxt(p, dtype=np.float64, ndmin=2, comments=None, skiprows=data_start,
+                                    encoding="latin-1")
+        except (ValueError, UserWarning):
+            return None
+        if values.shape[0] == 0 or values.shape[1] != skel.n_channels:
+            return None
+        converter = ChannelConverter(skel, values.shape[0])
+        if not converter.add(values):
+            return None
+        del values  # the channel array goes before the motion is made: lower peak memory
+    rows = converter.rows
+    if frames is not None and frames != rows:
+        warnings.warn(f"{p}: 'Frames: {frames}' but {rows} frame rows follow; using the {rows} rows",
+                      MocycleWarning, stacklevel=3)
+    return skel, frame_time, converter.arrays()
+
+
+def _read_chunks(p: Path, offset: int, skel: Skeleton, frames: int) -> ChannelConverter | None:
+    """The rows from byte ``offset`` on parsed by polars and converted a chunk at a time into arrays of the
+    ``Frames:`` count (allocated only when that count fits the bytes present and ``MOCYCLE_MAX_FRAMES``), or
+    ``None``: a short file, no polars, rows it does not take or more rows than ``Frames:`` says (the caller
+    reads the file the other way)."""
+    size = p.stat().st_size - offset
+    if not bvh_rows.wanted(size) or frames > size // (2 * skel.n_channels):  # a value is 2 bytes at least
+        return None
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")  # "input contained no data" and the like: the careful parse
-            values = np.loadtxt(p, dtype=np.float64, ndmin=2, comments=None, skiprows=data_start,
-                                encoding="latin-1")
-    except (ValueError, UserWarning):
+        check_frames(frames, skel.n_joints)
+    except MocycleError:
         return None
-    if values.shape[0] == 0 or values.shape[1] != skel.n_channels or not _plain_numbers(values):
+    converter = ChannelConverter(skel, frames)
+    try:
+        with contextlib.closing(bvh_rows.row_chunks(p, offset, skel.n_channels)) as chunks:
+            for values in chunks:
+                if not converter.add(values):
+                    return None
+    except bvh_rows.Unreadable:
         return None
-    if frames is not None and frames != values.shape[0]:
-        warnings.warn(f"{p}: 'Frames: {frames}' but {values.shape[0]} frame rows follow; using the "
-                      f"{values.shape[0]} rows", MocycleWarning, stacklevel=3)
-    return skel, frames, frame_time, values
+    return converter if converter.rows else None
 
 
 def _plain_numbers(values: np.ndarray) -> bool:
@@ -340,23 +373,6 @@ def _find_bad_row(body: list[str], start: int, n_channels: int, path) -> None:
     raise MotionFileError("no frame rows after 'Frame Time:'; expected at least one", path, start)
 
 
-def _channel_layout(skel: Skeleton):
-    """Per joint: (rotation channel columns, order), (position columns, axes)."""
-    col = 0
-    layout = []
-    for j in range(skel.n_joints):
-        rot_cols, pos_cols, pos_axes = [], [], []
-        for c in skel.channels[j]:
-            if c in ROTATION_CHANNELS:
-                rot_cols.append(col)
-            else:
-                pos_cols.append(col)
-                pos_axes.append(POSITION_CHANNELS.index(c))
-            col += 1
-        layout.append((rot_cols, skel.euler_order(j), pos_cols, pos_axes))
-    return layout
-
-
 def parse_bvh(data: str | bytes, path: str | os.PathLike | None = None) -> Motion:
     """Parse BVH text (``str`` or ``bytes``) into a :class:`Motion`; ``path`` only names errors."""
     text = _decode(data)
@@ -408,98 +424,11 @@ def _motion_from_channels(skel: Skeleton, values: np.ndarray, frame_time: float,
 def _arrays_from_channels(skel: Skeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
     """Local unit, sign-continuous quaternions ``(T, J, 4)``, constant translations ``(J, 3)`` and the
     ``{joint: (T, 3)}`` tracks of the joints whose position channels change, from the checked channel values
-    ``(T, C)`` (finite, within ``MAX_MAGNITUDE``).
-
-    One pass over the frames, :data:`BLOCK_FRAMES` at a time, so every temporary is a block (and stays in
-    cache): Euler angles to quaternion components (:func:`~mocycle.rotations.euler_quat_components`),
-    normalised (:func:`_norms`) and made sign-continuous with the previous block's last frame
-    (:func:`_flip_signs`) as :class:`Motion` would, so the motion takes the arrays as they are
-    (:func:`_motion`): bit for bit the motion of the previous reader.
-    """
-    T, J = values.shape[0], skel.n_joints
-    quats = np.empty((T, J, 4))
-    static = np.array(skel.offsets, dtype=np.float64)
-    tracks = {}
-    by_order: dict[str, list[tuple[int, list[int]]]] = {}
-    still = []
-    for j, (rot_cols, order, pos_cols, pos_axes) in enumerate(_channel_layout(skel)):
-        if rot_cols:
-            by_order.setdefault(order, []).append((j, rot_cols))
-        else:
-            still.append(j)
-        if pos_cols:  # the channel values replace the offset; a joint whose values never change is not tracked
-            static[j, pos_axes] = values[0, pos_cols]
-            if any(not np.array_equal(values[:, c], np.broadcast_to(values[0, c], (T,))) for c in pos_cols):
-                tracks[j] = np.empty((T, 3))
-                tracks[j][...] = static[j]
-                tracks[j][:, pos_axes] = values[:, pos_cols]
-    quats[:, still] = (0.0, 0.0, 0.0, 1.0)
-    groups = []
-    for order, items in by_order.items():
-        joints = [j for j, _ in items]
-        cols = [c for _, cs in items for c in cs]
-        if joints == list(range(joints[0], joints[-1] + 1)):  # a slice writes faster than a list of joints
-            joints = slice(joints[0], joints[-1] + 1)
-        if cols == list(range(cols[0], cols[-1] + 1)):
-            cols = slice(cols[0], cols[-1] + 1)
-        groups.append((order, joints, cols, len(items)))
-    for order, joints, cols, n in groups:
-        carry = None  # the previous block's last frame and its flip parity
-        for f0 in range(0, T, BLOCK_FRAMES):
-            f1 = min(T, f0 + BLOCK_FRAMES)
-            # half angles (k, B, n) in one pass over the block's channels (a view of them when cols is a slice)
-            angles = values[f0:f1, cols].reshape(f1 - f0, n, len(order)).transpose(2, 0, 1)
-            comp = euler_quat_components(np.multiply(angles, np.pi / 360.0, order="C"), order)
-            comp = [np.zeros((f1 - f0, n)) if c is None else c for c in comp]
-            norm = _norms(comp)
-            sign, carry = _flip_signs(comp, carry)
-            if sign is not None:
-                norm *= sign  # x / -n is exactly -(x / n): the flip costs no pass of its own
-            out = quats[f0:f1, joints] if isinstance(joints, slice) else np.empty((f1 - f0, n, 4))
-            for m in range(4):
-                np.divide(comp[m], norm, out=out[..., m])
-            if not isinstance(joints, slice):  # joints of this order interleaved with others'
-                quats[f0:f1, joints] = out
-    return quats, static, tracks
-
-
-def _norms(comp: list[np.ndarray]) -> np.ndarray:
-    """The quaternions' norms from their four component arrays, summed in ``np.linalg.norm``'s order (so
-    the quotients are what :class:`Motion` makes of :func:`~mocycle.rotations.euler_to_quats`' quaternions,
-    bit for bit)."""
-    x, y, z, w = comp
-    norm = np.multiply(x, x)
-    sq = np.multiply(y, y)
-    norm += sq
-    np.multiply(z, z, out=sq)
-    norm += sq
-    np.multiply(w, w, out=sq)
-    norm += sq
-    return np.sqrt(norm, out=norm)
-
-
-def _flip_signs(comp: list[np.ndarray], carry):
-    """Signs ``(B, n)`` (or ``None``: none flips) that make a block of quaternions (components ``(B, n)``)
-    sign-continuous, as :func:`~mocycle.rotations.continuous_quats` does over the whole take: a frame flips
-    when its dot product with the frame before is negative, and so do all frames after it.  ``carry``: the
-    previous block's last frame (its components, unflipped) and its flip parity, or ``None``.  Returns the
-    signs and this block's carry."""
-    dots = np.empty(comp[0].shape)
-    np.multiply(comp[0][1:], comp[0][:-1], out=dots[1:])
-    for c in comp[1:]:
-        dots[1:] += c[1:] * c[:-1]
-    if carry is None:
-        dots[0] = 1.0  # the first frame keeps its sign
-    else:
-        last, parity = carry
-        dots[0] = comp[0][0] * last[0] + comp[1][0] * last[1] + comp[2][0] * last[2] + comp[3][0] * last[3]
-    flips = np.logical_xor.accumulate(dots < 0, axis=0)  # an odd number of sign changes so far
-    if carry is not None:
-        flips ^= parity
-    carry = ([c[-1].copy() for c in comp], flips[-1].copy())
-    if not flips.any():
-        return None, carry
-    return 1.0 - 2.0 * flips, carry
+    ``(T, C)`` (finite, within ``MAX_MAGNITUDE``): :class:`~.bvh_channels.ChannelConverter` in one chunk."""
+    converter = ChannelConverter(skel, values.shape[0])
+    if not converter.add(values):
+        raise MocycleError(f"channel values must be finite numbers within ±{MAX_MAGNITUDE:g}")
+    return converter.arrays()
 
 
 def _motion(skel: Skeleton, quats: np.ndarray, static: np.ndarray, tracks: dict, frame_time: float, path) -> Motion:
