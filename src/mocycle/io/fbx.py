@@ -11,7 +11,7 @@ imported only when a file is read; ``docs/formats.md`` says why this binding).  
   like a bone does not rename the bone).  A leaf bone that no take of the file moves (Blender's ``_end``
   bones) becomes an End Site: every take of a file has the same joints.
 * **the take**: one animation stack (``take``: its name or 0-based index; default the first stack that moves
-  the skeleton, said in a :class:`~mocycle.errors.MocycleWarning` when the file holds several: Mixamo files
+  the skeleton, said in a :class:`~mocycle.errors.DefaultTake` warning when the file holds several: Mixamo files
   often begin with an empty ``Take 001``), baked by ufbx (``ufbx_bake_anim``): layers, pre/post rotations,
   rotation orders, pivots and scaling offsets composed into each node's local translation, rotation and
   scale, linearly keyed; then sampled at the frame rate from the stack's start to its stop.
@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import MocycleError, MocycleWarning, MotionFileError
+from ..errors import DefaultTake, MocycleError, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
 from ._nodes import NodeTRS, choose_take, joint_names, member_nodes, motion_from_nodes, skeleton_order, unique_names
@@ -274,7 +274,7 @@ class _Scene:
         why = "the first that moves the skeleton" if self.moving(chosen) & body else \
             "the first: no take moves the skeleton"
         warnings.warn(f"{self.path}: read take {self.stack_names[chosen]!r} ({why}); the file also holds "
-                      f"{', '.join(others)}: choose one with --take", MocycleWarning, stacklevel=4)
+                      f"{', '.join(others)}: choose one with --take", DefaultTake, stacklevel=4)
         return chosen
 
     def still_leaves(self, stack: int | None) -> set[int]:
@@ -310,9 +310,11 @@ def read_fbx(path: str | os.PathLike, *, take: str | int | None = None, fps: flo
     if fps is not None and not (np.isfinite(fps) and fps > 0):
         raise MotionFileError(f"the frame rate must be positive; got {fps!r}", p)
     ufbx = _import()
-    ancestors, joints, jparents, T, rate, up, unit = _guarded(p, lambda scene: _read(_Scene(ufbx, scene, p), take,
-                                                                                      fps))
-    return motion_from_nodes(ancestors, joints, jparents, T, 1.0 / rate, p, up=up, metres_per_unit=unit)
+    ancestors, joints, jparents, T, rate, up, unit, name = _guarded(
+        p, lambda scene: _read(_Scene(ufbx, scene, p), take, fps))
+    motion = motion_from_nodes(ancestors, joints, jparents, T, 1.0 / rate, p, up=up, metres_per_unit=unit)
+    motion.cache("take", lambda _: name)  # the take read (mocycle info says which)
+    return motion
 
 
 def _baked_keys(fs: _Scene, baked) -> dict[int, tuple]:
@@ -327,7 +329,7 @@ def _baked_keys(fs: _Scene, baked) -> dict[int, tuple]:
 
 def _read(fs: _Scene, take, fps) -> tuple:
     """The skeleton's nodes sampled at the frames of the take (:func:`member_nodes`), the frame count and rate,
-    and the file's declared vertical and unit: plain data, nothing of the binding."""
+    the file's declared vertical and unit, and the take's name: plain data, nothing of the binding."""
     p = fs.path
     stack = fs.choose(take)
     baked_nodes: dict[int, tuple] = {}
@@ -381,4 +383,4 @@ def _read(fs: _Scene, take, fps) -> tuple:
         return node
 
     ancestors, joints, jparents = member_nodes(fs.members, fs.parents, node_trs)
-    return ancestors, joints, jparents, T, rate, fs.up, fs.unit
+    return ancestors, joints, jparents, T, rate, fs.up, fs.unit, None if stack is None else fs.stack_names[stack]
