@@ -237,7 +237,9 @@ class _Scene:
         unit = float(settings.unit_meters)
         self.unit = unit if ufbx.find_prop(props, "UnitScaleFactor") is not None and np.isfinite(unit) \
             and 1e-9 < unit < 1e9 else None
-        self._moving: dict[int, set[int]] = {}
+        self._moves: dict[int, bool] = {}
+        t = [self.nodes[i].local_transform.translation for i in self.members]
+        self.rest = np.array([[v.x, v.y, v.z] for v in t], dtype=float).reshape(-1, 3)  # joints' rest offsets
 
     def skeleton_nodes(self) -> set[int]:
         """The skeleton's nodes and the nodes above its root."""
@@ -247,46 +249,57 @@ class _Scene:
             i = int(self.parents[i])
         return out
 
-    def bake(self, stack: int, rate: float):
-        return self.ufbx.bake_anim(self.scene, self.stacks[stack].anim, resample_rate=rate)
+    def keys(self, stack: int, rate: float, among: set[int] | None = None) -> dict[int, tuple]:
+        """``{node: ((times, translations), (times, rotations), (times, scales))}`` of ``stack`` baked by ufbx
+        (its curves resampled at ``rate`` where they are not linear), for the nodes it animates (``among``
+        them only, when given)."""
+        baked = self.ufbx.bake_anim(self.scene, self.stacks[stack].anim, resample_rate=rate)
+        out = {}
+        for b in (baked.nodes[k] for k in range(len(baked.nodes))):
+            at = self.by_typed.get(b.typed_id)
+            if at is not None and (among is None or at in among):
+                out[at] = (_keys(b.translation_keys, 3), _keys(b.rotation_keys, 4), _keys(b.scale_keys, 3))
+        return out
 
-    def moving(self, stack: int) -> set[int]:
-        """The nodes (indices) that take ``stack`` moves (a baked channel that is not constant)."""
-        if stack not in self._moving:
-            baked = self.bake(stack, self.rate or DEFAULT_FPS)
-            found = set()
-            for b in (baked.nodes[k] for k in range(len(baked.nodes))):
-                at = self.by_typed.get(b.typed_id)
-                if at is not None and not (b.constant_translation and b.constant_rotation and b.constant_scale):
-                    found.add(at)
-            self._moving[stack] = found
-        return self._moving[stack]
+    def moving(self, stack: int, among: set[int]) -> set[int]:
+        """The nodes ``among`` the given ones that take ``stack`` moves: a translation changing by more than 1e-6
+        of the skeleton's size, a rotation or scale by more than 1e-6 (exporters bake a still pose with
+        rounding)."""
+        size = max(float(np.abs(self.rest).max(initial=0.0)), 1e-12)
+        found = set()
+        for at, ((_, t), (_, r), (_, s)) in self.keys(stack, self.rate or DEFAULT_FPS, among).items():
+            if (len(t) > 1 and np.ptp(t, axis=0).max() > 1e-6 * size) or \
+                    (len(r) > 1 and np.ptp(r, axis=0).max() > 1e-6) or (len(s) > 1 and np.ptp(s, axis=0).max() > 1e-6):
+                found.add(at)
+        return found
+
+    def moves(self, stack: int) -> bool:
+        """Whether take ``stack`` moves the skeleton (or a node above it)."""
+        if stack not in self._moves:
+            self._moves[stack] = bool(self.moving(stack, self.skeleton_nodes()))
+        return self._moves[stack]
 
     def choose(self, take) -> int | None:
         """The stack called ``take``, or without one the first that moves the skeleton (said in a warning when
         the file holds several takes)."""
         if take is not None or len(self.stacks) < 2:
             return choose_take(self.stack_names, take, self.path, "take", "animation stack")
-        body = self.skeleton_nodes()
-        chosen = next((k for k in range(len(self.stacks)) if self.moving(k) & body), 0)
-        others = [f"{name!r}" + ("" if self.moving(k) & body else " (still)")
+        chosen = next((k for k in range(len(self.stacks)) if self.moves(k)), 0)
+        others = [f"{name!r}" + ("" if k > chosen or self.moves(k) else " (still)")
                   for k, name in enumerate(self.stack_names) if k != chosen]
-        why = "the first that moves the skeleton" if self.moving(chosen) & body else \
-            "the first: no take moves the skeleton"
+        why = "the first that moves the skeleton" if self.moves(chosen) else "the first: no take moves the skeleton"
         warnings.warn(f"{self.path}: read take {self.stack_names[chosen]!r} ({why}); the file also holds "
                       f"{', '.join(others)}: choose one with --take", DefaultTake, stacklevel=4)
         return chosen
 
-    def still_leaves(self, stack: int | None) -> set[int]:
+    def still_leaves(self) -> set[int]:
         """The skeleton's leaf nodes that no take of the file moves."""
         member = set(self.members)
         leaves = {i for i in self.members if not any(c in member for c in self.children[i])}
-        if stack is not None:
-            leaves -= self.moving(stack)
         for k in range(len(self.stacks)):
             if not leaves:
                 break
-            leaves -= self.moving(k)
+            leaves -= self.moving(k, leaves)
         return leaves
 
 
@@ -317,16 +330,6 @@ def read_fbx(path: str | os.PathLike, *, take: str | int | None = None, fps: flo
     return motion
 
 
-def _baked_keys(fs: _Scene, baked) -> dict[int, tuple]:
-    """``{node: ((times, translations), (times, rotations), (times, scales))}`` of a baked stack."""
-    out = {}
-    for b in (baked.nodes[k] for k in range(len(baked.nodes))):
-        at = fs.by_typed.get(b.typed_id)
-        if at is not None:
-            out[at] = (_keys(b.translation_keys, 3), _keys(b.rotation_keys, 4), _keys(b.scale_keys, 3))
-    return out
-
-
 def _read(fs: _Scene, take, fps) -> tuple:
     """The skeleton's nodes sampled at the frames of the take (:func:`member_nodes`), the frame count and rate,
     the file's declared vertical and unit, and the take's name: plain data, nothing of the binding."""
@@ -336,7 +339,7 @@ def _read(fs: _Scene, take, fps) -> tuple:
     rate: float | None = fps or fs.rate
     start = end = 0.0
     if stack is not None:
-        baked_nodes = _baked_keys(fs, fs.bake(stack, rate or DEFAULT_FPS))
+        baked_nodes = fs.keys(stack, rate or DEFAULT_FPS)
         all_times = [k[0] for trs in baked_nodes.values() for k in trs]
         if all_times:
             times_all = np.concatenate(all_times)
@@ -346,7 +349,7 @@ def _read(fs: _Scene, take, fps) -> tuple:
             if rate is None:  # no rate declared: the keys' own, baked again at it (no resampled points between)
                 rate = regular_rate(times_all) or DEFAULT_FPS
                 if rate != DEFAULT_FPS:
-                    baked_nodes = _baked_keys(fs, fs.bake(stack, rate))
+                    baked_nodes = fs.keys(stack, rate)
         begin, stop = float(fs.stacks[stack].time_begin), float(fs.stacks[stack].time_end)
         if np.isfinite(begin) and np.isfinite(stop) and stop > begin:
             start, end = begin, stop
@@ -360,7 +363,7 @@ def _read(fs: _Scene, take, fps) -> tuple:
     times = start + np.arange(T) / rate
 
     names = joint_names([n.name for n in fs.nodes], fs.members)
-    still = fs.still_leaves(stack)
+    still = fs.still_leaves()
     trs: dict[int, NodeTRS] = {}
 
     def node_trs(i: int) -> NodeTRS:
