@@ -14,7 +14,8 @@ imported only when a file is read; ``docs/formats.md`` says why this binding).  
   the skeleton, said in a :class:`~mocycle.errors.DefaultTake` warning when the file holds several: Mixamo files
   often begin with an empty ``Take 001``), baked by ufbx (``ufbx_bake_anim``): layers, pre/post rotations,
   rotation orders, pivots and scaling offsets composed into each node's local translation, rotation and
-  scale, linearly keyed; then sampled at the frame rate from the stack's start to its stop.
+  scale, linearly keyed; then sampled at the frame rate from the skeleton's first key to its last, within the
+  stack's start and stop (as Blender imports it).
 * **the frame rate**: ``fps`` when given; else the one the file declares (``GlobalSettings``' ``TimeMode``,
   the same for every take); without one, the keys' own rate when they lie on a regular grid of at least 12
   keys a second, else 30 fps.
@@ -339,8 +340,11 @@ def _read(fs: _Scene, take, fps) -> tuple:
     rate: float | None = fps or fs.rate
     start = end = 0.0
     if stack is not None:
+        body = fs.skeleton_nodes()
         baked_nodes = fs.keys(stack, rate or DEFAULT_FPS)
-        all_times = [k[0] for trs in baked_nodes.values() for k in trs]
+        # the keys of the skeleton's channels that change (ufbx gives a still node two keys at the stack's ends)
+        all_times = [t for at, trs in baked_nodes.items() if at in body for t, v in trs
+                     if len(t) > 1 and np.ptp(v, axis=0).max() > 0]
         if all_times:
             times_all = np.concatenate(all_times)
             if not np.isfinite(times_all).all():
@@ -350,9 +354,12 @@ def _read(fs: _Scene, take, fps) -> tuple:
                 rate = regular_rate(times_all) or DEFAULT_FPS
                 if rate != DEFAULT_FPS:
                     baked_nodes = fs.keys(stack, rate)
+        # the skeleton's keys within the stack's span (Maya's may run on past the last key: Blender, too, ends
+        # a take at its last key)
         begin, stop = float(fs.stacks[stack].time_begin), float(fs.stacks[stack].time_end)
         if np.isfinite(begin) and np.isfinite(stop) and stop > begin:
-            start, end = begin, stop
+            start, end = (max(start, begin), min(end, stop)) if all_times and min(end, stop) > max(start, begin) \
+                else (begin, stop)
     rate = float(rate or DEFAULT_FPS)
     problem = frame_time_problem(1.0 / rate)
     if problem:

@@ -571,17 +571,18 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
     targets = _targets(f, N)  # every take's: the same skeleton and End Sites for each
     members = _skeleton_nodes(f, parents, targets)
     names = _names(f) if _animations(f) else []
+    body = set(members)  # the skeleton's nodes and the nodes above it
+    i = int(parents[members[0]])
+    while i >= 0:
+        body.add(i)
+        i = int(parents[i])
     if take is None and names:
-        body = set(members)
-        i = int(parents[members[0]])
-        while i >= 0:
-            body.add(i)
-            i = int(parents[i])
         index: int | None
         index, channels = _default_take(f, body, N, names)
     else:
         index = choose_take(names, take, p, "animation", "animation")
         channels = _channels(f, index, N) if index is not None else []
+    channels = [c for c in channels if c[0] in body]  # a mesh's or a camera's keys do not make the take longer
     if channels:
         keys = [c[2] for c in channels]
         rate = fps
@@ -613,8 +614,6 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
         return trs[i]
 
     for node, kind, keys, values, interp, label in channels:
-        if node not in members and not _is_above(node, members, parents):
-            continue
         n = node_trs(node)
         setattr(n, kind, _sample(times, keys, values, interp, kind == "rotation", p, label))
     ancestors, joints, jparents = member_nodes(members, parents, node_trs)
@@ -630,13 +629,3 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
         name = names[index]
         motion.cache("take", lambda _: name)  # the take read (mocycle info says which)
     return motion
-
-
-def _is_above(node: int, members: list[int], parents: np.ndarray) -> bool:
-    """Whether ``node`` is an ancestor of the skeleton's root."""
-    i = int(parents[members[0]])
-    while i >= 0:
-        if i == node:
-            return True
-        i = int(parents[i])
-    return False
