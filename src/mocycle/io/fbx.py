@@ -97,9 +97,10 @@ def _with_scene(path: Path, work):
 
     With every element counted (:func:`_owned`), the scene's cache and its elements hold each other: only
     freeing the scene breaks that cycle (left to the garbage collector, ufbx 0.0.5's context crashes in its own
-    deallocation: it releases its name twice).  Freeing leaves the context's element table freed but still
-    listed, so the context must die at once, with nothing else holding it and no collection in between: the
-    scene's last reference goes in the same call that frees it (``pop().free()``), with the collector off."""
+    deallocation: it releases its name after the collector has cleared it, a null pointer).  Freeing leaves
+    the context's element table freed but still listed, so the context must die at once, with nothing else
+    holding it and no collection in between: the scene's last reference goes in the same call that frees it
+    (``pop().free()``), with the collector off."""
     held = [_load(path)]
     error: BaseException | None = None
     try:
