@@ -11,7 +11,8 @@ up axis), the load (and bake) time of FILE (median of 5), and a short fuzz: ``--
 FILE (bit flips, interesting values, cuts, repeats), each loaded in a child process twice: the binding used
 plainly (load, the nodes and takes as lists, bake the first take, its first node's keys, then the
 garbage collector) and, for ``ufbx``, through mocycle's reader (``read_fbx``); children that die on a
-signal (a crash in C; 139 is a segmentation fault) or hang (10 s) are counted.  ``--wheels`` asks pip which
+signal (a crash in C; 139 is a segmentation fault) or hang (10 s) are counted; for ``ufbx``, three plain uses
+that read a scene element again after dropping it (``PROBES``), each in a child.  ``--wheels`` asks pip which
 wheels each binding has on PyPI for CPython 3.11 and 3.13 on Linux, macOS and Windows (``pip download
 --only-binary``, nothing installed).  ``docs/formats.md`` has the figures.
 """
@@ -59,6 +60,16 @@ try:
 except Exception as exc:
     print("error", type(exc).__name__)
 """
+
+#: ufbx's own API used plainly in ways that read an element a second time after dropping it (the crash the
+#: issue met: "exit 139 in GC after list(bake.nodes[1].rotation_keys)"): each run on FILE in a child
+PROBES = {
+    "a node dropped, then read again": "n = s.nodes[3]; del n; s.nodes[3].name",
+    "node names listed, then a node read": "names = [n.name for n in s.nodes]; s.nodes[1].name",
+    "a take baked and its keys listed, then the take read again":
+        "st = s.anim_stacks[0]; b = ufbx.bake_anim(s, st.anim); k = list(b.nodes[1].rotation_keys); del st; "
+        "gc.collect(); s.anim_stacks[0].name",
+}
 
 MOCYCLE = r"""
 import gc, sys, warnings
@@ -201,12 +212,17 @@ def main(argv=None) -> int:
             settings = scene.settings
             row["frame_rate"] = settings.frames_per_second
             row["unit_metres"] = settings.unit_meters
-            row["up_axis"] = str(settings.axes.up)
+            row["up_axis"] = getattr(settings.axes.up, "name", str(settings.axes.up))
         except (NotImplementedError, AttributeError) as exc:
             row["settings"] = f"{type(exc).__name__}: {exc}"
         scripts = {"plain": PLAIN}
         if dist == "ufbx":
             scripts["mocycle"] = MOCYCLE
+            row["plain_use_probes"] = {}
+            for label, code in PROBES.items():
+                done = subprocess.run([sys.executable, "-c", f"import gc, ufbx\ns = ufbx.load_file({str(args.file)!r})"
+                                       f"\n{code}\nprint('ok')"], capture_output=True, text=True, timeout=60)
+                row["plain_use_probes"][label] = "ok" if done.returncode == 0 else f"exit {done.returncode}"
         row["fuzz"] = fuzz(dist, data, args.mutations, args.seed, scripts)
         report["installed"] = row
     if args.wheels:
