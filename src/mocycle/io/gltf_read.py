@@ -5,14 +5,18 @@ What is read (``docs/formats.md`` has the whole story):
 * **the skeleton**: the joints of the file's skin (the one with the most joints when there are several), plus any
   node lying between two of them; parents first.  The nodes above the skeleton's root (Blender's armature object,
   an axis or unit conversion) are composed into the root.  Without a skin, the animated nodes and the nodes
-  between them form the skeleton.  A leaf joint that no channel animates becomes an End Site.
-* **the animation**: one of the file's animations (``take``: its name or its 0-based index; default the first),
+  between them form the skeleton (the nodes any animation moves: the same for every take).  A leaf joint that
+  no channel of any animation animates becomes an End Site: every take has the same joints.
+* **the animation**: one of the file's animations (``take``: its name or its 0-based index; default the first
+  that moves the skeleton, said in a :class:`~mocycle.errors.DefaultTake` warning when there are several),
   its ``translation``, ``rotation`` and ``scale`` channels on those nodes (``weights`` are morph targets: not
   read), with LINEAR (slerp for rotations), STEP and CUBICSPLINE (Hermite, glTF's tangents scaled by the key
-  interval) samplers, sampled at one frame rate: the keys' own when all key times lie on one regular grid
-  (rounded to a whole number of frames per second when within 1e-4 of one), else ``fps`` (default 30).
+  interval) samplers, sampled at the file's frame rate (``fps`` when given): the key rate of its animations,
+  the one on whose frames the keys of most of them lie (rounded to a whole number of frames per second when
+  within 1e-4 of one), else 30; a take whose keys lie off those frames says so (a MocycleWarning).
   A file without animations is its rest pose, one frame.
-* **units and axes**: glTF's metres and +Y up, as the file holds them; except in a file mocycle wrote (its
+* **units and axes**: glTF's metres and +Y up, as the file holds them and as the skeleton says
+  (:attr:`Skeleton.up`, :attr:`Skeleton.metres_per_unit`); except in a file mocycle wrote (its
   scene's ``extras.mocycle.units``), whose unit scale and vertical turn are undone, so the motion read is the
   one written.
 * scale on nodes (also animated): the joints' world positions are the file's; see :mod:`._nodes`.
