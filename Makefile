@@ -110,7 +110,7 @@ BPY_LIBS := libx11-6 libxrender1 libxfixes3 libxi6 libxkbcommon0 libxext6 libxxf
 	$(BPY_PYTHON_$*) -m venv .venv-bpy$*
 	.venv-bpy$*/bin/python -m pip install --quiet --upgrade pip
 	.venv-bpy$*/bin/python -m pip install --quiet "bpy==$(BPY_VERSION_$*)" $(BPY_NUMPY_$*) pytest setuptools wheel \
-		pygltflib
+		pygltflib "ufbx>=0.0.5,<0.1"
 	.venv-bpy$*/bin/python -c "import bpy" 2>/dev/null || \
 		(apt-get update -qq && apt-get install -y -qq --no-install-recommends $(BPY_LIBS))
 	.venv-bpy$*/bin/python -c "import bpy, numpy, sys; print('bpy', bpy.app.version_string, 'Python', \
@@ -128,10 +128,11 @@ test-blender-zips: blender-extension
 	MOCYCLE_BLENDER_DIST=$(CURDIR)/dist $(BPY52)/bin/python -m pytest -q -p no:cacheprovider tests/test_blender_zips.py
 
 # the Blender tests install the linux zip built above (MOCYCLE_BLENDER_ZIP) into each Blender; pygltflib (the glTF-out
-# test writes .glb files) is added to a bpy venv made before it was part of the recipe above
+# test writes .glb files) and ufbx (the FBX-in tests read what Blender exports; a wheel, no compiler) are added to a bpy
+# venv made before they were part of the recipe above
 ZIP_LINUX := $(CURDIR)/dist/mocycle-$(VERSION)-linux_x64.zip
-BLENDER_TESTS = .venv-bpy$(1)/bin/python -c "import pygltflib" 2>/dev/null || \
-	.venv-bpy$(1)/bin/python -m pip install --quiet pygltflib; \
+BLENDER_TESTS = .venv-bpy$(1)/bin/python -c "import pygltflib, ufbx; ufbx.bake_anim" 2>/dev/null || \
+	.venv-bpy$(1)/bin/python -m pip install --quiet pygltflib "ufbx>=0.0.5,<0.1"; \
 	cd tests_blender && MOCYCLE_BLENDER_ZIP=$(ZIP_LINUX) nice -n 5 ../.venv-bpy$(1)/bin/python -m pytest -q
 
 test-blender52: .venv-bpy52/.installed blender-extension

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+import mocycle
 from conftest import shared_path
 from helpers import max_angle, random_motion
 from mocycle.cli import app
@@ -22,7 +23,8 @@ def test_every_command_has_help():
 
 def test_info_json_facts(tmp_path):
     m = random_motion(61)
-    path = write_bvh(m, tmp_path / "m.bvh")
+    with pytest.warns(mocycle.MocycleWarning, match="BVH names are one word each"):
+        path = write_bvh(m, tmp_path / "m.bvh")
     result = runner.invoke(app, ["info", str(path), "--json"])
     assert result.exit_code == 0, result.output
     facts = json.loads(result.stdout)
@@ -30,7 +32,7 @@ def test_info_json_facts(tmp_path):
     assert np.isclose(facts["fps"], 60) and np.isclose(facts["duration_s"], 1.0)
     steps = np.linalg.norm(np.diff(m.root_positions, axis=0), axis=1).sum()
     assert np.isclose(facts["root_path_length"], steps, rtol=1e-6)
-    assert set(facts["rotation_range_deg"]["Left Up Leg"]) == {"Zrotation", "Xrotation", "Yrotation"}
+    assert set(facts["rotation_range_deg"]["Left_Up_Leg"]) == {"Zrotation", "Xrotation", "Yrotation"}
     assert 0 < facts["rotation_spread_deg"]["Spine"] <= 180
 
 

@@ -69,7 +69,8 @@ def extension(tmp_path_factory):
 
 @pytest.fixture
 def scene(extension):
-    """An empty scene (objects, armatures and actions removed), 30 fps, frame 1."""
+    """An empty scene (objects, armatures and actions removed), 30 fps, frame 1, metres (a test that sets the
+    scene's unit, as the Mixamo-style FBX test does, would otherwise scale what the next one imports)."""
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob)
     for coll in (bpy.data.armatures, bpy.data.actions):
@@ -77,6 +78,7 @@ def scene(extension):
             coll.remove(item)
     sc = bpy.context.scene
     sc.render.fps, sc.render.fps_base = 30, 1.0
+    sc.unit_settings.system, sc.unit_settings.scale_length, sc.unit_settings.length_unit = "METRIC", 1.0, "METERS"
     sc.frame_set(1)
     sc.mocycle.parts.clear()
     sc.mocycle.last_task = ""

@@ -123,3 +123,88 @@ def test_loop_glb_plays_the_cycle_and_loops(scene, tmp_path):
     step = float(np.median(np.abs(np.diff(got, axis=0)).max(axis=(1, 2))) / height)
     print(f"loop: {n} frames, last key vs first {seam:.1e} of the height (a frame's step: {step:.1e})")
     assert seam <= TOLERANCE
+
+
+def fingered_walk():
+    """The synthetic walk with five fingers of four joints on each hand hanging down (40 joints below the hips
+    while the arms swing down, as Mixamo rigs have them), which turned the detected vertical upside down."""
+    from mocycle.datasets import synthetic_walk
+    from mocycle.motion import Motion, Skeleton
+
+    walk = synthetic_walk(n_frames=90, fps=30, seed=2).motion
+    sk = walk.skeleton
+    names, parents, offsets = list(sk.names), list(sk.parents), [tuple(o) for o in sk.offsets]
+    channels = list(sk.channels)
+    world_rotations, _ = walk.world_transforms()
+    for side in ("Left", "Right"):
+        hand = names.index(f"{side}Hand")
+        down = world_rotations[:, hand].mean(axis=0).T
+        for f in range(5):
+            parent = hand
+            for k in range(4):
+                names.append(f"{side}Finger{f}_{k}")
+                parents.append(parent)
+                offsets.append(tuple(down @ [0.4 * (f - 2), -3.0, 0.0]))
+                channels.append(("Zrotation", "Xrotation", "Yrotation"))
+                parent = len(names) - 1
+    skeleton = Skeleton(tuple(names), parents, np.asarray(offsets), tuple(channels), sk.end_sites)
+    T, extra = walk.n_frames, len(names) - sk.n_joints
+    rot = np.concatenate([walk.rotations, np.tile([0.0, 0, 0, 1], (T, extra, 1))], axis=1)
+    static = np.vstack([walk.translations[0], np.asarray(offsets[sk.n_joints:])])
+    return Motion(skeleton, rot, static, walk.frame_time, tracks={0: walk.root_positions})
+
+
+def blender_export(motion, tmp_path, kind: str):
+    """``motion`` (centimetres) as BVH, imported by Blender in metres and exported by its FBX (Y up, or Z up:
+    ``fbx-z``) or glTF exporter; the file."""
+    import mocycle
+
+    bvh = mocycle.write(motion, tmp_path / "take.bvh")
+    assert bpy.ops.import_anim.bvh(filepath=str(bvh), global_scale=0.01, update_scene_fps=True,
+                                   update_scene_duration=True) == {"FINISHED"}
+    arm = bpy.context.active_object
+    sc = bpy.context.scene
+    sc.frame_end = sc.frame_start + motion.n_frames - 1
+    bpy.ops.object.select_all(action="DESELECT")
+    arm.select_set(True)
+    bpy.context.view_layer.objects.active = arm
+    if kind == "glb":
+        path = tmp_path / "take.glb"
+        assert bpy.ops.export_scene.gltf(filepath=str(path), export_format="GLB", export_animations=True) == {
+            "FINISHED"}
+    else:
+        path = tmp_path / f"take_{kind}.fbx"
+        axes = {"fbx-y": ("Y", "-Z"), "fbx-z": ("Z", "Y")}[kind]
+        assert bpy.ops.export_scene.fbx(filepath=str(path), bake_anim=True, axis_up=axes[0],
+                                        axis_forward=axes[1]) == {"FINISHED"}
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob)
+    return path
+
+
+@pytest.mark.parametrize("source", ["bvh", "fbx-y", "fbx-z", "glb"])
+def test_written_glb_stands_upright(scene, tmp_path, source):
+    """A Mixamo-like take (40 finger joints hanging below the hips) read from BVH, from Blender's FBX (declaring
+    Y up, or Z up) and from its glTF, then written as ``.glb``: Blender's own importer shows the head above the
+    feet, every frame, by most of the body's height."""
+    try:
+        import ufbx  # noqa: F401
+    except ModuleNotFoundError:
+        if source.startswith("fbx"):
+            pytest.fail("ufbx is missing from this bpy environment (make test-blender installs it)")
+    import mocycle
+
+    motion = fingered_walk()
+    path = tmp_path / "take.bvh" if source == "bvh" else blender_export(motion, tmp_path, source)
+    if source == "bvh":
+        mocycle.write(motion, path)
+    read = mocycle.read(path)
+    out = mocycle.write(read, tmp_path / f"{source}.glb")
+    arm = import_glb(out, read.fps)
+    names = [n for n in ("Head", "LeftFoot", "RightFoot") if n in arm.pose.bones]
+    assert len(names) == 3, f"bones missing: {sorted(b.name for b in arm.pose.bones)[:8]}"
+    got, _ = played(arm, names)
+    height = got[:, 0, 2] - np.minimum(got[:, 1, 2], got[:, 2, 2])
+    print(f"\n{source} -> {out.name}: up read as {read.skeleton.up or 'detected'}; head above the lower foot by "
+          f"{height.min():.2f} to {height.max():.2f} m in Blender")
+    assert 1.0 < height.min() <= height.max() < 2.0  # metres: the body stands (1.5 m from feet to head)

@@ -48,6 +48,11 @@ class MocycleWarning(UserWarning):
     """Something odd but recoverable in the input (e.g. a wrong ``Frames:`` count)."""
 
 
+class DefaultTake(MocycleWarning):
+    """No take was named in a file holding several: which one was read (the first that moves the skeleton) and
+    which others the file holds.  ``mocycle info``, which lists the takes itself, leaves it out."""
+
+
 class NoPeriodicMotion(MocycleError):
     """The input is fine but holds no periodic motion (the CLI exits with code 3)."""
 

@@ -59,6 +59,11 @@ class Skeleton:
     channels : per joint, the channel names in file order, e.g.
         ``("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")``.
     end_sites : the End Sites, each with its parent joint and offset.
+    up : the world vertical the file declares, a unit 3-vector in the skeleton's axes (glTF: +Y; FBX: its
+        ``GlobalSettings``), or ``None`` when the file says nothing (BVH, ASF/AMC): then
+        :func:`mocycle.axes.vertical_axis` finds it from the body.
+    metres_per_unit : the length unit the file declares (glTF: 1; FBX: its ``UnitScaleFactor``), or ``None``;
+        the glTF writer's ``scale="auto"`` uses it.
     """
 
     names: tuple[str, ...]
@@ -66,6 +71,8 @@ class Skeleton:
     offsets: np.ndarray
     channels: tuple[tuple[str, ...], ...]
     end_sites: tuple[EndSite, ...] = field(default=())
+    up: tuple[float, float, float] | None = None
+    metres_per_unit: float | None = None
 
     def __post_init__(self):
         names = tuple(str(n) for n in self.names)
@@ -89,6 +96,17 @@ class Skeleton:
             bad = [c for c in ch if c not in ROTATION_CHANNELS + POSITION_CHANNELS]
             if bad or len(set(ch)) != len(ch):
                 raise MocycleError(f"joint {name!r}: bad channel list {list(ch)}")
+        if self.up is not None:
+            up = np.asarray(self.up, dtype=np.float64).reshape(-1)
+            norm = float(np.linalg.norm(up)) if up.shape == (3,) and np.isfinite(up).all() else 0.0
+            if not norm > 0:
+                raise MocycleError(f"the skeleton's up must be a non-zero 3-vector; got {self.up!r}")
+            object.__setattr__(self, "up", tuple(float(v) for v in up / norm))
+        if self.metres_per_unit is not None:
+            unit = float(self.metres_per_unit)
+            if not (np.isfinite(unit) and unit > 0):
+                raise MocycleError(f"the skeleton's metres_per_unit must be positive; got {self.metres_per_unit!r}")
+            object.__setattr__(self, "metres_per_unit", unit)
         parents.setflags(write=False)
         offsets.setflags(write=False)
         object.__setattr__(self, "names", names)

@@ -6,8 +6,8 @@ from scipy.spatial.transform import Rotation
 
 from conftest import SHARED_DATA, shared_path
 from helpers import max_angle, random_motion
-from mocycle.errors import MotionFileError
-from mocycle.io.bvh import format_bvh, motion_channels, parse_bvh, read_bvh, write_bvh
+from mocycle.errors import MocycleWarning, MotionFileError
+from mocycle.io.bvh import format_bvh, motion_channels, one_word_names, parse_bvh, read_bvh, write_bvh
 
 SHARED_BVH = sorted(SHARED_DATA.glob("*/*.bvh")) or [None]  # None: skip with a message
 
@@ -21,16 +21,43 @@ def _round_trip_errors(m, m2):
 
 def test_round_trip_synthetic_keeps_everything(tmp_path):
     m = random_motion(80, spin=True)
-    path = write_bvh(m, tmp_path / "m.bvh")
+    with pytest.warns(MocycleWarning, match="BVH names are one word each"):  # its names hold spaces
+        path = write_bvh(m, tmp_path / "m.bvh")
     m2 = read_bvh(path)
     ang, rel = _round_trip_errors(m, m2)
     assert ang < 1e-6 and rel < 1e-6
-    assert m2.skeleton.names == m.skeleton.names
+    joints, sites, _ = one_word_names(m.skeleton)
+    assert list(m2.skeleton.names) == joints  # what was written is what is read
     assert m2.skeleton.channels == m.skeleton.channels  # per-joint orders kept
     assert [(s.parent, s.offset, s.name) for s in m2.skeleton.end_sites] == [
-        (s.parent, s.offset, s.name) for s in m.skeleton.end_sites
+        (s.parent, s.offset, name) for s, name in zip(m.skeleton.end_sites, sites, strict=True)
     ]
     assert m2.frame_time == m.frame_time  # exact, not rounded to 6 digits
+
+
+def test_names_are_written_one_word_each(tmp_path):
+    """A whitespace-splitting reader gets one token per joint name: spaces and tabs become underscores, a name
+    that would then repeat another gets a number; mocycle reads the names written; said once, as a warning."""
+    from mocycle.motion import EndSite, Motion, Skeleton
+
+    rot = ("Zrotation", "Xrotation", "Yrotation")
+    skeleton = Skeleton(("Hips", "bras droit", "main\tdroite", "bras_droit"), [-1, 0, 1, 0], np.ones((4, 3)),
+                        (("Xposition", "Yposition", "Zposition") + rot, rot, rot, rot),
+                        (EndSite(2, (0.0, 1.0, 0.0), "bout du doigt"),))
+    m = Motion.rest(skeleton, 3)
+    with pytest.warns(MocycleWarning, match=r"3 written with underscores: 'bras droit' as 'bras_droit_2', "
+                                            r"'main\\tdroite' as 'main_droite', 'bout du doigt' as 'bout_du_doigt'"):
+        path = write_bvh(m, tmp_path / "m.bvh")
+    for line in path.read_text().splitlines():
+        words = line.split()
+        if words and words[0] in ("ROOT", "JOINT"):
+            assert len(words) == 2, line
+    again = read_bvh(path)
+    assert again.skeleton.names == ("Hips", "bras_droit_2", "main_droite", "bras_droit")
+    assert again.skeleton.end_sites[0].name == "bout_du_doigt"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        write_bvh(again, tmp_path / "again.bvh")  # one-word names: nothing to say
 
 
 def test_written_euler_curves_are_continuous():

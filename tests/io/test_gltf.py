@@ -165,6 +165,37 @@ def test_units_and_axes(tmp_path):
         gltf_frame(walk, up="w")
 
 
+def test_the_declared_unit_wins_and_a_moving_ik_target_is_no_body():
+    """A file's declared unit is the GLB's, whatever the body measures (the same for every take of a file); a
+    leaf IK target that moves first (RobotExpressive's feet, under the root beside the body) was taken for the
+    body: 0 units tall."""
+    walk = synthetic_walk(n_frames=30).motion
+    sk = walk.skeleton
+
+    def declared(unit):
+        return Motion(Skeleton(sk.names, sk.parents, sk.offsets, sk.channels, sk.end_sites, metres_per_unit=unit),
+                      walk.rotations, walk.translations, walk.frame_time)
+
+    assert gltf_frame(declared(0.01)).unit == "cm"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", mocycle.MocycleWarning)  # the file says metres: a 170 m body, no guess
+        frame = gltf_frame(declared(1.0))
+    assert frame.unit == "m" and frame.scale == 1.0
+    assert (gltf_frame(declared(0.02)).unit, gltf_frame(declared(0.02)).scale) == ("file", 0.02)
+    assert gltf_frame(declared(0.02), scale="cm").scale == 0.01  # an override still wins
+    six = ("Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation", "Yrotation")
+    rig = Skeleton(("Bone", "FootIK", *sk.names), [-1, 0, 0, *(sk.parents[1:] + 2)],
+                   np.vstack([[0, 0, 0], [10, 0, 0], sk.offsets]), [six, six, *sk.channels],
+                   [EndSite(e.parent + 2, e.offset, e.name) for e in sk.end_sites])
+    T = walk.n_frames
+    q = np.concatenate([np.tile([0, 0, 0, 1.0], (T, 2, 1)), walk.rotations], axis=1)
+    t = np.concatenate([np.zeros((T, 2, 3)), walk.translations], axis=1)
+    t[:, 1, 2] = np.linspace(0, 30, T)  # the IK target slides
+    ik = Motion(rig, q, t, walk.frame_time)
+    assert ik.travel_joint == 1
+    assert gltf_frame(ik).body_size > 0.9 * gltf_frame(walk).body_size
+
+
 def test_a_body_of_no_known_unit_is_warned_about():
     walk = synthetic_walk(n_frames=30).motion
     with pytest.warns(mocycle.MocycleWarning, match="--gltf-scale"):

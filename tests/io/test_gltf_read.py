@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 import mocycle
 from mocycle.datasets import synthetic_walk, to_z_up
-from mocycle.errors import MotionFileError
+from mocycle.errors import DefaultTake, MotionFileError
 from mocycle.io.gltf import body_size
 from mocycle.io.gltf_read import DEFAULT_FPS, gltf_takes, read_gltf
 
@@ -63,8 +63,9 @@ def test_scale_of_a_foreign_glb_is_metres(tmp_path):
 # -- small files built here ---------------------------------------------------------------------------------------
 def small_glb(path, samplers, *, skin=True, extra_nodes=None, animations=None, times=None, blob_edit=None,
               json_edit=None):
-    """A two-joint chain (root at the origin, child 1 m up its Y) with the given samplers on the child's rotation:
-    ``samplers``: list of (name, interpolation, times, values)."""
+    """A two-joint chain (root at the origin, child 1 m up its Y, a tip 1 m above) with the given samplers on the
+    child's rotation: ``samplers``: list of (name, interpolation, times, values[, node]) (``node``: the one
+    turned, else the child)."""
     blob = bytearray()
     gl = g.GLTF2(asset=g.Asset(version="2.0", generator="test"))
 
@@ -81,11 +82,12 @@ def small_glb(path, samplers, *, skin=True, extra_nodes=None, animations=None, t
     if skin:
         gl.skins = [g.Skin(joints=[0, 1, 2])]
     anims = []
-    for name, interp, t, v in samplers:
+    for name, interp, t, v, *node in samplers:
         s = g.AnimationSampler(input=add(np.asarray(t)[:, None], "SCALAR"), output=add(v, "VEC4"),
                                interpolation=interp)
         anims.append(g.Animation(name=name, samplers=[s], channels=[
-            g.AnimationChannel(sampler=0, target=g.AnimationChannelTarget(node=1, path="rotation"))]))
+            g.AnimationChannel(sampler=0, target=g.AnimationChannelTarget(node=node[0] if node else 1,
+                                                                          path="rotation"))]))
     gl.animations = anims
     gl.scenes = [g.Scene(nodes=[0])]
     gl.scene = 0
@@ -152,7 +154,8 @@ def test_regular_keys_set_the_frame_rate(tmp_path):
     assert m.fps == 24.0 and m.n_frames == 25
     irregular = small_glb(tmp_path / "b.glb", [("swing", "LINEAR", [0.0, 0.1, 0.35, 1.0],
                                                [turn(0), turn(5), turn(10), turn(20)])])
-    m = read_gltf(irregular)
+    with pytest.warns(mocycle.MocycleWarning, match="the keys of take 'swing' lie on no regular grid"):
+        m = read_gltf(irregular)
     assert m.fps == DEFAULT_FPS and m.n_frames == 31
 
 
@@ -160,7 +163,9 @@ def test_several_animations_by_name(tmp_path):
     path = small_glb(tmp_path / "a.glb", [("first", "LINEAR", [0.0, 1.0], [turn(0), turn(10)]),
                                           ("second", "LINEAR", [0.0, 2.0], [turn(0), turn(60)])])
     assert gltf_takes(path) == ["first", "second"]
-    assert read_gltf(path, fps=10).n_frames == 11
+    with pytest.warns(DefaultTake, match=r"read take 'first' \(the first that moves the skeleton\); the file also "
+                                         r"holds 'second': choose one with --take"):
+        assert read_gltf(path, fps=10).n_frames == 11
     second = read_gltf(path, take="second", fps=10)
     assert second.n_frames == 21 and tip_angle(second)[-1] == pytest.approx(60, abs=1e-4)
     assert mocycle.read(path, take="1", sample_fps=10).n_frames == 21
@@ -312,3 +317,60 @@ def test_gltf_text_with_data_uri_and_bin_file(tmp_path):
     gl.save_json(str(tmp_path / "file.gltf"))
     assert any(p.suffix == ".bin" for p in tmp_path.iterdir())
     assert tip_angle(mocycle.read(tmp_path / "file.gltf", sample_fps=10)) == pytest.approx(expected, abs=1e-9)
+
+
+def test_the_default_take_is_the_first_that_moves(tmp_path):
+    """A first animation whose keys all hold one pose is not the default; the warning names the take read."""
+    path = small_glb(tmp_path / "a.glb", [("still", "LINEAR", [0.0, 1.0], [turn(5), turn(5)]),
+                                          ("swing", "LINEAR", [0.0, 1.0], [turn(0), turn(90)])])
+    with pytest.warns(DefaultTake, match=r"read take 'swing' \(the first that moves the skeleton\); the file also "
+                                         r"holds 'still' \(still\)"):
+        m = read_gltf(path, fps=10)
+    assert tip_angle(m)[-1] == pytest.approx(90, abs=1e-4)
+    assert m.cache("take") == "swing"
+    from mocycle import tasks
+
+    facts = tasks.info.run(path).facts
+    assert facts["take"] == "swing" and facts["takes"] == ["still", "swing"]
+
+
+def test_every_take_has_the_same_joints(tmp_path):
+    """The tip (a leaf) turns in "b" only: a joint in both takes, not an End Site in "a"."""
+    path = small_glb(tmp_path / "a.glb", [("a", "LINEAR", [0.0, 1.0], [turn(0), turn(10)]),
+                                          ("b", "LINEAR", [0.0, 1.0], [turn(0), turn(20)], 2)])
+    a, b = read_gltf(path, take="a"), read_gltf(path, take="b")
+    assert a.skeleton.names == b.skeleton.names == ("root", "child", "tip")
+
+
+def test_a_node_named_like_a_joint_does_not_rename_it(tmp_path):
+    """RobotExpressive has a mesh node "Torso" beside the joint "Torso", which was read as "Torso.1"."""
+    path = small_glb(tmp_path / "a.glb", [("swing", "LINEAR", [0.0, 1.0], [turn(0), turn(90)])],
+                     extra_nodes=[g.Node(name="child"), g.Node(name="root")])
+    m = read_gltf(path)
+    assert m.skeleton.names == ("root", "child")
+
+
+def test_one_frame_rate_for_every_take(tmp_path):
+    """The file's rate is its animations' key rate: a take whose keys lie on no grid is sampled at it (not at
+    30 fps) and says so."""
+    t = np.arange(25) / 24
+    path = small_glb(tmp_path / "a.glb", [("walk", "LINEAR", t, [turn(k) for k in range(25)]),
+                                          ("run", "LINEAR", [0.0, 0.1, 0.35, 1.0],
+                                           [turn(0), turn(5), turn(10), turn(20)])])
+    assert read_gltf(path, take="walk").fps == 24
+    with pytest.warns(mocycle.MocycleWarning, match="the keys of take 'run' lie on no regular grid of the file's "
+                                                    "24 fps frames; sampled at 24 fps"):
+        run = read_gltf(path, take="run")
+    assert run.fps == 24 and run.n_frames == 25
+
+
+def test_the_vertical_and_unit_are_declared(tmp_path):
+    """glTF is metres and +Y up; a file mocycle wrote reads back with the vertical and unit of the motion
+    written."""
+    path = small_glb(tmp_path / "a.glb", [("swing", "LINEAR", [0.0, 1.0], [turn(0), turn(90)])])
+    m = read_gltf(path)
+    assert m.skeleton.up == (0.0, 1.0, 0.0) and m.skeleton.metres_per_unit == 1.0
+    walk = to_z_up(synthetic_walk(n_frames=30).motion)
+    again = mocycle.read(mocycle.write(walk, tmp_path / "walk.glb"))
+    assert again.skeleton.up == pytest.approx((0.0, 0.0, 1.0), abs=1e-9)
+    assert again.skeleton.metres_per_unit == pytest.approx(0.01)

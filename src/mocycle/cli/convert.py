@@ -25,7 +25,7 @@ def convert(
         help="Frame rate of AMC input files, which do not store it (CMU: 120).")] = AMC_FPS,
     take: Annotated[str | None, typer.Option(
         help="Which take of a glTF or FBX input to read: its name or 0-based index (mocycle info lists them); "
-             "default the first.")] = None,
+             "default the first that moves the skeleton.")] = None,
     frame_range: Annotated[str | None, typer.Option("--range", help="Keep frames START:STOP.")] = None,
     force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
     gltf_scale: Annotated[str, GLTF_SCALE] = "auto",

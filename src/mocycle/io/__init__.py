@@ -88,7 +88,8 @@ def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None
     asf : the ``.asf`` skeleton of an ``.amc`` file; default: the one beside it (same
         subject number, or the only one).
     fps : frame rate of ``.amc`` files, which do not store it (CMU: 120).
-    take : glTF and FBX only: the animation (stack) to read, by name or 0-based index; default the first.
+    take : glTF and FBX only: the animation (stack) to read, by name or 0-based index; default the first that
+        moves the skeleton (a :class:`~mocycle.errors.DefaultTake` warning says which).
         Other files hold one take: a name other than their stem is an error.
     sample_fps : glTF and FBX only: the frame rate to sample the animation at; default the file's own (glTF: the
         keys' rate when regular, else 30; FBX: the scene's frame rate).

@@ -95,8 +95,21 @@ def unique_names(names: list[str | None], prefix: str = "node") -> list[str]:
     return out
 
 
+def joint_names(names: list[str | None], members: list[int]) -> list[str]:
+    """A name for every node (``names``: the file's, by node index) made unique among the skeleton's nodes
+    (``members``) first, in skeleton order, then among the others: a mesh or an empty called like a bone
+    (RobotExpressive's ``Torso``) does not rename the bone."""
+    order = list(members) + [i for i in range(len(names)) if i not in set(members)]
+    unique = unique_names([names[i] for i in order])
+    out = [""] * len(names)
+    for i, name in zip(order, unique, strict=True):
+        out[i] = name
+    return out
+
+
 def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: list[int], n_frames: int,
-                      frame_time: float, path, *, leaves_as_sites: bool = True) -> Motion:
+                      frame_time: float, path, *, leaves_as_sites: bool = True, up=None,
+                      metres_per_unit: float | None = None) -> Motion:
     """The motion that plays ``joints`` as the scene does.
 
     Parameters
@@ -107,8 +120,9 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     n_frames, frame_time : the frames the transforms were sampled at.
     path : the file, for messages.
     leaves_as_sites : make leaf joints without animation End Sites.
+    up, metres_per_unit : the vertical and unit the file declares (``None``: it does not), kept by the skeleton.
     """
-    T, J = int(n_frames), len(joints)
+    declared_up, T, J = up, int(n_frames), len(joints)
     check_frames(T, J, "the animation", path)
     up = np.asarray(parents, dtype=np.int64)  # checked as an array, used as one
     if J == 0 or up.shape != (J,) or up[0] != -1 or np.any(up[1:] < 0) or np.any(up[1:] >= np.arange(1, J)):
@@ -185,7 +199,8 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     end_sites = tuple(EndSite(parent=new_index[int(up[j])], offset=_vec3(site_offsets[j]),
                               name=joints[j].name) for j in sites)
     try:
-        skeleton = Skeleton(tuple(names), np.asarray(kparents), offsets, tuple(channels), end_sites)
+        skeleton = Skeleton(tuple(names), np.asarray(kparents), offsets, tuple(channels), end_sites, up=declared_up,
+                            metres_per_unit=metres_per_unit)
         return Motion(skeleton, rotations, static, frame_time, tracks=tracks, copy=False)
     except MocycleError as exc:
         raise MotionFileError(str(exc), path) from None

@@ -492,32 +492,60 @@ def bvh_size(motion: Motion) -> int:
 _ROWS_PER_CHUNK = 1024  # the text of 1024 rows of 69 channels: about 1 MB (a StringIO holds 4 bytes a character)
 
 
-def bvh_chunks(motion: Motion) -> Iterator[str]:
+def one_word_names(skeleton: Skeleton) -> tuple[list[str], list[str | None], list[tuple[str, str]]]:
+    """Joint and End Site names as one word each, which every BVH reader takes (most split a line at white
+    space): white space inside a name becomes ``_`` (``bras droit`` -> ``bras_droit``), an empty name
+    ``joint<j>``, and a joint name that then repeats another gets ``_2``, ``_3``.  Returns (joint names, End
+    Site names, the ``(name, written)`` pairs that changed)."""
+    taken: set[str] = set()
+    joints, changed = [], []
+    for j, name in enumerate(skeleton.names):
+        word = "_".join(name.split()) or f"joint{j}"
+        if word != name or word in taken:
+            base, k = word, 2
+            while word in taken or (word != name and word in skeleton.names):
+                word, k = f"{base}_{k}", k + 1
+        taken.add(word)
+        joints.append(word)
+        if word != name:
+            changed.append((name, word))
+    sites: list[str | None] = []
+    for site in skeleton.end_sites:
+        word = "_".join(site.name.split()) if site.name else site.name
+        sites.append(word or None)
+        if site.name and word != site.name:
+            changed.append((site.name, str(word)))
+    return joints, sites, changed
+
+
+def bvh_chunks(motion: Motion, names: tuple[list[str], list[str | None]] | None = None) -> Iterator[str]:
     """The BVH text of ``motion`` in pieces (the header, then blocks of frames), so that a long take is
-    written without holding its whole text."""
+    written without holding its whole text.  ``names``: the joint and End Site names to write (default the
+    skeleton's)."""
     skel = motion.skeleton
+    joint_names, site_names = names if names is not None else (list(skel.names), [s.name for s in skel.end_sites])
     out = io.StringIO()
     out.write("HIERARCHY\n")
     children: list[list[int]] = [[] for _ in range(skel.n_joints)]
     for j, p in enumerate(skel.parents.tolist()):
         if p >= 0:
             children[p].append(j)
-    sites: list[list[EndSite]] = [[] for _ in range(skel.n_joints)]
-    for site in skel.end_sites:
-        sites[site.parent].append(site)
+    sites: list[list[tuple[EndSite, str | None]]] = [[] for _ in range(skel.n_joints)]
+    for site, site_name in zip(skel.end_sites, site_names, strict=True):
+        sites[site.parent].append((site, site_name))
     # A stack of ("open", joint, depth) and ("close", joint, depth): depth-first, children in order.
     stack = [("close", 0, 0), ("open", 0, 0)]
     while stack:
         what, j, depth = stack.pop()
         tab = "\t" * depth
         if what == "close":
-            for s in sites[j]:
-                label = "End Site" + (f" {s.name}" if s.name else "")
+            for s, site_name in sites[j]:
+                label = "End Site" + (f" {site_name}" if site_name else "")
                 out.write(f"{tab}\t{label}\n{tab}\t{{\n")
                 out.write(f"{tab}\t\tOFFSET {' '.join(_fmt(v) for v in s.offset)}\n{tab}\t}}\n")
             out.write(f"{tab}}}\n")
             continue
-        out.write(f"{tab}{'ROOT' if j == 0 else 'JOINT'} {skel.names[j]}\n{tab}{{\n")
+        out.write(f"{tab}{'ROOT' if j == 0 else 'JOINT'} {joint_names[j]}\n{tab}{{\n")
         out.write(f"{tab}\tOFFSET {' '.join(_fmt(v) for v in skel.offsets[j])}\n")
         chans = skel.channels[j]
         out.write(f"{tab}\tCHANNELS {len(chans)}{''.join(' ' + c for c in chans)}\n")
@@ -540,9 +568,17 @@ def bvh_chunks(motion: Motion) -> Iterator[str]:
 
 
 def write_bvh(motion: Motion, path: str | os.PathLike) -> Path:
-    """Write ``motion`` as a BVH file at ``path`` (atomically).  Returns the path."""
+    """Write ``motion`` as a BVH file at ``path`` (atomically).  Returns the path.
+
+    Names are written one word each (:func:`one_word_names`; a :class:`~mocycle.errors.MocycleWarning` lists
+    what changed), so that every BVH reader reads one joint per name; mocycle reads back the names written."""
+    joints, sites, changed = one_word_names(motion.skeleton)
+    if changed:
+        shown = ", ".join(f"{a!r} as {b!r}" for a, b in changed[:5]) + (" ..." if len(changed) > 5 else "")
+        warnings.warn(f"{path}: BVH names are one word each (most readers split a line at spaces): {len(changed)} "
+                      f"written with underscores: {shown}", MocycleWarning, stacklevel=2)
     try:
-        return atomic_write(path, bvh_chunks(motion))
+        return atomic_write(path, bvh_chunks(motion, (joints, sites)))
     except OSError as exc:
         raise MotionFileError(f"cannot write file ({exc.strerror or exc})", path) from None
 

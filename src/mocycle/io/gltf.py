@@ -55,7 +55,8 @@ class GltfFrame:
     """From the motion's units and axes to glTF's: ``p_gltf = scale * rotation @ p``.
 
     scale : metres per motion unit.
-    unit : the unit's name (a key of :data:`UNITS`, or ``"given"`` when ``scale`` was a number).
+    unit : the unit's name (a key of :data:`UNITS`; ``"given"`` when ``scale`` was a number, ``"file"`` for a
+        unit the file declares that is none of them).
     up : ``(3,)`` the motion's vertical, motion axes.
     rotation : ``(3, 3)`` the rotation that takes ``up`` to +Y.
     body_size : the body's size in motion units (what ``"auto"`` measured).
@@ -84,10 +85,14 @@ class GltfFrame:
 def body_size(motion: Motion) -> float:
     """The body's size in motion units: the largest extent of the rest pose (a T-pose's height or arm span)
     or of the median frame's pose, whichever is larger; the travel joint and the joints and End Sites below
-    it (a static ``joint_Root`` left behind at the room's origin is no part of the body)."""
+    it (a static ``joint_Root`` left behind at the room's origin is no part of the body), or the body's root
+    and everything below it when the travel joint has no joint below it (an IK target that moves, as
+    RobotExpressive's feet)."""
     sk = motion.skeleton
     parents = list(sk.parents) + [site.parent for site in sk.end_sites]
     travel, below = motion.travel_joint, []
+    if not sk.children(travel):
+        travel = sk.body_root()
     for i, p in enumerate(parents):  # parents come first
         if i == travel or (p >= 0 and p in below):
             below.append(i)
@@ -125,9 +130,12 @@ def gltf_frame(motion: Motion, scale: float | str = "auto", up=None) -> GltfFram
     ----------
     motion : the take.
     scale : metres per motion unit (a positive number), a unit name of :data:`UNITS`, or ``"auto"``: the unit
-        that makes the body (:func:`body_size`) closest to :data:`HUMAN_HEIGHT_M` on a log scale; a
-        :class:`~mocycle.errors.MocycleWarning` when even that leaves it outside :data:`PLAUSIBLE_HEIGHT_M`.
-    up : ``None`` or ``"auto"`` to detect the motion's vertical, or ``"y"``, ``"z"``, ``"-z"``, ... or a 3-vector.
+        the file declares (the skeleton's :attr:`~mocycle.motion.Skeleton.metres_per_unit`: glTF, FBX), the same
+        for every take of a file; else the unit that makes the body (:func:`body_size`) closest to
+        :data:`HUMAN_HEIGHT_M` on a log scale, with a :class:`~mocycle.errors.MocycleWarning` when even that
+        leaves it outside :data:`PLAUSIBLE_HEIGHT_M`.
+    up : ``None`` or ``"auto"`` for the motion's vertical (the declared one, else detected:
+        :func:`mocycle.axes.vertical_axis`), or ``"y"``, ``"z"``, ``"-z"``, ... or a 3-vector.
 
     Examples
     --------
@@ -144,7 +152,12 @@ def gltf_frame(motion: Motion, scale: float | str = "auto", up=None) -> GltfFram
     scale, up = check_options(scale, up)
     v = vertical_axis(motion, up)
     size = body_size(motion)
-    unit, metres = _units(scale, size)
+    declared = motion.skeleton.metres_per_unit
+    if scale == "auto" and declared is not None:
+        unit = next((name for name, m in UNITS.items() if abs(m - declared) <= 1e-9 * m), "file")
+        metres = declared
+    else:
+        unit, metres = _units(scale, size)
     if v[1] < -1 + 1e-12:  # upside down: half a turn about X (align_vectors has no unique answer)
         rot = np.diag([1.0, -1.0, -1.0])
     else:

@@ -5,14 +5,18 @@ What is read (``docs/formats.md`` has the whole story):
 * **the skeleton**: the joints of the file's skin (the one with the most joints when there are several), plus any
   node lying between two of them; parents first.  The nodes above the skeleton's root (Blender's armature object,
   an axis or unit conversion) are composed into the root.  Without a skin, the animated nodes and the nodes
-  between them form the skeleton.  A leaf joint that no channel animates becomes an End Site.
-* **the animation**: one of the file's animations (``take``: its name or its 0-based index; default the first),
+  between them form the skeleton (the nodes any animation moves: the same for every take).  A leaf joint that
+  no channel of any animation animates becomes an End Site: every take has the same joints.
+* **the animation**: one of the file's animations (``take``: its name or its 0-based index; default the first
+  that moves the skeleton, said in a :class:`~mocycle.errors.DefaultTake` warning when there are several),
   its ``translation``, ``rotation`` and ``scale`` channels on those nodes (``weights`` are morph targets: not
   read), with LINEAR (slerp for rotations), STEP and CUBICSPLINE (Hermite, glTF's tangents scaled by the key
-  interval) samplers, sampled at one frame rate: the keys' own when all key times lie on one regular grid
-  (rounded to a whole number of frames per second when within 1e-4 of one), else ``fps`` (default 30).
+  interval) samplers, sampled at the file's frame rate (``fps`` when given): the key rate of its animations,
+  the one on whose frames the keys of most of them lie (rounded to a whole number of frames per second when
+  within 1e-4 of one), else 30; a take whose keys lie off those frames says so (a MocycleWarning).
   A file without animations is its rest pose, one frame.
-* **units and axes**: glTF's metres and +Y up, as the file holds them; except in a file mocycle wrote (its
+* **units and axes**: glTF's metres and +Y up, as the file holds them and as the skeleton says
+  (:attr:`Skeleton.up`, :attr:`Skeleton.metres_per_unit`); except in a file mocycle wrote (its
   scene's ``extras.mocycle.units``), whose unit scale and vertical turn are undone, so the motion read is the
   one written.
 * scale on nodes (also animated): the joints' world positions are the file's; see :mod:`._nodes`.
@@ -29,15 +33,16 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..errors import MotionFileError
+from ..errors import DefaultTake, MocycleWarning, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
-from ._nodes import NodeTRS, choose_take, member_nodes, motion_from_nodes, skeleton_order, unique_names
+from ._nodes import NodeTRS, choose_take, joint_names, member_nodes, motion_from_nodes, skeleton_order, unique_names
 
 __all__ = ["DEFAULT_FPS", "gltf_takes", "read_gltf"]
 
@@ -338,11 +343,6 @@ def gltf_takes(path: str | os.PathLike) -> list[str]:
     return _names(_File(Path(path)))
 
 
-def _choose(f: _File, take) -> int | None:
-    names = _names(f) if _animations(f) else []
-    return choose_take(names, take, f.path, "animation", "animation")
-
-
 def _sample(times: np.ndarray, keys: np.ndarray, values: np.ndarray, interpolation: str, rotation: bool,
             path, label: str) -> np.ndarray:
     """``values`` keyed at ``keys`` (glTF sampler) at ``times``: ``(len(times), width)``."""
@@ -394,27 +394,43 @@ def _sample(times: np.ndarray, keys: np.ndarray, values: np.ndarray, interpolati
     return out
 
 
-def _frame_rate(all_keys: list[np.ndarray], fps: float | None) -> tuple[float, float, float]:
-    """(first key time, last key time, frames per second) of an animation's key times."""
+def _grid_step(all_keys: list[np.ndarray]) -> float | None:
+    """The step (seconds) of the one regular grid, from the animation's first key, that every key time lies
+    on (within 1e-3 of a step), or ``None``."""
     start = min(float(k[0]) for k in all_keys)
-    end = max(float(k[-1]) for k in all_keys)
-    if fps is not None:
-        return start, end, float(fps)
     steps = np.concatenate([np.diff(k) for k in all_keys if len(k) > 1] or [np.zeros(0)])
     steps = steps[steps > 0]
     if not len(steps):
-        return start, end, DEFAULT_FPS
+        return None
     step = float(np.median(steps))
-    regular = all(np.allclose((k - start) / step, np.round((k - start) / step), rtol=0, atol=1e-3)
-                  for k in all_keys)
-    if not regular or not step > 0:
-        return start, end, DEFAULT_FPS
+    if not step > 0 or not all(np.allclose((k - start) / step, np.round((k - start) / step), rtol=0, atol=1e-3)
+                               for k in all_keys):
+        return None
+    return step
+
+
+def _on_grid(all_keys: list[np.ndarray], rate: float) -> bool:
+    """Whether every key time lies on the frames of ``rate`` from the animation's first key."""
+    start = min(float(k[0]) for k in all_keys)
+    return all(np.allclose((k - start) * rate, np.round((k - start) * rate), rtol=0, atol=1e-3) for k in all_keys)
+
+
+def _rate_of(step: float | None) -> float | None:
+    """The frame rate of one key per ``step`` (rounded to a whole number within 1e-4), or ``None`` for no grid
+    or sparse authored keys (fewer than :data:`MIN_KEY_RATE` a second)."""
+    if step is None or 1.0 / step < MIN_KEY_RATE:
+        return None
     rate = 1.0 / step
-    if rate < MIN_KEY_RATE:  # a few keys far apart: an authored clip, not one key per frame
-        return start, end, DEFAULT_FPS
-    if abs(rate - round(rate)) < 1e-4 * rate and round(rate) > 0:
-        rate = float(round(rate))
-    return start, end, rate
+    return float(round(rate)) if abs(rate - round(rate)) < 1e-4 * rate and round(rate) > 0 else rate
+
+
+def _file_rate(keys_by_animation: list[list[np.ndarray]]) -> float | None:
+    """The file's frame rate: among the key rates of its animations, the one on whose frames the keys of the
+    most animations lie (the lower on a tie); ``None`` when no animation keys each frame."""
+    rates = sorted({r for keys in keys_by_animation if keys for r in [_rate_of(_grid_step(keys))] if r})
+    if not rates:
+        return None
+    return max(rates, key=lambda r: (sum(bool(keys) and _on_grid(keys, r) for keys in keys_by_animation), -r))
 
 
 def _skeleton_nodes(f: _File, parents: np.ndarray, animated: set[int]) -> list[int]:
@@ -456,14 +472,94 @@ def _is_mocycle(f: _File) -> dict | None:
     return None
 
 
+def _channels(f: _File, index: int, n_nodes: int, values: bool = True, inputs: dict | None = None) -> list:
+    """The ``translation``, ``rotation`` and ``scale`` channels of animation ``index`` that target a node:
+    ``(node, path, key times, values or None, interpolation, label)``; ``values=False`` reads the key times
+    only (``inputs`` keeps them by accessor: samplers often share theirs)."""
+    p = f.path
+    anim = _animations(f)[index]
+    samplers = _list(getattr(anim, "samplers", None), "animation.samplers", p)
+    out = []
+    for c, ch in enumerate(_list(getattr(anim, "channels", None), "animation.channels", p)):
+        target = getattr(ch, "target", None)
+        kind = getattr(target, "path", None)
+        node = getattr(target, "node", None)
+        if kind not in _PATHS or node is None:
+            continue  # morph weights, pointers, no node: nothing a skeleton plays
+        node = _int(node, f"channels[{c}].target.node", p, 0, n_nodes - 1)
+        s = _int(getattr(ch, "sampler", None), f"channels[{c}].sampler", p, 0, max(len(samplers) - 1, 0))
+        if s >= len(samplers):
+            raise MotionFileError(f"channels[{c}] names sampler {s}; the animation has none", p)
+        sampler = samplers[s]
+        interp = getattr(sampler, "interpolation", None) or "LINEAR"
+        if interp not in ("LINEAR", "STEP", "CUBICSPLINE"):
+            raise MotionFileError(f"samplers[{s}]: unknown interpolation {interp!r}", p)
+        source = getattr(sampler, "input", None)
+        keys = None if inputs is None or not isinstance(source, int) else inputs.get(source)
+        if keys is None:
+            keys = f.accessor(source, f"samplers[{s}].input", (1,))[:, 0]
+            if not np.isfinite(keys).all() or np.any(np.diff(keys) < 0):
+                raise MotionFileError(f"samplers[{s}].input: key times must be finite and increasing", p)
+            if inputs is not None and isinstance(source, int):
+                inputs[source] = keys
+        data = None
+        if values:
+            data = f.accessor(getattr(sampler, "output", None), f"samplers[{s}].output", (_PATHS[kind],))
+            if not np.isfinite(data).all():
+                raise MotionFileError(f"samplers[{s}].output holds NaN or infinite values", p)
+        out.append((node, kind, keys, data, interp, f"animation {index} channel {c}"))
+    return out
+
+
+def _targets(f: _File, n_nodes: int) -> set[int]:
+    """The nodes that a channel of any animation moves (``translation``, ``rotation`` or ``scale``): the JSON
+    only, no data read."""
+    out = set()
+    for anim in _animations(f):
+        for ch in _list(getattr(anim, "channels", None), "animation.channels", f.path):
+            target = getattr(ch, "target", None)
+            node = getattr(target, "node", None)
+            if getattr(target, "path", None) in _PATHS and node is not None:
+                out.add(_int(node, "channels.target.node", f.path, 0, n_nodes - 1))
+    return out
+
+
+def _moves(channels: list, nodes: set[int]) -> bool:
+    """Whether a channel on ``nodes`` changes its value."""
+    return any(node in nodes and len(data) > 1 and float(np.ptp(data, axis=0).max()) > 0
+               for node, _, _, data, _, _ in channels)
+
+
+def _default_take(f: _File, body: set[int], n_nodes: int, names: list[str]) -> tuple[int, list]:
+    """The first animation that moves the skeleton (``body``: its nodes and the nodes above it), or the first,
+    and its channels; a :class:`~mocycle.errors.DefaultTake` warning names it and the others."""
+    still, chosen, channels = [], None, []
+    for k in range(len(names)):
+        channels = _channels(f, k, n_nodes)
+        if _moves(channels, body):
+            chosen = k
+            break
+        still.append(k)
+    if chosen is None:
+        chosen, channels = 0, _channels(f, 0, n_nodes)
+    if len(names) > 1:
+        others = [f"{name!r}" + (" (still)" if k in still else "") for k, name in enumerate(names) if k != chosen]
+        why = "the first: no animation moves the skeleton" if chosen in still else "the first that moves the skeleton"
+        warnings.warn(f"{f.path}: read take {names[chosen]!r} ({why}); the file also holds {', '.join(others)}: "
+                      f"choose one with --take", DefaultTake, stacklevel=3)
+    return chosen, channels
+
+
 def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: float | None = None) -> Motion:
     """Read a glTF file's skeleton and one of its animations as a :class:`Motion`.
 
     Parameters
     ----------
     path : a ``.glb`` or ``.gltf`` file.
-    take : the animation's name (or 0-based index); default the first (:func:`gltf_takes` lists them).
-    fps : the frame rate to sample at; default the keys' own when regular, else :data:`DEFAULT_FPS`.
+    take : the animation's name (or 0-based index); default the first that moves the skeleton
+        (:func:`gltf_takes` lists them).
+    fps : the frame rate to sample at; default the file's: the key rate of its animations (the one most of
+        them key every frame at), else :data:`DEFAULT_FPS`.
 
     Raises
     ------
@@ -475,36 +571,33 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
         raise MotionFileError(f"the frame rate must be positive; got {fps!r}", p)
     f = _File(p)
     parents = _parents(f)
-    index = _choose(f, take)
-    channels = []  # (node, path, times, values, interpolation)
-    if index is not None:
-        anim = _animations(f)[index]
-        samplers = _list(getattr(anim, "samplers", None), "animation.samplers", p)
-        for c, ch in enumerate(_list(getattr(anim, "channels", None), "animation.channels", p)):
-            target = getattr(ch, "target", None)
-            kind = getattr(target, "path", None)
-            node = getattr(target, "node", None)
-            if kind not in _PATHS or node is None:
-                continue  # morph weights, pointers, no node: nothing a skeleton plays
-            node = _int(node, f"channels[{c}].target.node", p, 0, len(parents) - 1)
-            s = _int(getattr(ch, "sampler", None), f"channels[{c}].sampler", p, 0, max(len(samplers) - 1, 0))
-            if s >= len(samplers):
-                raise MotionFileError(f"channels[{c}] names sampler {s}; the animation has none", p)
-            sampler = samplers[s]
-            interp = getattr(sampler, "interpolation", None) or "LINEAR"
-            if interp not in ("LINEAR", "STEP", "CUBICSPLINE"):
-                raise MotionFileError(f"samplers[{s}]: unknown interpolation {interp!r}", p)
-            keys = f.accessor(getattr(sampler, "input", None), f"samplers[{s}].input", (1,))[:, 0]
-            if not np.isfinite(keys).all() or np.any(np.diff(keys) < 0):
-                raise MotionFileError(f"samplers[{s}].input: key times must be finite and increasing", p)
-            values = f.accessor(getattr(sampler, "output", None), f"samplers[{s}].output", (_PATHS[kind],))
-            if not np.isfinite(values).all():
-                raise MotionFileError(f"samplers[{s}].output holds NaN or infinite values", p)
-            channels.append((node, kind, keys, values, interp, f"animation {index} channel {c}"))
-    animated = {c[0] for c in channels}
-    members = _skeleton_nodes(f, parents, animated)
+    N = len(parents)
+    targets = _targets(f, N)  # every take's: the same skeleton and End Sites for each
+    members = _skeleton_nodes(f, parents, targets)
+    names = _names(f) if _animations(f) else []
+    body = set(members)  # the skeleton's nodes and the nodes above it
+    i = int(parents[members[0]])
+    while i >= 0:
+        body.add(i)
+        i = int(parents[i])
+    if take is None and names:
+        index: int | None
+        index, channels = _default_take(f, body, N, names)
+    else:
+        index = choose_take(names, take, p, "animation", "animation")
+        channels = _channels(f, index, N) if index is not None else []
+    channels = [c for c in channels if c[0] in body]  # a mesh's or a camera's keys do not make the take longer
     if channels:
-        start, end, rate = _frame_rate([c[2] for c in channels], fps)
+        keys = [c[2] for c in channels]
+        rate = fps
+        if rate is None:
+            inputs: dict = {}
+            rate = _file_rate([[c[2] for c in _channels(f, k, N, values=False, inputs=inputs)]
+                               for k in range(len(names))]) or DEFAULT_FPS
+            if not _on_grid(keys, rate):
+                warnings.warn(f"{p}: the keys of take {names[index]!r} lie on no regular grid of the file's "  # type: ignore[index]
+                              f"{rate:g} fps frames; sampled at {rate:g} fps", MocycleWarning, stacklevel=2)
+        start, end = min(float(k[0]) for k in keys), max(float(k[-1]) for k in keys)
         problem = frame_time_problem(1.0 / rate)
         if problem:
             raise MotionFileError(problem, p)
@@ -515,36 +608,28 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
     else:
         rate, T, times = fps or DEFAULT_FPS, 1, np.zeros(1)
 
-    names = unique_names([getattr(f.items("nodes")[i], "name", None) for i in range(len(parents))])
+    node_names = joint_names([getattr(f.items("nodes")[i], "name", None) for i in range(N)], members)
     trs: dict[int, NodeTRS] = {}
 
     def node_trs(i: int) -> NodeTRS:
         if i not in trs:
             t, q, s = _rest_trs(f, i)
-            trs[i] = NodeTRS(names[i], t[None], q[None], s[None])
+            trs[i] = NodeTRS(node_names[i], t[None], q[None], s[None], animated=i in targets)
         return trs[i]
 
     for node, kind, keys, values, interp, label in channels:
-        if node not in members and not _is_above(node, members, parents):
-            continue
         n = node_trs(node)
-        sampled = _sample(times, keys, values, interp, kind == "rotation", p, label)
-        setattr(n, kind, sampled)
-        n.animated = True
+        setattr(n, kind, _sample(times, keys, values, interp, kind == "rotation", p, label))
     ancestors, joints, jparents = member_nodes(members, parents, node_trs)
     units = _is_mocycle(f)
+    up, metres = (0.0, 1.0, 0.0), 1.0  # glTF: metres, +Y up (the specification)
     if units is not None:  # undo mocycle's writer: back to the motion's own units and axes
-        back = Rotation.from_quat(units["rotation"]).inv().as_quat()
-        ancestors.insert(0, NodeTRS("mocycle units", np.zeros((1, 3)), back[None],
+        back = Rotation.from_quat(units["rotation"]).inv()
+        ancestors.insert(0, NodeTRS("mocycle units", np.zeros((1, 3)), back.as_quat()[None],
                                     np.full((1, 3), 1.0 / units["scale"])))
-    return motion_from_nodes(ancestors, joints, jparents, T, 1.0 / rate, p)
-
-
-def _is_above(node: int, members: list[int], parents: np.ndarray) -> bool:
-    """Whether ``node`` is an ancestor of the skeleton's root."""
-    i = int(parents[members[0]])
-    while i >= 0:
-        if i == node:
-            return True
-        i = int(parents[i])
-    return False
+        up, metres = tuple(back.apply([0.0, 1.0, 0.0])), units["scale"]
+    motion = motion_from_nodes(ancestors, joints, jparents, T, 1.0 / rate, p, up=up, metres_per_unit=metres)
+    if index is not None:
+        name = names[index]
+        motion.cache("take", lambda _: name)  # the take read (mocycle info says which)
+    return motion

@@ -23,7 +23,7 @@ def amc_fps():
 
 def take():
     return option(None, "Which take of a glTF or FBX input to read: an animation's (FBX: animation stack's) name or "
-                        "0-based index, as mocycle info lists them; default the first.", Text())
+                        "0-based index, as mocycle info lists them; default the first that moves the skeleton.", Text())
 
 
 def method(help: str = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."):

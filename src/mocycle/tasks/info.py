@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from ..errors import DefaultTake
 from . import fields
 from .options import Options as _Options
 from .report import Recorder, Report, load
@@ -79,9 +81,9 @@ def motion_info(motion: Motion) -> dict:
     }
 
 
-def take_names(item, chosen: str | None) -> dict:
-    """``takes`` (the names of the takes a glTF or FBX file holds) and ``take`` (the one read); nothing for other
-    inputs."""
+def take_names(item, chosen: str | None, motion: Motion | None = None) -> dict:
+    """``takes`` (the names of the takes a glTF or FBX file holds) and ``take`` (the one read: the reader keeps
+    its name with the ``motion``, ``motion.cache("take")``); nothing for other inputs."""
     from pathlib import Path
 
     from ..io import TAKE_SUFFIXES, takes
@@ -90,7 +92,10 @@ def take_names(item, chosen: str | None) -> dict:
     if is_motion(item) or Path(item).suffix.lower() not in TAKE_SUFFIXES:
         return {}
     names = takes(item)
-    if chosen is None:
+    known = None if motion is None else motion.cache("take")
+    if known is not None:
+        read = known
+    elif chosen is None:
         read = names[0] if names else None
     else:
         read = str(chosen) if str(chosen) in names else names[int(chosen)]
@@ -101,7 +106,9 @@ def run(take, options: Options | None = None) -> Report:
     """The facts of one take (a :class:`Motion` or a motion file)."""
     options = options or Options()
     with Recorder() as rec:
-        motion = load(take, options.amc_fps, options.take)
+        with warnings.catch_warnings():  # the facts list the takes and the one read
+            warnings.simplefilter("ignore", DefaultTake)
+            motion = load(take, options.amc_fps, options.take)
         facts = motion_info(motion)
-        facts.update(take_names(take, options.take))
+        facts.update(take_names(take, options.take, motion))
     return rec.report("info", facts, {"motion": motion})
