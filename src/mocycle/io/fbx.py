@@ -35,6 +35,7 @@ from ..errors import MocycleError, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
 from ._nodes import NodeTRS, choose_take, member_nodes, motion_from_nodes, skeleton_order, unique_names
+from .fbx_scan import opened
 
 __all__ = ["DEFAULT_FPS", "fbx_takes", "read_fbx"]
 
@@ -62,7 +63,10 @@ def _load(path: Path):
     if size > MAX_FILE_BYTES:
         raise MotionFileError(f"the file holds {size:,} bytes; FBX files over {MAX_FILE_BYTES:,} are not read", path)
     try:
-        return pufbx.load_fbx(str(path))
+        with opened(path) as name:  # regular files only, no deflate bomb; any file name (fbx_scan)
+            return pufbx.load_fbx(name)
+    except MotionFileError:
+        raise
     except Exception as exc:  # ufbx's error (its message says what it expected), or the binding's
         text = " ".join(str(exc).split())[:200] or type(exc).__name__
         raise MotionFileError(f"not a readable FBX file ({text})", path) from None
