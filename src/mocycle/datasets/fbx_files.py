@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Node", "ObjectName", "Zeros", "chain_scene", "fbx_bytes", "write_fbx"]
+__all__ = ["Node", "ObjectName", "Zeros", "bomb_scene", "chain_scene", "fbx_bytes", "write_fbx", "zeros_stream"]
 
 #: FBX time ticks per second
 SECOND = 46186158000
@@ -96,18 +96,19 @@ def _binary_prop(value) -> bytes:
     raise TypeError(f"no FBX property type for {type(value).__name__}")
 
 
-def _binary_node(node: Node, at: int) -> bytes:
-    """The record of ``node`` starting at file offset ``at`` (32-bit offsets: FBX 7.4)."""
+def _binary_node(node: Node, at: int, wide: bool) -> bytes:
+    """The record of ``node`` starting at file offset ``at`` (32-bit offsets before FBX 7.5, 64-bit from it)."""
     name = node.name.encode()
     props = b"".join(_binary_prop(p) for p in node.props)
-    head = 13 + len(name)
+    fields = "<QQQB" if wide else "<IIIB"
+    head = struct.calcsize(fields) + len(name)
     body = bytearray()
     for child in node.children:
-        body += _binary_node(child, at + head + len(props) + len(body))
+        body += _binary_node(child, at + head + len(props) + len(body), wide)
     if node.children:
-        body += bytes(13)
+        body += bytes(struct.calcsize(fields))
     end = at + head + len(props) + len(body)
-    return struct.pack("<IIIB", end, len(node.props), len(props), len(name)) + name + props + bytes(body)
+    return struct.pack(fields, end, len(node.props), len(props), len(name)) + name + props + bytes(body)
 
 
 def _ascii_prop(value) -> str:
@@ -141,17 +142,18 @@ def _ascii_node(node: Node, depth: int, out: list[str]) -> None:
         out.append(line + "\n")
 
 
-def fbx_bytes(nodes: list[Node], binary: bool = True) -> bytes:
-    """The FBX file of the top-level records ``nodes`` (binary FBX 7400, or ASCII)."""
+def fbx_bytes(nodes: list[Node], binary: bool = True, version: int = 7400) -> bytes:
+    """The FBX file of the top-level records ``nodes`` (binary FBX ``version``, or ASCII)."""
     if not binary:
         out = ["; FBX 7.4.0 project file\n"]
         for node in nodes:
             _ascii_node(node, 0, out)
         return "".join(out).encode("utf-8", "surrogateescape")
-    data = bytearray(_HEADER + struct.pack("<I", 7400))
+    wide = version >= 7500
+    data = bytearray(_HEADER + struct.pack("<I", version))
     for node in nodes:
-        data += _binary_node(node, len(data))
-    data += bytes(13)  # the end of the top-level records
+        data += _binary_node(node, len(data), wide)
+    data += bytes(25 if wide else 13)  # the end of the top-level records
     return bytes(data)
 
 
@@ -202,8 +204,16 @@ def chain_scene(n_bones: int = 3, frames: int = 31, fps: int = 30, names: list[s
     return [header, settings, Node("Objects", (), objects), Node("Connections", (), connections)]
 
 
-def write_fbx(path, nodes: list[Node], binary: bool = True) -> Path:
+def write_fbx(path, nodes: list[Node], binary: bool = True, version: int = 7400) -> Path:
     """Write :func:`fbx_bytes` of ``nodes`` to ``path``; returns it."""
     path = Path(path)
-    path.write_bytes(fbx_bytes(nodes, binary))
+    path.write_bytes(fbx_bytes(nodes, binary, version))
     return path
+
+
+def bomb_scene(n_values: int = 300_000_000, n_bones: int = 3) -> list[Node]:
+    """:func:`chain_scene` with a mesh whose vertices are ``n_values`` zero doubles, compressed: 300 million
+    (2.4 GB as doubles) make a file of 2.3 MB."""
+    mesh = Node("Geometry", (5000, ObjectName("Geometry", "body"), "Mesh"), [
+        Node("Vertices", (Zeros(n_values),)), Node("PolygonVertexIndex", (np.array([0, 1, -3], "<i4"),))])
+    return chain_scene(n_bones, extra=[mesh])
