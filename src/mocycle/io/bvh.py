@@ -24,6 +24,7 @@ from __future__ import annotations
 import io
 import math
 import os
+import re
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
@@ -556,17 +557,50 @@ def format_bvh(motion: Motion) -> str:
 
 def bvh_size(motion: Motion) -> int:
     """Bytes of the BVH file of ``motion`` (counted piece by piece, without holding the text)."""
-    return sum(len(piece.encode("utf-8")) for piece in bvh_chunks(motion))
+    with warnings.catch_warnings():  # a size: the writer says what it changes
+        warnings.simplefilter("ignore")
+        return sum(len(piece.encode("utf-8")) for piece in bvh_chunks(motion))
 
 
 #: Frames per piece of text :func:`bvh_chunks` yields.
 _ROWS_PER_CHUNK = 1024  # the text of 1024 rows of 69 channels: about 1 MB (a StringIO holds 4 bytes a character)
 
 
+#: what a BVH joint or End Site name cannot hold: braces (read as the hierarchy's), control characters (a line
+#: break ends the name), text that is no Unicode (a lone surrogate: the file is UTF-8)
+_NOT_IN_A_NAME = re.compile("[{}\x00-\x1f\x7f\ud800-\udfff]")
+_IN_PLACE = {"{": "(", "}": ")"}
+
+
+def _bvh_name(name: str) -> str:
+    def one(match: re.Match) -> str:
+        c = match.group()
+        return _IN_PLACE.get(c, "\ufffd" if "\ud800" <= c <= "\udfff" else "_")
+
+    return _NOT_IN_A_NAME.sub(one, name).strip() or "_"
+
+
+def bvh_skeleton(skeleton: Skeleton) -> Skeleton:
+    """``skeleton`` with joint and End Site names a BVH file holds and reads back as they are: ``{``/``}`` as
+    ``(``/``)``, control characters as ``_``, lone surrogates as U+FFFD, no space at either end (one warning
+    saying which, :func:`mocycle.text.renamed`); the same skeleton when every name is fine."""
+    from ..text import renamed
+
+    sites = [s.name for s in skeleton.end_sites if s.name is not None]
+    if not any(_NOT_IN_A_NAME.search(n) or n != n.strip() or not n for n in (*skeleton.names, *sites)):
+        return skeleton
+    names = renamed(list(skeleton.names) + sites, _bvh_name, "BVH")
+    joints, site_names = names[:skeleton.n_joints], iter(names[skeleton.n_joints:])
+    end_sites = tuple(EndSite(s.parent, s.offset, next(site_names) if s.name is not None else None)
+                      for s in skeleton.end_sites)
+    return Skeleton(tuple(joints), skeleton.parents, skeleton.offsets, skeleton.channels, end_sites)
+
+
 def bvh_chunks(motion: Motion) -> Iterator[str]:
     """The BVH text of ``motion`` in pieces (the header, then blocks of frames), so that a long take is
-    written without holding its whole text."""
-    skel = motion.skeleton
+    written without holding its whole text.  Names BVH cannot hold are changed, with a warning
+    (:func:`bvh_skeleton`)."""
+    skel = bvh_skeleton(motion.skeleton)
     out = io.StringIO()
     out.write("HIERARCHY\n")
     children: list[list[int]] = [[] for _ in range(skel.n_joints)]
