@@ -46,3 +46,22 @@ def test_failed_write_leaves_no_temporary_file(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         atomic_write(tmp_path / "c.bvh", "data")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_name_too_long_for_its_temporary_file_is_written(tmp_path):
+    """A 245-byte name (a take of 235 letters and its record's tail) once made a temporary name of over 255
+    bytes; its temporary file now stands for it by a shortened name, and killed writes' leftovers still go."""
+    name = "w" * 235 + ".loop.json"
+    stale = tmp_path / (".w" + "w" * 149 + "~" + "0" * 12 + ".4194399.x1y2.tmp")
+    path = atomic_write(tmp_path / name, "record")
+    assert path.read_text() == "record" and [p.name for p in tmp_path.iterdir()] == [name]
+    from mocycle.io.atomic import _temporary_prefix
+
+    prefix = _temporary_prefix(name)
+    assert len(prefix.encode()) < 170 and prefix.startswith(".www")
+    (tmp_path / (prefix + "4194399.x1y2.tmp")).write_text("partial")
+    stale.write_text("another long name's")
+    atomic_write(tmp_path / name, "again")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([name, stale.name])
+    odd = "é" * 120 + "\udcff.bvh"  # 245 bytes, one not UTF-8: cut within a character
+    assert atomic_write(tmp_path / odd, "x").read_text() == "x"
