@@ -23,7 +23,9 @@ def served(app):
 
     sock = socket.socket()
     sock.bind(("127.0.0.1", 0))
-    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
+    from mocycle.studio.server import config
+
+    server = uvicorn.Server(config(app, log_level="warning", lifespan="on"))  # as mocycle studio serves it
     access = getattr(getattr(app, "state", None), "access", None)
     if access is not None:
         access.bind("127.0.0.1", sock.getsockname()[1])  # as mocycle studio does: only this Host is answered
