@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Node", "ObjectName", "Zeros", "bomb_scene", "chain_scene", "fbx_bytes", "write_fbx", "zeros_stream"]
+__all__ = ["Node", "ObjectName", "Raw", "Zeros", "bomb_scene", "chain_scene", "fbx_bytes", "read_records", "write_fbx",
+           "zeros_stream"]
 
 #: FBX time ticks per second
 SECOND = 46186158000
@@ -41,6 +42,15 @@ class ObjectName:
 
     cls: str
     name: str
+
+
+@dataclass(frozen=True)
+class Raw:
+    """A property as a binary file holds it: its type code and its bytes (an array's header and stored data as
+    they are, never decompressed); what :func:`read_records` gives, for mutating a file's structure."""
+
+    code: bytes
+    payload: bytes
 
 
 @dataclass(frozen=True)
@@ -77,7 +87,17 @@ def _binary_array(value) -> bytes:
     return _ARRAYS[a.dtype] + struct.pack("<III", len(a), 0, len(raw)) + raw
 
 
+def _encoded(text: str) -> bytes:
+    """UTF-8, a byte that was not UTF-8 (U+DC80..U+DCFF) as that byte, another lone surrogate as its own bytes."""
+    try:
+        return text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError:
+        return text.encode("utf-8", "surrogatepass")
+
+
 def _binary_prop(value) -> bytes:
+    if isinstance(value, Raw):
+        return value.code + value.payload
     if isinstance(value, (np.ndarray, Zeros)):
         return _binary_array(value)
     if isinstance(value, bool):
@@ -87,9 +107,9 @@ def _binary_prop(value) -> bytes:
     if isinstance(value, float):
         return b"D" + struct.pack("<d", value)
     if isinstance(value, ObjectName):
-        value = value.name.encode("utf-8", "surrogateescape") + b"\x00\x01" + value.cls.encode()
+        value = _encoded(value.name) + b"\x00\x01" + value.cls.encode()
     if isinstance(value, str):
-        value = value.encode("utf-8", "surrogateescape")
+        value = _encoded(value)
         return b"S" + struct.pack("<I", len(value)) + value
     if isinstance(value, bytes):
         return b"R" + struct.pack("<I", len(value)) + value
@@ -148,7 +168,7 @@ def fbx_bytes(nodes: list[Node], binary: bool = True, version: int = 7400) -> by
         out = ["; FBX 7.4.0 project file\n"]
         for node in nodes:
             _ascii_node(node, 0, out)
-        return "".join(out).encode("utf-8", "surrogateescape")
+        return _encoded("".join(out))
     wide = version >= 7500
     data = bytearray(_HEADER + struct.pack("<I", version))
     for node in nodes:
@@ -202,6 +222,53 @@ def chain_scene(n_bones: int = 3, frames: int = 31, fps: int = 30, names: list[s
         Node("P", ("UpAxis", "int", "Integer", "", 1)), Node("P", ("UnitScaleFactor", "double", "Number", "", 1.0)),
         Node("P", ("TimeMode", "enum", "", "", 6))])])
     return [header, settings, Node("Objects", (), objects), Node("Connections", (), connections)]
+
+
+_SIZES = {b"Y": 2, b"C": 1, b"B": 1, b"I": 4, b"F": 4, b"D": 8, b"L": 8}
+
+
+def read_records(data: bytes) -> tuple[int, list[Node]]:
+    """``(version, records)`` of a binary FBX file: each property a :class:`Raw` (arrays as stored).  Raises
+    ``ValueError`` for a file whose records do not fit together (a test helper: no limits on nesting beyond
+    the file's size)."""
+    if not data.startswith(_HEADER[:21]) or len(data) < 27:
+        raise ValueError("not a binary FBX file")
+    version = struct.unpack_from("<I", data, 23)[0]
+    fields = struct.Struct("<QQQB" if version >= 7500 else "<IIIB")
+
+    def records(at: int, end: int) -> tuple[list[Node], int]:
+        out = []
+        while at + fields.size <= end:
+            stop, n_props, props_len, name_len = fields.unpack_from(data, at)
+            if stop == 0:
+                return out, at + fields.size
+            if not at < stop <= end:
+                raise ValueError(f"a record at byte {at} ends at {stop}")
+            name = data[at + fields.size:at + fields.size + name_len].decode("latin-1")
+            p = at + fields.size + name_len
+            props_end = p + props_len
+            props = []
+            for _ in range(n_props):
+                code = data[p:p + 1]
+                if code in _SIZES:
+                    n = _SIZES[code]
+                elif code in (b"S", b"R"):
+                    n = 4 + struct.unpack_from("<I", data, p + 1)[0]
+                elif code in (b"f", b"d", b"l", b"i", b"b", b"c"):
+                    n = 12 + struct.unpack_from("<III", data, p + 1)[2]
+                else:
+                    raise ValueError(f"property type {code!r} at byte {p}")
+                props.append(Raw(code, data[p + 1:p + 1 + n]))
+                p += 1 + n
+            if p > props_end:
+                raise ValueError(f"the properties of the record at byte {at} run past it")
+            children, _ = records(props_end, stop) if props_end < stop else ([], stop)
+            out.append(Node(name, tuple(props), children))
+            at = stop
+        return out, at
+
+    top, _ = records(27, len(data))
+    return version, top
 
 
 def write_fbx(path, nodes: list[Node], binary: bool = True, version: int = 7400) -> Path:
