@@ -131,16 +131,18 @@ def _targets():
         from mocycle.io.gltf import write_gltf
 
         glb_seeds.append(write_gltf(m, scratch / f"seed{k}.glb").read_bytes())
+    from fuzz_scenes import join_gltf, mutate_fbx, mutate_gltf, reads_guarded, sandbox
+
     from mocycle.datasets.fbx_files import chain_scene, fbx_bytes
     from mocycle.datasets.gltf_files import chain_document, gltf_file
-    from fuzz_scenes import join_gltf, mutate_fbx, mutate_gltf, reads_guarded, sandbox
 
     # FBX: files written here (binary 7.4 and 7.5, ASCII), and any under $MOCYCLE_FUZZ_FBX (Blender's)
     fbx_binary = [fbx_bytes(chain_scene(4)), fbx_bytes(chain_scene(6, frames=61), version=7500)]
     fbx_dir = os.environ.get("MOCYCLE_FUZZ_FBX")
     fbx_seeds = fbx_binary + [fbx_bytes(chain_scene(4), binary=False)]
     if fbx_dir and Path(fbx_dir).is_dir():
-        fbx_seeds += [p.read_bytes() for p in sorted(Path(fbx_dir).glob("**/*.fbx"), key=lambda p: p.stat().st_size)[:4]]
+        found = sorted(Path(fbx_dir).glob("**/*.fbx"), key=lambda p: p.stat().st_size)
+        fbx_seeds += [p.read_bytes() for p in found[:4]]
     # glTF, structured: read in a folder with its buffer, a FIFO, a link out and a sub-folder; no open outside
     doc, blob = chain_document(4, times=np.arange(31) / 30)
     take_dir = sandbox(scratch / "gltf", blob)

@@ -96,6 +96,11 @@ def _list(doc: dict, key: str) -> list:
     return value
 
 
+def _items(value) -> list[dict]:
+    """The objects of a JSON list (none when ``value`` is not a list)."""
+    return [x for x in value if isinstance(x, dict)] if isinstance(value, list) else []
+
+
 def _edit_gltf(doc: dict, blob: bytearray, rng: random.Random) -> None:
     op = rng.choice(("value", "value", "delete", "count", "uri", "name", "nodes", "cycle", "times", "anims",
                      "type", "interp", "path", "extras", "length"))
@@ -163,11 +168,11 @@ def _edit_gltf(doc: dict, blob: bytearray, rng: random.Random) -> None:
         rng.choice(dicts("accessors"))["type"] = rng.choice(["SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT4", "x",
                                                              [], 3])
     elif op == "interp":
-        samplers = [s for a in dicts("animations") for s in (a.get("samplers") or []) if isinstance(s, dict)]
+        samplers = [s for a in dicts("animations") for s in _items(a.get("samplers"))]
         if samplers:
             rng.choice(samplers)["interpolation"] = rng.choice(["LINEAR", "STEP", "CUBICSPLINE", "SPLINE", 1, None])
     elif op == "path":
-        channels = [c for a in dicts("animations") for c in (a.get("channels") or []) if isinstance(c, dict)]
+        channels = [c for a in dicts("animations") for c in _items(a.get("channels"))]
         if channels:
             target = rng.choice(channels).setdefault("target", {})
             if isinstance(target, dict):
@@ -197,7 +202,10 @@ def mutate_gltf(data: bytes, rng: random.Random) -> bytes:
         return data
     blob = bytearray(blob)
     for _ in range(rng.randint(1, 4)):
-        _edit_gltf(doc, blob, rng)
+        try:
+            _edit_gltf(doc, blob, rng)
+        except (TypeError, AttributeError, KeyError, IndexError, ValueError):  # an edit that does not fit this tree
+            continue
     if rng.random() < 0.1:
         binary = not binary
     return join_gltf(doc, bytes(blob), binary)
@@ -210,8 +218,9 @@ def sandbox(scratch: Path, blob: bytes) -> Path:
     take.mkdir(parents=True, exist_ok=True)
     (scratch / "secret.bin").write_bytes(b"SECRET" * 1000)
     (take / "good.bin").write_bytes(blob)
-    for name, make in (("pipe.bin", lambda p: os.mkfifo(p)), ("link.bin", lambda p: os.symlink(scratch / "secret.bin", p)),
-                       ("folder", lambda p: p.mkdir())):
+    makers = (("pipe.bin", os.mkfifo), ("link.bin", lambda p: os.symlink(scratch / "secret.bin", p)),
+              ("folder", Path.mkdir))
+    for name, make in makers:
         if not os.path.lexists(take / name):
             make(take / name)
     return take
@@ -356,7 +365,10 @@ def mutate_fbx(data: bytes, rng: random.Random) -> bytes:
     except (ValueError, struct.error, RecursionError, IndexError):
         return data
     for _ in range(rng.randint(1, 3)):
-        _edit_fbx(records, rng)
+        try:
+            _edit_fbx(records, rng)
+        except (TypeError, AttributeError, KeyError, IndexError, ValueError, struct.error):
+            continue
     if rng.random() < 0.2:
         version = 7500 if version < 7500 else 7400
     try:
