@@ -204,3 +204,18 @@ def test_writing_holds_one_piece_of_text_at_a_time_not_the_take():
 
     short, long = peak(take[:2000]), peak(take)
     assert long < 1.5 * short, f"writing 16000 frames peaked at {long} bytes, 2000 frames at {short}"
+
+
+def test_a_deep_chain_is_written_in_linear_size():
+    """A 10,000-deep chain once wrote 200 million tabs (its indentation grew with the depth): past MAX_INDENT
+    levels every line is indented alike, and the file reads back."""
+    from mocycle.io.bvh import MAX_INDENT, format_bvh, parse_bvh
+    from mocycle.motion import Motion, Skeleton
+
+    n = 3000
+    sk = Skeleton(tuple(f"j{i}" for i in range(n)), np.arange(-1, n - 1), np.tile([0.0, 1.0, 0.0], (n, 1)),
+                  (("Zrotation", "Xrotation", "Yrotation"),) * n)
+    text = format_bvh(Motion.rest(sk, 2))
+    assert max(len(line) - len(line.lstrip("\t")) for line in text.splitlines()) == MAX_INDENT + 1
+    assert len(text) < 400 * n  # quadratic indentation: about 18 million characters
+    assert parse_bvh(text).n_joints == n

@@ -85,6 +85,10 @@ def _matrices(node: NodeTRS, rows: slice, n: int, path=None) -> np.ndarray:
     return m
 
 
+def _constant(node: NodeTRS) -> bool:
+    return all(not isinstance(a, Sampled) and len(a) == 1 for a in (node.translation, node.rotation, node.scale))
+
+
 def _rotation_part(m: np.ndarray) -> np.ndarray:
     """The rotations ``(n, 3, 3)`` of world matrices ``(n, 3, 3)``: scale divided out (per column), then the
     nearest rotation (exact already when the scale is uniform; a mirror's reflection taken out)."""
@@ -176,6 +180,8 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     static = np.zeros((K, 3))
     site_offsets = {j: np.zeros(3) for j in sites}
     block = max(1, min(_BLOCK, _BLOCK_CELLS // J))
+    # a joint whose transform does not change: its local matrix made once, not once per block
+    still = [_matrices(node, slice(0, 1), 1, path)[0] if _constant(node) else None for node in joints]
     for start in range(0, T, block):
         rows = slice(start, min(T, start + block))
         n = rows.stop - start
@@ -184,7 +190,7 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
             top = top @ _matrices(a, rows, n, path)
         world = np.empty((n, J, 4, 4))
         for j in range(J):
-            local = _matrices(joints[j], rows, n, path)
+            local = still[j] if still[j] is not None else _matrices(joints[j], rows, n, path)
             world[:, j] = (top if up[j] < 0 else world[:, up[j]]) @ local
         rot = _rotation_part(world[:, :, :3, :3].reshape(-1, 3, 3)).reshape(n, J, 3, 3)
         pos = world[:, :, :3, 3]

@@ -562,6 +562,8 @@ def bvh_size(motion: Motion) -> int:
         return sum(len(piece.encode("utf-8")) for piece in bvh_chunks(motion))
 
 
+#: Tabs of indentation at most (readers go by the braces; past this depth every level is indented alike).
+MAX_INDENT = 32
 #: Frames per piece of text :func:`bvh_chunks` yields.
 _ROWS_PER_CHUNK = 1024  # the text of 1024 rows of 69 channels: about 1 MB (a StringIO holds 4 bytes a character)
 
@@ -614,7 +616,7 @@ def bvh_chunks(motion: Motion) -> Iterator[str]:
     stack = [("close", 0, 0), ("open", 0, 0)]
     while stack:
         what, j, depth = stack.pop()
-        tab = "\t" * depth
+        tab = "\t" * min(depth, MAX_INDENT)  # deeper levels alike: a 10,000-deep chain's tabs would be quadratic
         if what == "close":
             for s in sites[j]:
                 label = "End Site" + (f" {s.name}" if s.name else "")
