@@ -181,7 +181,8 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     site_offsets = {j: np.zeros(3) for j in sites}
     block = max(1, min(_BLOCK, _BLOCK_CELLS // J))
     # a joint whose transform does not change: its local matrix made once, not once per block
-    still = [_matrices(node, slice(0, 1), 1, path)[0] if _constant(node) else None for node in joints]
+    still: list[np.ndarray | None] = [_matrices(node, slice(0, 1), 1, path)[0] if _constant(node) else None
+                                      for node in joints]
     for start in range(0, T, block):
         rows = slice(start, min(T, start + block))
         n = rows.stop - start
@@ -190,7 +191,8 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
             top = top @ _matrices(a, rows, n, path)
         world = np.empty((n, J, 4, 4))
         for j in range(J):
-            local = still[j] if still[j] is not None else _matrices(joints[j], rows, n, path)
+            fixed = still[j]
+            local = fixed if fixed is not None else _matrices(joints[j], rows, n, path)
             world[:, j] = (top if up[j] < 0 else world[:, up[j]]) @ local
         rot = _rotation_part(world[:, :, :3, :3].reshape(-1, 3, 3)).reshape(n, J, 3, 3)
         pos = world[:, :, :3, 3]

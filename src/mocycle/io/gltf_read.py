@@ -30,6 +30,7 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -125,7 +126,7 @@ def check_types(document: dict, path) -> None:
     """Every field the reader uses has its JSON type (:data:`_SCHEMA`), or one :class:`MotionFileError` naming
     it (``accessors[3].type must be text; got a list``); a field set to ``null`` counts as absent.  Values and
     indices are checked where they are used; this is the one place types are."""
-    todo = [(document, _SCHEMA, "")]
+    todo: list[tuple[Any, Any, str]] = [(document, _SCHEMA, "")]
     while todo:
         value, schema, where = todo.pop()
         if value is None:
@@ -163,7 +164,8 @@ class _File:
         binary = data[:4] == b"glTF"
         if path.suffix.lower() == ".glb" and not binary:
             raise MotionFileError("not a binary glTF file: expected it to start with 'glTF'", path)
-        self.blob = None
+        self.blob: bytes | bytearray | None = None
+        text: bytes | bytearray
         if binary:
             text, self.blob = self._chunks(data)
         else:
@@ -178,10 +180,10 @@ class _File:
             raise MotionFileError("not a glTF file: expected a JSON object with a 'nodes' list", path)
         check_types(document, path)
         self.gl = _Obj(document)
-        self._buffers: dict[int, bytes] = {}
+        self._buffers: dict[int, bytes | bytearray] = {}
         self._buffer_bytes = 0  # of the buffers read so far (at most MAX_FILE_BYTES together)
 
-    def _chunks(self, data: bytes) -> tuple[bytes, bytes | None]:
+    def _chunks(self, data: bytes | bytearray) -> tuple[bytes | bytearray, bytes | bytearray | None]:
         """The JSON chunk and the binary chunk (or ``None``) of a GLB, every length checked against the file."""
         if len(data) < 20:
             raise MotionFileError(f"a binary glTF file holds at least 20 bytes; this one {len(data)}", self.path)
@@ -220,7 +222,7 @@ class _File:
             raise MotionFileError(f"{what} is {i}, but the file has no {kind}", self.path)
         return items[i]
 
-    def buffer(self, index: int) -> bytes:
+    def buffer(self, index: int) -> bytes | bytearray:
         if index in self._buffers:
             return self._buffers[index]
         buf = self.item("buffers", index, "bufferView.buffer")
