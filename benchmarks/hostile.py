@@ -214,7 +214,9 @@ def run(folder: Path, command: str, cap_gb: float = 0) -> dict:
     peak = next((ln.split()[1] for ln in proc.stderr.splitlines() if ln.startswith("@@peak_mb")), "?")
     lines = [ln for ln in proc.stderr.splitlines() if ln and not ln.startswith("@@")]
     out = " ".join(proc.stdout.split())
-    first = next((ln for ln in lines if ln.startswith("error")), lines[0] if lines else out[-160:])
+    said = [" ".join(ln.split()) for ln in proc.stdout.splitlines() if ln.strip()]
+    summary = next((ln for ln in said if "takes:" in ln or ln.startswith("wrote")), " / ".join(said[:2]))
+    first = next((ln for ln in lines if ln.startswith(("error", "warning"))), summary or (lines[0] if lines else out))
     left = [p.name for p in set(folder.rglob("*")) - before if p.name.endswith(".tmp")]
     return {"code": proc.returncode, "message": first.replace(str(folder) + "/", "").strip(), "seconds": seconds,
             "peak_mb": peak, "traceback": "Traceback" in proc.stderr, "tmp_left": left}

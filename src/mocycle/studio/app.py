@@ -309,15 +309,10 @@ def _file_name(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("._") or "take"
 
 
-def motion_file(report, role: str, name: str, suffix: str) -> bytes:
-    """``report.motions[role]`` as ``mocycle loop -o NAME.bvh|.glb`` writes it (``tasks.clips.for_output``:
-    a .glb loop holds the clip ``NAME`` ending in ``_loop``, with its closing frame), as bytes."""
-    with tempfile.TemporaryDirectory(prefix="mocycle-studio-") as folder:
-        return write_motion_file(report, role, Path(folder) / f"{name}{suffix}").read_bytes()
-
-
 def write_motion_file(report, role: str, path: Path) -> Path:
-    """:func:`motion_file` written to ``path``."""
+    """``report.motions[role]`` written to ``path`` as ``mocycle loop -o NAME.bvh|.glb`` writes it
+    (``tasks.clips.for_output``: a .glb loop holds the clip ``NAME`` ending in ``_loop``, with its closing
+    frame)."""
     from ..io import write
     from ..tasks.clips import for_output
 
