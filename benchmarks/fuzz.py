@@ -1,6 +1,6 @@
 """Long fuzzing run of every reader, to run before releases (the suite's fuzz tests are the short version).
 
-    python benchmarks/fuzz.py [--seconds 3600] [--readers bvh,asf,amc,mck,mosw,json,glb,fbx]
+    python benchmarks/fuzz.py [--seconds 3600] [--readers bvh,asf,amc,mck,mosw,json,glb,gltf,fbx,fbxs]
                               [--engine auto|atheris|random]
                               [--rss-mb 2048] [--timeout 10] [--max-frames 100000] [--out DIR] [--data DIR]
     python benchmarks/fuzz.py --replay DIR/json-oom-... [...]    # saved inputs, each in a fresh process
@@ -16,10 +16,14 @@ Engines: ``atheris`` (coverage-guided libFuzzer; ``pip install atheris``, a whee
 x86-64 Linux; the binary formats are mutated inside their zlib payload by a custom mutator) or ``random``
 (mutations of the seeds, no coverage feedback); ``auto`` takes atheris when it imports.  Seeds are generated
 takes and, when ``../shared/data`` is present, a few real files.  The glTF reader (``glb``) is seeded with GLBs
-mocycle writes; the FBX reader (``fbx``) with the ``.fbx`` files under ``$MOCYCLE_FUZZ_FBX`` (a folder; e.g. the ones
-Blender exports in ``tests_blender/test_formats_in.py``, or ``benchmarks/fbx_seeds.py`` run in the bpy environment),
-and is skipped, saying so, without them.  Both read from a file (their readers take paths), written anew for
-each input.  ufbx is C: a crash there kills the child, reported as ``child died``.
+mocycle writes; the FBX reader (``fbx``) with binary (7.4, 7.5) and ASCII files written by
+:mod:`mocycle.datasets.fbx_files` and the ``.fbx`` files under ``$MOCYCLE_FUZZ_FBX`` (a folder; e.g. the ones
+Blender exports in ``tests_blender/test_formats_in.py``, or ``benchmarks/fbx_seeds.py`` run in the bpy
+environment).  ``gltf`` and ``fbxs`` are the same readers fed structure-aware mutations (``fuzz_scenes.py``:
+types, counts, uris, names, node chains, deflate bombs), the glTF read in a folder with a FIFO, a link out and
+a secret beside it, any open outside the folder counted as a crash (``ReadOutside``).  All read from a file
+(their readers take paths), written anew for each input.  ufbx is C: a crash there kills the child, reported as
+``child died``.
 
 Prints per reader: inputs tried, accepted, refused, crashes (by signature), hangs, blow-ups and peak memory
 (an input libFuzzer's RSS watchdog blames is tried again alone in a fresh process: a blow-up only if it fails
@@ -45,7 +49,7 @@ from pathlib import Path
 
 from mocycle.datasets.asfamc_text import TINY_AMC, TINY_ASF
 
-READERS = ("bvh", "asf", "amc", "mck", "mosw", "json", "glb", "fbx")
+READERS = ("bvh", "asf", "amc", "mck", "mosw", "json", "glb", "gltf", "fbx", "fbxs")
 DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
 ASF, AMC = TINY_ASF, TINY_AMC
@@ -127,14 +131,39 @@ def _targets():
         from mocycle.io.gltf import write_gltf
 
         glb_seeds.append(write_gltf(m, scratch / f"seed{k}.glb").read_bytes())
+    from fuzz_scenes import join_gltf, mutate_fbx, mutate_gltf, reads_guarded, sandbox
+
+    from mocycle.datasets.fbx_files import chain_scene, fbx_bytes
+    from mocycle.datasets.gltf_files import chain_document, gltf_file
+
+    # FBX: files written here (binary 7.4 and 7.5, ASCII), and any under $MOCYCLE_FUZZ_FBX (Blender's)
+    fbx_binary = [fbx_bytes(chain_scene(4)), fbx_bytes(chain_scene(6, frames=61), version=7500)]
     fbx_dir = os.environ.get("MOCYCLE_FUZZ_FBX")
-    fbx_seeds = [p.read_bytes() for p in sorted(Path(fbx_dir).glob("**/*.fbx"), key=lambda p: p.stat().st_size)[:4]] \
-        if fbx_dir and Path(fbx_dir).is_dir() else []
+    fbx_seeds = fbx_binary + [fbx_bytes(chain_scene(4), binary=False)]
+    if fbx_dir and Path(fbx_dir).is_dir():
+        found = sorted(Path(fbx_dir).glob("**/*.fbx"), key=lambda p: p.stat().st_size)
+        fbx_seeds += [p.read_bytes() for p in found[:4]]
+    # glTF, structured: read in a folder with its buffer, a FIFO, a link out and a sub-folder; no open outside
+    doc, blob = chain_document(4, times=np.arange(31) / 30)
+    take_dir = sandbox(scratch / "gltf", blob)
+    with_uri = json.loads(json.dumps(doc))
+    with_uri["buffers"][0]["uri"] = "good.bin"
+    gltf_seeds = [join_gltf(with_uri, b"", False), gltf_file(scratch / "chain.glb", doc, blob).read_bytes(),
+                  gltf_file(scratch / "chain.gltf", doc, blob).read_bytes(), glb_seeds[0]]
+
+    def gltf(data):
+        path = take_dir / ("fuzz.glb" if data[:4] == b"glTF" else "fuzz.gltf")
+        path.write_bytes(data)
+        with reads_guarded(scratch / "gltf"):
+            finite(glb_reader(path))
+
     return {"bvh": (bvh, bvh_seeds, None), "asf": (asf, [ASF.encode()], None), "amc": (amc, [AMC.encode()], None),
             "mck": (mck, mck_seeds, MCK), "mosw": (mosw, [encode(segment(walk))], MOSW),
             "json": (swings_json, [json.dumps(swings_document(segment(walk[:40]))).encode()], None),
             "glb": (from_file(".glb", glb_reader), glb_seeds, None),
-            "fbx": (from_file(".fbx", fbx_reader), fbx_seeds, None)}
+            "gltf": (gltf, gltf_seeds, None, mutate_gltf),
+            "fbx": (from_file(".fbx", fbx_reader), fbx_seeds, None),
+            "fbxs": (from_file(".fbx", fbx_reader), fbx_binary, None, mutate_fbx)}
 
 
 INTERESTING = [b"\x00", b"\xff", b"\x7f", b"\x80", b"\x00\x00\x00\x00", b"\xff\xff\xff\xff", b"\x00\xca\x9a\x3b",
@@ -199,7 +228,8 @@ def _peak_mb() -> float:
 def child_random(reader: str, seconds: float, rss_mb: int, timeout: float, out: Path, seed: int) -> dict:
     from mocycle.errors import MotionFileError
 
-    run, seeds, magic = _targets()[reader]
+    run, seeds, magic, *structured = _targets()[reader]
+    mutate = structured[0] if structured else None
     _limit_memory(rss_mb)
     rng = random.Random(seed)
     stats = {"reader": reader, "engine": "random", "tried": 0, "accepted": 0, "refused": 0, "crashes": {},
@@ -217,15 +247,20 @@ def child_random(reader: str, seconds: float, rss_mb: int, timeout: float, out: 
     end = time.monotonic() + seconds
     while time.monotonic() < end:
         base = rng.choice(corpus)
-        data = in_payload(magic, base, lambda d: mutate_bytes(d, rng)) if rng.random() < 0.75 else \
-            mutate_bytes(base, rng)
+        if mutate is not None:  # structure-aware: edits of the file's structure, at times bytes on top
+            data = mutate(base, rng)
+            if data is base or rng.random() < 0.15:
+                data = mutate_bytes(data, rng)
+        else:
+            data = in_payload(magic, base, lambda d: mutate_bytes(d, rng)) if rng.random() < 0.75 else \
+                mutate_bytes(base, rng)
         stats["tried"] += 1
         t0 = time.monotonic()
         signal.setitimer(signal.ITIMER_REAL, timeout)
         try:
             run(data)
             stats["accepted"] += 1
-            if len(corpus) < 200:
+            if len(corpus) < 200 and len(data) < 1 << 20:
                 corpus.append(data)  # accepted variants seed further mutations
         except MotionFileError:
             stats["refused"] += 1
@@ -267,14 +302,16 @@ def child_atheris(reader: str, seconds: float, rss_mb: int, timeout: float, out:
         import mocycle.io.asfamc  # noqa: F401
         import mocycle.io.bvh  # noqa: F401
         import mocycle.io.fbx  # noqa: F401
+        import mocycle.io.fbx_scan  # noqa: F401
         import mocycle.io.gltf_read  # noqa: F401
         import mocycle.io.inflate  # noqa: F401
         import mocycle.io.mck  # noqa: F401
         import mocycle.io.mosw  # noqa: F401
+        import mocycle.io.regular  # noqa: F401
         import mocycle.io.swings_json  # noqa: F401
         import mocycle.swings.playback  # noqa: F401
         from mocycle.errors import MotionFileError
-    run, seeds, magic = _targets()[reader]
+    run, seeds, magic, *structured = _targets()[reader]
     corpus = Path(tempfile.mkdtemp(prefix=f"mocycle-fuzz-{reader}-"))
     for k, s in enumerate(seeds):
         (corpus / f"seed{k}").write_bytes(s)
@@ -286,6 +323,10 @@ def child_atheris(reader: str, seconds: float, rss_mb: int, timeout: float, out:
             pass
 
     def mutator(data: bytes, max_size: int, mseed: int) -> bytes:
+        if structured:  # the file's structure edited (fuzz_scenes), else libFuzzer's own byte mutation
+            rng = random.Random(mseed)
+            out = structured[0](data, rng) if rng.random() < 0.85 else data
+            return out if out is not data and len(out) <= max_size else atheris.Mutate(data, max_size)
         out = in_payload(magic, data, lambda d: atheris.Mutate(d, max(len(d) * 2, 64)))
         return out if len(out) <= max_size else atheris.Mutate(data, max_size)
 
@@ -293,7 +334,7 @@ def child_atheris(reader: str, seconds: float, rss_mb: int, timeout: float, out:
     argv = [sys.argv[0], f"-max_total_time={int(seconds)}", f"-rss_limit_mb={rss_mb}", f"-timeout={int(timeout)}",
             f"-seed={seed}", f"-artifact_prefix={out}/{reader}-", "-print_final_stats=1", "-max_len=262144",
             str(corpus)]
-    atheris.Setup(argv, one, custom_mutator=mutator if magic else None)
+    atheris.Setup(argv, one, custom_mutator=mutator if magic or structured else None)
     atheris.Fuzz()
 
 

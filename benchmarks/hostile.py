@@ -1,10 +1,11 @@
 """Hostile input through the command line: bombs, deep and wide skeletons, absurd numbers, options and paths.
 
-    python benchmarks/hostile.py [--markdown]
+    python benchmarks/hostile.py [--markdown] [--cap-gb 3] [--only TEXT]
 
-Builds each hostile file in a temporary folder, runs the ``mocycle`` command on it in a fresh process and
-prints the exit code, the first line of the error, the seconds and the peak memory of that process, and
-whether a partial or temporary file was left.  ``--markdown`` prints the rows for ``docs/reliability.md``.
+Builds each hostile file in a temporary folder, runs the ``mocycle`` command on it in a fresh process (under an
+address-space limit of ``--cap-gb``, except ``batch``) and prints the exit code, the first line of the error,
+the seconds and the peak memory of that process, and whether a partial or temporary file was left.
+``--markdown`` prints the rows for ``docs/reliability.md``.
 """
 
 from __future__ import annotations
@@ -104,6 +105,54 @@ def build(folder: Path) -> None:
     parts = [MOSW, z.compress(body)] + [z.compress(zeros) for _ in range(64)]
     (folder / "zbomb.mosw").write_bytes(b"".join(parts) + z.flush())
     np.save(folder / "unused.npy", np.zeros(1))
+    files_that_lie(folder, walk)
+
+
+def files_that_lie(folder: Path, walk) -> None:
+    """glTF and FBX files that lie (issue 36), in ``scene/`` with a secret in ``secret/`` beside it, and a batch
+    library ``lib/`` (a good take, a 235-letter name, a FIFO buffer, a deflate bomb)."""
+    from mocycle.datasets.fbx_files import bomb_scene, chain_scene, fbx_bytes, write_fbx
+    from mocycle.datasets.gltf_files import chain_document, gltf_file
+    from mocycle.io import write
+
+    scene, secret = folder / "scene", folder / "secret"
+    scene.mkdir()
+    secret.mkdir()
+    (secret / "token.txt").write_text("TOKEN-5f1e2d3c4b5a\n" * 60)
+    doc, blob = chain_document(3)
+    for name, uri in (("outside", "../secret/token.txt"), ("passwd", "/etc/passwd"), ("zero", "/dev/zero")):
+        d = json.loads(json.dumps(doc))
+        d["buffers"][0]["byteLength"] = 10_000
+        gltf_file(scene / f"{name}.gltf", d, blob, uri=uri)
+    gltf_file(scene / "piped.gltf", doc, blob, uri="pipe.bin")
+    (scene / "pipe.bin").unlink()
+    os.mkfifo(scene / "pipe.bin")
+    os.mkfifo(scene / "fifo.gltf")
+    gltf_file(scene / "chain10k.gltf", *chain_document(10_000))
+    gltf_file(scene / "same20k.gltf", *chain_document(20_000, names=["joint"] * 20_000))
+    gltf_file(scene / "anims10k.gltf", *chain_document(3, n_animations=10_000, animation_names=["walk"] * 10_000))
+    typed, _ = chain_document(3)
+    typed["accessors"][1]["type"] = []
+    gltf_file(scene / "typed.gltf", typed, blob)
+    gltf_file(scene / "odd.gltf", *chain_document(4, names=["\ud800", "{", "}", "end"]))
+    for joints in (3, 60):
+        d, b = chain_document(joints, times=(0.0, 1_999_999 / 30))
+        d["animations"][0]["channels"] += [{"sampler": 0, "target": {"node": k, "path": "rotation"}}
+                                           for k in range(1, joints)]
+        gltf_file(scene / f"frames2m_{joints}.gltf", d, b)
+    write_fbx(scene / "chain10k.fbx", chain_scene(10_000))
+    write_fbx(scene / "bomb.fbx", bomb_scene())
+    with open(os.fsencode(scene) + b"/bad\xffname.fbx", "wb") as fh:
+        fh.write(fbx_bytes(chain_scene(3)))
+    write(walk, folder / "walk<!--<script>.bvh")
+    lib = folder / "lib"
+    lib.mkdir()
+    write(walk, lib / "good.bvh")
+    write(walk, lib / ("w" * 235 + ".bvh"))
+    gltf_file(lib / "piped.gltf", doc, blob, uri="pipe.bin")
+    (lib / "pipe.bin").unlink()
+    os.mkfifo(lib / "pipe.bin")
+    write_fbx(lib / "bomb.fbx", bomb_scene())
 
 
 CASES = [
@@ -127,20 +176,47 @@ CASES = [
     ("`-o` in a missing folder", "loop {d}/walk.bvh -o {d}/missing/l.bvh"),
     ("`swings -o` in a missing folder", "swings {d}/walk.bvh -o {d}/missing/s.mosw"),
     ("`-o` equal to the input", "convert {d}/walk.bvh {d}/walk.bvh"),
+    ("glTF buffer `uri: ../secret/token.txt`", "convert {d}/scene/outside.gltf {d}/out/x.bvh"),
+    ("glTF buffer `uri: /etc/passwd`", "info {d}/scene/passwd.gltf"),
+    ("glTF buffer `uri: /dev/zero`", "info {d}/scene/zero.gltf"),
+    ("glTF buffer a FIFO beside it", "info {d}/scene/piped.gltf"),
+    ("glTF file a FIFO", "info {d}/scene/fifo.gltf"),
+    ("glTF chain of 10,000 nodes (767 KB)", "convert {d}/scene/chain10k.gltf {d}/out/chain.bvh"),
+    ("glTF 20,000 nodes of one name", "info {d}/scene/same20k.gltf"),
+    ("glTF 10,000 animations of one name", "info {d}/scene/anims10k.gltf --take walk.9999"),
+    ("glTF `accessors[1].type: []`", "info {d}/scene/typed.gltf"),
+    ("glTF nodes `\\ud800`, `{`, `}`", "convert {d}/scene/odd.gltf {d}/out/odd.bvh"),
+    ("glTF 2 keys 2,000,000 frames apart, 3 nodes", "info {d}/scene/frames2m_3.gltf"),
+    ("glTF 2 keys 2,000,000 frames apart, 60 nodes", "info {d}/scene/frames2m_60.gltf"),
+    ("FBX chain of 10,000 bones (4.3 MB)", "convert {d}/scene/chain10k.fbx {d}/out/fchain.bvh"),
+    ("FBX deflate bomb: 300M zero doubles (2.3 MB)", "info {d}/scene/bomb.fbx"),
+    ("FBX file name not UTF-8", "info {d}/scene/bad\udcffname.fbx"),
+    ("take named `walk<!--<script>.bvh`", "report {d}/walk<!--<script>.bvh -o {d}/out/r.html"),
+    ("`batch --json`, refused", "batch loop {d}/walk.bvh -o {d}/walk.bvh --json"),
+    ("batch: good, 235-letter name, FIFO buffer, bomb", "batch loop {d}/lib -o {d}/out/lib --workers 2"),
 ]
 
 
-def run(folder: Path, command: str) -> dict:
+def run(folder: Path, command: str, cap_gb: float = 0) -> dict:
     env = {**os.environ, "PYTHONPATH": str(SRC) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     before = {p for p in folder.rglob("*")}
+
+    def cap():  # the address space of the command (not of a batch: its dask workers map more)
+        import resource
+
+        if cap_gb and not command.startswith("batch"):
+            resource.setrlimit(resource.RLIMIT_AS, (int(cap_gb * 2**30), resource.RLIM_INFINITY))
+
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-c", RUN, *command.format(d=folder).split()], capture_output=True,
-                          text=True, env=env, timeout=900)
+                          text=True, env=env, timeout=900, preexec_fn=cap)
     seconds = time.perf_counter() - t0
     peak = next((ln.split()[1] for ln in proc.stderr.splitlines() if ln.startswith("@@peak_mb")), "?")
     lines = [ln for ln in proc.stderr.splitlines() if ln and not ln.startswith("@@")]
     out = " ".join(proc.stdout.split())
-    first = next((ln for ln in lines if ln.startswith("error")), lines[0] if lines else out[-160:])
+    said = [" ".join(ln.split()) for ln in proc.stdout.splitlines() if ln.strip()]
+    summary = next((ln for ln in said if "takes:" in ln or ln.startswith("wrote")), " / ".join(said[:2]))
+    first = next((ln for ln in lines if ln.startswith(("error", "warning"))), summary or (lines[0] if lines else out))
     left = [p.name for p in set(folder.rglob("*")) - before if p.name.endswith(".tmp")]
     return {"code": proc.returncode, "message": first.replace(str(folder) + "/", "").strip(), "seconds": seconds,
             "peak_mb": peak, "traceback": "Traceback" in proc.stderr, "tmp_left": left}
@@ -149,6 +225,8 @@ def run(folder: Path, command: str) -> dict:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--markdown", action="store_true")
+    parser.add_argument("--cap-gb", type=float, default=3.0, help="address-space limit of each command (0: none)")
+    parser.add_argument("--only", help="run the cases whose family contains this text")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="mocycle-hostile-") as tmp:
         folder = Path(tmp)
@@ -156,7 +234,9 @@ def main(argv=None) -> int:
         build(folder)
         bad = False
         for family, command in CASES:
-            r = run(folder, command)
+            if args.only and args.only not in family:
+                continue
+            r = run(folder, command, args.cap_gb)
             bad |= r["traceback"] or bool(r["tmp_left"])
             if args.markdown:
                 print(f"| {family} | `mocycle {command.replace('{d}/', '').replace('{d}', '.')}` | {r['code']} | "

@@ -19,9 +19,11 @@ memory (VmRSS) at start, after the first minute, at its highest and at the end; 
 
     python benchmarks/studio_fuzz.py --attacks [--take PATH]
 
-runs instead the memory attacks of issue 30 against a studio serving ``PATH`` (default: CMU 07_01 on the
-100-joint iClone rig from ../shared/data, else a generated 2000-frame walk): a 1 GiB body, 60 loop jobs of
-20 cycles, 68 strokes as long as the studio allows (and one longer), with the server's RSS after each.
+runs instead the memory attacks of issues 30 and 36 against a studio serving ``PATH`` (default: CMU 07_01 on
+the 100-joint iClone rig from ../shared/data, else a generated 2000-frame walk): a 1 GiB body, 60 loop jobs of
+20 cycles, 68 strokes as long as the studio allows (and one longer), 40 parallel slow downloads of a 100-cycle
+loop, 300 connections that never end their request head, 50 clients that leave mid-body, then SIGTERM; with
+the server's RSS after each.
 """
 
 from __future__ import annotations
@@ -296,8 +298,8 @@ def start(paths, env):
         time.sleep(0.5)
 
 
-def attacks(take: Path, env) -> int:
-    """The issue's memory attacks against a real server; the server's RSS after each."""
+def attacks(take: Path, env, only_36: bool = False) -> int:
+    """The issues' memory attacks against a real server; the server's RSS after each (``only_36``: issue 36's)."""
     import socket
 
     import httpx
@@ -311,6 +313,9 @@ def attacks(take: Path, env) -> int:
         h = {"X-Mocycle-Token": token, "Content-Type": "application/json"}
         c = httpx.Client(base_url=url.rstrip("/"), headers=h, timeout=600)
         tid = takes[0]["id"]
+        if only_36:
+            rows += files_that_lie_attacks(proc, c, host, token, tid)
+            return 0
         # 1 GiB body, declared and then streamed until the server stops reading
         sent = 0
         with socket.create_connection(tuple(host.rsplit(":", 1)), timeout=60) as sock:
@@ -364,15 +369,96 @@ def attacks(take: Path, env) -> int:
         gone = c.get("/api/strokes/s1/motion")
         rows.append(("68 strokes of 12,000 frames", f"{dict(codes)}; the first stroke now {gone.status_code} "
                      f"in {time.monotonic() - t0:.0f} s", rss_mb(proc.pid)))
+        rows += files_that_lie_attacks(proc, c, host, token, tid)
+        return 0
     finally:
+        t0 = time.monotonic()
         proc.send_signal(signal.SIGTERM)
         proc.wait(60)
+        err = proc.stderr.read()
+        rows.append(("SIGTERM", f"exit {proc.returncode} in {time.monotonic() - t0:.1f} s; tracebacks on the "
+                     f"server's stderr over the whole run: {err.count('Traceback')}", float("nan")))
+        _print_attacks(take, takes, rows)
+
+
+def _print_attacks(take: Path, takes, rows) -> None:
     print(f"studio memory attacks on {take.name} ({takes[0]['facts'].get('joints')} joints, "
           f"{takes[0]['facts'].get('frames')} frames)")
     print("| attack | answer | server RSS after, MB |\n|---|---|---|")
     for what, answer, mb in rows:
         print(f"| {what} | {answer} | {mb:.0f} |")
-    return 0
+
+
+def files_that_lie_attacks(proc, c, host: str, token: str, tid: str) -> list[tuple[str, str, float]]:
+    """Issue 36's attacks: 40 parallel downloads of a 100-cycle loop (the server's RSS sampled meanwhile), 300
+    connections that never finish their request head, 50 clients that leave mid-body."""
+    import socket
+    import threading
+
+    import httpx
+
+    rows = []
+    j = c.post(f"/api/takes/{tid}/loop", json={"cycles": 100, "root": "motion", "force": True}).json()
+    while j["status"] in ("queued", "running"):
+        time.sleep(0.1)
+        j = c.get(f"/api/jobs/{j['id']}").json()
+    before = rss_mb(proc.pid)
+    sizes, peak, done = [], [before], threading.Event()
+
+    def download():
+        with httpx.stream("GET", f"{c.base_url}/api/jobs/{j['id']}/loop.bvh", headers=c.headers, timeout=600) as r:
+            n = 0
+            for piece in r.iter_bytes(1 << 16):
+                n += len(piece)
+                time.sleep(0.002)  # slow readers: the server must not buffer the rest for each
+            sizes.append(n)
+
+    def watch():
+        while not done.is_set():
+            peak.append(rss_mb(proc.pid))
+            time.sleep(0.05)
+
+    watcher = threading.Thread(target=watch)
+    watcher.start()
+    t0 = time.monotonic()
+    threads = [threading.Thread(target=download) for _ in range(40)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(600)
+    done.set()
+    watcher.join()
+    rows.append((f"40 parallel slow downloads of the {max(sizes, default=0) / 2**20:.1f} MiB loop.bvh of a 100-cycle "
+                 f"loop", f"{len(sizes)} × 200 in {time.monotonic() - t0:.0f} s; RSS before {before:.0f} MB, at most "
+                 f"{max(peak):.0f} MB during", rss_mb(proc.pid)))
+    address = tuple(host.rsplit(":", 1))
+    slow = []
+    for _ in range(300):
+        sock = socket.create_connection((address[0], int(address[1])))
+        sock.sendall(b"GET /api/takes HTTP/1.1\r\nHost: " + host.encode() + b"\r\n")
+        slow.append(sock)
+    time.sleep(12)
+    closed = 0
+    for sock in slow:
+        sock.setblocking(False)
+        try:
+            closed += sock.recv(100) == b""
+        except BlockingIOError:
+            pass
+        except OSError:
+            closed += 1
+        sock.close()
+    rows.append(("300 connections sending a request head but never its end", f"{closed} of 300 closed by the server "
+                 "within 12 s", rss_mb(proc.pid)))
+    for _ in range(50):
+        sock = socket.create_connection((address[0], int(address[1])))
+        sock.sendall(f"POST /api/takes/{tid}/loop HTTP/1.1\r\nHost: {host}\r\nContent-Type: application/json\r\n"
+                     f"X-Mocycle-Token: {token}\r\nContent-Length: 1000\r\n\r\n{{\"cycles\"".encode())
+        sock.close()
+    time.sleep(1)
+    alive = c.get("/api/takes").status_code
+    rows.append(("50 clients leaving mid-body", f"the server answers {alive} after them", rss_mb(proc.pid)))
+    return rows
 
 
 def main(argv=None) -> int:
@@ -381,6 +467,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--frames", type=int, default=1000, help="frames of the walk the valid requests work on")
     ap.add_argument("--attacks", action="store_true", help="the issue's memory attacks instead of the fuzz")
+    ap.add_argument("--only-36", action="store_true", help="with --attacks: only issue 36's (downloads, slow heads, "
+                                                          "clients that leave)")
     ap.add_argument("--take", type=Path, default=REPO.parent / "shared" / "data" / "cmu-iclone" / "07_01.bvh")
     args = ap.parse_args(argv)
     env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
@@ -392,7 +480,7 @@ def main(argv=None) -> int:
 
             take = Path(tempfile.mkdtemp(prefix="mocycle-studio-attacks-")) / "walk_2000.bvh"
             write(synthetic_walk(n_frames=2000).motion, take)
-        return attacks(take, env)
+        return attacks(take, env, args.only_36)
     with tempfile.TemporaryDirectory(prefix="mocycle-studio-fuzz-") as tmp:
         folder = Path(tmp)
         make_library(folder, args.frames)

@@ -11,6 +11,25 @@ import socket
 import threading
 import time
 
+
+def _import_test_client():
+    """Starlette's TestClient, imported now, in the main thread, before any studio exists: its import warns
+    (starlette 1.x prefers httpx2), and a studio's analysis thread reading a BVH sets the process's warning
+    filters to "error" for a moment (``warnings.catch_warnings`` is not thread-safe), which made that warning
+    an exception when the first ``api_client`` raced it."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            from starlette.testclient import TestClient
+        except ImportError:  # the tests that need it skip without starlette or httpx
+            return None
+    return TestClient
+
+
+_TestClient = _import_test_client()
+
 CHROMIUM = os.environ.get("MOCYCLE_CHROMIUM", "/usr/bin/chromium")
 ARGS = ["--no-sandbox", "--disable-gpu", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
         "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run"]
@@ -23,7 +42,9 @@ def served(app):
 
     sock = socket.socket()
     sock.bind(("127.0.0.1", 0))
-    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
+    from mocycle.studio.server import config
+
+    server = uvicorn.Server(config(app, log_level="warning", lifespan="on"))  # as mocycle studio serves it
     access = getattr(getattr(app, "state", None), "access", None)
     if access is not None:
         access.bind("127.0.0.1", sock.getsockname()[1])  # as mocycle studio does: only this Host is answered
@@ -43,14 +64,8 @@ def served(app):
 def api_client(app, **kwargs):
     """Starlette's TestClient for the studio app as its own page talks to it: ``Host: 127.0.0.1`` and the
     server's token on every request (``headers=`` adds or replaces headers)."""
-    import warnings
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # starlette 1.x suggests httpx2 over httpx; both work
-        from starlette.testclient import TestClient
-
     headers = {"X-Mocycle-Token": app.state.access.token, **kwargs.pop("headers", {})}
-    return TestClient(app, base_url=kwargs.pop("base_url", "http://127.0.0.1"), headers=headers, **kwargs)
+    return _TestClient(app, base_url=kwargs.pop("base_url", "http://127.0.0.1"), headers=headers, **kwargs)
 
 
 @contextlib.contextmanager

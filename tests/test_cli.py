@@ -23,7 +23,7 @@ def test_every_command_has_help():
 
 def test_info_json_facts(tmp_path):
     m = random_motion(61)
-    with pytest.warns(mocycle.MocycleWarning, match="BVH names are one word each"):
+    with pytest.warns(mocycle.MocycleWarning, match=r"BVH \(one word each\)"):
         path = write_bvh(m, tmp_path / "m.bvh")
     result = runner.invoke(app, ["info", str(path), "--json"])
     assert result.exit_code == 0, result.output

@@ -25,7 +25,7 @@ import math
 import os
 import re
 
-__all__ = ["json_text", "path_hex", "printable", "unicode_clean"]
+__all__ = ["json_text", "path_hex", "printable", "renamed", "unicode_clean", "valid_unicode"]
 
 _SURROGATES = re.compile("[\ud800-\udfff]")
 _UNPRINTABLE = re.compile("[\x00-\x1f\x7f-\x9f\u200e\u200f\u202a-\u202e\u2066-\u2069\ud800-\udfff]")
@@ -49,6 +49,44 @@ def unicode_clean(text: str) -> str:
     """``text`` with lone surrogates written as escapes (as :func:`printable` does) and nothing else changed:
     what strict UTF-8 (a JSON or CSV file) can hold."""
     return _SURROGATES.sub(_escape, text)
+
+
+def valid_unicode(text: str) -> str:
+    """``text`` with every lone surrogate (text that is no Unicode: ``"\\ud800"`` from a JSON escape, a byte that
+    was not UTF-8) replaced by U+FFFD, what a file that must be UTF-8 can hold."""
+    return _SURROGATES.sub("\ufffd", text)
+
+
+def renamed(names, fix, fmt: str, what: str = "joint name") -> list[str]:
+    """``names`` as the format ``fmt`` can hold them: ``fix(name)`` of each, then a changed name that meets
+    another gets ``.1``, ``.2``...; when any changed, one :class:`~mocycle.errors.MocycleWarning` says which
+    (the first five), so a writer says it once per file."""
+    import warnings
+
+    from .errors import MocycleWarning
+
+    names = [str(n) for n in names]
+    fixed = [fix(n) for n in names]
+    changed = [i for i, (a, b) in enumerate(zip(names, fixed, strict=True)) if a != b]
+    if not changed:
+        return fixed
+    moved = set(changed)
+    taken = {fixed[i] for i in range(len(fixed)) if i not in moved}
+    following: dict[str, int] = {}  # base -> the next number to try (linear in the names)
+    for i in changed:
+        base = name = fixed[i]
+        k = following.get(base, 1)
+        while name in taken:
+            name, k = f"{base}.{k}", k + 1
+        following[base] = k
+        taken.add(name)
+        fixed[i] = name
+    shown = ", ".join(f"{printable(repr(names[i]))} -> {printable(repr(fixed[i]))}" for i in changed[:5])
+    more = f" and {len(changed) - 5} more" if len(changed) > 5 else ""
+    plural = "s" if len(changed) > 1 else ""
+    warnings.warn(f"{len(changed)} {what}{plural} changed to what {fmt} can hold: {shown}{more}", MocycleWarning,
+                  stacklevel=3)
+    return fixed
 
 
 def path_hex(path) -> str | None:

@@ -62,3 +62,21 @@ def test_a_folder_is_listed_once_however_many_outputs_go_there(tmp_path, monkeyp
         atomic_write(tmp_path / f"out{k}.bvh", "new")
     assert len(listed) == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"out{k}.bvh" for k in range(50))
+
+
+def test_a_name_too_long_for_its_temporary_file_is_written(tmp_path):
+    """A 245-byte name (a take of 235 letters and its record's tail) once made a temporary name of over 255
+    bytes; its temporary file now stands for it by a shortened name, and killed writes' leftovers still go."""
+    from mocycle.io.atomic import _temporary_prefix
+
+    name = "w" * 235 + ".loop.json"
+    prefix = _temporary_prefix(name)
+    assert len(prefix.encode()) < 170 and prefix.startswith(".www")
+    stale = tmp_path / (".w" + "w" * 149 + "~" + "0" * 12 + ".4194399.x1y2.tmp")  # another long name's
+    stale.write_text("another long name's")
+    (tmp_path / (prefix + "4194399.x1y2.tmp")).write_text("partial")  # a killed write of this name's
+    path = atomic_write(tmp_path / name, "record")
+    assert path.read_text() == "record"
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([name, stale.name])
+    odd = "é" * 120 + "\udcff.bvh"  # 245 bytes, one not UTF-8: cut within a character
+    assert atomic_write(tmp_path / odd, "x").read_text() == "x"

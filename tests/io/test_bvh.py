@@ -21,7 +21,7 @@ def _round_trip_errors(m, m2):
 
 def test_round_trip_synthetic_keeps_everything(tmp_path):
     m = random_motion(80, spin=True)
-    with pytest.warns(MocycleWarning, match="BVH names are one word each"):  # its names hold spaces
+    with pytest.warns(MocycleWarning, match=r"what BVH \(one word each\) can hold"):  # its names hold spaces
         path = write_bvh(m, tmp_path / "m.bvh")
     m2 = read_bvh(path)
     ang, rel = _round_trip_errors(m, m2)
@@ -45,15 +45,16 @@ def test_names_are_written_one_word_each(tmp_path):
                         (("Xposition", "Yposition", "Zposition") + rot, rot, rot, rot),
                         (EndSite(2, (0.0, 1.0, 0.0), "bout du doigt"),))
     m = Motion.rest(skeleton, 3)
-    with pytest.warns(MocycleWarning, match=r"3 written with underscores: 'bras droit' as 'bras_droit_2', "
-                                            r"'main\\tdroite' as 'main_droite', 'bout du doigt' as 'bout_du_doigt'"):
+    with pytest.warns(MocycleWarning, match=r"3 joint names changed to what BVH \(one word each\) can hold: "
+                                            r"'bras droit' -> 'bras_droit.1', 'main\\tdroite' -> 'main_droite', "
+                                            r"'bout du doigt' -> 'bout_du_doigt'"):
         path = write_bvh(m, tmp_path / "m.bvh")
     for line in path.read_text().splitlines():
         words = line.split()
         if words and words[0] in ("ROOT", "JOINT"):
             assert len(words) == 2, line
     again = read_bvh(path)
-    assert again.skeleton.names == ("Hips", "bras_droit_2", "main_droite", "bras_droit")
+    assert again.skeleton.names == ("Hips", "bras_droit.1", "main_droite", "bras_droit")
     assert again.skeleton.end_sites[0].name == "bout_du_doigt"
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -231,3 +232,18 @@ def test_writing_holds_one_piece_of_text_at_a_time_not_the_take():
 
     short, long = peak(take[:2000]), peak(take)
     assert long < 1.5 * short, f"writing 16000 frames peaked at {long} bytes, 2000 frames at {short}"
+
+
+def test_a_deep_chain_is_written_in_linear_size():
+    """A 10,000-deep chain once wrote 200 million tabs (its indentation grew with the depth): past MAX_INDENT
+    levels every line is indented alike, and the file reads back."""
+    from mocycle.io.bvh import MAX_INDENT, format_bvh, parse_bvh
+    from mocycle.motion import Motion, Skeleton
+
+    n = 3000
+    sk = Skeleton(tuple(f"j{i}" for i in range(n)), np.arange(-1, n - 1), np.tile([0.0, 1.0, 0.0], (n, 1)),
+                  (("Zrotation", "Xrotation", "Yrotation"),) * n)
+    text = format_bvh(Motion.rest(sk, 2))
+    assert max(len(line) - len(line.lstrip("\t")) for line in text.splitlines()) == MAX_INDENT + 1
+    assert len(text) < 400 * n  # quadratic indentation: about 18 million characters
+    assert parse_bvh(text).n_joints == n

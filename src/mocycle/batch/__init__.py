@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 import tempfile
 import time
+import uuid
 from collections.abc import Callable
 from contextlib import ExitStack
 from pathlib import Path
@@ -21,18 +22,21 @@ from ..text import printable
 from . import forkserver
 from .commands import COMMANDS, check_suffix
 from .discover import Take, find_takes
-from .take import Job, fresh_record, problem_row, row_key, take_key
+from .take import TAKE_TIMEOUT_S, Job, fresh_record, problem_row, row_key, take_key
 
 __all__ = ["COMMANDS", "Job", "Take", "find_takes", "run_batch"]
 
 
 def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, *, suffix: str | None = None,
               resume: bool = False, scheduler: str | None = None, workers: int | None = None,
-              progress: Callable | None = None) -> tuple[list[dict], dict]:
+              progress: Callable | None = None,
+              take_timeout_s: float | None = TAKE_TIMEOUT_S) -> tuple[list[dict], dict]:
     """Run ``command`` over the takes of ``inputs``; write the outputs under ``outdir`` and the results files.
 
     progress : ``progress(total, resumed)`` -> an object with ``advance(row)`` usable as a context manager
         (:func:`.progress.progress_for`); ``None``: silent.
+    take_timeout_s : seconds a take may run; one that runs longer gets an ``error`` row and its worker process
+        is stopped (:func:`.take.process`); ``None`` or 0: no limit.
     Returns the rows (in the order of the takes) and ``summary``-style run facts (``results.json``'s ``run``).
 
     Raises MocycleError (nothing is run) for an output folder that cannot be made or written (checked first),
@@ -44,7 +48,10 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
     outdir = check_outdir(Path(outdir))
     suffix = check_suffix(COMMANDS[command], suffix)
     takes = find_takes(inputs, outdir)
-    job = Job(command=command, options=options, outdir=outdir, suffix=suffix)
+    if take_timeout_s is not None and not (take_timeout_s >= 0 and take_timeout_s < float("inf")):
+        raise MocycleError(f"the take timeout must be a number of seconds >= 0; got {take_timeout_s!r}")
+    job = Job(command=command, options=options, outdir=outdir, suffix=suffix, timeout_s=take_timeout_s or None,
+              run_id=uuid.uuid4().hex)
     _refuse_overwriting_inputs(job, takes)
     check_collisions(job, takes)
     make_outdir(outdir)

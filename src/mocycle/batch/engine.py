@@ -135,6 +135,10 @@ def _run(job: Job, takes: list[Take], on_row, scheduler: str | None, workers: in
                 row = future.result()
             except KilledWorker as exc:  # the take itself kills workers
                 row = lost_row(job, take, f"the take killed its workers ({message_of(exc)})")
+            except Exception as exc:  # whatever else one take raised is its row, never the batch's end
+                if future.status != "error":  # not the take's own error: the cluster went away (the batch stops)
+                    raise
+                row = lost_row(job, take, f"the take failed outside its task ({message_of(exc)})")
             on_row(row)
         return {"engine": "dask.distributed", "scheduler": client.scheduler.address, "workers": n_workers,
                 "worker_start": start}

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+import threading
 import time
 import traceback
 import warnings
@@ -28,6 +30,8 @@ __all__ = ["STATUSES", "Job", "base_row", "fresh_record", "problem_row", "proces
            "take_key"]
 
 STATUSES = ("ok", "no-periodic-motion", "refused", "error")
+#: seconds a take may run in a batch by default (``mocycle batch --take-timeout``)
+TAKE_TIMEOUT_S = 3600.0
 
 
 @dataclass(frozen=True)
@@ -35,13 +39,18 @@ class Job:
     """What every take of a batch shares (sent to the workers once per take; small and picklable).
 
     command : the task name; options : its ``Options``; outdir : the output folder (absolute);
-    suffix : the output suffix (``None``: the command writes only its record).
+    suffix : the output suffix (``None``: the command writes only its record); timeout_s : see
+    :func:`process`; run_id : what tells this run's records from an earlier run's.
     """
 
     command: str
     options: Options
     outdir: Path
     suffix: str | None
+    #: seconds one take may run before its worker is stopped and its row says so (``None``: no limit)
+    timeout_s: float | None = None
+    #: this batch run (a take that overran in it is not run again within it)
+    run_id: str = ""
 
     @property
     def options_hash(self) -> str:
@@ -87,7 +96,49 @@ def process(job: Job, take: Take) -> dict:
 
     The outputs are written atomically (``mocycle.io.write``), then the record; outputs an earlier run left
     at this take's place that this run does not write again are removed, so the tree agrees with the row.
+    A take that runs past ``job.timeout_s`` gets its record (status ``error``, saying so) written by a watchdog,
+    which then ends the worker process: a thread cannot be stopped, a process can (a LocalCluster's nanny
+    starts a new worker; the scheduler gives it the take again, which then returns that record at once).
     """
+    overran = _overran(job, take)
+    if overran is not None:
+        return overran
+    watchdog = None
+    if job.timeout_s:
+        watchdog = threading.Timer(job.timeout_s, _stop_overrunning, (job, take))
+        watchdog.daemon = True
+        watchdog.start()
+    try:
+        return _process(job, take)
+    finally:
+        if watchdog is not None:
+            watchdog.cancel()
+
+
+def _overran(job: Job, take: Take) -> dict | None:
+    """The record this run's watchdog left for ``take`` (it ran over the time limit), or ``None``."""
+    try:
+        row = json.loads(job.record_path(take).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return row if isinstance(row, dict) and row.get("overran_in") == job.run_id and job.run_id else None
+
+
+def _stop_overrunning(job: Job, take: Take) -> None:
+    """The watchdog: the take's record says it ran over the limit, then this worker process ends."""
+    row = {**base_row(job, take), "status": "error", "overran_in": job.run_id, "worker": _worker_name(),
+           "message": f"the take ran longer than --take-timeout ({job.timeout_s:g} s); its worker process was "
+                      f"stopped", "wall_seconds": job.timeout_s, "output_checks": []}
+    try:
+        from ..io.atomic import atomic_write
+
+        job.record_path(take).parent.mkdir(parents=True, exist_ok=True)
+        atomic_write(job.record_path(take), json_text(row, indent=1))
+    finally:
+        os._exit(75)  # the whole worker: the take's thread cannot be stopped on its own
+
+
+def _process(job: Job, take: Take) -> dict:
     from .. import tasks
     from ..io import write
     from ..io.atomic import atomic_write
@@ -117,13 +168,21 @@ def process(job: Job, take: Take) -> dict:
     row["warnings"] += [str(w.message) for w in caught if not issubclass(w.category, DeprecationWarning)
                         and str(w.message) not in row["warnings"]]
     row["outputs"] = [printable(p.relative_to(job.outdir).as_posix()) for p in written]
-    row["output_checks"] = [_check_of(take, p) for p in written]
     record = job.record_path(take)
-    _remove_stale(job, take, {c["tail"] for c in row["output_checks"]})
-    row["wall_seconds"] = time.perf_counter() - t0
-    row["worker"] = _worker_name()
-    record.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write(record, json_text(row, indent=1))
+    try:
+        row["output_checks"] = [_check_of(take, p) for p in written]
+        _remove_stale(job, take, {c["tail"] for c in row["output_checks"]})
+        row["wall_seconds"] = time.perf_counter() - t0
+        row["worker"] = _worker_name()
+        record.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write(record, json_text(row, indent=1))
+    except OSError as exc:  # a name too long, a read-only or immutable record or folder: the row says so
+        row["status"] = "error"
+        row["message"] = printable(f"cannot write its record {record.name} ({exc.strerror or exc})"
+                                   + (f"; before that: {row['message']}" if row["message"] else ""))
+        row["record"] = None
+        row.setdefault("output_checks", [])
+        row["wall_seconds"] = time.perf_counter() - t0
     return row
 
 

@@ -14,6 +14,7 @@ from typing import Annotated
 import click
 import typer
 
+from ..batch.take import TAKE_TIMEOUT_S
 from ..errors import MocycleError
 from ..tasks.options import MISSING, Flag, flag_declaration, old_flag_warning
 from ..tasks.spec import SPECS
@@ -84,6 +85,9 @@ def batch(
     workers: Annotated[int | None, typer.Option(
         min=1, help="LocalCluster: number of worker processes (default one per core); with --scheduler: wait "
                     "for this many workers.")] = None,
+    take_timeout: Annotated[float, typer.Option(
+        min=0, help="Seconds one take may run; a take that runs longer gets an error row and its worker process "
+                    "is stopped (a new one takes its place). 0: no limit.")] = TAKE_TIMEOUT_S,
     as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON (no progress).")] = False,
 ):
     """Run one command over many takes on dask.distributed; a row per take in OUTDIR/results.csv and .json.
@@ -105,8 +109,13 @@ def batch(
     from ..batch.progress import progress_for
 
     progress = None if as_json else (lambda total, resumed: progress_for(err, total, resumed))
-    rows, run = run_batch(command, inputs, outdir, options, suffix=suffix, resume=resume, scheduler=scheduler,
-                          workers=workers, progress=progress)
+    try:
+        rows, run = run_batch(command, inputs, outdir, options, suffix=suffix, resume=resume, scheduler=scheduler,
+                              workers=workers, progress=progress, take_timeout_s=take_timeout)
+    except MocycleError as exc:  # refused before any work, or the run itself failed: --json still says so
+        if as_json:
+            print_json({"status": "error", "error": str(exc), "exit_code": 1})
+        raise
     if as_json:
         print_json(run)
         return

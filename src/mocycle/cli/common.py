@@ -174,6 +174,13 @@ def friendly(func: Callable) -> Callable:
                 err.print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
                 refused = isinstance(exc, (NoPeriodicMotion, LoopRefused))
                 raise typer.Exit(EXIT_NOT_FOUND if refused else EXIT_ERROR) from None
+            except MemoryError:  # an input (or options) that asks for more than this machine or its limit gives
+                _print_warnings(caught)
+                message = _naming_the_input("out of memory: the input or the options ask for more memory than this "
+                                            "process may use (MOCYCLE_MAX_FRAMES lowers what a file may claim)",
+                                            kwargs)
+                err.print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
+                raise typer.Exit(EXIT_ERROR) from None
         _print_warnings(caught)
         return result
 
@@ -198,9 +205,11 @@ def _naming_the_input(message: str, kwargs: dict) -> str:
 
 
 def _print_warnings(caught) -> None:
+    said = set()
     for w in caught:
-        if issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)):
-            continue
+        if issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)) or str(w.message) in said:
+            continue  # each said once, however often it was raised
+        said.add(str(w.message))
         err.print(f"[yellow]warning:[/] {escape(str(w.message))}", markup=True, soft_wrap=True)
 
 

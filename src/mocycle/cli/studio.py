@@ -37,7 +37,10 @@ def serve(application, host: str, port: int, open_browser: bool, ready=None) -> 
             err.print(f"warning: --host {host} serves your motion library to the network (every machine that "
                       "can reach this one); only the URL below, which carries the server's token, opens it",
                       soft_wrap=True, markup=False)
-    server = uvicorn.Server(uvicorn.Config(application, log_level="warning", lifespan="on"))
+    from ..studio.server import config
+
+    # slow request heads closed, connections bounded, a stop that waits for nobody for long (studio/server.py)
+    server = uvicorn.Server(config(application, log_level="warning", lifespan="on"))
     out.print(f"mocycle studio on {escape(url)} (Ctrl-C to stop)", soft_wrap=True)
     if open_browser:
         threading.Timer(0.8, webbrowser.open, (url,)).start()

@@ -31,32 +31,62 @@ from ..rotations import nearest_rotations
 
 _MOVING = ("Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation", "Yrotation")
 _TURNING = ("Zrotation", "Xrotation", "Yrotation")
-_BLOCK = 2048  # frames per block of world matrices: 2048 x J x 128 bytes
+_BLOCK = 2048  # most frames per block of world matrices
+_BLOCK_CELLS = 1 << 18  # most frames x joints per block: the world matrices of a block take 128 bytes a cell
+
+
+class Sampled:
+    """An animated translation, rotation or scale sampled only when a block of frames is asked for:
+    ``sample(times) -> (len(times), width)``.  A reader hands one to :class:`NodeTRS` instead of the whole
+    ``(T, width)`` array, so that reading holds one block of every node's values, not the whole take of each
+    (a file's key times may claim a long span in a few bytes)."""
+
+    def __init__(self, times: np.ndarray, width: int, sample):
+        self.times, self.width, self.sample = times, width, sample
+
+    def __len__(self) -> int:
+        return len(self.times)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return len(self.times), self.width
+
+    def __getitem__(self, rows: slice) -> np.ndarray:
+        return np.asarray(self.sample(self.times[rows]), dtype=np.float64).reshape(-1, self.width)
 
 
 @dataclass
 class NodeTRS:
     """One node's local transform, sampled at the motion's frames: ``translation (T, 3)`` or ``(1, 3)`` when
-    constant, ``rotation (T, 4)`` or ``(1, 4)`` (x, y, z, w), ``scale (T, 3)`` or ``(1, 3)``."""
+    constant, ``rotation (T, 4)`` or ``(1, 4)`` (x, y, z, w), ``scale (T, 3)`` or ``(1, 3)``; an animated one
+    may be a :class:`Sampled` (``T`` frames, made a block at a time)."""
 
     name: str
-    translation: np.ndarray
-    rotation: np.ndarray
-    scale: np.ndarray
+    translation: np.ndarray | Sampled
+    rotation: np.ndarray | Sampled
+    scale: np.ndarray | Sampled
     animated: bool = False
 
 
-def _matrices(node: NodeTRS, rows: slice, n: int) -> np.ndarray:
+def _matrices(node: NodeTRS, rows: slice, n: int, path=None) -> np.ndarray:
     """``(n, 4, 4)`` local matrices ``T · R · S`` of ``node`` over the frames ``rows``."""
-    def take(a):
+    def take(a, what):
+        if isinstance(a, Sampled):
+            block = a[rows]
+            _check_values(node.name, what, block, path)
+            return block
         return np.broadcast_to(a if len(a) == 1 else a[rows], (n, a.shape[1]))
 
-    q = take(node.rotation)
+    q = take(node.rotation, "rotation")
     m = np.zeros((n, 4, 4))
-    m[:, :3, :3] = Rotation.from_quat(q).as_matrix() * take(node.scale)[:, None, :]
-    m[:, :3, 3] = take(node.translation)
+    m[:, :3, :3] = Rotation.from_quat(q).as_matrix() * take(node.scale, "scale")[:, None, :]
+    m[:, :3, 3] = take(node.translation, "translation")
     m[:, 3, 3] = 1.0
     return m
+
+
+def _constant(node: NodeTRS) -> bool:
+    return all(not isinstance(a, Sampled) and len(a) == 1 for a in (node.translation, node.rotation, node.scale))
 
 
 def _rotation_part(m: np.ndarray) -> np.ndarray:
@@ -71,25 +101,38 @@ def _rotation_part(m: np.ndarray) -> np.ndarray:
     return nearest_rotations(r)
 
 
+def _check_values(name: str, what: str, a: np.ndarray, path) -> None:
+    """Refuse NaN, infinite or absurd values (and zero rotations) in one node's ``what`` (one clear error)."""
+    if a.size and not (np.isfinite(a).all() and np.abs(a).max() <= MAX_MAGNITUDE):
+        raise MotionFileError(f"node {name!r}: its {what} holds NaN, infinite or absurd values", path)
+    if what == "rotation" and a.size and np.any(np.linalg.norm(a, axis=1) < 1e-12):
+        raise MotionFileError(f"node {name!r}: a zero rotation quaternion", path)
+
+
 def check_trs(nodes: list[NodeTRS], path) -> None:
-    """Refuse NaN, infinite or absurd values and zero rotations in the transforms (one clear error)."""
+    """Refuse NaN, infinite or absurd values and zero rotations in the transforms (one clear error); a
+    :class:`Sampled` one is checked a block at a time as it is sampled."""
     for node in nodes:
         for what, a in (("translation", node.translation), ("rotation", node.rotation), ("scale", node.scale)):
-            if a.size and not (np.isfinite(a).all() and np.abs(a).max() <= MAX_MAGNITUDE):
-                raise MotionFileError(f"node {node.name!r}: its {what} holds NaN, infinite or absurd values", path)
-        if node.rotation.size and np.any(np.linalg.norm(node.rotation, axis=1) < 1e-12):
-            raise MotionFileError(f"node {node.name!r}: a zero rotation quaternion", path)
+            if not isinstance(a, Sampled):
+                _check_values(node.name, what, a, path)
 
 
 def unique_names(names: list[str | None], prefix: str = "node") -> list[str]:
-    """Node names made usable as joint names: a name for each unnamed node, ``.1``, ``.2`` after repeats."""
+    """Node names made usable as joint names: a name for each unnamed node, ``.1``, ``.2`` after repeats
+    (linear in the names: each base name's next number is kept)."""
     out, taken = [], set()
+    following: dict[str, int] = {}  # base name -> the next number to try after it
     for i, name in enumerate(names):
         base = str(name).strip() if name is not None and str(name).strip() else f"{prefix}{i}"
         base = " ".join(base.split())  # one line, no tabs: a BVH joint name
-        candidate, k = base, 1
-        while candidate in taken:
-            candidate, k = f"{base}.{k}", k + 1
+        candidate, k = base, following.get(base, 1)
+        if candidate in taken:
+            candidate = f"{base}.{k}"
+            while candidate in taken:
+                k += 1
+                candidate = f"{base}.{k}"
+            following[base] = k + 1
         taken.add(candidate)
         out.append(candidate)
     return out
@@ -132,7 +175,8 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     children = np.zeros(J, dtype=int)
     np.add.at(children, up[1:], 1)
     sites = [j for j in range(1, J) if leaves_as_sites and children[j] == 0 and not joints[j].animated]
-    keep = [j for j in range(J) if j not in set(sites)]
+    site_set = set(sites)
+    keep = [j for j in range(J) if j not in site_set]
     new_index = {j: k for k, j in enumerate(keep)}
 
     # which joints' local translations can change: their own translation is animated, or a scale above them
@@ -149,15 +193,20 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     tracks = {new_index[j]: np.empty((T, 3)) for j in keep if varying[j]}
     static = np.zeros((K, 3))
     site_offsets = {j: np.zeros(3) for j in sites}
-    for start in range(0, T, _BLOCK):
-        rows = slice(start, min(T, start + _BLOCK))
+    block = max(1, min(_BLOCK, _BLOCK_CELLS // J))
+    # a joint whose transform does not change: its local matrix made once, not once per block
+    still: list[np.ndarray | None] = [_matrices(node, slice(0, 1), 1, path)[0] if _constant(node) else None
+                                      for node in joints]
+    for start in range(0, T, block):
+        rows = slice(start, min(T, start + block))
         n = rows.stop - start
         top = np.broadcast_to(np.eye(4), (n, 4, 4))
         for a in ancestors:
-            top = top @ _matrices(a, rows, n)
+            top = top @ _matrices(a, rows, n, path)
         world = np.empty((n, J, 4, 4))
         for j in range(J):
-            local = _matrices(joints[j], rows, n)
+            fixed = still[j]
+            local = fixed if fixed is not None else _matrices(joints[j], rows, n, path)
             world[:, j] = (top if up[j] < 0 else world[:, up[j]]) @ local
         rot = _rotation_part(world[:, :, :3, :3].reshape(-1, 3, 3)).reshape(n, J, 3, 3)
         pos = world[:, :, :3, 3]
@@ -209,43 +258,69 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
 def skeleton_order(parents: np.ndarray, children: list[list[int]], chosen, path) -> list[int]:
     """The skeleton's nodes, depth first from its root with children in the file's order (a BVH's order): the
     ``chosen`` nodes (a skin's joints, a file's bones), any node lying between two of them, and, when they have
-    several roots, their lowest common ancestor (refused when they have none).  ``parents`` must form a tree."""
-    members = set(int(i) for i in chosen)
-    if not members:
+    several roots, their lowest common ancestor (refused when they have none).  ``parents`` must form a tree.
+
+    Linear in the nodes: one pass from the tops down (which nodes have a chosen node above them), one from the
+    leaves up (which have one below)."""
+    N = len(parents)
+    up = [int(p) for p in np.asarray(parents).tolist()]
+    member = np.zeros(N, dtype=bool)
+    member[[int(i) for i in chosen]] = True
+    if not member.any():
         raise MotionFileError("no joints: nothing to read as a skeleton", path)
-
-    def ancestors(i):
-        out = []
-        while parents[i] >= 0:
-            i = int(parents[i])
-            out.append(i)
-        return out
-
-    chains = {i: ancestors(i) for i in members}
-    tops = [i for i in members if not any(a in members for a in chains[i])]
-    if len(tops) > 1:
-        common = set(chains[tops[0]])
-        for t in tops[1:]:
-            common &= set(chains[t])
+    order = _top_down(up, children)
+    below = _counts_below(order, up, member)  # chosen nodes in each node's subtree, itself included
+    above = _any_above(order, up, member)  # a chosen node above (not counting the node itself)
+    tops = [i for i in order if member[i] and not above[i]]
+    if len(tops) > 1:  # several roots: their lowest common ancestor joins them
+        tops_below = _counts_below(order, up, np.isin(np.arange(N), tops))
+        common = [i for i in order if tops_below[i] == len(tops)]
         if not common:
             raise MotionFileError(f"the skeleton's joints have {len(tops)} roots with no common parent node", path)
-        root = next(a for a in chains[tops[0]] if a in common)
-        members.add(root)
-        chains[root] = ancestors(root)
-    for i in list(members):  # nodes between a joint and its nearest joint above are joints too
-        between: list[int] = []
-        for a in chains[i]:
-            if a in members:
-                members.update(between)
-                break
-            between.append(a)
-    root = next(i for i in members if not any(a in members for a in ancestors(i)))
-    order, stack = [], [root]
+        root = common[-1]  # the deepest: the last of them from the top down
+        member[root] = True
+        below = _counts_below(order, up, member)
+        above = _any_above(order, up, member)
+    else:
+        root = tops[0]
+    # nodes between a joint and a joint above it are joints too: a chosen node above and one below
+    member |= above & (below > 0)
+    out, stack = [], [root]
+    while stack:
+        i = stack.pop()
+        out.append(i)
+        stack += [c for c in reversed(children[i]) if member[c]]
+    return out
+
+
+def _top_down(up: list[int], children: list[list[int]]) -> list[int]:
+    """Every node, each after its parent (depth first from the tops)."""
+    order: list[int] = []
+    stack = [i for i, p in enumerate(up) if p < 0]
     while stack:
         i = stack.pop()
         order.append(i)
-        stack += [c for c in reversed(children[i]) if c in members]
+        stack += children[i]
     return order
+
+
+def _counts_below(order: list[int], up: list[int], marked: np.ndarray) -> np.ndarray:
+    """How many ``marked`` nodes each node's subtree holds (itself included)."""
+    counts = marked.astype(np.int64)
+    for i in reversed(order):
+        if up[i] >= 0:
+            counts[up[i]] += counts[i]
+    return counts
+
+
+def _any_above(order: list[int], up: list[int], marked: np.ndarray) -> np.ndarray:
+    """Whether a ``marked`` node lies strictly above each node."""
+    above = np.zeros(len(up), dtype=bool)
+    for i in order:
+        p = up[i]
+        if p >= 0:
+            above[i] = above[p] or marked[p]
+    return above
 
 
 def choose_take(names: list[str], take, path, noun: str, none_held: str) -> int | None:

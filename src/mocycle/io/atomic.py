@@ -1,6 +1,7 @@
 """Write files all at once: to a temporary file beside the target, then rename.
 
-The temporary file is ``.<name>.<pid>.<random>.tmp`` beside the target; it is removed on every exit
+The temporary file is ``.<name>.<pid>.<random>.tmp`` beside the target (for a name too long for that, its
+first 150 bytes and a hash of the whole stand for ``<name>``); it is removed on every exit
 the process lives to see (an exception, Ctrl-C, SIGTERM handled by the CLI).  A run killed outright
 (SIGKILL, power loss) leaves it behind: the next write to the same target removes such leftovers of
 processes that no longer run (:func:`clean_stale`).  Readers never take them for takes (they end in
@@ -27,6 +28,22 @@ _leftovers: dict[str, list[str]] = {}  # per folder (absolute) listed by this pr
 _lock = threading.Lock()  # batch's threaded workers write side by side
 
 
+#: the longest name a file may have (bytes; most file systems)
+NAME_MAX = 255
+
+
+def _temporary_prefix(name: str) -> str:
+    """``.<name>.``, the start of a temporary file's name for the target ``name``; for a long name (whose
+    temporary name would pass :data:`NAME_MAX` bytes) its first 150 bytes and a hash of the whole instead."""
+    if len(os.fsencode(name)) <= NAME_MAX - 50:  # room for ".", ".<pid>.<random>.tmp"
+        return f".{name}."
+    import hashlib
+
+    raw = os.fsencode(name)
+    head = os.fsdecode(raw[:150])  # bytes of a cut character stay bytes (surrogate escapes)
+    return f".{head}~{hashlib.sha256(raw).hexdigest()[:12]}."
+
+
 def _file_mode(path: Path) -> int:
     """The mode a plain ``open(path, "w")`` would give: the old file's, else 0o666 minus the umask."""
     try:
@@ -50,7 +67,8 @@ def atomic_write(path: str | os.PathLike, data: str | bytes | Iterable[str] | It
     path = Path(path)
     mode = "wb" if binary or isinstance(data, bytes) else "w"
     clean_stale(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent or ".")
+    fd, tmp = tempfile.mkstemp(prefix=f"{_temporary_prefix(path.name)}{os.getpid()}.", suffix=".tmp",
+                               dir=path.parent or ".")
     try:
         with os.fdopen(fd, mode, **({} if mode == "wb" else {"encoding": "utf-8", "newline": ""})) as fh:
             if isinstance(data, str | bytes):
@@ -103,7 +121,7 @@ def clean_stale(path: str | os.PathLike) -> list[Path]:
     """
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
-    prefix = f".{path.name}."
+    prefix = _temporary_prefix(path.name)
     removed: list[Path] = []
     with _lock:
         names = _folder_leftovers(folder)

@@ -26,6 +26,7 @@ import contextlib
 import io
 import math
 import os
+import re
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
@@ -485,11 +486,45 @@ def format_bvh(motion: Motion) -> str:
 
 def bvh_size(motion: Motion) -> int:
     """Bytes of the BVH file of ``motion`` (counted piece by piece, without holding the text)."""
-    return sum(len(piece.encode("utf-8")) for piece in bvh_chunks(motion))
+    with warnings.catch_warnings():  # a size: the writer says what it changes
+        warnings.simplefilter("ignore")
+        return sum(len(piece.encode("utf-8")) for piece in bvh_chunks(motion))
 
 
+#: Tabs of indentation at most (readers go by the braces; past this depth every level is indented alike).
+MAX_INDENT = 32
 #: Frames per piece of text :func:`bvh_chunks` yields.
 _ROWS_PER_CHUNK = 1024  # the text of 1024 rows of 69 channels: about 1 MB (a StringIO holds 4 bytes a character)
+
+
+#: what a BVH joint or End Site name cannot hold: braces (read as the hierarchy's), control characters (a line
+#: break ends the name), text that is no Unicode (a lone surrogate: the file is UTF-8)
+_NOT_IN_A_NAME = re.compile("[{}\x00-\x1f\x7f\ud800-\udfff]")
+_IN_PLACE = {"{": "(", "}": ")"}
+
+
+def _bvh_name(name: str) -> str:
+    def one(match: re.Match) -> str:
+        c = match.group()
+        return _IN_PLACE.get(c, "\ufffd" if "\ud800" <= c <= "\udfff" else "_")
+
+    return "_".join(_NOT_IN_A_NAME.sub(one, name).split()) or "_"  # one word: white space inside to "_"
+
+
+def bvh_skeleton(skeleton: Skeleton) -> Skeleton:
+    """``skeleton`` with joint and End Site names a BVH file holds and reads back as they are: ``{``/``}`` as
+    ``(``/``)``, control characters as ``_``, lone surrogates as U+FFFD, no space at either end (one warning
+    saying which, :func:`mocycle.text.renamed`); the same skeleton when every name is fine."""
+    from ..text import renamed
+
+    sites = [s.name for s in skeleton.end_sites if s.name is not None]
+    if not any(_NOT_IN_A_NAME.search(n) or len(n.split()) != 1 or n != n.strip() for n in (*skeleton.names, *sites)):
+        return skeleton
+    names = renamed(list(skeleton.names) + sites, _bvh_name, "BVH (one word each)")
+    joints, site_names = names[:skeleton.n_joints], iter(names[skeleton.n_joints:])
+    end_sites = tuple(EndSite(s.parent, s.offset, next(site_names) if s.name is not None else None)
+                      for s in skeleton.end_sites)
+    return Skeleton(tuple(joints), skeleton.parents, skeleton.offsets, skeleton.channels, end_sites)
 
 
 def one_word_names(skeleton: Skeleton) -> tuple[list[str], list[str | None], list[tuple[str, str]]]:
@@ -521,9 +556,12 @@ def one_word_names(skeleton: Skeleton) -> tuple[list[str], list[str | None], lis
 def bvh_chunks(motion: Motion, names: tuple[list[str], list[str | None]] | None = None) -> Iterator[str]:
     """The BVH text of ``motion`` in pieces (the header, then blocks of frames), so that a long take is
     written without holding its whole text.  ``names``: the joint and End Site names to write (default the
-    skeleton's)."""
+    skeleton's as BVH holds them: :func:`bvh_skeleton`, then :func:`one_word_names`)."""
     skel = motion.skeleton
-    joint_names, site_names = names if names is not None else (list(skel.names), [s.name for s in skel.end_sites])
+    if names is None:
+        joints, sites, _ = one_word_names(bvh_skeleton(skel))
+        names = (joints, sites)
+    joint_names, site_names = names
     out = io.StringIO()
     out.write("HIERARCHY\n")
     children: list[list[int]] = [[] for _ in range(skel.n_joints)]
@@ -537,7 +575,7 @@ def bvh_chunks(motion: Motion, names: tuple[list[str], list[str | None]] | None 
     stack = [("close", 0, 0), ("open", 0, 0)]
     while stack:
         what, j, depth = stack.pop()
-        tab = "\t" * depth
+        tab = "\t" * min(depth, MAX_INDENT)  # deeper levels alike: a 10,000-deep chain's tabs would be quadratic
         if what == "close":
             for s, site_name in sites[j]:
                 label = "End Site" + (f" {site_name}" if site_name else "")
@@ -570,9 +608,10 @@ def bvh_chunks(motion: Motion, names: tuple[list[str], list[str | None]] | None 
 def write_bvh(motion: Motion, path: str | os.PathLike) -> Path:
     """Write ``motion`` as a BVH file at ``path`` (atomically).  Returns the path.
 
-    Names are written one word each (:func:`one_word_names`; a :class:`~mocycle.errors.MocycleWarning` lists
-    what changed), so that every BVH reader reads one joint per name; mocycle reads back the names written."""
-    joints, sites, changed = one_word_names(motion.skeleton)
+    Names are written as BVH holds them (:func:`bvh_skeleton`: no braces, control characters or lone
+    surrogates) and one word each (:func:`one_word_names`), a :class:`~mocycle.errors.MocycleWarning` listing
+    what changed, so that every BVH reader reads one joint per name; mocycle reads back the names written."""
+    joints, sites, changed = one_word_names(bvh_skeleton(motion.skeleton))  # what BVH holds, then one word
     if changed:
         shown = ", ".join(f"{a!r} as {b!r}" for a, b in changed[:5]) + (" ..." if len(changed) > 5 else "")
         warnings.warn(f"{path}: BVH names are one word each (most readers split a line at spaces): {len(changed)} "

@@ -44,6 +44,7 @@ from ..errors import DefaultTake, MocycleError, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
 from ._nodes import NodeTRS, choose_take, joint_names, member_nodes, motion_from_nodes, skeleton_order, unique_names
+from .fbx_scan import opened
 
 __all__ = ["DEFAULT_FPS", "fbx_takes", "read_fbx"]
 
@@ -133,7 +134,10 @@ def _load(path: Path):
     if size > MAX_FILE_BYTES:
         raise MotionFileError(f"the file holds {size:,} bytes; FBX files over {MAX_FILE_BYTES:,} are not read", path)
     try:  # meshes and embedded textures are not read: the motion is the skeleton's
-        return ufbx.load_file(str(path), ignore_geometry=True, ignore_embedded=True)
+        with opened(path) as name:  # regular files only, no deflate bomb; any file name (fbx_scan)
+            return ufbx.load_file(name, ignore_geometry=True, ignore_embedded=True)
+    except MotionFileError:
+        raise
     except Exception as exc:  # ufbx's error (its message says what it expected), or the binding's
         text = " ".join(str(exc).split())[:200] or type(exc).__name__
         raise MotionFileError(f"not a readable FBX file ({text})", path) from None

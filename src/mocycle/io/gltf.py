@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import os
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +34,7 @@ from ..clip import Clip, jsonable
 from ..errors import MocycleError, MocycleWarning, MotionFileError, OptionError
 from ..motion import Motion
 from ..rotations import quat_multiply
+from ..text import renamed, valid_unicode
 from .atomic import atomic_write
 
 __all__ = ["HUMAN_HEIGHT_M", "UNITS", "GltfFrame", "check_options", "gltf_frame", "write_gltf"]
@@ -308,7 +309,9 @@ def write_gltf(motion: Motion, path: str | os.PathLike, *, clip: Clip | None = N
     sk = motion.skeleton
     J, T = sk.n_joints, motion.n_frames
     names = list(sk.names) + [s.name or f"{sk.names[s.parent]}_end" for s in sk.end_sites]
-    taken = set(sk.names)
+    names = renamed(names, valid_unicode, "glTF (UTF-8 text)")  # a lone surrogate as U+FFFD, one warning
+    clip = replace(clip, name=valid_unicode(clip.name))
+    taken = set(names[:J])
     for i in range(J, len(names)):  # End Site names unique among the nodes
         base, k = names[i], 1
         while names[i] in taken:

@@ -35,6 +35,7 @@ import json
 import os
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -42,7 +43,17 @@ from scipy.spatial.transform import Rotation
 from ..errors import DefaultTake, MocycleWarning, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
-from ._nodes import NodeTRS, choose_take, joint_names, member_nodes, motion_from_nodes, skeleton_order, unique_names
+from ._nodes import (
+    NodeTRS,
+    Sampled,
+    choose_take,
+    joint_names,
+    member_nodes,
+    motion_from_nodes,
+    skeleton_order,
+    unique_names,
+)
+from .regular import read_regular
 
 __all__ = ["DEFAULT_FPS", "gltf_takes", "read_gltf"]
 
@@ -100,26 +111,75 @@ def _list(value, what: str, path) -> list:
     return value
 
 
+# The fields the reader uses and their JSON types ("int": a whole number, not true/false; "num": any number;
+# [x]: a list of x; {...}: an object with those fields). Other fields are not read, and extras are anyone's.
+_SCHEMA = {
+    "asset": {"generator": "str"},
+    "nodes": [{"name": "str", "children": ["int"], "translation": ["num"], "rotation": ["num"], "scale": ["num"],
+               "matrix": ["num"]}],
+    "skins": [{"joints": ["int"]}],
+    "accessors": [{"bufferView": "int", "byteOffset": "int", "componentType": "int", "normalized": "bool",
+                   "count": "int", "type": "str"}],
+    "bufferViews": [{"buffer": "int", "byteOffset": "int", "byteLength": "int", "byteStride": "int"}],
+    "buffers": [{"uri": "str", "byteLength": "int"}],
+    "animations": [{"name": "str", "channels": [{"sampler": "int", "target": {"node": "int", "path": "str"}}],
+                    "samplers": [{"input": "int", "output": "int", "interpolation": "str"}]}],
+    "scenes": [{"nodes": ["int"]}],
+}
+_TYPES = {"int": ((int,), "a whole number"), "num": ((int, float), "a number"), "str": ((str,), "text"),
+          "bool": ((bool,), "true or false")}
+
+
+def _what(value) -> str:
+    if value is None:
+        return "null"
+    return {bool: "true/false", str: "text", list: "a list", dict: "an object"}.get(type(value), "a number")
+
+
+def check_types(document: dict, path) -> None:
+    """Every field the reader uses has its JSON type (:data:`_SCHEMA`), or one :class:`MotionFileError` naming
+    it (``accessors[3].type must be text; got a list``); a field set to ``null`` counts as absent.  Values and
+    indices are checked where they are used; this is the one place types are."""
+    todo: list[tuple[Any, Any, str]] = [(document, _SCHEMA, "")]
+    while todo:
+        value, schema, where = todo.pop()
+        if value is None:
+            continue
+        if isinstance(schema, dict):
+            if not isinstance(value, dict):
+                raise MotionFileError(f"{where or 'the glTF JSON'} must be an object; got {_what(value)}", path)
+            todo += [(value.get(k), sub, f"{where}.{k}" if where else k) for k, sub in schema.items()]
+        elif isinstance(schema, list):
+            if not isinstance(value, list):
+                raise MotionFileError(f"{where} must be a list; got {_what(value)}", path)
+            item = schema[0]
+            if isinstance(item, str):
+                kinds, name = _TYPES[item]
+                bad = next((i for i, x in enumerate(value) if isinstance(x, bool) or not isinstance(x, kinds)), None)
+                if bad is not None:
+                    raise MotionFileError(f"{where}[{bad}] must be {name}; got {_what(value[bad])}", path)
+            else:
+                bad = next((i for i, x in enumerate(value) if not isinstance(x, dict)), None)
+                if bad is not None:
+                    raise MotionFileError(f"{where}[{bad}] must be an object; got {_what(value[bad])}", path)
+                todo += [(x, item, f"{where}[{i}]") for i, x in enumerate(value)]
+        else:
+            kinds, name = _TYPES[schema]
+            if isinstance(value, bool) != (schema == "bool") or not isinstance(value, kinds):
+                raise MotionFileError(f"{where} must be {name}; got {_what(value)}", path)
+
+
 class _File:
     """A loaded glTF: its JSON (as pygltflib objects) and its buffers' bytes, every access checked."""
 
     def __init__(self, path: Path):
         self.path = path
-        try:
-            size = path.stat().st_size
-        except OSError as exc:
-            raise MotionFileError(f"cannot read file ({exc.strerror or exc})", path) from None
-        if size > MAX_FILE_BYTES:
-            raise MotionFileError(f"the file holds {size:,} bytes; glTF files over {MAX_FILE_BYTES:,} are not read",
-                                  path)
-        try:
-            data = path.read_bytes()
-        except OSError as exc:
-            raise MotionFileError(f"cannot read file ({exc.strerror or exc})", path) from None
+        data = read_regular(path, MAX_FILE_BYTES, "the file")  # no FIFO, device or folder; bounded
         binary = data[:4] == b"glTF"
         if path.suffix.lower() == ".glb" and not binary:
             raise MotionFileError("not a binary glTF file: expected it to start with 'glTF'", path)
-        self.blob = None
+        self.blob: bytes | bytearray | None = None
+        text: bytes | bytearray
         if binary:
             text, self.blob = self._chunks(data)
         else:
@@ -132,10 +192,12 @@ class _File:
             raise MotionFileError(f"the glTF JSON does not parse ({str(exc)[:120]})", path) from None
         if not isinstance(document, dict) or not isinstance(document.get("nodes", []), list):
             raise MotionFileError("not a glTF file: expected a JSON object with a 'nodes' list", path)
+        check_types(document, path)
         self.gl = _Obj(document)
-        self._buffers: dict[int, bytes] = {}
+        self._buffers: dict[int, bytes | bytearray] = {}
+        self._buffer_bytes = 0  # of the buffers read so far (at most MAX_FILE_BYTES together)
 
-    def _chunks(self, data: bytes) -> tuple[bytes, bytes | None]:
+    def _chunks(self, data: bytes | bytearray) -> tuple[bytes | bytearray, bytes | bytearray | None]:
         """The JSON chunk and the binary chunk (or ``None``) of a GLB, every length checked against the file."""
         if len(data) < 20:
             raise MotionFileError(f"a binary glTF file holds at least 20 bytes; this one {len(data)}", self.path)
@@ -174,7 +236,7 @@ class _File:
             raise MotionFileError(f"{what} is {i}, but the file has no {kind}", self.path)
         return items[i]
 
-    def buffer(self, index: int) -> bytes:
+    def buffer(self, index: int) -> bytes | bytearray:
         if index in self._buffers:
             return self._buffers[index]
         buf = self.item("buffers", index, "bufferView.buffer")
@@ -200,21 +262,40 @@ class _File:
             except (binascii.Error, ValueError):
                 raise MotionFileError(f"buffers[{index}]: the data URI is not base64", self.path) from None
         else:
-            from urllib.parse import unquote
-
-            file = (self.path.parent / unquote(uri))
-            try:
-                if file.stat().st_size > MAX_FILE_BYTES:
-                    raise MotionFileError(f"buffers[{index}]: {uri} is over {MAX_FILE_BYTES:,} bytes", self.path)
-                data = file.read_bytes()
-            except OSError as exc:
-                raise MotionFileError(f"buffers[{index}]: cannot read {uri} ({exc.strerror or exc})", self.path) \
-                    from None
+            label = f"buffers[{index}]'s file {uri[:120]!r}"
+            data = read_regular(self.local_file(uri, f"buffers[{index}].uri"), MAX_FILE_BYTES - self._buffer_bytes,
+                                label, self.path, exact=length)  # never more than byteLength
         if len(data) < length:
             raise MotionFileError(f"buffers[{index}] says {length:,} bytes but holds {len(data):,} (truncated?)",
                                   self.path)
+        self._buffer_bytes += len(data)
         self._buffers[index] = data
         return data
+
+    def local_file(self, uri: str, what: str) -> Path:
+        """The file a relative ``uri`` names in the glTF's own folder (links followed, and only when they stay
+        inside it).  An absolute path, a scheme (``file:``, ``http:``), ``..`` or a link leading out is refused
+        with one message that says nothing of what lies outside."""
+        from urllib.parse import unquote, urlsplit
+
+        text = unquote(uri)
+        try:
+            scheme = urlsplit(uri).scheme
+        except ValueError:
+            scheme = "?"
+        parts = text.split("/")
+        if scheme or not text or text.startswith("/") or "\\" in text or "\0" in text or ".." in parts:
+            raise MotionFileError(f"{what} must be a relative path to a file in the glTF's own folder (no '..', no "
+                                  f"absolute path, no scheme); got {uri[:120]!r}", self.path)
+        folder = self.path.parent.resolve()
+        try:
+            target = (folder / text).resolve()
+        except (OSError, RuntimeError):
+            target = None
+        if target is None or folder not in target.parents:
+            raise MotionFileError(f"{what} {uri[:120]!r} leads outside the glTF's own folder (a symbolic link); "
+                                  f"only files in the folder are read", self.path)
+        return target
 
     def accessor(self, index, what: str, widths: tuple[int, ...]) -> np.ndarray:
         """Accessor ``index`` as float64 ``(count, width)`` (normalised integers scaled to [-1, 1] or [0, 1]);
@@ -271,7 +352,8 @@ class _File:
 
 
 def _parents(f: _File) -> np.ndarray:
-    """Each node's parent (``-1`` at the top); a node with two parents or a cycle is refused."""
+    """Each node's parent (``-1`` at the top); a node with two parents or a cycle is refused (linear time: the
+    nodes reached from the tops are the tree, any other node lies on a cycle)."""
     nodes = f.items("nodes")
     N = len(nodes)
     parents = np.full(N, -1, dtype=np.int64)
@@ -282,16 +364,18 @@ def _parents(f: _File) -> np.ndarray:
                 raise MotionFileError(f"node {c} has two parents (or is its own child); the nodes must form a tree",
                                       f.path)
             parents[c] = i
-    # cycles: every node must reach the top within N steps
-    depth = np.zeros(N, dtype=np.int64)
-    for i in range(N):
-        j, steps = i, 0
-        while parents[j] >= 0:
-            j = int(parents[j])
-            steps += 1
-            if steps > N:
-                raise MotionFileError(f"the node tree has a cycle through node {i}", f.path)
-        depth[i] = steps
+    children: list[list[int]] = [[] for _ in range(N)]
+    for c, p in enumerate(parents.tolist()):
+        if p >= 0:
+            children[p].append(c)
+    reached = np.zeros(N, dtype=bool)
+    stack = np.flatnonzero(parents < 0).tolist()
+    while stack:
+        i = stack.pop()
+        reached[i] = True
+        stack += children[i]
+    if not reached.all():
+        raise MotionFileError(f"the node tree has a cycle through node {int(np.argmin(reached))}", f.path)
     return parents
 
 
@@ -394,6 +478,21 @@ def _sample(times: np.ndarray, keys: np.ndarray, values: np.ndarray, interpolati
     return out
 
 
+def _sampler(keys: np.ndarray, values: np.ndarray, interpolation: str, rotation: bool, path, label: str):
+    """``times -> values`` of one sampler (:func:`_sample`), its key and value counts checked now."""
+    n = len(keys)
+    if interpolation == "CUBICSPLINE" and len(values) != 3 * n:
+        raise MotionFileError(f"{label}: a CUBICSPLINE sampler needs 3 values per key ({3 * n}); it has "
+                              f"{len(values)}", path)
+    if interpolation != "CUBICSPLINE" and len(values) != n:
+        raise MotionFileError(f"{label}: {n} key times but {len(values)} values", path)
+
+    def sample(times: np.ndarray) -> np.ndarray:
+        return _sample(times, keys, values, interpolation, rotation, path, label)
+
+    return sample
+
+
 def _grid_step(all_keys: list[np.ndarray]) -> float | None:
     """The step (seconds) of the one regular grid, from the animation's first key, that every key time lies
     on (within 1e-3 of a step), or ``None``."""
@@ -458,13 +557,14 @@ def _is_mocycle(f: _File) -> dict | None:
     if getattr(asset, "generator", None) != "mocycle":
         return None
     for scene in f.items("scenes"):
-        extras = getattr(scene, "extras", None)
-        units = extras.get("mocycle", {}).get("units") if isinstance(extras, dict) else None
+        extras = getattr(scene, "extras", None)  # anyone's: any JSON at all
+        ours = extras.get("mocycle") if isinstance(extras, dict) else None
+        units = ours.get("units") if isinstance(ours, dict) else None
         if isinstance(units, dict):
             try:
                 scale = float(units["metres_per_unit"])
                 quat = np.asarray(units["source_to_gltf_rotation_xyzw"], dtype=float)
-            except (KeyError, TypeError, ValueError):
+            except (KeyError, TypeError, ValueError, OverflowError):
                 return None
             if np.isfinite(scale) and scale > 0 and quat.shape == (4,) and np.isfinite(quat).all() \
                     and np.linalg.norm(quat) > 0.5:
@@ -617,9 +717,13 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
             trs[i] = NodeTRS(node_names[i], t[None], q[None], s[None], animated=i in targets)
         return trs[i]
 
+    used = set(members) | _above(members[0], parents)
     for node, kind, keys, values, interp, label in channels:
+        if node not in used:
+            continue
         n = node_trs(node)
-        setattr(n, kind, _sample(times, keys, values, interp, kind == "rotation", p, label))
+        # sampled a block of frames at a time when the motion is made (never the whole take per channel)
+        setattr(n, kind, Sampled(times, _PATHS[kind], _sampler(keys, values, interp, kind == "rotation", p, label)))
     ancestors, joints, jparents = member_nodes(members, parents, node_trs)
     units = _is_mocycle(f)
     up, metres = (0.0, 1.0, 0.0), 1.0  # glTF: metres, +Y up (the specification)
@@ -633,3 +737,13 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
         name = names[index]
         motion.cache("take", lambda _: name)  # the take read (mocycle info says which)
     return motion
+
+
+def _above(node: int, parents: np.ndarray) -> set[int]:
+    """The nodes above ``node`` (its parent, its parent's parent, ...)."""
+    out = set()
+    i = int(parents[node])
+    while i >= 0:
+        out.add(i)
+        i = int(parents[i])
+    return out

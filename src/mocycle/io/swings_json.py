@@ -21,12 +21,14 @@ import numpy as np
 from ..errors import MocycleWarning, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..segmentation import MAX_SKELETON_BYTES, Segmentation, checked_segmentation
-from .bvh import parse_bvh, skeleton_text
+from .bvh import bvh_skeleton, parse_bvh, skeleton_text
 
 
 def swings_document(seg: Segmentation) -> dict:
     """The swings JSON document of ``seg`` (JSON-ready values; :func:`segmentation_from_dict` reads it back)."""
-    return {**seg.to_dict(), "skeleton_bvh": skeleton_text(seg.skeleton)}
+    skeleton = bvh_skeleton(seg.skeleton)  # names BVH cannot hold changed (one warning), here and in "joints"
+    return {**seg.to_dict(), "joints": [skeleton.names[j] for j in seg.joints],
+            "skeleton_bvh": skeleton_text(skeleton)}
 
 
 def read_swings_json(path: str | os.PathLike):

@@ -25,13 +25,17 @@ result, and the files are named ``NAME_loop.forced.*`` with an ``X-Mocycle-Faile
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import itertools
+import os
 import re
+import shutil
 import tempfile
 import threading
 import time
 import traceback
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,8 +43,8 @@ import numpy as np
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
 from starlette.middleware import Middleware
-from starlette.requests import Request
-from starlette.responses import HTMLResponse, JSONResponse, Response
+from starlette.requests import ClientDisconnect, Request
+from starlette.responses import HTMLResponse, JSONResponse, Response, StreamingResponse
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
@@ -96,6 +100,9 @@ class Studio:
         self._motions = Held("payload", lim.max_payloads, 1 << 62)
         self._relayout: dict[str, str] = {}  # take id -> its running relayout job
         self._lock = threading.Lock()
+        #: the downloads' files (:class:`Downloads`), removed with the server
+        self.files = Path(tempfile.mkdtemp(prefix="mocycle-studio-"))
+        weakref.finalize(self, shutil.rmtree, self.files, True)
         if analyse:
             for take in self.takes.values():
                 self.analysis.submit("analyse", lambda job, t=take: self._analyse(t))
@@ -117,6 +124,8 @@ class Studio:
 
     # ------------------------------------------------------------ background analysis of the library
     def _analyse(self, take: Take) -> None:
+        """Read and loop one take of the library; whatever happens, it ends ``done`` or ``failed`` (never left
+        ``running``): a bad file or a bug is its message, not the end of the analysis."""
         if take.status == "refused":  # a link out of the served folder: never read
             return
         take.status = "running"
@@ -134,6 +143,14 @@ class Studio:
             take.status = "done"
         except MocycleError as exc:
             take.status, take.error = "failed", display(str(exc))
+        except MemoryError:
+            take.status, take.error = "failed", "out of memory: this take needs more than the studio may use"
+        except Exception as exc:  # a bug: said on the page and the terminal, the analysis goes on
+            traceback.print_exc()
+            take.status, take.error = "failed", display(f"internal error: {type(exc).__name__}: {exc}"[:300])
+        finally:
+            if take.status == "running":  # interrupted (the server stopping)
+                take.status, take.error = "failed", "the analysis was interrupted"
 
     def take(self, take_id: str) -> Take:
         take = self.takes.get(v.path_id("take", take_id))
@@ -174,7 +191,7 @@ class Studio:
             report = tasks.loop.run(Labelled(take.motion(self.amc_fps), take.name), o)
             f = report.facts
             view, view_facts = loop_view(report)
-            return {"report": report, "view": view, "take": take, "facts": {
+            return {"report": report, "view": view, "take": take, "files": Downloads(self.files), "facts": {
                 "loop": loop_summary(f), "options": o.to_dict(), "warnings": list(report.warnings),
                 "failed_checks": f["failed_checks"], "forced": bool(f["failed_checks"]),
                 "frames_out": f["frames_out"], "phase": take_phase(report), "excitation": strip_excitation(report),
@@ -225,7 +242,8 @@ class Studio:
         asked = v.stroke_request(body, motion.n_frames, motion.frame_time, self.limits.max_stroke_frames)
         report = author.run((motion, asked["stroke"]), author.Options(**asked["options"], amc_fps=self.amc_fps))
         sid = f"s{next(self._stroke_ids)}"
-        kept = {"take": take.id, "motion": report.motions["authored"], "report": report}
+        kept = {"take": take.id, "motion": report.motions["authored"], "report": report,
+                "files": Downloads(self.files)}
         facts = {k: val for k, val in report.facts.items() if k != "trajectory"}
         warnings, timings = list(report.warnings), dict(report.timings_s)
         self.strokes.put(sid, kept, held_bytes(kept, self._shared()))
@@ -269,6 +287,8 @@ def answers(handler):
     async def wrapped(request: Request):
         try:
             return await handler(request)
+        except ClientDisconnect:  # the client left before its body arrived: no one to answer, nothing to say
+            return Response(status_code=400)
         except v.HTTPProblem as exc:
             return _error(exc.status, str(exc))
         except LoopRefused as exc:
@@ -289,27 +309,92 @@ def _file_name(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("._") or "take"
 
 
-def motion_file(report, role: str, name: str, suffix: str) -> bytes:
-    """``report.motions[role]`` as ``mocycle loop -o NAME.bvh|.glb`` writes it (``tasks.clips.for_output``:
-    a .glb loop holds the clip ``NAME`` ending in ``_loop``, with its closing frame), as bytes."""
+def write_motion_file(report, role: str, path: Path) -> Path:
+    """``report.motions[role]`` written to ``path`` as ``mocycle loop -o NAME.bvh|.glb`` writes it
+    (``tasks.clips.for_output``: a .glb loop holds the clip ``NAME`` ending in ``_loop``, with its closing
+    frame)."""
     from ..io import write
     from ..tasks.clips import for_output
 
-    with tempfile.TemporaryDirectory(prefix="mocycle-studio-") as folder:
-        path = Path(folder) / f"{name}{suffix}"
-        motion, clip = for_output(report, role, path)
-        write(motion, path, clip=clip)
-        return path.read_bytes()
+    motion, clip = for_output(report, role, path)
+    return write(motion, path, clip=clip)
 
 
-def _download(data, name: str, headers: dict | None = None) -> Response:
+def _remove_files(paths: dict) -> None:
+    for path in paths.values():
+        with contextlib.suppress(OSError):
+            path.unlink()
+
+
+class Downloads:
+    """The files of one loop job or authored animation, each made once (the first request makes it, the others
+    wait for it) and kept on disk while the job or animation is kept: removed when it is dropped (evicted), so
+    the disk holds at most the kept jobs' and strokes' files and memory none of them."""
+
+    def __init__(self, folder: Path):
+        self.folder = folder
+        self.paths: dict[str, Path] = {}
+        self.lock = threading.Lock()
+        weakref.finalize(self, _remove_files, self.paths)
+
+    def get(self, name: str, make) -> Path:
+        """The file ``name`` (made by ``make(path)`` the first time)."""
+        with self.lock:
+            path = self.paths.get(name)
+            if path is None or not path.exists():
+                self.folder.mkdir(parents=True, exist_ok=True)
+                target = Path(tempfile.mkdtemp(prefix="dl-", dir=self.folder)) / name
+                path = self.paths[name] = make(target)
+            return path
+
+
+#: bytes an answer sends at a time: a slow reader holds this much of the server's memory, not the whole file
+CHUNK = 256 << 10
+
+
+def _bytes_answer(data: bytes, media: str = BINARY, headers: dict | None = None) -> Response:
+    """``data`` sent a :data:`CHUNK` at a time (uvicorn waits for each to drain): many slow clients of one
+    large payload share the one copy instead of each buffering it."""
+    if len(data) <= CHUNK:
+        return Response(data, media_type=media, headers=headers)
+    view = memoryview(data)
+
+    async def pieces():
+        for at in range(0, len(view), CHUNK):
+            yield bytes(view[at:at + CHUNK])
+
+    return StreamingResponse(pieces(), media_type=media, headers={"Content-Length": str(len(data)),
+                                                                  **(headers or {})})
+
+
+def _file_answer(path: Path, name: str, headers: dict | None = None) -> Response:
+    """The file ``path`` as the download ``name``, read and sent a :data:`CHUNK` at a time (opened now: a file
+    removed meanwhile is still sent whole)."""
+    fh = open(path, "rb")  # noqa: SIM115 - closed by the stream
+    size = os.fstat(fh.fileno()).st_size
+
+    async def pieces():
+        try:
+            while chunk := await run_in_threadpool(fh.read, CHUNK):
+                yield chunk
+        finally:
+            fh.close()
+
     media = DOWNLOADS.get(Path(name).suffix, BINARY)
-    return Response(data, media_type=media, headers={"Content-Disposition": f'attachment; filename="{name}"',
-                                                     **(headers or {})})
+    return StreamingResponse(pieces(), media_type=media, headers={
+        "Content-Length": str(size), "Content-Disposition": f'attachment; filename="{name}"', **(headers or {})})
+
+
+#: seconds a request body may take to arrive (408 after)
+BODY_TIMEOUT_S = 30.0
 
 
 async def _body(request: Request) -> dict:
-    return v.parse_body(await request.body())  # the Guard cut it off past the body limit (413)
+    try:  # the Guard cut it off past the body limit (413)
+        raw = await asyncio.wait_for(request.body(), BODY_TIMEOUT_S)
+    except TimeoutError:
+        raise v.TimedOut(f"the request body did not arrive within {BODY_TIMEOUT_S:g} s") from None
+    return v.parse_body(raw)
 
 
 def _suffix(request) -> str:
@@ -357,7 +442,7 @@ async def options(request):
 async def take_motion(request):
     st = _studio(request)
     data = await run_in_threadpool(st.motion_bytes, st.take(request.path_params["id"]))
-    return Response(data, media_type=BINARY)
+    return _bytes_answer(data)
 
 
 async def loop(request):
@@ -371,7 +456,7 @@ async def plane(request):
     st = _studio(request)
     take = st.take(request.path_params["id"])
     data = await run_in_threadpool(st.plane, take, v.plane_query(request.query_params))
-    return Response(data, media_type=BINARY)
+    return _bytes_answer(data)
 
 
 async def relayout(request):
@@ -392,7 +477,7 @@ async def stroke(request):
 async def stroke_motion(request):
     s = _studio(request).stroke_of(request.path_params["stroke"])
     data = await run_in_threadpool(motion_payload, s["motion"], {"name": "authored"})
-    return Response(data, media_type=BINARY)
+    return _bytes_answer(data)
 
 
 async def stroke_file(request):
@@ -400,8 +485,9 @@ async def stroke_file(request):
     sid, suffix = request.path_params["stroke"], _suffix(request)
     s = st.stroke_of(sid)
     name = f"{_file_name(Path(st.takes[s['take']].name).stem)}_authored_{sid}"
-    data = await run_in_threadpool(motion_file, s["report"], "authored", name, suffix)
-    return _download(data, name + suffix)
+    path = await run_in_threadpool(s["files"].get, name + suffix,
+                                   lambda target: write_motion_file(s["report"], "authored", target))
+    return _file_answer(path, name + suffix)
 
 
 async def job_status(request):
@@ -431,18 +517,21 @@ async def job_motion(request):
     result = _loop_job(request)
     data = await run_in_threadpool(motion_payload, result["view"], {
         "name": "loop", "forced": result["facts"]["forced"]})
-    return Response(data, media_type=BINARY)
+    return _bytes_answer(data)
 
 
 async def job_file(request):
+    """The loop as a file, made once per job and suffix (:class:`Downloads`) and streamed from disk: forty
+    downloads of a large loop cost one file, not forty builds in memory."""
     result = _loop_job(request)
     suffix = _suffix(request)
     name = f"{_file_name(Path(result['take'].name).stem)}_loop"
-    data = await run_in_threadpool(motion_file, result["report"], "loop", name, suffix)
+    path = await run_in_threadpool(result["files"].get, name + suffix,
+                                   lambda target: write_motion_file(result["report"], "loop", target))
     failed = [c["check"] for c in result["facts"]["failed_checks"]]
     if failed:  # forced: the file's name and a header say so
-        return _download(data, f"{name}.forced{suffix}", {"X-Mocycle-Failed-Checks": ", ".join(failed)})
-    return _download(data, name + suffix)
+        return _file_answer(path, f"{name}.forced{suffix}", {"X-Mocycle-Failed-Checks": ", ".join(failed)})
+    return _file_answer(path, name + suffix)
 
 
 async def not_found(request, exc):
@@ -479,6 +568,7 @@ async def _lifespan(app):
     yield
     app.state.studio.analysis.shutdown()
     app.state.studio.interactive.shutdown()
+    shutil.rmtree(app.state.studio.files, ignore_errors=True)
 
 
 def create_app(paths=(), *, studio: Studio | None = None, amc_fps: float = tasks.AMC_FPS,

@@ -10,10 +10,10 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 import itertools
+import queue
 import threading
 import traceback
 from collections import OrderedDict
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -151,7 +151,13 @@ class Jobs:
 
     def __init__(self, workers: int = 1, *, max_pending: int | None = None, keep: int = 10_000,
                  keep_bytes: int = 1 << 62, size=None, prefix: str = "j", ids=None):
-        self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="mocycle-studio")
+        # daemon threads (not a ThreadPoolExecutor, whose threads the interpreter waits for at exit): Ctrl-C or
+        # SIGTERM ends the server at once, even during a long loop
+        self._queue: queue.SimpleQueue = queue.SimpleQueue()
+        self._threads = [threading.Thread(target=self._serve, name=f"mocycle-studio-{k}", daemon=True)
+                         for k in range(workers)]
+        for thread in self._threads:
+            thread.start()
         self._live: dict[str, Job] = {}  # queued or running
         self.finished = Held("job", keep, keep_bytes)
         self.max_pending = max_pending
@@ -171,8 +177,15 @@ class Jobs:
                 raise Busy(f"{len(self._live)} jobs, some cancelled, are waiting to be reached; try again shortly")
             job = Job(id=f"{self._prefix}{next(self._ids)}", kind=kind)
             self._live[job.id] = job
-        self._pool.submit(self._run, job, fn)
+        self._queue.put((job, fn))
         return job
+
+    def _serve(self) -> None:
+        while True:
+            item = self._queue.get()
+            if item is None:
+                return
+            self._run(*item)
 
     def _run(self, job: Job, fn) -> None:
         try:
@@ -230,7 +243,9 @@ class Jobs:
         return job
 
     def shutdown(self) -> None:
+        """Cancel what waits or runs and let the threads end (without waiting for them)."""
         with self._lock:
             for job in self._live.values():
                 job.cancel_event.set()
-        self._pool.shutdown(wait=False, cancel_futures=True)
+        for _ in self._threads:
+            self._queue.put(None)

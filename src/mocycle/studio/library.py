@@ -16,6 +16,8 @@ from ..motion import Motion
 
 #: the motion files the library lists (``.amc`` needs its ``.asf`` beside it)
 SUFFIXES = (".bvh", ".amc", ".fbx", ".glb", ".gltf")
+#: seconds a request waits for another request's (or the analysis's) read of the same take before a 503
+READ_WAIT_S = 20.0
 
 
 def display(text: str) -> str:
@@ -79,6 +81,7 @@ class Take:
     reason: str | None = None  # why there is no loop
     error: str | None = None
     _motion: Motion | None = field(default=None, repr=False)
+    _failed: str | None = field(default=None, repr=False)  # why it could not be read
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
     @property
@@ -87,15 +90,29 @@ class Take:
         return display(self.path.name)
 
     def motion(self, amc_fps: float) -> Motion:
-        """The take, read once (a refused take: an error, never read)."""
+        """The take, read once (a refused take: an error, never read); a request that waits :data:`READ_WAIT_S`
+        for another one's read of it gets a 503 (no request thread waits on one take for long); a take that
+        failed to read fails again at once, with the same message."""
         if self.status == "refused":
             raise MocycleError(f"{self.name}: {self.error}")
-        with self._lock:
+        if not self._lock.acquire(timeout=READ_WAIT_S):
+            from .validate import Unavailable
+
+            raise Unavailable(f"{self.name} is still being read; try again in a moment")
+        try:
             if self._motion is None:
+                if self._failed is not None:
+                    raise MocycleError(self._failed)
                 from .. import tasks
 
-                self._motion = tasks.info.run(self.path, tasks.info.Options(amc_fps=amc_fps)).motions["motion"]
+                try:
+                    self._motion = tasks.info.run(self.path, tasks.info.Options(amc_fps=amc_fps)).motions["motion"]
+                except MocycleError as exc:
+                    self._failed = str(exc)
+                    raise
             return self._motion
+        finally:
+            self._lock.release()
 
     def to_dict(self) -> dict:
         return {"id": self.id, "name": self.name, "path": display(str(self.path)), "status": self.status,

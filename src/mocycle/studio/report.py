@@ -85,7 +85,10 @@ def report_pieces(title: str, take, loop_report=None, reason: str | None = None)
                     parts=strip_parts(loop_report), warnings=list(loop_report.warnings),
                     failed_checks=facts["failed_checks"])
     imports = {name: _data_url(_module_text(name)) for name in MODULES}
-    payload = json.dumps(data, allow_nan=False).replace("</", "<\\/")
+    # in a <script> element "<!--" followed by "<script" swallows the rest of the page, "</script" ends it: no
+    # "<", ">" or "&" in the JSON (JSON escapes them), whatever a title or a name holds
+    payload = json.dumps(data, allow_nan=False).replace("<", "\\u003c").replace(">", "\\u003e").replace(
+        "&", "\\u0026")
     css = (STATIC / "studio.css").read_text(encoding="utf-8")
     page = f"""<!doctype html>
 <html lang="en">

@@ -4,8 +4,8 @@
 Every check here is explicit (no schema library): a body is parsed with a bounded depth, numbers must be
 JSON numbers (``true`` is not ``1``, ``1e9`` is not a keyframe), booleans JSON booleans, lists have bounded
 lengths, keyframes lie within the take.  The HTTP errors the handlers raise are here too, each with its
-status: :class:`BadRequest` 400, :class:`NotFound` 404, :class:`Gone` 410, :class:`TooLarge` 413,
-:class:`Busy` 429.
+status: :class:`BadRequest` 400, :class:`NotFound` 404, :class:`TimedOut` 408, :class:`Gone` 410,
+:class:`TooLarge` 413, :class:`Busy` 429, :class:`Unavailable` 503.
 """
 
 from __future__ import annotations
@@ -32,6 +32,10 @@ class NotFound(HTTPProblem):
     status = 404
 
 
+class TimedOut(HTTPProblem):
+    status = 408
+
+
 class Gone(HTTPProblem):
     status = 410
 
@@ -42,6 +46,10 @@ class TooLarge(HTTPProblem):
 
 class Busy(HTTPProblem):
     status = 429
+
+
+class Unavailable(HTTPProblem):
+    status = 503
 
 
 #: most keyframes a request may name; most samples a stroke may have (a 10-minute stroke at 120 Hz is 72,000)
@@ -63,6 +71,27 @@ def _no_constant(name: str):
     raise BadRequest(f"the request body holds {name}, which is not a JSON number")
 
 
+class _Written(float):
+    """A JSON number beyond float's range (``1e400``): infinite, but shown as it was written (also by the
+    tasks' option checks, which quote ``repr``)."""
+
+    text: str
+
+    def __repr__(self) -> str:
+        return self.text
+
+    __str__ = __repr__
+
+
+def _float(text: str) -> float:
+    number = float(text)
+    if math.isfinite(number):
+        return number
+    out = _Written(number)
+    out.text = text
+    return out
+
+
 def parse_body(raw: bytes) -> dict:
     """The body as a JSON object: UTF-8, not nested beyond the parser's recursion limit, no NaN or Infinity
     (each a :class:`BadRequest`)."""
@@ -71,7 +100,7 @@ def parse_body(raw: bytes) -> dict:
     except UnicodeDecodeError:
         raise BadRequest("the request body is not UTF-8 text") from None
     try:
-        body = json.loads(text, parse_constant=_no_constant)
+        body = json.loads(text, parse_constant=_no_constant, parse_float=_float)
     except RecursionError:
         raise BadRequest("the request body nests too deep") from None
     except ValueError as exc:  # JSONDecodeError, an integer of too many digits
@@ -112,6 +141,8 @@ def _show(value) -> str:
         return f"a list of {len(value)} items"
     if isinstance(value, dict):
         return "an object"
+    if isinstance(value, _Written):
+        return f"{value.text[:37]} (beyond the largest number, about 1.8e308)"
     text = json.dumps(value)
     return text if len(text) <= 40 else text[:37] + "..."
 
