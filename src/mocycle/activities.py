@@ -299,13 +299,13 @@ def _stride_figures(chain, landings, heading, path, fps):
 
 
 def gait_of(flight: float, double: float, speed: float, body: float) -> str:
-    """``"walk"`` or ``"run"``, told by the feet: a flight phase (:data:`FLIGHT_SHARE`) is a run, double support
-    (:data:`DOUBLE_SUPPORT_SHARE`) a walk; only where the feet show neither does the speed decide
-    (:data:`RUN_SPEED` body heights per second)."""
-    if flight >= FLIGHT_SHARE:
-        return "run"
-    if double >= DOUBLE_SUPPORT_SHARE:
-        return "walk"
+    """``"walk"`` or ``"run"``, told by the feet: a flight phase (:data:`FLIGHT_SHARE`) without double support is
+    a run, double support (:data:`DOUBLE_SUPPORT_SHARE`) without flight a walk; where the feet show neither or
+    both (contacts a rig's floating feet make unsure) the speed decides (:data:`RUN_SPEED` body heights per
+    second)."""
+    flies, both = flight >= FLIGHT_SHARE, double >= DOUBLE_SUPPORT_SHARE
+    if flies != both:
+        return "run" if flies else "walk"
     return "run" if speed > RUN_SPEED * body else "walk"
 
 
