@@ -503,24 +503,28 @@ _NOT_IN_A_NAME = re.compile("[{}\x00-\x1f\x7f\ud800-\udfff]")
 _IN_PLACE = {"{": "(", "}": ")"}
 
 
-def _bvh_name(name: str) -> str:
+def _bvh_name(name: str, one_word: bool = True) -> str:
     def one(match: re.Match) -> str:
         c = match.group()
         return _IN_PLACE.get(c, "\ufffd" if "\ud800" <= c <= "\udfff" else "_")
 
-    return "_".join(_NOT_IN_A_NAME.sub(one, name).split()) or "_"  # one word: white space inside to "_"
+    held = _NOT_IN_A_NAME.sub(one, name)
+    return ("_".join(held.split()) if one_word else held.strip()) or "_"  # one word: white space inside to "_"
 
 
-def bvh_skeleton(skeleton: Skeleton) -> Skeleton:
+def bvh_skeleton(skeleton: Skeleton, one_word: bool = True) -> Skeleton:
     """``skeleton`` with joint and End Site names a BVH file holds and reads back as they are: ``{``/``}`` as
-    ``(``/``)``, control characters as ``_``, lone surrogates as U+FFFD, no space at either end (one warning
-    saying which, :func:`mocycle.text.renamed`); the same skeleton when every name is fine."""
+    ``(``/``)``, control characters as ``_``, lone surrogates as U+FFFD, no space at either end, and with
+    ``one_word`` white space inside as ``_`` (most BVH readers split a line at spaces); one warning saying
+    which (:func:`mocycle.text.renamed`); the same skeleton when every name is fine."""
     from ..text import renamed
 
     sites = [s.name for s in skeleton.end_sites if s.name is not None]
-    if not any(_NOT_IN_A_NAME.search(n) or len(n.split()) != 1 or n != n.strip() for n in (*skeleton.names, *sites)):
+    if not any(_NOT_IN_A_NAME.search(n) or (one_word and len(n.split()) != 1) or n != n.strip() or not n
+               for n in (*skeleton.names, *sites)):
         return skeleton
-    names = renamed(list(skeleton.names) + sites, _bvh_name, "BVH (one word each)")
+    names = renamed(list(skeleton.names) + sites, lambda n: _bvh_name(n, one_word),
+                    "BVH (one word each)" if one_word else "BVH")
     joints, site_names = names[:skeleton.n_joints], iter(names[skeleton.n_joints:])
     end_sites = tuple(EndSite(s.parent, s.offset, next(site_names) if s.name is not None else None)
                       for s in skeleton.end_sites)
@@ -624,5 +628,8 @@ def write_bvh(motion: Motion, path: str | os.PathLike) -> Path:
 
 def skeleton_text(skeleton: Skeleton) -> str:
     """The BVH text of the skeleton's rest pose (one frame), which :func:`parse_bvh` reads back (the swings
-    files keep their skeleton so)."""
-    return format_bvh(Motion.rest(skeleton, 1))
+    files keep their skeleton so): names as BVH holds them but with their spaces (:func:`bvh_skeleton` with
+    ``one_word=False``: mocycle's reader takes a name with spaces)."""
+    skeleton = bvh_skeleton(skeleton, one_word=False)
+    names = (list(skeleton.names), [s.name for s in skeleton.end_sites])
+    return "".join(bvh_chunks(Motion.rest(skeleton, 1), names))

@@ -26,7 +26,8 @@ from .bvh import bvh_skeleton, parse_bvh, skeleton_text
 
 def swings_document(seg: Segmentation) -> dict:
     """The swings JSON document of ``seg`` (JSON-ready values; :func:`segmentation_from_dict` reads it back)."""
-    skeleton = bvh_skeleton(seg.skeleton)  # names BVH cannot hold changed (one warning), here and in "joints"
+    # names BVH cannot hold changed (one warning), here and in "joints"; spaces kept (mocycle reads this text)
+    skeleton = bvh_skeleton(seg.skeleton, one_word=False)
     return {**seg.to_dict(), "joints": [skeleton.names[j] for j in seg.joints],
             "skeleton_bvh": skeleton_text(skeleton)}
 
