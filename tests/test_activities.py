@@ -153,7 +153,7 @@ def test_a_loop_off_the_strides_or_the_takes_turn_is_refused():
 
     from mocycle.activities import line_periodic
     from mocycle.cycle import extract_cycle
-    from mocycle.cycle.parts import part_checks, part_phase
+    from mocycle.cycle.parts import part_checks, part_phase, part_piece
 
     take = synthetic_walk_turn_walk(turn_deg=90.0, seed=6)
     motion = take.motion
@@ -163,7 +163,7 @@ def test_a_loop_off_the_strides_or_the_takes_turn_is_refused():
     wrong = 1.3 * right.period_frames
     pm = line_periodic(np.arange(piece.n_frames) / wrong, wrong, motion.frame_time, "test", "legs", "a wrong period")
     cycle = extract_cycle(piece, phase=part_phase(replace(right, periodic=pm, period_frames=wrong)))
-    failed = {f.name for f in part_checks(motion, acts, right, cycle)}
+    failed = {f.name for f in part_checks(part_piece(motion, acts, k), cycle)}
     assert "stride" in failed
     good = extract_cycle(piece, phase=part_phase(right))
-    assert part_checks(motion, acts, right, good) == []
+    assert part_checks(part_piece(motion, acts, k), good) == []

@@ -117,6 +117,8 @@ class Activity:
     legs_still: bool = True
     #: the phase of the part's frames (frame ``start`` first), a PeriodicMotion, once known
     periodic: object = field(default=None, repr=False)
+    #: the whole take is one cycle (a game clip): its frames are the loop (:func:`one_cycle`)
+    one_cycle: bool = False
 
     @property
     def n_frames(self) -> int:
@@ -473,6 +475,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     if landings is None:
         parts = _other(motion, 0, T, min_periods, False, options)
         _decide(parts, min_periods)
+        parts = _or_one_cycle(motion, parts, None)
         return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=False,
                           reason="the rig's feet were not found by name: the take is looked at without gait; "
                                  + _listing(parts), landings=None)
@@ -521,8 +524,83 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
                 _asked_phase(motion, p, min_periods, options)
     _decide(parts, min_periods)
     parts = _second_look(motion, parts, min_periods, options)
+    parts = _or_one_cycle(motion, parts, landings)
     return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True, reason=_listing(parts),
                       landings=landings)
+
+
+#: A take is one cycle when its wrap (last frame to first, or, when the last frame repeats the first, the one
+#: before it) changes the joints' velocity by no more than WRAP_JUMP times its median step, and it moves
+#: through the wrap: its speed at its ends at least MOVING_WRAP of its 90th-percentile speed (a gesture that
+#: starts and ends at rest does not).
+WRAP_JUMP, MOVING_WRAP = 1.5, 0.4
+#: A last frame closer to the first than this share of the median step repeats it (a closing frame).
+CLOSING_FRAME = 0.25
+
+
+def one_cycle(motion: Motion) -> int | None:
+    """The period (frames) of a take that is one cycle of its own motion (a game clip: a walk or run of one
+    stride, often with a closing frame that repeats the first), or ``None``: the take is no such clip
+    (:data:`WRAP_JUMP`, :data:`MOVING_WRAP`; the joints' rotations decide, not the root's travel).  Of the
+    two readings, an open cycle of all the frames or a cycle closed by its last frame, the one whose wrap
+    changes the velocity less."""
+    T = motion.n_frames
+    if T < 8:
+        return None
+    X, _ = pose_matrix(motion, rep="expmap", root="drop", joints=None, normalize=False, weights=None)
+    if not float(np.degrees(np.sqrt(X.var(axis=0).sum()))) >= STILL_DEG:
+        return None  # nothing moves
+    steps = np.linalg.norm(np.diff(X, axis=0), axis=1)
+    typical = float(np.median(steps))
+    if not typical > 0:
+        return None
+    ends = 0.25 * float(steps[:2].sum() + steps[-2:].sum())
+    if ends < MOVING_WRAP * float(np.percentile(steps, 90)):
+        return None  # it rests where it starts and ends: a gesture, not a cycle
+
+    def jump(last: int) -> float:  # frames 0 .. last as the cycle: the velocity change across its wrap
+        into, out = X[0] - X[last], X[1] - X[0]
+        return float(np.linalg.norm(into - (X[last] - X[last - 1])) + np.linalg.norm(out - into))
+
+    if float(np.linalg.norm(X[-1] - X[0])) <= CLOSING_FRAME * typical:  # the last frame repeats the first
+        return T - 1 if jump(T - 2) <= 2 * WRAP_JUMP * typical else None
+    best, period = min((jump(T - 1), T), (jump(T - 2), T - 1))
+    return period if best <= 2 * WRAP_JUMP * typical else None
+
+
+def _or_one_cycle(motion: Motion, parts: list[Activity], landings: Landings | None) -> list[Activity]:
+    """``parts``, or, when none of them loops and the whole take is one cycle (:func:`one_cycle`), the take as
+    one part that is looped as it is: its kind from its feet (a walk or run of one stride) or its limbs."""
+    if any(p.loop for p in parts):
+        return parts
+    period = one_cycle(motion)
+    if period is None:
+        return parts
+    T = motion.n_frames
+    kind, limbs = "periodic", "all"
+    own: dict[str, list[int]] = {}
+    if landings is not None and landings.frames.size:
+        for f, k in zip(landings.frames.tolist(), landings.foot.tolist(), strict=True):
+            own.setdefault(landings.sides[k], []).append(int(f))
+        if len(own) >= 2:  # both feet land in it: a stride of a gait
+            down = landings.down
+            path = _horizontal_path(motion)
+            speed = float(np.linalg.norm(path[-1] - path[0])) * motion.fps / max(T - 1, 1)
+            turn = float(heading_degrees(motion)[-1] - heading_degrees(motion)[0])
+            gait = gait_of(float(np.mean(down == 0)), float(np.mean(down >= 2)), speed, _body_height(motion))
+            way = "straight" if abs(turn) <= TURN_DEG else ("turning left" if turn > 0 else "turning right")
+            kind, limbs = f"{gait} {way}", "legs"
+    if kind == "periodic" and _legs_still(motion.skeleton, _rotation_spread(motion)):
+        kind = "arms"
+    closing = period == T - 1
+    why = (f"the take is one cycle of {period} frames: its last frame repeats its first (a closing frame), looped "
+           f"as it is" if closing else f"the take is one cycle of {period} frames: its last pose leads back to "
+           f"its first, looped as it is")
+    x = np.arange(T, dtype=np.float64) / period
+    part = Activity(start=0, stop=T, kind=kind, limbs=limbs, period_frames=float(period), loop=True, reason=why,
+                    landings=own, one_cycle=True,
+                    periodic=line_periodic(x, period, motion.frame_time, "one cycle", limbs, why))
+    return [part]
 
 
 def _second_look(motion: Motion, parts: list[Activity], min_periods: float, options: dict) -> list[Activity]:

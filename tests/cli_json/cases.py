@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-TIMING_KEYS = ("seconds", "metrics_seconds")
+TIMING_KEYS = ("seconds", "metrics_seconds", "timings_s")
 
 #: name -> the command line (``{tmp}`` is the folder of the takes, ``{out}`` a scratch folder).
 CASES: dict[str, list[str]] = {

@@ -189,3 +189,39 @@ def test_a_session_at_120_fps_is_cut_as_at_30(tmp_path):
     assert [k for k, *_ in slow] == [k for k, *_ in fast]
     for (_, a, b), (_, c, d) in zip(slow, fast, strict=True):
         assert abs(a - c) <= 4 and abs(b - d) <= 4
+
+
+@pytest.mark.parametrize("closing", [True, False])
+def test_a_clip_of_one_cycle_loops_at_its_own_length(tmp_path, closing):
+    """A game clip is one cycle, often with a closing frame: looped as it is, exit 0, at its own length."""
+    n = 60
+    clip = synthetic_walk(n_frames=n + closing, fps=60.0, period_s=1.0, noise_deg=0.0, seed=3).motion
+    src = write(clip, tmp_path / "clip.bvh")
+    result = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "out.bvh"), "--root", "motion", "--json"])
+    assert result.exit_code == 0, result.output
+    facts = json.loads(result.stdout)
+    assert facts["cycle_frames"] == n and facts["method"] == "clip" and "one cycle" in facts["reason"]
+    looped = read(tmp_path / "out.bvh")
+    np.testing.assert_allclose(looped.rotations[:n], clip.rotations[:n], atol=1e-6)  # the clip as it is
+    assert "only 1.00 periods" not in result.stderr
+
+
+def test_one_cycle_clips_blend_transition_and_stretch(tmp_path):
+    walk = write(synthetic_walk(n_frames=61, fps=60.0, period_s=1.0, noise_deg=0.3, seed=1).motion,
+                 tmp_path / "walk.bvh")
+    run = write(synthetic_run(n_frames=42, fps=60.0, period_s=0.7, noise_deg=0.3, seed=2).motion,
+                tmp_path / "run.bvh")
+    blend = runner.invoke(app, ["blend", str(walk), str(run), "-o", str(tmp_path / "b.bvh"), "--json"])
+    assert blend.exit_code == 0, blend.output
+    assert json.loads(blend.stdout)["input_periods_frames"] == [60.0, 42.0]
+    tr = runner.invoke(app, ["transition", str(walk), str(run), "-o", str(tmp_path / "t.bvh")])
+    assert tr.exit_code == 0, tr.output
+    st = runner.invoke(app, ["stretch", str(walk), "--factor", "2.5", "-o", str(tmp_path / "s.bvh"), "--json"])
+    assert st.exit_code == 0 and read(tmp_path / "s.bvh").n_frames == round(61 * 2.5), st.output
+
+
+def test_a_gesture_that_ends_where_it_began_is_no_cycle():
+    from mocycle.activities import one_cycle
+
+    assert one_cycle(synthetic_gesture(n_frames=120, fps=60.0, seed=1).motion) is None
+    assert one_cycle(synthetic_walk(n_frames=90, fps=60.0, noise_deg=0.0).motion) is None  # 1.5 cycles

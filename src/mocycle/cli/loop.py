@@ -34,8 +34,9 @@ def loop(
     """
     check_output(plot, [path], force, ".png", "--plot")
     check_output(feet_plot, [path], force, ".png", "--feet-plot")
-    try:
-        report = tasks.loop.run(path, options)
+    plots = plot is not None or feet_plot is not None
+    try:  # without plots each loop is written as soon as it is made, and let go (a long session's hundreds)
+        report = tasks.loop.run(path, options, deliver=None if plots else write)
     except (NoPeriodicMotion, LoopRefused) as exc:
         if as_json and getattr(exc, "facts", None) is not None:  # the same shape, status and reason: exit 3
             print_json({"file": str(path), **exc.facts})
@@ -47,14 +48,18 @@ def loop(
         # refused before any file is written
         raise MocycleError("--feet-plot needs locked feet (--feet lock, or auto with --root motion)")
     print_warnings(report)
-    cycles_made = report.result if everything else [report.result]
-    files = write(report)  # every cycle was made and checked before writing; one file per loop (OUT.part<k>-...)
+    if plots:  # every cycle was made and checked before writing; one file per loop (OUT.part<k>-...)
+        files = {role: (str(target), written.n_frames, report.motions[role].n_frames != written.n_frames)
+                 for role, (target, written) in write(report).items()}
+        cycles_made = report.result if everything else [report.result]
+    else:
+        files = {role: w for r in roles for role, w in report.extras[r]["written"].items()}
+        cycles_made = [None] * len(loops)
     shown = []
     for facts, cycle in zip(loops, cycles_made, strict=True):
         role = facts["role"]
         tag = tasks.loop.output_tag(facts)
-        target, written = files[role]
-        closing = report.motions[role].n_frames != written.n_frames
+        target, frames_out, closing = files[role]
         images = []
         if feet_plot is not None:
             images.append(feet_plot.with_suffix(f".{tag}.png") if tag else feet_plot)
@@ -67,12 +72,12 @@ def loop(
             plot_loop(report.motions["input"], cycle, images[-1],
                       title=f"{path.name}: {options.method}"
                       + (f" {options.model}" if options.method == "harmonic" else ""))
-        facts.update(output=str(target), frames_out=written.n_frames, closing_frame=closing)
+        facts.update(output=target, frames_out=frames_out, closing_frame=closing)
         shown.append(({"file": str(path), **facts, "seconds": report.seconds,
                        "metrics_seconds": report.timings_s["metrics"]}, images))
     if as_json:
         top = {k: v for k, v in report.facts.items() if k not in shown[0][0]}
-        print_json({**shown[0][0], **top, "loops": [f for f, _ in shown]})
+        print_json({**shown[0][0], **top, "loops": [f for f, _ in shown], "timings_s": report.timings_s})
         return
     _print_parts(path, report.facts)
     for facts, images in shown:

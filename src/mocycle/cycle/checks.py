@@ -197,11 +197,13 @@ def loop_checks(motion: Motion, cycle: Cycle, metrics: dict | None = None) -> li
 
 
 def check_loop(motion: Motion, cycle: Cycle, metrics: dict | None = None, force: bool = False,
-               label: str | None = None, extra: list[FailedCheck] | None = None) -> list[FailedCheck]:
+               label: str | None = None, extra: list[FailedCheck] | None = None,
+               skip: tuple[str, ...] = ()) -> list[FailedCheck]:
     """Raise :class:`~mocycle.errors.LoopRefused` when ``cycle`` fails a check of :func:`loop_checks` (or is
     one of ``extra``, checks the caller made); with ``force`` warn instead (naming each failed check) and
-    return the failures.  ``label`` names the take."""
-    failed = loop_checks(motion, cycle, metrics) + list(extra or [])
+    return the failures.  ``label`` names the take; ``skip``: checks that do not apply (a one-cycle clip looped
+    as it is has its author's own seam and no second cycle to cut)."""
+    failed = [f for f in loop_checks(motion, cycle, metrics) if f.name not in skip] + list(extra or [])
     if not failed:
         return failed
     where = f"{label}: " if label else ""

@@ -61,3 +61,19 @@ def cut_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, p
     positions = np.mod(x - axis.x[a], 1.0) * lag
     return Cycle(space=space, P=Pc, L=Lc, drift=drift, method="cut", model=None, n_harmonics=None, axis=axis,
                  positions=positions, periodic=periodic)
+
+
+def clip_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, periodic: PeriodicMotion) -> Cycle:
+    """A take that is one cycle (a game clip) as its own loop: its first ``N`` frames (``N`` the period, the
+    clip's length or one less when its last frame repeats the first) as they are, no fit and no cross-fade;
+    the drift per cycle from the closing frame when there is one, else the frames' travel carried on by one
+    more step (the mean of the clip's first and last steps)."""
+    N = int(round(axis.period_frames))
+    if not 2 <= N <= P.shape[0]:
+        raise MocycleError(f"a clip of {P.shape[0]} frames cannot hold one cycle of {N} frames")
+    # the step across the wrap: to the closing frame, else the mean of the clip's first and last steps
+    drift = L[N] - L[0] if P.shape[0] > N else L[N - 1] - L[0] + 0.5 * ((L[1] - L[0]) + (L[N - 1] - L[N - 2]))
+    x = axis.x[axis.frames()]
+    positions = np.mod(x - axis.x[0], 1.0) * N
+    return Cycle(space=space, P=P[:N].copy(), L=L[:N].copy(), drift=drift, method="clip", model=None,
+                 n_harmonics=None, axis=axis, positions=positions, periodic=periodic)

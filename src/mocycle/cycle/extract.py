@@ -15,7 +15,7 @@ from ..motion import Motion
 from ..phase.analysis import MIN_PERIODS, PeriodicMotion, PhaseResult, find_phase_every
 from ..threads import limit_threads
 from .centroid import centroid_cycle
-from .cut import cut_cycle
+from .cut import clip_cycle, cut_cycle
 from .harmonic import MODELS
 from .harmonic_fit import harmonic_cycle
 from .metric_rows import loop_blocks, metric_features
@@ -91,7 +91,7 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", h
     t0 = time.perf_counter()
     if not isinstance(motion, Motion):
         raise MocycleError(f"extract_cycle needs a Motion; got {type(motion).__name__}")
-    _check_choice(method, METHODS, "method")
+    _check_choice(method, (*METHODS, "clip"), "method")  # "clip": a one-cycle take as it is (cycle.parts)
     _check_choice(time_axis, TIME_AXES, "time_axis")
     if method == "harmonic":
         _check_choice(model, MODELS, "model")
@@ -116,6 +116,8 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", h
     elif method == "centroid":
         cycle = centroid_cycle(space, P, Q, axis, periodic)
         cycle = cycle.rolled(calmest_start(*loop_blocks(cycle)))
+    elif method == "clip":
+        cycle = clip_cycle(space, P, Q, axis, periodic)
     else:
         cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion))
     path, drift = space.bend(cycle.L, cycle.drift, space.heading_trend(L[:, 3], axis.period_frames)[0])

@@ -12,13 +12,22 @@ memory in proportion to its own frames.
 from __future__ import annotations
 
 import contextlib
+import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..activities import Activities, Activity, heading_degrees, nothing_to_loop, segment_activities, stride_reference
-from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
+from ..activities import (
+    Activities,
+    Activity,
+    Landings,
+    heading_degrees,
+    nothing_to_loop,
+    segment_activities,
+    stride_reference,
+)
+from ..errors import LoopRefused, MocycleError, MocycleWarning, NoPeriodicMotion, OptionError
 from ..motion import Motion
 from ..phase.analysis import PhaseResult
 from .checks import FailedCheck, check_loop
@@ -34,21 +43,52 @@ TURN_SLACK_DEG, TURN_SLACK_SHARE = 10.0, 0.25
 
 
 @dataclass(kw_only=True)
-class PartLoop:
-    """One part's loop: ``index`` in the take's parts, the ``part``, the ``cycle`` fitted on its frames (frame 0
-    of the cycle's time axis is the part's first frame), the loop ``metrics`` against those frames and the checks
-    it ``failed`` (kept only when forced)."""
+class PartPiece:
+    """What looping one part needs, in the part's own frames (frame 0 is the part's first): its ``motion``
+    (a view of the take's frames, or a copy once sent to another process), the take's hips ``heading``
+    ``(n,)`` in degrees over them (the heading frame fitted once on the take), the take's foot ``landings``
+    near them (a stride or two either side, as the stride ruler reads them), the ``part`` itself and its
+    ``index`` among the take's parts, ``offset`` its first frame in the take and ``alone`` whether the take is
+    this one part.  Its size is the part's: a process that loops it needs nothing else of the take."""
 
     index: int
     part: Activity
+    motion: Motion
+    heading: np.ndarray
+    landings: Landings | None
+    offset: int
+    alone: bool
+
+
+def part_piece(motion: Motion, acts: Activities, index: int) -> PartPiece:
+    """The :class:`PartPiece` of part ``index`` of ``acts`` (the parts of ``motion``)."""
+    part = acts.parts[index]
+    a, b = part.start, part.stop
+    landings = None
+    if acts.landings is not None:
+        L = acts.landings
+        P = part.period_frames if np.isfinite(part.period_frames) else b - a
+        lo, hi = max(0, int(a - 2 * P)), min(motion.n_frames, int(np.ceil(b + 2 * P)) + 1)
+        keep = (L.frames >= lo) & (L.frames < hi)
+        landings = Landings(L.frames[keep] - a, L.foot[keep], L.sides, L.down[a:b])
+    rebased = replace(part, start=0, stop=b - a, landings={k: [f - a for f in v] for k, v in part.landings.items()})
+    return PartPiece(index=index, part=rebased, motion=motion[a:b], heading=heading_degrees(motion)[a:b],
+                     landings=landings, offset=a, alone=len(acts.parts) == 1)
+
+
+@dataclass(kw_only=True)
+class PartLoop:
+    """One part's loop: ``index`` in the take's parts, the ``part`` (in its own frames, ``offset`` its first
+    frame in the take), the ``cycle`` fitted on its frames (frame 0 of the cycle's time axis is the part's
+    first frame), the loop ``metrics`` against those frames and the checks it ``failed`` (kept only when
+    forced)."""
+
+    index: int
+    part: Activity
+    offset: int
     cycle: Cycle
     metrics: dict
     failed: list[FailedCheck]
-
-    @property
-    def offset(self) -> int:
-        """The part's first frame in the take."""
-        return self.part.start
 
 
 def part_phase(part: Activity) -> PhaseResult:
@@ -62,17 +102,18 @@ def part_phase(part: Activity) -> PhaseResult:
                        frame_time=pm.frame_time, joints_used=pm.joints_used)
 
 
-def part_checks(motion: Motion, acts: Activities, part: Activity, cycle: Cycle) -> list[FailedCheck]:
+def part_checks(piece: PartPiece, cycle: Cycle) -> list[FailedCheck]:
     """The checks a part's loop must pass beside :func:`~mocycle.cycle.checks.loop_checks`, on the take's own
-    evidence over the frames the loop was fitted on (``motion``: the whole take; ``cycle`` fitted on the part's
-    frames): a gait part's cycle agrees with the stride period of the landings there (within
-    :data:`STRIDE_AGREEMENT`; the landings found once, ``acts.landings``), and every loop turns as the hips do
-    there (within max(:data:`TURN_SLACK_DEG`, :data:`TURN_SLACK_SHARE` × the take's turn))."""
+    evidence over the frames the loop was fitted on (``cycle`` fitted on the piece's frames): a gait part's
+    cycle agrees with the stride period there (within :data:`STRIDE_AGREEMENT` of the landings' median stride
+    or of the legs' own period, :func:`~mocycle.activities.stride_reference`; the landings found once on the
+    take), and every loop turns as the hips do there (within max(:data:`TURN_SLACK_DEG`,
+    :data:`TURN_SLACK_SHARE` × the take's turn))."""
     failed = []
-    s, e = part.start + cycle.axis.regions[0][0], part.start + cycle.axis.regions[-1][1]
+    s, e = cycle.axis.regions[0][0], cycle.axis.regions[-1][1]
     P = cycle.period_frames
-    if acts.landings is not None and part.gait:
-        rulers, _ = stride_reference(motion, acts.landings, s, e)
+    if piece.landings is not None and piece.part.gait:
+        rulers, _ = stride_reference(piece.motion, piece.landings, s, e)
         if rulers:  # the cycle must agree with one: the landings' median stride, or the legs' own period
             stride = min(rulers, key=lambda r: abs(P / r - 1.0))
             off = P / stride - 1.0
@@ -83,7 +124,7 @@ def part_checks(motion: Motion, acts: Activities, part: Activity, cycle: Cycle) 
                     f"{stride:.1f} frames here, the legs repeating)"))
     # the hips' heading over the frames looped, read two ways a ruler might: a line through it, and its change
     # between the ends (a tenth of a period each) over the periods between; the loop must agree with one
-    heading = heading_degrees(motion)[s:e]
+    heading = piece.heading[s:e]
     t = np.arange(heading.size, dtype=np.float64)
     h = min(max(1, int(round(0.1 * P))), max(1, heading.size // 4))
     line = float(np.polyfit(t, heading, 1)[0]) * P if heading.size > 2 else 0.0
@@ -99,31 +140,41 @@ def part_checks(motion: Motion, acts: Activities, part: Activity, cycle: Cycle) 
     return failed
 
 
-def loop_part(motion: Motion, acts: Activities, index: int, *, method: str = "harmonic", model: str = "M1",
-              harmonics: int | str = "auto", time_axis: str = "smooth", force: bool = False, label: str = "",
-              timer: Callable[[str], contextlib.AbstractContextManager] | None = None) -> PartLoop:
-    """The loop of part ``index`` of ``acts`` (the parts of ``motion``): its cycle fitted on the part's frames
-    with the part's phase, its metrics, and its checks (:func:`~mocycle.cycle.checks.check_loop` with
-    :func:`part_checks`).  ``label`` names the take in messages; ``timer(name)``: a context that times the
-    ``"cycle"`` and ``"metrics"`` stages.
+def loop_piece(piece: PartPiece, *, method: str = "harmonic", model: str = "M1", harmonics: int | str = "auto",
+               time_axis: str = "smooth", force: bool = False, label: str = "",
+               timer: Callable[[str], contextlib.AbstractContextManager] | None = None) -> PartLoop:
+    """The loop of one part (:class:`PartPiece`): its cycle fitted on the part's frames with the part's phase,
+    its metrics, and its checks (:func:`~mocycle.cycle.checks.check_loop` with :func:`part_checks`).  ``label``
+    names the take in messages; ``timer(name)``: a context that times the ``"cycle"`` and ``"metrics"`` stages.
+
+    A take that is one cycle (``part.one_cycle``: a game clip) is its own loop: its frames as they are (method
+    ``clip``, :func:`~mocycle.cycle.cut.clip_cycle`), whatever ``method`` says.
 
     Raises :class:`NoPeriodicMotion` when the part does not loop (its reason), :class:`LoopRefused` when its
     cycle fails a check (``force``: a warning instead, the failures in ``failed``), :class:`MocycleError` when
     the fit cannot be made on the part's frames."""
     timer = timer or (lambda name: contextlib.nullcontext())
-    part = acts.parts[index]
+    part = piece.part
     phase = part_phase(part)
-    piece = motion[part.start:part.stop]  # a view: the part's frames only
-    with timer("cycle"):
-        cycle = extract_cycle(piece, method=method, model=model, harmonics=harmonics, time_axis=time_axis,
+    with timer("cycle"), warnings.catch_warnings():
+        if part.one_cycle:  # a clip that is one cycle is its own loop: its frames as they are, not a fit of them
+            method = "clip"
+            warnings.filterwarnings("ignore", "only .* periods found", MocycleWarning)
+        cycle = extract_cycle(piece.motion, method=method, model=model, harmonics=harmonics, time_axis=time_axis,
                               phase=phase)
     with timer("metrics"):
-        metrics = loop_metrics(piece, cycle, cycle.repeat(2, root="motion"))
-        where = label if len(acts.parts) == 1 else \
-            f"{label + ' ' if label else ''}part {index} ({part.kind}, frames {part.start}-{part.stop})"
-        failed = check_loop(piece, cycle, metrics, force=force, label=where,
-                            extra=part_checks(motion, acts, part, cycle))
-    return PartLoop(index=index, part=part, cycle=cycle, metrics=metrics, failed=failed)
+        metrics = loop_metrics(piece.motion, cycle, cycle.repeat(2, root="motion"))
+        a, b = piece.offset, piece.offset + part.n_frames
+        where = label if piece.alone else \
+            f"{label + ' ' if label else ''}part {piece.index} ({part.kind}, frames {a}-{b})"
+        failed = check_loop(piece.motion, cycle, metrics, force=force, label=where,
+                            extra=part_checks(piece, cycle), skip=("seam", "fit") if part.one_cycle else ())
+    return PartLoop(index=piece.index, part=part, offset=piece.offset, cycle=cycle, metrics=metrics, failed=failed)
+
+
+def loop_part(motion: Motion, acts: Activities, index: int, **options) -> PartLoop:
+    """:func:`loop_piece` of part ``index`` of ``acts`` (the parts of ``motion``); ``options``: its."""
+    return loop_piece(part_piece(motion, acts, index), **options)
 
 
 def parts_to_try(acts: Activities, which: int | str | None) -> list[int]:

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..defaults import TIME_AXES
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from . import fields
-from .options import Choice, Flag, Integer, option
+from .options import Choice, Flag, Integer, Text, option
 from .report import Recorder, Report, label_of, load
 
 #: the loop metrics (``facts["metrics"]``): key -> (label, unit)
@@ -81,26 +81,40 @@ class Options(fields.CycleOptions):
     cycles: int = fields.cycles(1, "Repeat the cycle this many times in the output.")
     time_axis: str = option("smooth", "Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) "
                                       "or line.", Choice(TIME_AXES), flag="--time")
+    workers: int | None = option(None, "Processes that loop the parts side by side with --part all (default: the "
+                                       "cores this process may use; 1: one after another). The output is the same.",
+                                 Integer(1, optional=True))
+    scheduler: str | None = option(None, "Loop the parts on a dask cluster: its scheduler's address "
+                                         "(tcp://HOST:PORT) instead of local processes.", Text())
 
 
 
-def run(take, options: Options | None = None) -> Report:
+def run(take, options: Options | None = None, *, deliver=None) -> Report:
     """Cut the take into steady parts (:func:`~mocycle.activities.segment_activities`) and loop them, each on
-    its own frames (:func:`~mocycle.cycle.parts.loop_part`): a take that does one thing is one part, and no loop
-    ever spans a part border.
+    its own frames (:func:`~mocycle.cycle.parts.loop_piece`): a take that does one thing is one part, and no loop
+    ever spans a part border.  With ``which="all"`` the parts are looped side by side on ``workers`` processes
+    (or a dask cluster at ``scheduler``), each given only its own frames; the result is the same as one after
+    another.
 
     ``motions["loop"]`` is the chosen part's cycle repeated ``cycles`` times with the chosen root; with
     ``which="all"`` every part that loops gets ``motions["loop.part<k>"]`` (``k``: the part's index in
-    ``facts["parts"]``).  ``facts``: ``status``, ``reason`` (plain words), ``loops`` (each loop's figures:
-    ``part``, ``kind``, ``frames``, period, speed, turn per cycle, metrics, checks, feet), ``not_looped`` (every
-    part that was not, each with its reason: too short, refused by a check, a fit that could not be made),
-    ``parts`` (every part of the take) and, at the top level, the figures of the first loop.
+    ``facts["parts"]``).  ``deliver``: a function that writes one loop, given a report of that loop alone
+    (what a front end's writer takes), called as each loop is made (in the process that made it); its loops are
+    then not kept in the report (their arrays are released once written) and ``extras[role]["written"]`` holds
+    what it returned (``{role: (path, written motion's frames, closing frame)}``).  ``facts``: ``status``,
+    ``reason`` (plain words), ``loops`` (each loop's figures: ``part``, ``kind``, ``frames``, period, speed, turn
+    per cycle, metrics, checks, feet), ``not_looped`` (every part that was not, each with its reason: too short,
+    refused by a check, a fit that could not be made), ``parts`` (every part of the take) and, at the top
+    level, the figures of the first loop.
     Raises :class:`~mocycle.errors.NoPeriodicMotion` when no part of the take loops and
     :class:`~mocycle.errors.LoopRefused` when every part tried fails a loop check (``force``: a warning
     instead); both carry ``facts`` with the same shape (``status`` ``no-periodic-motion`` or ``refused``).
     """
+    import warnings
+
     from ..activities import nothing_to_loop, segment_activities
-    from ..cycle.parts import parts_to_try
+    from ..cycle.parts import part_piece, parts_to_try
+    from ..errors import MocycleWarning
 
     o = options or Options()
     everything = o.which == "all"
@@ -119,26 +133,30 @@ def run(take, options: Options | None = None) -> Report:
         parts = acts.parts
         loops, not_looped, motions, cycles, extras, refusals = [], [], {}, [], {}, []
         tried = parts_to_try(acts, o.which)
-        for k in tried:
-            try:
-                facts, result, extra, cycle = _loop_one(motion, acts, k, o, label, rec)
-            except LoopRefused as exc:
+        jobs = (_Job(part_piece(motion, acts, k), o, label, f"loop.part{k}" if everything else "loop", start,
+                     deliver) for k in tried)
+        for out in _outcomes(jobs, o, acts, tried):
+            for text in out.warnings:  # in part order, whichever process made them
+                warnings.warn(text, MocycleWarning, stacklevel=2)
+            for name, seconds in out.timings.items():
+                rec.timings_s[name] = rec.timings_s.get(name, 0.0) + seconds
+            k = out.index
+            if out.refused is not None:
+                exc = LoopRefused(out.refused, out.failed)
                 refusals.append(exc)
                 not_looped.append(_not_looped(k, parts[k], start, f"refused: {exc}", exc))
                 continue
-            except OptionError:
-                raise
-            except MocycleError as exc:  # NoPeriodicMotion too: this part alone does not loop
-                not_looped.append(_not_looped(k, parts[k], start, str(exc), exc))
+            if out.error is not None:  # NoPeriodicMotion too: this part alone does not loop
+                not_looped.append(_not_looped(k, parts[k], start, out.error))
                 continue
-            role = f"loop.part{k}" if everything else "loop"
-            facts["role"] = role
-            facts["frames"] = [f + start for f in facts["frames"]]
-            facts["excitation"] = [[a + start, b + start] for a, b in facts["excitation"]]
-            loops.append(facts)
-            motions[role] = result
-            extras[role] = extra
-            cycles.append(cycle)
+            loops.append(out.facts)
+            role = out.facts["role"]
+            if out.written is not None:
+                extras[role] = {"written": out.written}
+            else:
+                motions[role] = out.result
+                extras[role] = out.extra
+                cycles.append(out.cycle)
             if not everything:
                 break
         done = {d["part"] for d in not_looped} | {f["part"] for f in loops}
@@ -163,7 +181,125 @@ def run(take, options: Options | None = None) -> Report:
             raise exc
     motions["input"] = motion
     facts = _facts("ok", _chosen_reason(loops, parts, everything), loops, not_looped, acts, start)
-    return rec.report("loop", facts, motions, cycles if everything else cycles[0], extras)
+    return rec.report("loop", facts, motions, cycles if everything else (cycles[0] if cycles else None), extras)
+
+
+#: Below this many frames to loop, the parts are looped one after another (starting processes costs more).
+PARALLEL_FRAMES = 20_000
+
+
+@dataclass(frozen=True)
+class _Job:
+    """One part to loop, with all it needs: sent as it is to another process or a dask worker."""
+
+    piece: object   # mocycle.cycle.parts.PartPiece
+    options: Options
+    label: str
+    role: str
+    first: int      # the range's first frame in the file (frames in the facts are the file's)
+    deliver: object = None
+
+
+@dataclass
+class _Outcome:
+    """What became of one part: its facts and loop (or, delivered, what was written), or why it did not loop;
+    the warnings and stage times it made."""
+
+    index: int
+    facts: dict | None = None
+    result: object = None
+    cycle: object = None
+    extra: dict | None = None
+    written: dict | None = None
+    refused: str | None = None
+    failed: list = field(default_factory=list)
+    error: str | None = None
+    warnings: list = field(default_factory=list)
+    timings: dict = field(default_factory=dict)
+
+
+def _outcome(job: _Job) -> _Outcome:
+    """Loop one part (in whichever process runs it): its outcome, never an exception but a usage error."""
+    import warnings
+
+    from .report import _Part
+
+    piece = job.piece
+    out = _Outcome(index=piece.index)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            facts, result, extra, cycle = _loop_one(piece, job.options, job.label, lambda n: _Part(out.timings, n))
+        except LoopRefused as exc:
+            out.refused, out.failed = str(exc.args[0] if exc.args else exc), list(exc.failed)
+        except OptionError:
+            raise
+        except MocycleError as exc:
+            out.error = str(exc)
+        else:
+            facts["role"] = job.role
+            facts["frames"] = [f + job.first for f in facts["frames"]]
+            facts["excitation"] = [[a + job.first, b + job.first] for a, b in facts["excitation"]]
+            out.facts = facts
+            if job.deliver is None:
+                out.result, out.cycle, out.extra = result, cycle, extra
+            else:  # written now, in this process; only what was written goes back
+                report = Report(task="loop", facts={**facts, "loops": [facts]}, warnings=(), timings_s={},
+                                motions={job.role: result}, result=[cycle], extras={job.role: extra})
+                out.written = {role: (str(path), written.n_frames, written.n_frames != result.n_frames)
+                               for role, (path, written) in job.deliver(report).items()}
+    out.warnings = [str(w.message) for w in caught
+                    if not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning))]
+    return out
+
+
+def workers_for(options: Options) -> int:
+    """The processes ``loop`` may use: ``options.workers``, else the cores this process may use; one inside a
+    process that may not start others (a daemon: a batch or dask worker)."""
+    import multiprocessing
+    import os
+
+    if multiprocessing.current_process().daemon:
+        return 1
+    if options.workers is not None:
+        return options.workers
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def _outcomes(jobs, o: Options, acts, tried: list[int]):
+    """Each part's :class:`_Outcome`, in the order of ``tried``: one after another, or side by side on local
+    processes or on a dask cluster, each sent its part's frames only."""
+    frames = sum(acts.parts[k].n_frames for k in tried)
+    n = workers_for(o)
+    if o.which != "all" or len(tried) < 2 or (o.scheduler is None and (n < 2 or frames < PARALLEL_FRAMES)):
+        yield from map(_outcome, jobs)
+        return
+    if o.scheduler is not None:
+        from distributed import Client
+
+        with Client(o.scheduler, timeout="30s") as client:
+            futures = [client.submit(_outcome, job, pure=False) for job in jobs]
+            for future in futures:  # in part order, each as soon as it and those before are done
+                yield future.result()
+                future.release()
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    # workers forked from Python's forkserver, which imported the looping code once: they start warm and hold
+    # none of this process's memory (the take), only the parts sent to them
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(list(WORKER_MODULES))
+    with ProcessPoolExecutor(max_workers=min(n, len(tried)), mp_context=context) as pool:
+        yield from pool.map(_outcome, jobs, chunksize=1)
+
+
+#: what a worker process imports before its first part (the forkserver preloads them)
+WORKER_MODULES = ("numpy", "scipy.spatial.transform", "mocycle.tasks.loop", "mocycle.cycle", "mocycle.cycle.parts",
+                  "mocycle.tasks.feet", "mocycle.io", "mocycle.io.bvh", "mocycle.cli.common")
 
 
 def _not_looped(k, part, offset: int, reason: str, exc=None) -> dict:
@@ -199,7 +335,7 @@ def _chosen_reason(loops, parts, everything) -> str:
         return f"{len(loops)} loop(s) of {sum(1 for p in parts if p.loop)} part(s) that loop"
     f = loops[0]
     if len(parts) == 1:
-        return "the take does one thing: it is one part, looped"
+        return parts[0].reason if parts[0].one_cycle else "the take does one thing: it is one part, looped"
     others = sum(1 for p in parts if p.loop) - 1
     return (f"looped part {f['part']} ({f['kind']}, frames {f['frames'][0]}-{f['frames'][1]}): the steady part with "
             f"the most cycles" + (f"; {others} other part(s) can loop too (--part all writes every one)"
@@ -218,33 +354,32 @@ def _facts(status, reason, loops, not_looped, acts, offset) -> dict:
             "parts": parts, "first_frame": int(offset)}
 
 
-def _loop_one(motion, acts, k, o, label, rec):
-    """Part ``k``'s loop (:func:`~mocycle.cycle.parts.loop_part`), its feet and its facts (frames of the
-    range).  Returns ``(facts, repeated cycle, extras, cycle)``; raises LoopRefused and MocycleError."""
-    from ..cycle.parts import loop_part
+def _loop_one(piece, o, label, timer):
+    """A part's loop (:func:`~mocycle.cycle.parts.loop_piece`), its feet and its facts (frames of the range).
+    Returns ``(facts, repeated cycle, extras, cycle)``; raises LoopRefused and MocycleError."""
+    from ..cycle.parts import loop_piece
     from .feet import clean_feet
 
-    looped = loop_part(motion, acts, k, method=o.method, model=o.model, harmonics=o.harmonics,
-                       time_axis=o.time_axis, force=o.force, label=label, timer=rec.part)
-    fitted, part, metrics = looped.cycle, looped.part, looped.metrics
-    offset = part.start
-    with rec.part("feet"):
+    looped = loop_piece(piece, method=o.method, model=o.model, harmonics=o.harmonics, time_axis=o.time_axis,
+                        force=o.force, label=label, timer=timer)
+    fitted, part, metrics, offset = looped.cycle, looped.part, looped.metrics, looped.offset
+    with timer("feet"):
         frames = fitted.axis.frames()   # the swing clearance of the looped region of the take
         # the fitted cycle's skate is the metrics' when the feet are the ones found by name
         cycle, feet_facts, contacts = clean_feet(fitted, o.feet, o.root, o.foot_joints,
-                                                 reference=motion[offset + frames[0]:offset + frames[-1] + 1],
+                                                 reference=piece.motion[frames[0]:frames[-1] + 1],
                                                  before=fitted.repeat(2, root="motion"),
                                                  skate_before=None if o.foot_joints else metrics["skate"])
-    with rec.part("cycle"):
+    with timer("cycle"):
         result = cycle.repeat(o.cycles, root=o.root)
     regions = [[int(s) + offset, int(e) + offset] for s, e in cycle.axis.regions]
     facts = {
-        "part": k,
+        "part": looped.index,
         "kind": part.kind,
         "frames": [regions[0][0], regions[-1][1]],
         "frames_in": part.n_frames,
         "frames_out": result.n_frames,
-        "fps": motion.fps,
+        "fps": piece.motion.fps,
         **cycle.to_dict(),
         "speed": _speed(cycle),
         "excitation": regions,

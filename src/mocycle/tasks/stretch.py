@@ -39,13 +39,20 @@ def run(take, options: Options) -> Report:
     """The take lengthened by ``options.factor``: ``motions["stretched"]``; the windows used in ``facts``.
 
     Only the periodic region(s) are warped; raises NoPeriodicMotion when there is none (``force``: the whole take
-    is warped, with a warning)."""
+    is warped, with a warning).  A take that is one cycle (a game clip, :func:`~mocycle.activities.one_cycle`)
+    has no second cycle to warp against: it is lengthened by repeating itself seamlessly
+    (:func:`_repeated_clip`)."""
+    from ..activities import one_cycle
     from ..warp import stretch_motion
     from .feet import lock_motion, travels
 
     with Recorder() as rec:
         motion = load(take, options.amc_fps, options.take)
-        result, report = stretch_motion(motion, options.factor, window=options.window_frames, force=options.force)
+        if one_cycle(motion) is not None:
+            result, report = _repeated_clip(motion, options)
+        else:
+            result, report = stretch_motion(motion, options.factor, window=options.window_frames,
+                                            force=options.force)
         with rec.part("feet"):
             # the stretched take before locking is not kept: the locked one is made from its arrays (memory)
             result, feet_facts = lock_motion(result, options.feet, options.foot_joints, travels(motion),
@@ -53,3 +60,23 @@ def run(take, options: Options) -> Report:
         facts = {**report.to_dict(), "fps": motion.fps,
                  "joints_per_group": {g: len(names) for g, names in report.groups.items()}, "feet": feet_facts}
     return rec.report("stretch", facts, {"stretched": result, "input": motion}, report)
+
+
+def _repeated_clip(motion, options: Options):
+    """A one-cycle take lengthened by ``options.factor``: its loop (the clip as it is,
+    :func:`~mocycle.cycle.parts.part_cycle`) repeated with its root motion, cut to ``round(T * factor)``
+    frames; the report says so (one region, the whole take, and its cycle as every group's window)."""
+    import math
+
+    from ..cycle.parts import part_cycle
+    from ..warp.stretch import StretchReport
+
+    cycle = part_cycle(motion, force=options.force)
+    n_out = max(1, int(round(motion.n_frames * options.factor)))
+    N = cycle.n_frames
+    result = cycle.repeat(math.ceil(n_out / N), root="motion")[:n_out]
+    report = StretchReport(factor=options.factor, frames_in=motion.n_frames, frames_out=n_out,
+                           windows={"all": N}, cycles={"all": float(cycle.period_frames)},
+                           groups={"all": tuple(motion.skeleton.names)}, regions=((0, motion.n_frames),),
+                           regions_out=((0, n_out),))
+    return result, report
