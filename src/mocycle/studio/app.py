@@ -136,7 +136,7 @@ class Studio:
             try:
                 # force: every periodic motion's figures, also of a loop that is refused; loop_summary marks it
                 # refused from the same failed checks that make tasks.loop refuse it without force
-                report = tasks.loop.run(motion, tasks.loop.Options(which="all", force=True))
+                report = tasks.loop.run(motion, tasks.loop.Options(which="all", force=True, workers=1))
                 take.loops = [loop_summary(loop) for loop in report.facts["loops"]]
             except NoPeriodicMotion as exc:
                 take.reason = display(str(exc))
