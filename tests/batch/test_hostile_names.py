@@ -77,12 +77,12 @@ def test_the_same_takes_with_their_default_suffix_do_not_collide(tmp_path, walk_
 
 
 def test_every_class_output_of_which_all_is_claimed(tmp_path, walk_text):
-    """``loop --part all`` writes walk.class<K>.bvh (walk.part<K>-<kind>.bvh): a take named walk.class1.bvh would be
+    """``loop --part all`` writes walk.part<K>-<kind>.bvh: a take named walk.part1-arms.bvh would be
     overwritten."""
-    folder = _takes(tmp_path / "in", walk_text, "walk.bvh", "walk.class1.bvh")
+    folder = _takes(tmp_path / "in", walk_text, "walk.bvh", "walk.part1-arms.bvh")
     out = tmp_path / "out"
     job = Job(command="loop", options=tasks.loop.Options(which="all"), outdir=out, suffix=".bvh")
-    with pytest.raises(MocycleError, match=r"walk\.class1\.bvh would be the outputs of walk\.bvh \(--part all\)"):
+    with pytest.raises(MocycleError, match=r"walk\.part1-arms\.bvh would be the outputs of walk\.bvh \(--part all\)"):
         check_collisions(job, find_takes([folder], out))
     check_collisions(Job(command="loop", options=tasks.loop.Options(), outdir=out, suffix=".bvh"),
                      find_takes([folder], out))  # one class each: no collision

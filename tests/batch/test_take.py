@@ -77,7 +77,7 @@ def test_refused_and_no_periodic_motion_and_bugs_are_rows_not_exceptions(tmp_pat
 
 def test_a_take_without_periodic_motion(tmp_path):
     path = mocycle.write(synthetic_nonperiodic(n_frames=150, fps=30).motion, tmp_path / "noise.bvh")
-    for command, words in (("loop", "no repeating motion"), ("phase", "no long H1 bar")):
+    for command, words in (("loop", "no repeating motion"), ("phase", "no repeating motion")):
         row = process(_job(tmp_path, command), _take(path))
         assert row["status"] == "no-periodic-motion" and words in row["message"], command
         assert row["outputs"] == []
@@ -128,7 +128,7 @@ def test_output_suffixes_per_command():
 
 
 @pytest.mark.parametrize("command, options, suffix, outputs", [
-    ("info", {}, None, []), ("phase", {}, None, []), ("loop", {"which": "all"}, ".bvh", ["walk.class0.bvh"]),
+    ("info", {}, None, []), ("phase", {}, None, []), ("loop", {"which": "all"}, ".bvh", ["walk.part0-periodic.bvh"]),
     ("swings", {}, ".json", ["walk.json"]), ("compress", {}, ".mck", ["walk.mck"]),
     ("stretch", {"factor": 1.5}, ".bvh", ["walk.bvh"])])
 def test_every_command_writes_its_output_and_figures(tmp_path, short_walk, command, options, suffix, outputs):

@@ -8,6 +8,7 @@ does not import dask (only :func:`run_batch` does).
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import tempfile
 import time
@@ -50,6 +51,8 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
     takes = find_takes(inputs, outdir)
     if take_timeout_s is not None and not (take_timeout_s >= 0 and take_timeout_s < float("inf")):
         raise MocycleError(f"the take timeout must be a number of seconds >= 0; got {take_timeout_s!r}")
+    if any(f.name == "workers" for f in dataclasses.fields(options)):  # each take runs on one worker process
+        options = dataclasses.replace(options, workers=1, scheduler=None)
     job = Job(command=command, options=options, outdir=outdir, suffix=suffix, timeout_s=take_timeout_s or None,
               run_id=uuid.uuid4().hex)
     _refuse_overwriting_inputs(job, takes)
