@@ -289,17 +289,12 @@ def _outcomes(jobs, o: Options, acts, tried: list[int]):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    # workers forked from Python's forkserver, which imported the looping code once: they start warm and hold
-    # none of this process's memory (the take), only the parts sent to them
-    context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(list(WORKER_MODULES))
+    # forked workers start warm (the looping code imported) and share this process's pages until they write
+    # them; each is sent its part's frames (a pickled copy of the part only)
+    methods = multiprocessing.get_all_start_methods()
+    context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     with ProcessPoolExecutor(max_workers=min(n, len(tried)), mp_context=context) as pool:
         yield from pool.map(_outcome, jobs, chunksize=1)
-
-
-#: what a worker process imports before its first part (the forkserver preloads them)
-WORKER_MODULES = ("numpy", "scipy.spatial.transform", "mocycle.tasks.loop", "mocycle.cycle", "mocycle.cycle.parts",
-                  "mocycle.tasks.feet", "mocycle.io", "mocycle.io.bvh", "mocycle.cli.common")
 
 
 def _not_looped(k, part, offset: int, reason: str, exc=None) -> dict:
