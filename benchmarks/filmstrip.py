@@ -23,9 +23,10 @@ import mocycle
 
 
 def _up(motion) -> int:
-    """The vertical axis index: the one along which the mean pose is tallest."""
-    W = motion.world_positions()
-    return int(np.argmax(np.ptp(W.mean(axis=0), axis=0)))
+    """The vertical axis index (mocycle's own reading of the take's up)."""
+    from mocycle.axes import vertical_axis
+
+    return int(np.argmax(np.abs(vertical_axis(motion))))
 
 
 def main(argv=None) -> int:
@@ -71,15 +72,18 @@ def main(argv=None) -> int:
                 P[k * n:(k + 1) * n] += k * shift
         d = P[-1, travel] - P[0, travel]
         d[up] = 0.0
-        fwd = d / (np.linalg.norm(d) or 1.0) if np.linalg.norm(d) > 1e-6 else np.eye(3)[h[0]]
         frames = np.linspace(0, P.shape[0] - 1, args.poses).round().astype(int)
+        body = float(np.ptp(P[0, travel:, up]))  # a static root far from the body (Bandai's) is no bone to draw
+        moves = np.linalg.norm(d) > 0.1 * body   # on the spot: the poses side by side instead
+        fwd = d / np.linalg.norm(d) if moves else np.eye(3)[h[0]]
+        drawn = [(p, j) for j, p in enumerate(parents) if p >= 0 and
+                 np.linalg.norm(P[0, j] - P[0, p]) < 0.75 * max(body, 1e-9)]
         axr = fig.add_subplot(len(loops) + 2, 2, 2 * (row + 2) + 1)
         for k, f in enumerate(frames):
-            x = (P[f] - P[frames[0], travel]) @ fwd + k * 0.0
+            x = (P[f] - P[frames[0], travel]) @ fwd + (0.0 if moves else 0.6 * k * body)
             y = P[f, :, up]
-            for j, p in enumerate(parents):
-                if p >= 0:
-                    axr.plot([x[p], x[j]], [y[p], y[j]], color=c, lw=1)
+            for p, j in drawn:
+                axr.plot([x[p], x[j]], [y[p], y[j]], color=c, lw=1)
             axr.text(x[travel], y.max() * 1.02, str(f), fontsize=6, ha="center")
         axr.set_aspect("equal")
         axr.set_title(f"part {loop['part']} {loop['kind']}: {n} frames a cycle, {args.poses} poses over "
