@@ -447,14 +447,16 @@ def _split_turns(part: Activity, heading: np.ndarray, path: np.ndarray, fps: flo
 
 
 def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, joints=None, step: int = 1,
-                       **phase_options) -> Activities:
+                       map=map, **phase_options) -> Activities:
     """Cut ``motion`` into steady parts (module notes); ``min_periods``: cycles a part needs to be looped.
 
     ``joints``, ``step`` and ``phase_options`` (``classes``, ``pca``, ``delay``, ``n_landmarks``) are
     :func:`~mocycle.phase.find_phase`'s, used inside the parts without gait (``joints``: the joints those parts'
     periodic motion is found on, instead of the moving arm joints or the whole body; ``step``: the phase found
     on every ``step``-th frame).  Gait parts take their phase from the landings, or, when ``joints`` are given,
-    from the cohomology of those joints inside the part.  Without feet found by name, the whole take is looked
+    from the cohomology of those joints inside the part.  ``map``: how the stretches between gait parts, which
+    are looked at each on its own, are mapped (a process pool's ``map`` looks at them side by side; the parts
+    are the same).  Without feet found by name, the whole take is looked
     at as frames without gait (arms, then the whole body, region by region).  Every part that loops (``loop``)
     holds at least ``min_periods`` cycles of its own ``periodic`` phase, and a part without gait at least
     :data:`MIN_REPEATS`.
@@ -513,7 +515,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     parts.sort(key=lambda p: p.start)
     _reach(motion, parts, T)
     parts = [q for p in parts for q in (_split_turns(p, heading, path, fps) if " " not in p.kind else [p])]
-    parts = _fill(motion, parts, landings, min_periods, options)
+    parts = _fill(motion, parts, min_periods, options, map)
     keep = np.sort(np.concatenate(stepped)) if stepped else np.zeros(0, dtype=np.intp)
     steps = Landings(landings.frames[keep], landings.foot[keep], landings.sides, landings.down)
     for p in parts:
@@ -904,18 +906,38 @@ def _repeating_reach(motion: Motion, part: Activity, want: int, edge: int) -> in
     return edge - int(bad[0]) if bad.size else want
 
 
-def _fill(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float,
-          options: dict) -> list[Activity]:
-    """The parts with the frames between them (and before the first, after the last) as parts of their own."""
+def _fill(motion: Motion, parts: list[Activity], min_periods: float, options: dict, map=map) -> list[Activity]:
+    """The parts with the frames between them (and before the first, after the last) as parts of their own,
+    each stretch looked at on its own (:func:`_other`, through ``map``)."""
     T = motion.n_frames
-    out, at = [], 0
+    gaps, at = [], 0
     for p in [*parts, None]:
         stop = T if p is None else p.start
         if stop > at:
-            out.extend(_other(motion, at, stop, min_periods, bool(parts), options))
+            gaps.append((at, stop))
         if p is not None:
-            out.append(p)
             at = p.stop
+    found = map(_gap_parts, [_Gap(motion[a:b], a, min_periods, bool(parts), options) for a, b in gaps])
+    out = [*parts, *(q for qs in found for q in qs)]
+    return sorted(out, key=lambda q: q.start)
+
+
+@dataclass(frozen=True)
+class _Gap:
+    """Frames between gait parts to look at on their own (sent as they are to another process)."""
+
+    motion: Motion
+    offset: int
+    min_periods: float
+    gait_near: bool
+    options: dict
+
+
+def _gap_parts(gap: _Gap) -> list[Activity]:
+    """:func:`_other` of a stretch between gait parts, in the take's frames."""
+    out = _other(gap.motion, 0, gap.motion.n_frames, gap.min_periods, gap.gait_near, gap.options)
+    for q in out:
+        q.start, q.stop = q.start + gap.offset, q.stop + gap.offset
     return out
 
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
+from functools import partial
 
 from ..defaults import TIME_AXES
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
@@ -118,7 +120,7 @@ def run(take, options: Options | None = None, *, deliver=None) -> Report:
 
     o = options or Options()
     everything = o.which == "all"
-    with Recorder() as rec:
+    with Recorder() as rec, contextlib.ExitStack() as stack:
         motion = load(take, o.amc_fps, o.take)
         start, stop = parse_range(o.frame_range, motion.n_frames)
         motion = motion[start:stop]
@@ -127,15 +129,19 @@ def run(take, options: Options | None = None, *, deliver=None) -> Report:
             from ..contacts import find_feet
 
             find_feet(motion.skeleton, o.foot_joints)
+        pool = _pool(o, motion.n_frames)
+        if pool is not None:
+            stack.enter_context(pool)  # shut down when the loops are done, or the take refused
         with rec.part("parts"):
             acts = segment_activities(motion, min_periods=o.min_periods, joints=o.joints, classes=o.classes,
-                                      pca=o.pca, delay=o.delay, step=o.step)
+                                      pca=o.pca, delay=o.delay, step=o.step,
+                                      map=map if pool is None else partial(pool.map, chunksize=1))
         parts = acts.parts
         loops, not_looped, motions, cycles, extras, refusals = [], [], {}, [], {}, []
         tried = parts_to_try(acts, o.which)
         jobs = (_Job(part_piece(motion, acts, k), o, label, f"loop.part{k}" if everything else "loop", start,
                      deliver) for k in tried)
-        for out in _outcomes(jobs, o, acts, tried):
+        for out in _outcomes(jobs, o, tried, pool):
             for text in out.warnings:  # in part order, whichever process made them
                 warnings.warn(text, MocycleWarning, stacklevel=2)
             for name, seconds in out.timings.items():
@@ -269,15 +275,25 @@ def workers_for(options: Options) -> int:
         return os.cpu_count() or 1
 
 
-def _outcomes(jobs, o: Options, acts, tried: list[int]):
-    """Each part's :class:`_Outcome`, in the order of ``tried``: one after another, or side by side on local
-    processes or on a dask cluster, each sent its part's frames only."""
-    frames = sum(acts.parts[k].n_frames for k in tried)
-    n = workers_for(o)
-    if o.which != "all" or len(tried) < 2 or (o.scheduler is None and (n < 2 or frames < PARALLEL_FRAMES)):
-        yield from map(_outcome, jobs)
-        return
-    if o.scheduler is not None:
+def _pool(o: Options, n_frames: int):
+    """The local processes that look at a long take's stretches and loop its parts side by side (``None``: one
+    after another here, or on a dask cluster): with ``which="all"``, ``workers_for(o)`` of two or more and a take
+    of :data:`PARALLEL_FRAMES` or more.  Forked where the platform forks: the workers start warm (the code
+    imported) and share this process's pages until they write them; each is sent its own frames."""
+    if o.which != "all" or o.scheduler is not None or n_frames < PARALLEL_FRAMES or workers_for(o) < 2:
+        return None
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    methods = multiprocessing.get_all_start_methods()
+    return ProcessPoolExecutor(max_workers=workers_for(o),
+                               mp_context=multiprocessing.get_context("fork" if "fork" in methods else "spawn"))
+
+
+def _outcomes(jobs, o: Options, tried: list[int], pool):
+    """Each part's :class:`_Outcome`, in the order of ``tried``: one after another, on the local ``pool``, or on
+    the dask cluster at ``o.scheduler``, each sent its part's frames only."""
+    if o.scheduler is not None and o.which == "all" and len(tried) > 1:
         from distributed import Client
 
         with Client(o.scheduler, timeout="30s") as client:
@@ -286,15 +302,10 @@ def _outcomes(jobs, o: Options, acts, tried: list[int]):
                 yield future.result()
                 future.release()
         return
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    # forked workers start warm (the looping code imported) and share this process's pages until they write
-    # them; each is sent its part's frames (a pickled copy of the part only)
-    methods = multiprocessing.get_all_start_methods()
-    context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-    with ProcessPoolExecutor(max_workers=min(n, len(tried)), mp_context=context) as pool:
-        yield from pool.map(_outcome, jobs, chunksize=1)
+    if pool is None or len(tried) < 2:
+        yield from map(_outcome, jobs)
+        return
+    yield from pool.map(_outcome, jobs, chunksize=1)
 
 
 def _not_looped(k, part, offset: int, reason: str, exc=None) -> dict:
