@@ -264,12 +264,18 @@ def stride_periods(landings: Landings, fps: float, start: int = 0, stop: int | N
 
 # ------------------------------------------------------------------------------------------- segmentation
 def heading_degrees(motion: Motion) -> np.ndarray:
-    """The hips' (travel joint's) heading ``(T,)`` in degrees, unwrapped, positive turning left about up."""
+    """The hips' (travel joint's) heading ``(T,)`` in degrees, unwrapped, positive turning left about up: made
+    once per motion and kept with it (read-only), as the segmentation and every part's checks read it."""
+    return motion.cache("heading degrees", _heading_degrees)
 
+
+def _heading_degrees(motion: Motion) -> np.ndarray:
     frame = HeadingFrame.fit(motion)
     _, psi = frame.tilt(motion)
     # heading_angles runs from e1 towards e2 = up x e1: counter-clockwise seen from above, i.e. to the left
-    return np.degrees(np.asarray(psi, dtype=np.float64))
+    out = np.degrees(np.asarray(psi, dtype=np.float64))
+    out.setflags(write=False)
+    return out
 
 
 def _body_height(motion: Motion) -> float:

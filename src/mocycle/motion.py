@@ -526,7 +526,8 @@ class Motion:
         run each need (the vertical axis, the heading frame) is computed once per motion.  A value is
         returned as it was kept: make it read-only, or copy it where the caller may change it.  ``key`` names
         the value; the modules that keep one say which (``"up"``: :func:`mocycle.axes.vertical_axis`,
-        ``"heading"`` and ``"heading tilt"``: :class:`mocycle.features.HeadingFrame`).
+        ``"heading"`` and ``"heading tilt"``: :class:`mocycle.features.HeadingFrame`, ``"heading degrees"``:
+        :func:`mocycle.activities.heading_degrees`).
 
         Examples
         --------

@@ -72,7 +72,7 @@ def part_piece(motion: Motion, acts: Activities, index: int) -> PartPiece:
         keep = (L.frames >= lo) & (L.frames < hi)
         landings = Landings(L.frames[keep] - a, L.foot[keep], L.sides, L.down[a:b])
     rebased = replace(part, start=0, stop=b - a, landings={k: [f - a for f in v] for k, v in part.landings.items()})
-    return PartPiece(index=index, part=rebased, motion=motion[a:b], heading=heading_degrees(motion)[a:b],
+    return PartPiece(index=index, part=rebased, motion=motion[a:b], heading=heading_degrees(motion)[a:b].copy(),
                      landings=landings, offset=a, alone=len(acts.parts) == 1)
 
 
