@@ -551,7 +551,8 @@ def one_cycle(motion: Motion) -> int | None:
     stride, often with a closing frame that repeats the first), or ``None``: the take is no such clip
     (:data:`WRAP_JUMP`, :data:`MOVING_WRAP`; the joints' rotations decide, not the root's travel).  Of the
     two readings, an open cycle of all the frames or a cycle closed by its last frame, the one whose wrap
-    changes the velocity less."""
+    changes the velocity less.  A take like itself a third to four fifths of its length later holds more
+    than one cycle and is no such clip."""
     T = motion.n_frames
     if T < 8:
         return None
@@ -565,6 +566,10 @@ def one_cycle(motion: Motion) -> int | None:
     ends = 0.25 * float(steps[:2].sum() + steps[-2:].sum())
     if ends < MOVING_WRAP * float(np.percentile(steps, 90)):
         return None  # it rests where it starts and ends: a gesture, not a cycle
+
+    lags = np.arange(max(2, int(0.3 * T)), int(0.8 * T) + 1)
+    if lags.size and min(_unlike(X, int(lag)) for lag in lags) < UNLIKE_ONE_STEP:
+        return None  # it repeats within itself: more than one cycle (the parts say how many)
 
     def jump(last: int) -> float:  # frames 0 .. last as the cycle: the velocity change across its wrap
         into, out = X[0] - X[last], X[1] - X[0]
