@@ -109,6 +109,9 @@ def test_extract_cycle_loops(walk):
     check_loop(walk, action, f["period_frames"])
     st = bpy.context.scene.mocycle
     assert st.last_period == pytest.approx(f["period_frames"]) and st.last_seam >= 0 and st.last_skate >= 0
+    one_liner(st.last_message)
+    assert st.last_ok and st.last_message.endswith(f"a loop of {f['cycle_frames']} frames "
+                                                   f"({f['cycle_frames'] / FPS:.2f} s)"), st.last_message
 
 
 def test_extract_cycle_root_motion_repeated(walk):
@@ -268,6 +271,7 @@ def said(st) -> str:
 def one_liner(text: str) -> None:
     assert text and "\n" not in text and len(text) <= 160, text
     assert "class" not in text.lower() and "nan" not in text.lower().split(), text
+    assert text.endswith(" …") or text.count("(") == text.count(")"), text
 
 
 def test_a_failed_run_clears_the_previous_result(walk, tmp_path):
@@ -426,3 +430,13 @@ def _flatten(node):
             yield from _flatten(item)
         else:
             yield item
+
+
+def test_find_phase_numbers_the_parts_of_the_frames_read(walk):
+    """With a frame range, the parts list gives Blender's frame numbers (the range's first frame is the first
+    part's), and remembers the range: the panel passes a part picked in it only while the same range is set."""
+    st = bpy.context.scene.mocycle
+    assert bpy.ops.mocycle.find_phase(use_frame_range=True, frame_start=31, frame_end=210) == {"FINISHED"}
+    assert st.parts[0].frames.startswith("31-") and st.parts[-1].frames.endswith("-210"), [p.frames for p in st.parts]
+    assert st.parts_action == "Walk" and st.parts_range == "31..210"
+    assert "frames 31-" in st.last_message

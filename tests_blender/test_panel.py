@@ -58,6 +58,7 @@ def test_panel_draws_options_buttons_and_last_result(scene, tmp_path):
     assert buttons == ["Find Phase", "Extract Cycle", "Blend Cycles", "Transition", "Stretch"]
     props = {i["prop"]: i["value"] for i in items if "prop" in i}
     assert props["Method"] == "harmonic" and props["Model"] == "M1" and props["Factor"] == "1.5"
+    assert "Take" not in props  # (a file's take: the add-on reads the active action, never a file)
     labels = [i["label"] for i in items if "label" in i]
     assert any(t.startswith("Period: ") for t in labels) and any(t.startswith("Seam: ") for t in labels)
     assert any(t.startswith("Foot skate: ") for t in labels)

@@ -342,7 +342,8 @@ def _extract_cycle(self, context, arm):
                f"Seam: {_seam(f['metrics']['seam_pose'])}",
                f"Foot skate: {_speed(context, skate)}"]
     failed = f.get("failed_checks") or []
-    message = (f"{new.name}: {_part(f, first)}, {why}; a loop of {_seconds(f['cycle_frames'], f['fps'])[:-1]}"
+    message = (f"{new.name}: {_part(f, first)}, {why}; a loop of {f['cycle_frames']} frames "
+               f"({f['cycle_frames'] / f['fps']:.2f} s)"
                f"{'' if options.cycles == 1 else f' × {options.cycles}'}"
                + (f" ({words.refusal(failed)}, kept because forced)" if failed else ""))
     metrics = report.facts["metrics"]

@@ -99,7 +99,9 @@ class MOCYCLE_PT_panel(bpy.types.Panel):
                 col.label(text=f"Parts of {st.parts_action}: pick one for the buttons below")
             else:  # another action's (or other frames'): shown, not used
                 col.active = False
-                col.label(text=f"Parts of {st.parts_action}, not of these frames: not used", icon="INFO")
+                other = "not the active action" if action is None or st.parts_action != action.name else \
+                    "other frames"
+                col.label(text=f"Parts of {st.parts_action} ({other}): not used", icon="INFO")
             col.template_list("MOCYCLE_UL_parts", "", st, "parts", st, "part_index", rows=3)
 
         box = layout.box()

@@ -16,8 +16,9 @@ from bpy.props import (
 from mocycle import tasks
 
 #: fields the add-on fills from Blender itself: the frame range from frame numbers, the phase joints from the
-#: Pose Mode selection, the part from the list ``find_phase`` or ``extract_cycle`` made; AMC input never reaches it
-FROM_BLENDER = {"amc_fps", "frame_range", "joints", "which"}
+#: Pose Mode selection, the part from the list ``find_phase`` or ``extract_cycle`` made; AMC input and the take
+#: of a glTF or FBX file never reach it (it reads the active action)
+FROM_BLENDER = {"amc_fps", "frame_range", "joints", "which", "take"}
 #: a value for fields the task requires (no default)
 REQUIRED_DEFAULTS = {"factor": 1.5}
 
