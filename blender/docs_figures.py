@@ -21,7 +21,7 @@ class Recorder:
     """Stands in for ``bpy.types.UILayout``: records what a panel draws, as nested lists of items."""
 
     def __init__(self, kind="column"):
-        self.kind, self.items, self.enabled = kind, [], True
+        self.kind, self.items, self.enabled, self.active = kind, [], True, True
 
     def _child(self, kind):
         child = Recorder(kind)
@@ -53,12 +53,12 @@ class Recorder:
         self.items.append({"prop": text if text is not None else rna.name, "value": value, "type": rna.type,
                            "enabled": self.enabled})
 
-    def operator(self, idname, text=""):
-        self.items.append({"button": text or idname})
-
-        class Properties:  # the panel sets the operator's options on it
+    def operator(self, idname, text="", icon="NONE"):
+        class Properties:  # the panel sets the operator's options on it (recorded under "options")
             pass
-        return Properties()
+        options = Properties()
+        self.items.append({"button": text or idname, "options": options})
+        return options
 
     def template_list(self, list_type, list_id, data, prop, active_data, active_prop, rows=2):
         import bpy
@@ -72,7 +72,14 @@ class Recorder:
         self.items.append({"list": rows_out, "active": getattr(active_data, active_prop)})
 
     def to_json(self):
-        return {"kind": self.kind, "items": [i.to_json() if isinstance(i, Recorder) else i for i in self.items]}
+        def item(i):
+            if isinstance(i, Recorder):
+                return i.to_json()
+            if "options" in i:
+                return {**i, "options": {k: v for k, v in vars(i["options"]).items() if isinstance(
+                    v, (str, int, float, bool))}}
+            return i
+        return {"kind": self.kind, "active": self.active, "items": [item(i) for i in self.items]}
 
 
 def record(out: Path, zip_path: str):

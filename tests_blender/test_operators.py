@@ -109,6 +109,9 @@ def test_extract_cycle_loops(walk):
     check_loop(walk, action, f["period_frames"])
     st = bpy.context.scene.mocycle
     assert st.last_period == pytest.approx(f["period_frames"]) and st.last_seam >= 0 and st.last_skate >= 0
+    one_liner(st.last_message)
+    assert st.last_ok and st.last_message.endswith(f"a loop of {f['cycle_frames']} frames "
+                                                   f"({f['cycle_frames'] / FPS:.2f} s)"), st.last_message
 
 
 def test_extract_cycle_root_motion_repeated(walk):
@@ -188,7 +191,7 @@ def test_extract_cycle_lists_the_parts_and_loops_the_one_picked(scene, tmp_path)
     runs = [k for i, k in enumerate(kinds) if i == 0 or k != kinds[i - 1]]  # a straight walk may come in two parts
     assert runs == ["walk straight", "walk turning left", "walk straight"], kinds
     assert all(p.reason for p in st.parts if not p.loops)
-    assert "(walk" in st.last_message and "the steady part with the most cycles" in st.last_message
+    assert "(walk" in st.last_message and "the part with the most cycles" in st.last_message
     arm.animation_data.action = bpy.data.actions["Turn"]
     turning = next(k for k, p in enumerate(st.parts) if p.kind == "walk turning left")
     assert bpy.ops.mocycle.extract_cycle(which=turning, root="motion") == {"FINISHED"}
@@ -256,3 +259,184 @@ def test_real_walk(scene):
     assert bpy.ops.mocycle.extract_cycle() == {"FINISHED"}
     f = facts(arm.animation_data.action)
     check_loop(arm, arm.animation_data.action, f["period_frames"])
+
+
+# ------------------------------------------------------------------------------- what the panel says (issue 37)
+def said(st) -> str:
+    """Everything the panel shows of the last run: its line, its figures, its details and the parts list."""
+    rows = [f"{p.kind} {p.frames} {p.reason}" for p in st.parts]
+    return "\n".join([st.last_message, st.last_figures, st.last_detail, *rows])
+
+
+def one_liner(text: str) -> None:
+    assert text and "\n" not in text and len(text) <= 160, text
+    assert "class" not in text.lower() and "nan" not in text.lower().split(), text
+    assert text.endswith(" …") or text.count("(") == text.count(")"), text
+
+
+def test_a_failed_run_clears_the_previous_result(walk, tmp_path):
+    """Find Phase on a walk fills the list and the last result; a failed run on another take shows that take's
+    failure and its parts, nothing of the walk's; a failure that leaves no parts empties the list."""
+    from mocycle.datasets import synthetic_nonperiodic
+
+    st = bpy.context.scene.mocycle
+    assert bpy.ops.mocycle.find_phase() == {"FINISHED"} and st.parts and st.last_period > 0
+    wander = import_bvh(write_take(tmp_path, "Wander", synthetic_nonperiodic, n_frames=240))
+    with pytest.raises(RuntimeError) as caught:
+        bpy.ops.mocycle.extract_cycle()
+    one_liner(str(caught.value).removeprefix("Error: ").strip())
+    assert st.last_task == "extract_cycle" and st.last_action == "Wander" and not st.last_ok
+    assert "Walk" not in said(st) and "Wander" in st.last_message and "repeat" in st.last_message
+    assert st.last_period == st.last_seam == st.last_skate == -1.0 and st.last_figures == ""
+    assert st.parts_action == "Wander" and [p.kind for p in st.parts] == ["gesture"] and not st.parts[0].loops
+    # a failure with no parts to show (an action that does not exist): the list is emptied, not the walk's
+    bpy.context.view_layer.objects.active = walk
+    assert bpy.ops.mocycle.find_phase() == {"FINISHED"} and st.parts_action == "Walk"
+    bpy.context.view_layer.objects.active = wander
+    with pytest.raises(RuntimeError, match="no action named"):
+        bpy.ops.mocycle.blend_cycles(other="Nope")
+    assert len(st.parts) == 0 and st.parts_action == "" and st.last_action == "Wander" and "Walk" not in said(st)
+
+
+def test_the_part_picked_is_said_in_plain_words(scene, tmp_path):
+    """Picking a part that does not loop (a gesture between a walk and a wave) and pressing Extract says which
+    part, its frames in Blender's numbers and why, in a line; a part picked in another action's list is not
+    passed on."""
+    from mocycle.datasets import synthetic_walk_then_wave
+
+    arm = import_bvh(write_take(tmp_path, "WalkWave", synthetic_walk_then_wave))
+    st = bpy.context.scene.mocycle
+    assert bpy.ops.mocycle.find_phase() == {"FINISHED"}
+    one_liner(st.last_message)
+    k = next(k for k, p in enumerate(st.parts) if not p.loops)
+    p = st.parts[k]
+    first = int(round(arm.animation_data.action.frame_range[0]))
+    with pytest.raises(RuntimeError) as caught:
+        bpy.ops.mocycle.extract_cycle(which=k)
+    message = str(caught.value).removeprefix("Error: ").strip()
+    one_liner(message)
+    assert f"part {k} ({p.kind}, frames {p.frames}) does not loop: " in message and p.reason in message
+    assert int(p.frames.split("-")[0]) >= first and st.part_index == -1 and len(st.parts) > 1
+    # the panel passes the part picked for this action and these frames only
+    st.part_index = k
+    assert panel_which(arm) == k
+    st.use_frame_range = True  # other frames: another list
+    assert panel_which(arm) == -1
+    st.use_frame_range = False
+    arm.animation_data.action = bpy.data.actions.new("Other")  # another action
+    assert panel_which(arm) == -1
+
+
+def panel_which(arm) -> int:
+    """The part the panel's Extract Cycle button passes (its ``which``), from the panel's own ``draw()``."""
+    import sys
+
+    layout = docs_figures().Recorder()
+    sys.modules["bl_ext.user_default.mocycle"].panel.MOCYCLE_PT_panel.draw(type("P", (), {"layout": layout})(),
+                                                                           bpy.context)
+    (button,) = [i for i in _flatten(layout.to_json()) if i.get("button") == "Extract Cycle"]
+    return button["options"]["which"]
+
+
+def test_figures_have_units_and_no_nan(scene, tmp_path):
+    """A rig whose feet are not found by name: its foot skate cannot be measured and is said so, never as
+    ``nan``; the period has frames and seconds, the skate of a walk whose feet are found Blender's length unit
+    per second; the action's facts are strict JSON (null, not NaN)."""
+    import mocycle
+    from mocycle.datasets import synthetic_walk
+    from mocycle.motion import Motion, Skeleton
+
+    m = synthetic_walk(n_frames=240, fps=FPS).motion
+    s = m.skeleton
+    plain = Skeleton(tuple(f"b{j}" for j in range(s.n_joints)), s.parents, s.offsets, s.channels,
+                     end_sites=s.end_sites)
+    path = tmp_path / "Rig.bvh"
+    mocycle.write(Motion(plain, m.rotations, m.translations, m.frame_time), path)
+    arm = import_bvh(path)
+    assert bpy.ops.mocycle.extract_cycle() == {"FINISHED"}
+    st = bpy.context.scene.mocycle
+    one_liner(st.last_message)
+    assert "nan" not in said(st).lower().replace("nance", "")  # (no "nan" word or number anywhere)
+    figures = st.last_figures.split("\n")
+    assert any(t.startswith("Period: ") and " frames (" in t and t.endswith(" s)") for t in figures), figures
+    assert "Foot skate: not measured" in figures and st.last_skate == -1.0
+    assert "foot skate, cycle (as fitted): not measured" in st.last_detail
+    text = arm.animation_data.action["mocycle"]
+    assert "NaN" not in text and json.loads(text)["metrics"]["skate"] is None
+    # a walk whose feet are found: the skate in the scene's length unit per second
+    walk = import_bvh(write_take(tmp_path, "Walk", synthetic_walk, n_frames=240))
+    bpy.context.view_layer.objects.active = walk
+    assert bpy.ops.mocycle.extract_cycle() == {"FINISHED"}
+    skate = next(t for t in st.last_figures.split("\n") if t.startswith("Foot skate: "))
+    assert skate.endswith("m/s") and st.last_skate >= 0, skate
+
+
+@pytest.fixture
+def limp(scene, tmp_path):
+    """A 500-frame walk whose phase is replaced, while the test runs, by the phase of a walk 1.5 times slower
+    (as in tests/studio/test_studio_refusal.py): its cycle fails the fit and stride checks and is refused."""
+    import mocycle
+    import mocycle.cycle.parts as parts_module
+    from mocycle.datasets import synthetic_walk
+    from mocycle.phase import find_phase
+
+    path = tmp_path / "Limp.bvh"
+    mocycle.write(synthetic_walk(n_frames=500, fps=FPS, noise_deg=1.0, seed=1).motion, path)
+    wrong = find_phase(synthetic_walk(n_frames=500, fps=FPS, period_s=1.5, noise_deg=1.0, seed=4).motion)
+    real = parts_module.part_phase
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(parts_module, "part_phase", lambda part: wrong if part.n_frames == 500 else real(part))
+        yield import_bvh(path)
+
+
+def test_a_refusal_is_one_line_with_its_detail_one_click_away(limp):
+    """The refusal's line names the part in Blender's frames and the failed checks in plain words; the
+    technical reason of each check, with its numbers, is in the Details sub-panel (and the Info editor)."""
+    st = bpy.context.scene.mocycle
+    with pytest.raises(RuntimeError) as caught:
+        bpy.ops.mocycle.extract_cycle()
+    message = str(caught.value).removeprefix("Error: ").strip()
+    one_liner(message)
+    assert message.startswith("Limp: part 0 (walk straight, frames 1-500) is not a loop: ") and "--force" not in message
+    assert message == st.last_message and not st.last_ok
+    assert "check fit: the cycle fits the take" in st.last_detail and "limit" in st.last_detail
+    addon = __import__("sys").modules["bl_ext.user_default.mocycle"]
+    layout = docs_figures().Recorder()
+    addon.panel.MOCYCLE_PT_details.draw(type("P", (), {"layout": layout})(), bpy.context)
+    text = json.dumps(layout.to_json())
+    assert "Copy Details" in text and "check fit" in text
+    lines = [i["label"] for i in _flatten(layout.to_json()) if "label" in i]
+    assert lines and max(map(len, lines)) <= 80  # wrapped to the sidebar, not one 600-character label
+    assert "Force (Advanced" in st.last_detail
+    assert bpy.ops.mocycle.copy_details() == {"FINISHED"}  # (headless Blender has no clipboard to read back)
+
+
+def docs_figures():
+    """``blender/docs_figures.py``, whose ``Recorder`` stands in for Blender's layout to record what a panel
+    draws."""
+    import importlib.util
+
+    from conftest import REPO
+
+    spec = importlib.util.spec_from_file_location("docs_figures", REPO / "blender" / "docs_figures.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _flatten(node):
+    for item in node["items"]:
+        if "items" in item:
+            yield from _flatten(item)
+        else:
+            yield item
+
+
+def test_find_phase_numbers_the_parts_of_the_frames_read(walk):
+    """With a frame range, the parts list gives Blender's frame numbers (the range's first frame is the first
+    part's), and remembers the range: the panel passes a part picked in it only while the same range is set."""
+    st = bpy.context.scene.mocycle
+    assert bpy.ops.mocycle.find_phase(use_frame_range=True, frame_start=31, frame_end=210) == {"FINISHED"}
+    assert st.parts[0].frames.startswith("31-") and st.parts[-1].frames.endswith("-210"), [p.frames for p in st.parts]
+    assert st.parts_action == "Walk" and st.parts_range == "31..210"
+    assert "frames 31-" in st.last_message

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
-import json
-
 import bpy
 
 from mocycle import tasks
-from mocycle.errors import MocycleError
+from mocycle.errors import LoopRefused, MocycleError, OptionError
+from mocycle.tasks import words
 from mocycle.tasks.clips import closing_frame
+from mocycle.tasks.loop import METRIC_LABELS
+from mocycle.tasks.report import Labelled
 from mocycle.tasks.spec import SPECS
+from mocycle.text import json_text
 
 from . import props, rig
 
@@ -64,33 +66,177 @@ def _state(context):
     return context.scene.mocycle
 
 
-def _record(context, task: str, action, period=-1.0, seam=-1.0, skate=-1.0, message="") -> None:
-    st = _state(context)
-    st.last_task, st.last_action = task, action.name if action else ""
-    st.last_period, st.last_seam, st.last_skate, st.last_message = period, seam, skate, message
+# ------------------------------------------------------------------------------------- what a run says
+class Said:
+    """What a run says: ``message`` (one short line: the status bar, the panel's last result), ``figures``
+    (``"Period: 30.0 frames (1.00 s)"``, each with its unit, none ``nan``) and ``detail`` (the technical lines:
+    the library's own words, each check's reason with its numbers; the panel's Details and the Info editor)."""
+
+    def __init__(self, message: str, figures=(), detail=()):
+        self.message, self.figures, self.detail = words.brief(message), list(figures), list(detail)
 
 
-def _keep_parts(context, parts: list[dict], first: int) -> None:
-    """The action's steady parts (``tasks.loop`` facts) in the panel's list, in the action's frame numbers."""
+#: how the library's words number frames, said in the detail whenever a text from it names frames
+FRAMES_NOTE = "(frame numbers in mocycle's own words count from 0 at the first frame read: Blender frame {first})"
+
+
+#: what "--force writes it anyway" is in Blender
+FORCE = "Force (Advanced, under Cycle, Blend or Transition) writes it anyway, with a warning naming the failed checks"
+
+
+def _frames(a: int, b: int, first: int) -> str:
+    """Take frames ``a..b`` (stop excluded, 0 at ``first``) as Blender frame numbers, both ends included."""
+    return f"frames {a + first}-{b + first - 1}"
+
+
+def _part(d: dict, first: int) -> str:
+    """``part 2 (gesture, frames 138-161)`` of a part's facts (``part`` or its index, ``kind``, ``frames``)."""
+    return f"part {d['part']} ({d['kind']}, {_frames(*d['frames'], first)})"
+
+
+def _seconds(frames, fps) -> str:
+    text = words.number(frames, 1, "frames")
+    if text is None:
+        return "not measured"
+    s = words.number(float(frames) / float(fps), 2, "s") if fps else None
+    return f"{text} ({s})" if s else text
+
+
+def _speed(context, value) -> str:
+    """A speed in Blender units per second in the scene's units (``1.23 cm/s``); ``not measured`` for none."""
+    if words.number(value) is None:
+        return "not measured"
+    units = context.scene.unit_settings
+    if units.system == "NONE":
+        return f"{float(value):.3g} units/s"
+    return bpy.utils.units.to_string(units.system, "LENGTH", float(value) * units.scale_length, precision=3) + "/s"
+
+
+def _seam(value) -> str:
+    text = words.number(value, 2, "× a frame's step")
+    return "not measured" if text is None else f"{text} (about 1 is seamless)"
+
+
+def _skate(feet: dict, metrics: dict | None = None):
+    """The loop's foot skate: after locking when the feet were locked, else as fitted (None: not measured)."""
+    after = feet.get("skate_after")
+    return after if after is not None else (metrics or {}).get("skate")
+
+
+def _parts_detail(parts: list[dict], first: int) -> list[str]:
+    lines = []
+    for k, p in enumerate(parts):
+        what = (f"{p['n_periods']:.1f} cycles of {p['period_frames']:.1f} frames"
+                if p["loop"] and words.number(p.get("period_frames")) and words.number(p.get("n_periods"))
+                else p["reason"] or "does not loop")
+        lines.append(f"{_part({'part': k, **p}, first)}: {what}")
+    return lines
+
+
+def _with_note(lines: list[str], first: int | None) -> list[str]:
+    if first is not None and any("frames " in line for line in lines):
+        lines = lines + [FRAMES_NOTE.format(first=first)]
+    return lines
+
+
+def _nothing(reason: str, parts: list[dict]) -> str:
+    """Why nothing loops, short: the library's reason (the CLI's words) unless it names frames, which the
+    parts list shows in Blender's numbers."""
+    if "frames " not in reason:
+        return reason
+    if len(parts) == 1 and parts[0]["reason"]:
+        return parts[0]["reason"]
+    return f"none of its {len(parts)} parts loops (the parts list says why for each)"
+
+
+def _failure(op, exc) -> Said:
+    """What a failed run says: a short line from the structured facts when the task left them (``tasks.loop``'s
+    refusals: the part, its frames in Blender's numbers, the failed checks in plain words), else the message
+    itself, cut to a line; the whole message and every check's reason in the detail."""
+    action, first = getattr(op, "_action", None), getattr(op, "_first", None)
+    name = f"{action.name}: " if action is not None else ""
+    text = " ".join(str(exc).split())
+    if isinstance(exc, OptionError):  # the option as the operator labels it
+        prop = op.rna_type.properties.get(exc.parameter)
+        text = f"{prop.name if prop else exc.parameter}: {exc.reason}"
+        return Said(name + text, detail=[text])
+    force = [FORCE] if isinstance(exc, LoopRefused) else []
+    facts = getattr(exc, "facts", None)
+    if facts and first is not None:
+        out, parts = facts.get("not_looped", []), facts.get("parts", [])
+        picked = getattr(op, "which", -1)
+        # the parts that were tried and did not loop: the one picked, else each that should have looped
+        tried = [d for d in out if (d["part"] == picked if picked >= 0 else
+                                    d["part"] < len(parts) and parts[d["part"]]["loop"])]
+        checks = [f"{_part(d, first)}, check {c['check']}: {c['reason']} (measured {c['value']:.3g}, limit "
+                  f"{c['limit']:.3g})" for d in out for c in d.get("failed_checks", [])]
+        # a refusal's own message repeats the checks' lines (with frames counted from the range read): left out
+        detail = checks if checks and facts.get("status") == "refused" else [text, *checks]
+        if tried:
+            d = tried[0]
+            why = (f"is {words.refusal(d['failed_checks'])}" if d.get("failed_checks") else
+                   f"does not loop: {d['reason']}")
+            message = f"{name}{_part(d, first)} {why}"
+        else:
+            message = name + _nothing(facts.get("reason") or text, parts)
+        return Said(message, detail=_with_note(detail + _parts_detail(parts, first) + force, first))
+    if isinstance(exc, LoopRefused) and exc.failed:  # blend, transition: which action's cycle, and why
+        labels = sorted((a.name for a in getattr(op, "_actions", ())), key=len, reverse=True)
+        who = next((a for a in labels if text.startswith(a)), action.name if action is not None else "")
+        checks = [f"check {c.name}: {c.reason} (measured {c.value:.3g}, limit {c.limit:.3g})" for c in exc.failed]
+        return Said(f"{who}: {words.refusal(exc.failed)}" if who else words.refusal(exc.failed),
+                    detail=[text, *checks, *force])
+    message = text if action is None or text.startswith(action.name) else name + text
+    return Said(message, detail=_with_note([text, *force], first))
+
+
+def _show(context, task: str, action, said: Said, ok: bool, period=-1.0, seam=-1.0, skate=-1.0) -> None:
+    """The panel's last result: this run's, whether it worked or not (nothing of the run before is kept)."""
     st = _state(context)
-    picked = st.part_index
+    st.last_task, st.last_action, st.last_ok = task, action.name if action else "", ok
+    st.last_message = said.message
+    st.last_figures = "\n".join(said.figures)
+    st.last_detail = "\n".join(said.detail)
+    st.last_period, st.last_seam = period, seam
+    st.last_skate = skate if words.number(skate) is not None else -1.0
+
+
+def _keep_parts(context, parts: list[dict], first: int, action, frames: str) -> None:
+    """The action's steady parts (``tasks.loop`` or ``tasks.phase`` facts) in the panel's list, in the action's
+    frame numbers; the list remembers whose parts they are (the action and the frame range read), so that a
+    part picked in it is passed on only for that action and range."""
+    st = _state(context)
+    same = st.parts_action == action.name and st.parts_range == frames
+    picked = st.part_index if same else -1
     st.parts.clear()
     for p in parts:
         item = st.parts.add()
-        a, b = p["frames"]
-        item.kind, item.frames, item.loops = p["kind"], f"{a + first}-{b + first - 1}", p["loop"]
-        item.period_frames = p["period_frames"] or 0.0
-        item.n_periods = p["n_periods"] or 0.0
-        item.reason = p["reason"] or ""
+        item.kind, item.frames, item.loops = p["kind"], _frames(*p["frames"], first)[7:], p["loop"]
+        item.period_frames = p["period_frames"] if words.number(p.get("period_frames")) else 0.0
+        item.n_periods = p["n_periods"] if words.number(p.get("n_periods")) else 0.0
+        item.reason = words.brief(p["reason"] or "")
+    st.parts_action, st.parts_range = action.name, frames
     st.part_index = picked if 0 <= picked < len(st.parts) else -1
 
 
+def _drop_parts(context) -> None:
+    st = _state(context)
+    st.parts.clear()
+    st.part_index = -1
+    st.parts_action = st.parts_range = ""
+
+
 def _keep_facts(action, report) -> None:
-    action["mocycle"] = json.dumps({"task": report.task, **report.facts}, default=str)
+    """The task's figures on the new action, as strict JSON (a figure that could not be measured is null)."""
+    action["mocycle"] = json_text({"task": report.task, **report.facts}, indent=None)
 
 
 class _Task(bpy.types.Operator):
-    """Shared run/report of the operators; subclasses implement ``work(context, arm) -> str``."""
+    """Shared run/report of the operators; subclasses implement ``work(context, arm) -> Said``.
+
+    Whatever happens the panel shows this run: its result, or why it failed (the parts list refilled from the
+    failed run's facts when it left them, else emptied unless it lists the parts of the action and frames this
+    run read)."""
 
     bl_options = {"REGISTER", "UNDO"}
 
@@ -100,15 +246,30 @@ class _Task(bpy.types.Operator):
         return ob is not None and ob.type == "ARMATURE"
 
     def execute(self, context):
+        self._action = self._first = None
+        self._frames = props.range_key(self)
+        self._actions = ()
         try:
             arm = _armature(context)
-            message = self.work(context, arm)
+            self._action = arm.animation_data.action
+            said = self.work(context, arm)
         except (MocycleError, ValueError) as exc:
-            self.report({"ERROR"}, str(exc))
+            said = _failure(self, exc)
+            facts = getattr(exc, "facts", None)
+            st = _state(context)
+            if facts and facts.get("parts") is not None and self._first is not None:
+                _keep_parts(context, facts["parts"], self._first, self._action, self._frames)
+            elif not (self._action is not None and st.parts_action == self._action.name
+                      and st.parts_range == self._frames):
+                _drop_parts(context)
+            _show(context, self._idname, self._action, said, ok=False)
+            if len(said.detail) > 1 or (said.detail and said.detail[0] != said.message):
+                self.report({"INFO"}, "mocycle details: " + " | ".join(said.detail))
+            self.report({"ERROR"}, said.message)
             return {"CANCELLED"}
         for w in getattr(self, "_warnings", ()):
-            self.report({"WARNING"}, w)
-        self.report({"INFO"}, message)
+            self.report({"WARNING"}, words.brief(w))
+        self.report({"INFO"}, said.message)
         return {"FINISHED"}
 
 
@@ -119,63 +280,91 @@ def _task_operator(task: str, idname: str, label: str, description: str, extra: 
     annotations = {**props.annotations(options_cls), **extra}
     return type(f"MOCYCLE_OT_{idname}", (_Task,), {
         "bl_idname": f"mocycle.{idname}", "bl_label": label, "bl_description": description,
-        "__annotations__": annotations, "options_cls": options_cls, "work": work})
+        "__annotations__": annotations, "options_cls": options_cls, "work": work, "_idname": idname})
 
 
 def _find_phase(self, context, arm):
     action = arm.animation_data.action
     first, last, window = _frame_range(self, action)
+    self._first = first
     motion = rig.to_motion(arm, action, (first, last))
     if window:
         a, b = (int(x) for x in window.split(":"))
         motion = motion[a:b]
-    report = tasks.phase.run(motion, props.options_from(self.options_cls, self, joints=_joints(self, arm)))
-    _keep_parts(context, report.facts["parts"], first)
+        self._first = first + a  # frame 0 of the task is the range's first frame
+    report = tasks.phase.run(Labelled(motion, action.name),
+                             props.options_from(self.options_cls, self, joints=_joints(self, arm)))
+    f, base = report.facts, self._first
+    _keep_parts(context, f["parts"], base, action, self._frames)
     self._warnings = report.warnings
-    found = report.facts["classes"]
+    found, parts = f["classes"], f["parts"]
+    detail = _with_note([f["reason"], *_parts_detail(parts, base),
+                         *(f"part {c['part']} period: {c['period_reason']}" for c in found), *report.warnings], base)
     if not found:
-        message = f"{action.name}: no part repeats ({report.facts['reason']})"
-        _record(context, "find_phase", action, message=message)
-        return message
+        message = f"{action.name}: {_nothing(f['reason'], parts)}"
+        said = Said(message, detail=detail)
+        _show(context, "find_phase", action, said, ok=False)
+        return said
     best = max(found, key=lambda c: c["n_periods"])
-    message = (f"{action.name}: {len(report.facts['parts'])} part(s), {len(found)} repeat; the longest, part "
-               f"{best['part']} ({best['kind']}): period {best['period_frames']:.1f} frames "
-               f"({best['period_s']:.2f} s), {best['n_periods']:.1f} cycles")
-    _record(context, "find_phase", action, period=best["period_frames"], message=message)
-    return message
+    fps = best["period_frames"] / best["period_s"] if words.number(best.get("period_s")) else None
+    figures = [f"Period: {_seconds(best['period_frames'], fps)}",
+               f"Cycles: {words.number(best['n_periods'], 1) or 'not measured'}"]
+    message = (f"{action.name}: {len(parts)} part(s), {len(found)} repeat(s); the most cycles: "
+               f"{_part(best, base)}, a period of {_seconds(best['period_frames'], fps)}")
+    said = Said(message, figures, detail)
+    _show(context, "find_phase", action, said, ok=True, period=best["period_frames"])
+    return said
 
 
 def _extract_cycle(self, context, arm):
     action = arm.animation_data.action
     first, last, window = _frame_range(self, action)
+    self._first = first
     motion = rig.to_motion(arm, action, (first, last))
     options = props.options_from(self.options_cls, self, frame_range=window, joints=_joints(self, arm),
                                  which=None if self.which < 0 else self.which)
-    report = tasks.loop.run(motion, options)
-    _keep_parts(context, report.facts["parts"], first)
+    report = tasks.loop.run(Labelled(motion, action.name), options)
+    f = report.facts
+    _keep_parts(context, f["parts"], first, action, self._frames)
     cycle, loop = report.result, report.motions["loop"]
     new = rig.write_action(arm, loop, f"{action.name}_cycle", first,
                            wrap=closing_frame(cycle, options.cycles, options.root), travel=options.root == "motion")
     _keep_facts(new, report)
     rig_assign(arm, new)
-    f = report.facts
-    skate = f["feet"]["skate_after"] if f["feet"].get("skate_after") is not None else f["metrics"]["skate"]
+    skate = _skate(f["feet"], f["metrics"])
     self._warnings = report.warnings
-    a, b = f["frames"]
-    part = "" if f.get("part") is None else f" ({f['kind']}, frames {a + first}-{b + first - 1})"
-    message = (f"{new.name}{part}: period {f['period_frames']:.1f} frames, {f['cycle_frames']} frames a cycle × "
-               f"{options.cycles}, seam {f['metrics']['seam_pose']:.2f}× median step, foot skate {skate:.3g}"
-               f"; {f['reason']}")
-    _record(context, "extract_cycle", new, f["period_frames"], f["metrics"]["seam_pose"], skate, message)
-    return message
+    others = sum(1 for p in f["parts"] if p["loop"]) - 1
+    why = ("the part picked" if options.which is not None else
+           "the take's one part" if len(f["parts"]) == 1 else "the part with the most cycles"
+           + (f"; {others} other part(s) loop too: pick one in the parts list" if others > 0 else ""))
+    figures = [f"Period: {_seconds(f['period_frames'], f['fps'])}",
+               f"Loop: {f['cycle_frames']} frames × {options.cycles}",
+               f"Seam: {_seam(f['metrics']['seam_pose'])}",
+               f"Foot skate: {_speed(context, skate)}"]
+    failed = f.get("failed_checks") or []
+    message = (f"{new.name}: {_part(f, first)}, {why}; a loop of {f['cycle_frames']} frames "
+               f"({f['cycle_frames'] / f['fps']:.2f} s)"
+               f"{'' if options.cycles == 1 else f' × {options.cycles}'}"
+               + (f" ({words.refusal(failed)}, kept because forced)" if failed else ""))
+    metrics = report.facts["metrics"]
+    detail = [f["reason"], f"period: {f['period_reason']}",
+              *(f"{label}: {words.number(metrics.get(k), 4, unit) or 'not measured'}"
+                for k, (label, unit) in METRIC_LABELS.items()),
+              *(f"check {c['check']}: {c['reason']}" for c in failed), *report.warnings,
+              *_parts_detail(f["parts"], first)]
+    said = Said(message, figures, _with_note(detail, first))
+    _show(context, "extract_cycle", new, said, True, f["period_frames"], f["metrics"]["seam_pose"],
+          -1.0 if skate is None else skate)
+    return said
 
 
 def _blend_cycles(self, context, arm):
     action = arm.animation_data.action
     actions = _actions(arm, action, self.other)
+    self._actions = actions
     if len(actions) < 2:
         raise MocycleError("blend needs at least one other action (Other actions)")
-    motions = [rig.to_motion(arm, a) for a in actions]
+    motions = [Labelled(rig.to_motion(arm, a), a.name) for a in actions]
     options = props.options_from(self.options_cls, self, which=None if self.which < 0 else self.which)
     report = tasks.blend.run(motions, options)
     result = report.result
@@ -185,18 +374,25 @@ def _blend_cycles(self, context, arm):
     rig_assign(arm, new)
     f = report.facts
     self._warnings = report.warnings
-    message = (f"{new.name}: blend of {', '.join(a.name for a in actions)}, period {f['period_frames']:.1f} "
-               f"frames, seam {f['seam']['seam_pose']:.2f}× median step")
-    _record(context, "blend_cycles", new, f["period_frames"], f["seam"]["seam_pose"], -1.0, message)
-    return message
+    fps = context.scene.render.fps / context.scene.render.fps_base
+    skate = f["feet"].get("skate_after")
+    figures = [f"Period: {_seconds(f['period_frames'], fps)}", f"Seam: {_seam(f['seam']['seam_pose'])}"] + (
+        [f"Foot skate: {_speed(context, skate)}"] if skate is not None else [])
+    message = (f"{new.name}: blend of {', '.join(a.name for a in actions)}, a period of "
+               f"{_seconds(f['period_frames'], fps)}")
+    said = Said(message, figures, [message, *report.warnings])
+    _show(context, "blend_cycles", new, said, True, f["period_frames"], f["seam"]["seam_pose"],
+          -1.0 if skate is None else skate)
+    return said
 
 
 def _transition(self, context, arm):
     action = arm.animation_data.action
     actions = _actions(arm, action, self.other)
+    self._actions = actions
     if len(actions) != 2:
         raise MocycleError("transition needs exactly one other action (Other actions)")
-    motions = [rig.to_motion(arm, a) for a in actions]
+    motions = [Labelled(rig.to_motion(arm, a), a.name) for a in actions]
     options = props.options_from(self.options_cls, self, which=None if self.which < 0 else self.which)
     report = tasks.transition.run(motions, options)
     new = rig.write_action(arm, report.motions["transition"], f"{actions[0].name}_to_{actions[1].name}",
@@ -205,26 +401,35 @@ def _transition(self, context, arm):
     rig_assign(arm, new)
     f = report.facts
     self._warnings = report.warnings
-    message = (f"{new.name}: {f['frames']} frames over {f['cycles']} cycles, period {f['period_frames_start']:.1f}"
-               f" → {f['period_frames_end']:.1f} frames")
-    _record(context, "transition", new, message=message)
-    return message
+    fps = context.scene.render.fps / context.scene.render.fps_base
+    figures = [f"Length: {_seconds(f['frames'], fps)}, {f['cycles']} cycles",
+               f"Period: {_seconds(f['period_frames_start'], fps)} → {_seconds(f['period_frames_end'], fps)}"]
+    message = (f"{new.name}: {f['frames']} frames over {f['cycles']} cycles, the period going from "
+               f"{words.number(f['period_frames_start'], 1, 'frames')} to "
+               f"{words.number(f['period_frames_end'], 1, 'frames')}")
+    said = Said(message, figures, [message, *report.warnings])
+    _show(context, "transition", new, said, True)
+    return said
 
 
 def _stretch(self, context, arm):
     action = arm.animation_data.action
     first, last = rig.action_frames(action)
+    self._first = first
     motion = rig.to_motion(arm, action, (first, last))
-    report = tasks.stretch.run(motion, props.options_from(self.options_cls, self))
+    report = tasks.stretch.run(Labelled(motion, action.name), props.options_from(self.options_cls, self))
     new = rig.write_action(arm, report.motions["stretched"], f"{action.name}_stretched", first)
     _keep_facts(new, report)
     rig_assign(arm, new)
     f = report.facts
     self._warnings = report.warnings
     skate = f["feet"].get("skate_after")
+    figures = [f"Length: {f['frames_in']} → {f['frames_out']} frames (× {f['factor']:g})"] + (
+        [f"Foot skate: {_speed(context, skate)}"] if skate is not None else [])
     message = f"{new.name}: {f['frames_in']} → {f['frames_out']} frames (factor {f['factor']:g})"
-    _record(context, "stretch", new, skate=-1.0 if skate is None else skate, message=message)
-    return message
+    said = Said(message, figures, [message, *report.warnings])
+    _show(context, "stretch", new, said, True, skate=-1.0 if skate is None else skate)
+    return said
 
 
 def rig_assign(arm, action) -> None:
@@ -250,4 +455,21 @@ Stretch = _task_operator("stretch", "stretch", "Stretch", "The active action len
                          "warping of its periodic part) as a new action", {}, _stretch)
 
 
-CLASSES = (FindPhase, ExtractCycle, BlendCycles, Transition, Stretch)
+class MOCYCLE_OT_copy_details(bpy.types.Operator):
+    """Copy the last run's message and technical detail to the clipboard"""
+
+    bl_idname = "mocycle.copy_details"
+    bl_label = "Copy Details"
+
+    @classmethod
+    def poll(cls, context):
+        return bool(context.scene.mocycle.last_detail)
+
+    def execute(self, context):
+        st = _state(context)
+        context.window_manager.clipboard = f"{st.last_message}\n{st.last_detail}"
+        self.report({"INFO"}, "mocycle: details copied")
+        return {"FINISHED"}
+
+
+CLASSES = (FindPhase, ExtractCycle, BlendCycles, Transition, Stretch, MOCYCLE_OT_copy_details)

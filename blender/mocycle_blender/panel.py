@@ -1,7 +1,10 @@
-"""The sidebar panel (3D view, tab "mocycle"): the options of each task, the parts found, the last result.
-Each button runs its operator with the panel's settings."""
+"""The sidebar panel (3D view, tab "mocycle"): the options of each task, the parts found, the last result in
+a few short lines, and its technical detail in the Details sub-panel (closed by default).  Each button runs its
+operator with the panel's settings."""
 
 from __future__ import annotations
+
+import textwrap
 
 import bpy
 
@@ -16,8 +19,27 @@ ADVANCED = {"classes", "pca", "delay", "min_periods", "n_landmarks", "time_axis"
 
 class MOCYCLE_UL_parts(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
-        what = f"{item.n_periods:.1f} × {item.period_frames:.1f} fr" if item.loops else item.reason
-        layout.label(text=f"{index}: {item.kind} [{item.frames}]  {what}", icon="CHECKMARK" if item.loops else "BLANK1")
+        what = (f"{item.n_periods:.1f} cycles of {item.period_frames:.1f} frames" if item.loops and item.n_periods
+                else item.reason or "does not loop")
+        layout.label(text=f"{index}: {item.kind}, frames {item.frames}: {what}",
+                     icon="CHECKMARK" if item.loops else "BLANK1")
+
+
+def parts_are_of(st, action) -> bool:
+    """The parts list holds the parts of ``action`` over the frames the operators would read now."""
+    return action is not None and len(st.parts) > 0 and st.parts_action == action.name and \
+        st.parts_range == props.range_key(st)
+
+
+def wrapped(layout, context, text: str, icon: str = "NONE") -> None:
+    """``text`` as labels, a line each, wrapped to the sidebar's width (a label is one line in Blender)."""
+    region = getattr(context, "region", None)
+    width = max(24, int((region.width if region else 420) / 7))
+    first = True
+    for paragraph in text.split("\n"):
+        for line in textwrap.wrap(paragraph, width) or [""]:
+            layout.label(text=line, icon=icon if first else "BLANK1" if icon != "NONE" else "NONE")
+            first = False
 
 
 def _options(layout, group, options_cls, advanced: bool):
@@ -26,12 +48,13 @@ def _options(layout, group, options_cls, advanced: bool):
             layout.prop(group, name)
 
 
-def _button(layout, idname, text, group, options_cls, st, extra=()):
+def _button(layout, idname, text, group, options_cls, st, extra=(), action=None):
     op = layout.operator(idname, text=text)
     props.copy_options(options_cls, group, op)
     for k in extra:
-        if k == "which":  # a part of the action (the list Find Phase or Extract Cycle filled last)
-            op.which = st.part_index if 0 <= st.part_index < len(st.parts) else -1
+        if k == "which":  # the part picked in the list, when the list is the active action's over these frames
+            picked = 0 <= st.part_index < len(st.parts) and parts_are_of(st, action)
+            op.which = st.part_index if picked else -1
         elif k == "other":
             op.other = st.other_action.name if st.other_action else ""
         else:
@@ -71,22 +94,32 @@ class MOCYCLE_PT_panel(bpy.types.Panel):
         _options(box, st.phase, tasks.phase.Options, advanced=False)
         _button(box, "mocycle.find_phase", "Find Phase", st.phase, tasks.phase.Options, st, common)
         if len(st.parts):  # the steady parts Find Phase or Extract Cycle found: pick one, the buttons below use it
-            box.template_list("MOCYCLE_UL_parts", "", st, "parts", st, "part_index", rows=3)
+            col = box.column()
+            if parts_are_of(st, action):
+                col.label(text=f"Parts of {st.parts_action}: pick one for the buttons below")
+            else:  # another action's (or other frames'): shown, not used
+                col.active = False
+                other = "not the active action" if action is None or st.parts_action != action.name else \
+                    "other frames"
+                col.label(text=f"Parts of {st.parts_action} ({other}): not used", icon="INFO")
+            col.template_list("MOCYCLE_UL_parts", "", st, "parts", st, "part_index", rows=3)
 
         box = layout.box()
         box.label(text="Cycle")
         _options(box, st.loop, tasks.loop.Options, advanced=False)
-        _button(box, "mocycle.extract_cycle", "Extract Cycle", st.loop, tasks.loop.Options, st, common + ("which",))
+        _button(box, "mocycle.extract_cycle", "Extract Cycle", st.loop, tasks.loop.Options, st, common + ("which",),
+                action)
 
         box = layout.box()
         box.label(text="Blend / Transition")
         box.prop(st, "other_action")
         box.prop(st, "other_weight")
         row = box.row()
-        op = _button(row, "mocycle.blend_cycles", "Blend Cycles", st.blend, tasks.blend.Options, st, ("which", "other"))
+        op = _button(row, "mocycle.blend_cycles", "Blend Cycles", st.blend, tasks.blend.Options, st, ("which", "other"),
+                     action)
         op.weights = f"{1 - st.other_weight:g},{st.other_weight:g}"
         _button(row, "mocycle.transition", "Transition", st.transition, tasks.transition.Options, st,
-                ("which", "other"))
+                ("which", "other"), action)
 
         box = layout.box()
         box.label(text="Stretch")
@@ -96,13 +129,10 @@ class MOCYCLE_PT_panel(bpy.types.Panel):
         box = layout.box()
         box.label(text="Last result")
         if st.last_task:
-            box.label(text=f"{st.last_task}: {st.last_action}")
-            if st.last_period >= 0:
-                box.label(text=f"Period: {st.last_period:.2f} frames")
-            if st.last_seam >= 0:
-                box.label(text=f"Seam: {st.last_seam:.2f} × median step")
-            if st.last_skate >= 0:
-                box.label(text=f"Foot skate: {st.last_skate:.3g} units/s")
+            # one short line and the figures with their units; the technical detail is under Details
+            wrapped(box, context, st.last_message, icon="CHECKMARK" if st.last_ok else "ERROR")
+            for line in filter(None, st.last_figures.split("\n")):
+                box.label(text=line)
         else:
             box.label(text="(nothing run yet)")
 
@@ -126,4 +156,26 @@ class MOCYCLE_PT_advanced(bpy.types.Panel):
             _options(box, group, cls, advanced=True)
 
 
-CLASSES = (MOCYCLE_UL_parts, MOCYCLE_PT_panel, MOCYCLE_PT_advanced)
+class MOCYCLE_PT_details(bpy.types.Panel):
+    """The last run's technical detail: the library's own words, each check's reason with its numbers, the
+    warnings; the same text goes to the Info editor, and Copy Details puts it on the clipboard."""
+
+    bl_label = "Details"
+    bl_parent_id = "MOCYCLE_PT_panel"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "mocycle"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        st = context.scene.mocycle
+        if not st.last_detail:
+            self.layout.label(text="(no details: run an operator)")
+            return
+        self.layout.operator("mocycle.copy_details", text="Copy Details", icon="COPYDOWN")
+        col = self.layout.column(align=True)
+        for paragraph in st.last_detail.split("\n"):
+            wrapped(col, context, paragraph)
+
+
+CLASSES = (MOCYCLE_UL_parts, MOCYCLE_PT_panel, MOCYCLE_PT_details, MOCYCLE_PT_advanced)

@@ -16,14 +16,20 @@ from bpy.props import (
 from mocycle import tasks
 
 #: fields the add-on fills from Blender itself: the frame range from frame numbers, the phase joints from the
-#: Pose Mode selection, the part from the list ``find_phase`` or ``extract_cycle`` made; AMC input never reaches it
-FROM_BLENDER = {"amc_fps", "frame_range", "joints", "which"}
+#: Pose Mode selection, the part from the list ``find_phase`` or ``extract_cycle`` made; AMC input and the take
+#: of a glTF or FBX file never reach it (it reads the active action)
+FROM_BLENDER = {"amc_fps", "frame_range", "joints", "which", "take"}
 #: a value for fields the task requires (no default)
 REQUIRED_DEFAULTS = {"factor": 1.5}
 
 
+#: labels that say what a field is in the words of the panel, where its name would not ("classes" counts the
+#: periodic motions looked for inside a part; the panel speaks of parts, not classes)
+LABELS = {"classes": "Periodic motions"}
+
+
 def _label(name: str) -> str:
-    return name.replace("_", " ").capitalize()
+    return LABELS.get(name, name.replace("_", " ").capitalize())
 
 
 def schema_property(name: str, spec: dict):
@@ -73,6 +79,14 @@ def copy_options(options_cls, source, target) -> None:
         setattr(target, k, getattr(source, k))
 
 
+def range_key(source) -> str:
+    """The frames an operator reads (``source``: the operator or the panel's state, both with the ``COMMON``
+    settings), as the parts list remembers them: ``""`` for all the action's frames, else ``"START..END"``."""
+    if not getattr(source, "use_frame_range", False):
+        return ""
+    return f"{source.frame_start}..{source.frame_end}"
+
+
 def _group(name: str, options_cls, more: dict | None = None):
     return type(name, (bpy.types.PropertyGroup,), {"__annotations__": {**annotations(options_cls), **(more or {})}})
 
@@ -100,7 +114,8 @@ StretchSettings = _group("MOCYCLE_PG_stretch", tasks.stretch.Options)
 
 
 class MOCYCLE_PG_part(bpy.types.PropertyGroup):
-    """One steady part of the action that Extract Cycle found (walk straight, turning, run, arms, ...)."""
+    """One steady part of the action that Find Phase or Extract Cycle found (walk straight, turning, run, arms,
+    ...)."""
 
     kind: StringProperty(name="Kind")
     frames: StringProperty(name="Frames")
@@ -123,12 +138,19 @@ MOCYCLE_PG_state = type("MOCYCLE_PG_state", (bpy.types.PropertyGroup,), {"__anno
     "other_weight": FloatProperty(name="Weight of the other", default=0.5, min=0.0, max=1.0),
     "parts": CollectionProperty(type=MOCYCLE_PG_part),
     "part_index": IntProperty(name="Part", default=-1),
+    # whose parts the list holds: the action and the frame range read ("" for all its frames)
+    "parts_action": StringProperty(),
+    "parts_range": StringProperty(),
+    # the last run, whether it worked or not: one short line, its figures with units, the technical detail
     "last_task": StringProperty(),
     "last_action": StringProperty(),
+    "last_ok": BoolProperty(default=True),
     "last_period": FloatProperty(default=-1.0),
     "last_seam": FloatProperty(default=-1.0),
     "last_skate": FloatProperty(default=-1.0),
     "last_message": StringProperty(),
+    "last_figures": StringProperty(),
+    "last_detail": StringProperty(),
 }})
 
 

@@ -111,8 +111,9 @@ def test_the_api_refuses_without_force_and_gives_with_force(refused_library):
 
 @pytest.mark.browser
 def test_the_page_shows_a_refused_loop_as_refused(refused_library, tmp_path):
-    """The library row and the review say refused with the reason, nothing is downloadable; the force button
-    shows the loop marked FORCED and downloads it as ``limp_loop.forced.bvh``."""
+    """The library row and the review say refused in plain words, each check's reason one click away, nothing
+    is downloadable; the force button shows the loop marked FORCED and downloads it as
+    ``limp_loop.forced.bvh``."""
     pytest.importorskip("uvicorn")
     pytest.importorskip("playwright")
     from studio_harness import CHROMIUM, chromium, served, watch_console
@@ -129,21 +130,28 @@ def test_the_page_shows_a_refused_loop_as_refused(refused_library, tmp_path):
         page.wait_for_function("window.__studio.library && window.__studio.library.done === 2", timeout=120_000)
         row = page.locator('[data-testid="take"]', has_text="limp.bvh")
         page.wait_for_function("document.querySelector('[data-testid=take][data-state=refused]')", timeout=10_000)
-        assert "refused (fit" in row.inner_text() and "plain cut" in row.inner_text()
+        # a line of plain words; each check's reason, with its numbers, one click away (a closed <details>)
+        line = row.locator("li.refused summary").inner_text()
+        assert line.startswith("refused: not a loop: the cycle found does not match") and "--force" not in line
+        assert not row.locator("li.refused .reason").is_visible()
+        row.locator("li.refused summary").click()
+        assert "fit: the cycle fits the take" in row.inner_text() and "plain cut" in row.inner_text()
         assert page.locator('[data-testid="take"]', has_text="walk.bvh").get_attribute("data-state") == "ok"
         before = page.evaluate("window.__studio.loopJob ? window.__studio.loopJob.id : null")
         row.click()  # (the page opened it first too: wait for the loop job of this click)
         status = page.locator('[data-testid="loop-status"]')
         page.wait_for_function(f"window.__studio.loopJob && window.__studio.loopJob.id !== {json.dumps(before)} && "
                                "document.getElementById('loop-status').dataset.state === 'refused'", timeout=120_000)
-        assert "refused: limp.bvh: not a loop (fit:" in status.inner_text()
+        assert status.inner_text().startswith("refused: not a loop: the cycle found does not match")
+        assert "--force" not in status.inner_text()
+        assert "plain cut" in page.locator("#metrics").inner_text()  # the checks' own reasons
         assert page.locator('[data-testid="loop-bvh"]').get_attribute("href") is None
         assert page.locator('[data-testid="loop-glb"]').get_attribute("href") is None
         assert not page.evaluate("!!window.__studio.player.loop")
         page.screenshot(path=str(tmp_path / "refused.png"))
         page.locator('[data-testid="force-loop"]').click()
         page.wait_for_function("document.getElementById('loop-status').dataset.state === 'forced'", timeout=120_000)
-        assert "FORCED" in status.inner_text() and "fit" in status.inner_text()
+        assert "FORCED: not a loop: " in status.inner_text() and "checks fit" in status.inner_text()
         assert page.evaluate("!!window.__studio.player.loop")
         with page.expect_download() as download:
             page.locator('[data-testid="loop-bvh"]').click()

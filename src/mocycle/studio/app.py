@@ -266,13 +266,17 @@ def _clean(value):
 
 
 class JSON(JSONResponse):
-    """JSON whose strings are valid UTF-8 whatever file names they carry."""
+    """JSON whose strings are valid UTF-8 whatever file names they carry, and whose figures that could not be
+    measured (NaN: the foot skate of a rig whose feet are not found by name) are null (strict JSON: the
+    page's parser refuses NaN, and a NaN in one take's figures made the whole library a 500)."""
 
     def render(self, content) -> bytes:
         try:
             return super().render(content)
-        except UnicodeEncodeError:
-            return super().render(_clean(content))
+        except ValueError:  # a string that is not UTF-8 (UnicodeEncodeError) or a number that is not finite
+            from ..text import json_text
+
+            return json_text(_clean(content), indent=None).encode("utf-8")
 
 
 def _error(status: int, message: str) -> JSONResponse:

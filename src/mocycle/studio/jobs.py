@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import LoopRefused, MocycleError
+from ..tasks import words
 from .validate import Busy, Gone, NotFound
 
 #: jobs held before they are reached, cancelled ones included: at most this many times ``max_pending``
@@ -137,8 +138,15 @@ class Job:
         return self.cancel_event.is_set()
 
     def to_dict(self) -> dict:
+        """Its state; ``error`` whole, ``error_line`` the line the page shows of it (a refusal: its failed checks
+        in plain words, :func:`~mocycle.tasks.words.refusal`; else :func:`~mocycle.tasks.words.brief`)."""
+        line = None
+        if self.error:
+            facts = self.result.get("facts", {}) if isinstance(self.result, dict) else {}
+            line = words.refusal(facts["failed_checks"]) if self.status == "refused" and facts.get(
+                "failed_checks") else words.brief(self.error)
         return {"id": self.id, "kind": self.kind, "status": self.status, "progress": round(self.progress, 4),
-                "error": self.error}
+                "error": self.error, "error_line": line}
 
 
 class Jobs:

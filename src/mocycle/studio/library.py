@@ -13,6 +13,7 @@ from pathlib import Path
 
 from ..errors import MocycleError
 from ..motion import Motion
+from ..tasks import words
 
 #: the motion files the library lists (``.amc`` needs its ``.asf`` beside it)
 SUFFIXES = (".bvh", ".amc", ".fbx", ".glb", ".gltf")
@@ -115,13 +116,20 @@ class Take:
             self._lock.release()
 
     def to_dict(self) -> dict:
+        """What the page lists; ``reason`` and ``error`` whole (the detail), ``reason_line`` and ``error_line``
+        the line the page shows of them (:func:`~mocycle.tasks.words.brief`)."""
         return {"id": self.id, "name": self.name, "path": display(str(self.path)), "status": self.status,
-                "facts": self.facts, "loops": self.loops, "reason": self.reason, "error": self.error}
+                "facts": self.facts, "loops": self.loops, "reason": self.reason, "error": self.error,
+                "reason_line": self.reason and words.brief(self.reason),
+                "error_line": self.error and words.brief(self.error)}
 
 
 def loop_summary(loop: dict) -> dict:
     """The figures the library shows for one loop (from ``tasks.loop`` facts).  ``refused``: the loop failed
-    checks (``failed_checks``, the ones ``tasks.loop`` refuses it for without ``force``); ``refusal``: why."""
+    checks (``failed_checks``, the ones ``tasks.loop`` refuses it for without ``force``); ``refusal``: why, each
+    check's reason with its numbers; ``refusal_line``: the same in a few plain words
+    (:func:`~mocycle.tasks.words.refusal`).  A figure that could not be measured (the foot skate of a rig
+    whose feet are not found by name) is None."""
     m = loop.get("metrics", {})
     failed = loop.get("failed_checks", [])
     return {"part": loop["part"], "kind": loop.get("kind"), "frames": loop.get("frames"),
@@ -131,4 +139,5 @@ def loop_summary(loop: dict) -> dict:
             "skate": m.get("skate"), "input_skate": m.get("input_skate"),
             "failed_checks": [c.get("check", c.get("name", "")) for c in failed],
             "refused": bool(failed), "refusal": "; ".join(f"{c['check']}: {c['reason']}" for c in failed) or None,
+            "refusal_line": words.refusal(failed) if failed else None,
             "excitation": loop.get("excitation")}

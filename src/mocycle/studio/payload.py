@@ -47,7 +47,8 @@ def unpack(data: bytes) -> tuple[dict, dict[str, np.ndarray]]:
 
 
 def skeleton_header(motion) -> dict:
-    """The figure to draw: point names and parents (joints, then End Sites), the vertical, floor and height."""
+    """The figure to draw: point names and parents (joints, then End Sites), the vertical, floor and height,
+    and the joints not drawn (``hidden``: :func:`detached_joints`)."""
     from ..contacts import body_height, floor_height, up_axis
 
     skel = motion.skeleton
@@ -56,7 +57,49 @@ def skeleton_header(motion) -> dict:
     parents = [int(p) for p in skel.parents] + [int(s.parent) for s in skel.end_sites]
     return {"frames": motion.n_frames, "fps": motion.fps, "names": names, "parents": parents,
             "joints": skel.n_joints, "travel": motion.travel_joint, "up": [float(v) for v in up],
-            "floor": floor_height(motion), "height": body_height(motion, up)}
+            "floor": floor_height(motion), "height": body_height(motion, up), "hidden": detached_joints(motion)}
+
+
+#: a joint "never moves" when its world position spans at most this share of the body's longest bone
+STILL_SHARE = 1e-4
+
+
+def detached_joints(motion) -> list[int]:
+    """The joints the viewer does not draw (nor their bones): a joint above the body (an ancestor of the travel
+    joint) that never moves and comes farther from the body (the travel joint) than the body's longest bone is
+    long, at some frame of the take.  Such a joint is a fixed point of the room, not a part of the body: the
+    Bandai Namco files' ``joint_Root`` stays at the room's origin while ``Hips`` carries the walk, and drawn as a
+    bone it is a stick from the origin to the hips that stretches across the room.  Decided from the motion
+    (no joint name is looked at), once for the whole take, so that no bone comes and goes while it plays.
+
+    The body's bones: the frame-0 offsets of the joints and End Sites hanging from the travel joint."""
+    from ..motion import chain_kinematics_blocks
+
+    skel = motion.skeleton
+    travel = motion.travel_joint
+    chain = skel.chain_to(travel)
+    above = chain[:-1]
+    if not above:
+        return []
+    body = {travel}
+    for j in range(travel + 1, skel.n_joints):  # parents come first
+        if int(skel.parents[j]) in body:
+            body.add(j)
+    rest = motion.translations_at(0)
+    bones = [float(np.linalg.norm(rest[j])) for j in body if j != travel]
+    bones += [float(np.linalg.norm(s.offset)) for s in skel.end_sites if s.parent in body]
+    longest = max(bones, default=0.0)
+    if not longest > 0:  # a body without bones (one joint): nothing to compare with
+        return []
+    low = np.full((len(above), 3), np.inf)
+    high = np.full((len(above), 3), -np.inf)
+    far = np.zeros(len(above))
+    for _, _, W in chain_kinematics_blocks(motion, chain, 8192):
+        low = np.minimum(low, W[:, :-1].min(axis=0))
+        high = np.maximum(high, W[:, :-1].max(axis=0))
+        far = np.maximum(far, np.linalg.norm(W[:, :-1] - W[:, -1:], axis=2).max(axis=0))
+    still = (high - low).max(axis=1) <= STILL_SHARE * longest
+    return [int(j) for j, s, d in zip(above, still, far, strict=True) if s and d > longest]
 
 
 def motion_payload(motion, extra: dict | None = None) -> bytes:

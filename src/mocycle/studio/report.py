@@ -12,6 +12,7 @@ import json
 from collections.abc import Iterator
 from pathlib import Path
 
+from ..text import json_text
 from .payload import motion_payload_pieces
 
 STATIC = Path(__file__).parent / "static"
@@ -87,8 +88,8 @@ def report_pieces(title: str, take, loop_report=None, reason: str | None = None)
     imports = {name: _data_url(_module_text(name)) for name in MODULES}
     # in a <script> element "<!--" followed by "<script" swallows the rest of the page, "</script" ends it: no
     # "<", ">" or "&" in the JSON (JSON escapes them), whatever a title or a name holds
-    payload = json.dumps(data, allow_nan=False).replace("<", "\\u003c").replace(">", "\\u003e").replace(
-        "&", "\\u0026")
+    # (strict JSON: a figure that could not be measured, NaN, is null)
+    payload = json_text(data, indent=None).replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
     css = (STATIC / "studio.css").read_text(encoding="utf-8")
     page = f"""<!doctype html>
 <html lang="en">

@@ -5,6 +5,8 @@ import { decode } from "mocycle/payload.js";
 
 const $ = (id) => document.getElementById(id);
 const fmt = (v, d = 2) => (v == null || !isFinite(v) ? "–" : Number(v).toFixed(d));
+// a figure with its unit, or "not measured" (null: what the loop's facts could not measure)
+const measured = (v, d, unit) => (v == null || !isFinite(v) ? "not measured" : `${Number(v).toFixed(d)} ${unit}`);
 
 function fromBase64(text) {
   const bytes = Uint8Array.from(atob(text), (c) => c.charCodeAt(0));
@@ -29,8 +31,9 @@ export function startReport(data) {
   if (data.summary) {
     const l = data.summary, m = data.metrics;
     rows.push(["period", `${fmt(l.period_frames, 1)} frames (${fmt(l.period_s)} s)`], ["loop", `${l.cycle_frames} frames`],
-      ["seam jump, pose / velocity", `${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} × median step`],
-      ["foot skate, loop / take", `${fmt(l.skate)} / ${fmt(l.input_skate)} units/s`],
+      ["seam jump, pose / velocity", `${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} × a frame's step (about 1 is seamless)`],
+      ["foot skate, loop / take", l.skate == null && l.input_skate == null ? "not measured (no feet found by name)" :
+        `${measured(l.skate, 2, "units/s")} / ${measured(l.input_skate, 2, "units/s")}`],
       ["template error", `${fmt(m.template_error, 4)} rad`], ["jerk, loop / take", fmt(m.jerk_ratio)],
       ["failed checks", data.failed_checks.map((c) => `${c.check}: ${c.reason}`).join("; ") || "none"]);
     for (const [k, v] of Object.entries(data.options)) rows.push([k, v ?? "–"]);
@@ -40,8 +43,8 @@ export function startReport(data) {
     // made with --force: the page says first that this loop fails its checks
     const b = $("banner");
     b.hidden = false;
-    b.textContent = `FORCED: this loop fails its checks (${data.failed_checks.map((c) => c.check).join(", ")}) ` +
-      "and is shown only because the report was made with --force: " + data.failed_checks.map((c) => `${c.check}: ${c.reason}`).join("; ");
+    b.textContent = `FORCED: ${data.summary.refusal_line} (checks ${data.failed_checks.map((c) => c.check).join(", ")}); ` +
+      "shown only because the report was made with --force: " + data.failed_checks.map((c) => `${c.check}: ${c.reason}`).join("; ");
   }
   const esc = (s) => String(s).replace(/[&<>]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;" }[c]));
   $("metrics").innerHTML = `<h2>${esc(data.title)}</h2><table>${rows.map(([k, v]) => `<tr><th>${esc(k)}</th><td>${esc(v)}</td></tr>`).join("")}</table>`;

@@ -31,6 +31,14 @@ function h(tag, attrs = {}, ...children) {
 
 function status(text, isError = false) { const el = $("status"); el.textContent = text; el.classList.toggle("error", isError); }
 const fmt = (v, d = 2) => (v == null || !isFinite(v) ? "–" : Number(v).toFixed(d));
+// a figure with its unit, or "not measured" (the server sends null for what it could not measure)
+const measured = (v, d, unit) => (v == null || !isFinite(v) ? "not measured" : `${Number(v).toFixed(d)} ${unit}`);
+const seam = (v) => measured(v, 2, "× a frame's step");
+// a line, and the whole text one click away when the line is only its start (the server cut it: tasks.words)
+function said(line, whole, cls) {
+  if (!whole || line === whole) return h("span", { class: cls }, line);
+  return h("details", { class: cls }, h("summary", {}, line), h("div", { class: "reason" }, whole));
+}
 
 // ---------------------------------------------------------------- library
 function renderLibrary(data) {
@@ -49,16 +57,16 @@ function renderLibrary(data) {
     row.classList.toggle("current", t.id === S.take);
     const f = t.facts || {};
     // a loop that fails its checks is refused (as mocycle loop refuses it): its status and the reason
-    const loops = t.loops.map((l) => h("li", { class: l.refused ? "refused" : "ok", "data-state": l.refused ? "refused" : "ok", title: l.refused ? l.refusal : null },
-      l.refused ? [h("span", { class: "bad" }, `refused (${l.failed_checks.join(", ")})`), " · "] : [],
+    // a loop that fails its checks: refused in plain words, each check's reason (with its numbers) one click away
+    const loops = t.loops.map((l) => h("li", { class: l.refused ? "refused" : "ok", "data-state": l.refused ? "refused" : "ok" },
       l.kind ? `${l.kind} ${l.frames ? `${l.frames[0]}–${l.frames[1]} ` : ""}· ` : "",
-      `period ${fmt(l.period_s)} s (${fmt(l.period_frames, 1)} fr) · seam ${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} · skate ${fmt(l.skate)}`,
-      l.refused ? h("div", { class: "reason" }, l.refusal) : null));
-    const state = t.status === "done" ? "" : ["failed", "refused"].includes(t.status) ? h("span", { class: "bad" }, t.error) : h("span", { class: "busy" }, `${t.status}…`);
+      `period ${fmt(l.period_s)} s (${fmt(l.period_frames, 1)} frames) · seam ${seam(l.seam_pose)} · foot skate ${measured(l.skate, 2, "units/s")}`,
+      l.refused ? said(`refused: ${l.refusal_line}`, `refused: ${l.refusal_line} (${l.refusal})`, "bad") : null));
+    const state = t.status === "done" ? "" : ["failed", "refused"].includes(t.status) ? said(t.error_line, t.error, "bad") : h("span", { class: "busy" }, `${t.status}…`);
     row.dataset.state = t.status !== "done" ? t.status : !t.loops.length ? "no-loop" : t.loops.some((l) => !l.refused) ? "ok" : "refused";
     row.replaceChildren(h("div", { class: "name" }, t.name),
       h("div", { class: "facts" }, `${f.frames ?? "…"} frames · ${fmt(f.fps, 0)} fps · ${t.status === "done" ? `${t.loops.length} loop${t.loops.length === 1 ? "" : "s"}` : ""} `, state),
-      h("ul", { class: "loops" }, loops, t.reason ? h("li", { class: "muted" }, `no loop: ${t.reason}`) : null));
+      h("ul", { class: "loops" }, loops, t.reason ? h("li", { class: "muted" }, said(`no loop: ${t.reason_line}`, `no loop: ${t.reason}`)) : null));
   }
 }
 
@@ -162,26 +170,27 @@ async function runLoop() {
       // refused as mocycle loop refuses it: no loop shown, nothing to download unless asked with force
       S.player.setLoop(null); S.player.setPhase(null, null);
       const force = h("button", { id: "loop-force", type: "button", "data-testid": "force-loop" }, "Show and download anyway (force)");
-      loopState("refused", `refused: ${j.error} `, force);
+      loopState("refused", `refused: ${j.error_line} `, force);  // each check's reason is in the table below
       force.addEventListener("click", () => { $("loop-options").elements.force.checked = true; runLoop(); });
       $("metrics").replaceChildren(h("table", {}, j.result.failed_checks.map((c) => h("tr", {}, h("th", {}, `failed check: ${c.check}`), h("td", {}, c.reason)))));
       return;
     }
-    if (j.status !== "done") { loopState("failed", j.error || j.status); S.player.setLoop(null); return; }
+    if (j.status !== "done") { loopState("failed", j.error ? said(j.error_line, j.error) : j.status); S.player.setLoop(null); return; }
     const loop = await fetchPayload(`/api/jobs/${j.id}/motion`);
     if (S.take !== id || seq !== S.loopSeq) return;
     loop.header.cycle_frames = j.result.view.cycle_frames;
     S.player.setLoop(loop, j.result.view.loop_frame);
     S.player.setPhase(j.result.phase, j.result.excitation, j.result.parts);
     const l = j.result.loop, failed = j.result.failed_checks;
-    const text = `loop ${l.cycle_frames} frames · period ${fmt(l.period_s)} s · ${fmt(j.result.seconds)} s`;
-    if (failed.length) loopState("forced", `FORCED: this loop fails its checks (${failed.map((c) => c.check).join(", ")}) and is shown because you asked · ${text}`);
+    const text = `loop of ${l.cycle_frames} frames · period ${fmt(l.period_s)} s · made in ${fmt(j.result.seconds)} s`;
+    if (failed.length) loopState("forced", `FORCED: ${l.refusal_line} (checks ${failed.map((c) => c.check).join(", ")}); shown because you asked · ${text}`);
     else loopState("ok", text);
     const row = (k, v, cls) => h("tr", {}, h("th", {}, k), h("td", { class: cls }, v));
     $("metrics").replaceChildren(h("table", {},
       row("period", `${fmt(l.period_frames, 1)} frames (${fmt(l.period_s)} s)`),
-      row("seam jump, pose / velocity", `${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} × median step`),
-      row("foot skate, loop / take", `${fmt(l.skate)} / ${fmt(l.input_skate)} units/s`),
+      row("seam jump, pose / velocity", `${fmt(l.seam_pose)} / ${fmt(l.seam_velocity)} × a frame's step (about 1 is seamless)`),
+      row("foot skate, loop / take", l.skate == null && l.input_skate == null ? "not measured (no feet found by name)" :
+        `${measured(l.skate, 2, "units/s")} / ${measured(l.input_skate, 2, "units/s")}`),
       row("failed checks", failed.map((c) => `${c.check}: ${c.reason}`).join("; ") || "none", failed.length ? "bad" : null),
       j.result.warnings.map((w) => row("warning", w))));
     setDownloads("loop", `/api/jobs/${j.id}/loop`);

@@ -8,7 +8,11 @@ export class Figure {
   constructor(viewer, header, color) {
     this.header = header;
     this.parents = header.parents;
-    this.bones = this.parents.map((p, i) => [p, i]).filter(([p]) => p >= 0);
+    // joints the server found detached from the body (studio/payload.py: a still joint above the body, farther
+    // from it than any bone of the body, e.g. a root left at the room's origin): neither they nor their bones
+    const hidden = new Set(header.hidden || []);
+    this.points = this.parents.map((_, i) => i).filter((i) => !hidden.has(i));
+    this.bones = this.parents.map((p, i) => [p, i]).filter(([p, i]) => p >= 0 && !hidden.has(p) && !hidden.has(i));
     const s = viewer.scaleOf(header);
     this.group = new THREE.Group();
     // the take's vertical goes to +Y, its floor to y = 0, its height to about 1.7 scene units
@@ -20,7 +24,7 @@ export class Figure {
     const radius = 0.022 / s;
     const mat = new THREE.MeshStandardMaterial({ color, roughness: 0.55, metalness: 0.05 });
     this.boneMesh = new THREE.InstancedMesh(new THREE.CylinderGeometry(radius, radius, 1, 8), mat, this.bones.length);
-    this.jointMesh = new THREE.InstancedMesh(new THREE.SphereGeometry(radius * 1.6, 10, 8), mat, this.parents.length);
+    this.jointMesh = new THREE.InstancedMesh(new THREE.SphereGeometry(radius * 1.6, 10, 8), mat, this.points.length);
     for (const m of [this.boneMesh, this.jointMesh]) { m.frustumCulled = false; this.group.add(m); }
     viewer.scene.add(this.offset);
     this._m = new THREE.Matrix4(); this._q = new THREE.Quaternion(); this._v = new THREE.Vector3();
@@ -31,11 +35,10 @@ export class Figure {
   setPose(P) {
     const { _m, _q, _v, _a, _b, _s } = this;
     _s.set(1, 1, 1);
-    for (let i = 0; i < this.parents.length; i++) {
-      _v.set(P[i * 3], P[i * 3 + 1], P[i * 3 + 2]);
-      _m.makeTranslation(_v.x, _v.y, _v.z);
-      this.jointMesh.setMatrixAt(i, _m);
-    }
+    this.points.forEach((i, k) => {
+      _m.makeTranslation(P[i * 3], P[i * 3 + 1], P[i * 3 + 2]);
+      this.jointMesh.setMatrixAt(k, _m);
+    });
     this.bones.forEach(([p, c], k) => {
       _a.set(P[p * 3], P[p * 3 + 1], P[p * 3 + 2]);
       _b.set(P[c * 3], P[c * 3 + 1], P[c * 3 + 2]);
