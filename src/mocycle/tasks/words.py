@@ -24,7 +24,7 @@ LINE = 160
 def check_words(check) -> str:
     """One failed check (a ``FailedCheck`` or its ``to_dict()``) in plain words."""
     name = check.get("check", check.get("name", "")) if isinstance(check, dict) else getattr(check, "name", "")
-    return CHECK_WORDS.get(name, f"it fails the {name} check")
+    return CHECK_WORDS.get(str(name), f"it fails the {name} check")
 
 
 def refusal(failed_checks) -> str:
