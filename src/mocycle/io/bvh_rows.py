@@ -115,11 +115,17 @@ def row_chunks(path: str | os.PathLike, offset: int, n_channels: int) -> Iterato
                 if values is not None:
                     return values
 
+        def submit(pool):
+            try:
+                return pool.submit(read_parse)
+            except RuntimeError as exc:  # the interpreter is shutting down (Ctrl-C, SIGTERM): no helper thread
+                raise Unreadable(str(exc)) from None
+
         with ThreadPoolExecutor(max_workers=1, thread_name_prefix="mocycle-bvh-rows") as pool:
-            pending = pool.submit(read_parse)
+            pending = submit(pool)
             while True:
                 values = pending.result()
                 if values is None:
                     return
-                pending = pool.submit(read_parse)  # the next piece is parsed while the caller converts this one
+                pending = submit(pool)  # the next piece is parsed while the caller converts this one
                 yield values
