@@ -524,12 +524,14 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     parts = _fill(motion, parts, min_periods, options, map)
     keep = np.sort(np.concatenate(stepped)) if stepped else np.zeros(0, dtype=np.intp)
     steps = Landings(landings.frames[keep], landings.foot[keep], landings.sides, landings.down)
-    for p in parts:
-        if p.gait and p.n_periods >= min_periods:
-            if joints is None:
-                _gait_phase(motion, p, steps)
-            else:
-                _asked_phase(motion, p, min_periods, options)
+    gait = [p for p in parts if p.gait and p.n_periods >= min_periods]
+    if joints is None:  # each part's phase from its own frames and the landings near them: side by side
+        jobs = [_GaitJob(motion[p.start:p.stop], _rebased_part(p), _steps_near(steps, p)) for p in gait]
+        for p, (periodic, period) in zip(gait, map(_gait_job, jobs), strict=True):
+            p.periodic, p.period_frames = periodic, period
+    else:
+        for p in gait:
+            _asked_phase(motion, p, min_periods, options)
     _decide(parts, min_periods)
     parts = _second_look(motion, parts, min_periods, options)
     parts = _or_one_cycle(motion, parts, landings)
@@ -646,6 +648,34 @@ def _second_look(motion: Motion, parts: list[Activity], min_periods: float, opti
 def _listing(parts: list[Activity]) -> str:
     kinds = ", ".join(f"{p.kind} {p.start}-{p.stop}" for p in parts)
     return f"{len(parts)} part(s): {kinds}" if parts else "no part"
+
+
+@dataclass(frozen=True)
+class _GaitJob:
+    """A gait part's frames, the part (its own frames) and the landings of the steps near it: what its phase
+    needs (sent as it is to another process)."""
+
+    motion: Motion
+    part: Activity
+    landings: Landings
+
+
+def _rebased_part(p: Activity) -> Activity:
+    return replace(p, start=0, stop=p.n_frames, landings={k: [f - p.start for f in v] for k, v in p.landings.items()})
+
+
+def _steps_near(steps: Landings, p: Activity) -> Landings:
+    """The landings of ``steps`` within a stride of part ``p``, in the part's frames."""
+    P = p.period_frames if np.isfinite(p.period_frames) else p.n_frames
+    near = (steps.frames >= p.start - P) & (steps.frames <= p.stop + P)
+    return Landings(steps.frames[near] - p.start, steps.foot[near], steps.sides, steps.down[p.start:p.stop])
+
+
+def _gait_job(job: _GaitJob) -> tuple[object, float]:
+    """:func:`_gait_phase` of one gait part: its ``(periodic, period_frames)``."""
+    p = job.part
+    _gait_phase(job.motion, p, job.landings)
+    return p.periodic, p.period_frames
 
 
 def _gait_phase(motion: Motion, p: Activity, landings: Landings) -> None:
