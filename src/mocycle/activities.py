@@ -533,7 +533,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
         for p in gait:
             _asked_phase(motion, p, min_periods, options)
     _decide(parts, min_periods)
-    parts = _second_look(motion, parts, min_periods, options)
+    parts = _second_look(motion, parts, min_periods, options, map)
     parts = _or_one_cycle(motion, parts, landings)
     return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True, reason=_listing(parts),
                       landings=landings)
@@ -618,31 +618,30 @@ def _or_one_cycle(motion: Motion, parts: list[Activity], landings: Landings | No
     return [part]
 
 
-def _second_look(motion: Motion, parts: list[Activity], min_periods: float, options: dict) -> list[Activity]:
+def _second_look(motion: Motion, parts: list[Activity], min_periods: float, options: dict,
+                 map=map) -> list[Activity]:
     """Frames where steps were seen but no gait part loops (landings missed on a rig whose feet slide, a
-    stumble) looked at again as frames without gait (:func:`_other`): each run of neighbouring parts that do
-    not loop, holding steps and lasting :data:`MIN_OTHER_S` or more, is replaced by what that finds when it
-    finds a motion that repeats there; otherwise the parts stay as they were."""
-    out: list[Activity] = []
+    stumble) looked at again as frames without gait (:func:`_other`, through ``map``): each run of neighbouring
+    parts that do not loop, holding steps and lasting :data:`MIN_OTHER_S` or more, is replaced by what that
+    finds when it finds a motion that repeats there; otherwise the parts stay as they were."""
+    runs: list[list[Activity]] = []
     k = 0
     while k < len(parts):
         j = k
         while j < len(parts) and not parts[j].loop:
             j += 1
-        if j == k:
-            out.append(parts[k])
-            k += 1
-            continue
-        run = parts[k:j]
-        a, b = run[0].start, run[-1].stop
-        if any(p.landings for p in run) and (b - a) * motion.frame_time >= MIN_OTHER_S:
-            again = _other(motion, a, b, min_periods, True, options)
-            _decide(again, min_periods)
-            if any(p.loop for p in again):
-                run = again
-        out.extend(run)
-        k = j
-    return out
+        runs.append(parts[k:j] if j > k else [parts[k]])
+        k = max(j, k + 1)
+    again = [r for r in runs if not r[0].loop and any(p.landings for p in r)
+             and (r[-1].stop - r[0].start) * motion.frame_time >= MIN_OTHER_S]
+    found = map(_gap_parts, [_Gap(motion[r[0].start:r[-1].stop], r[0].start, min_periods, True, options)
+                             for r in again])
+    instead = {}
+    for r, new in zip(again, found, strict=True):
+        _decide(new, min_periods)
+        if any(p.loop for p in new):
+            instead[id(r)] = new
+    return [p for r in runs for p in instead.get(id(r), r)]
 
 
 def _listing(parts: list[Activity]) -> str:
