@@ -145,9 +145,11 @@ def test_extract_cycle_options_reach_the_task(walk):
     assert f["frames_in"] == 180
     assert set(f["joints_used"].split(",")) == {pb.name for pb in legs}
     assert f["feet"]["mode"] == "lock"
-    # the cycle is now the active action: one period, too short to find a cycle in, so it is refused
-    with pytest.raises(RuntimeError, match="no periodic motion|no repeating motion|repeats long enough"):
-        bpy.ops.mocycle.extract_cycle()
+    # the cycle is now the active action: one cycle (with its closing key), a clip looped as it is
+    period = f["cycle_frames"]
+    assert bpy.ops.mocycle.extract_cycle() == {"FINISHED"}
+    again = facts(walk.animation_data.action)
+    assert again["method"] == "clip" and again["cycle_frames"] == period
     walk.animation_data.action = bpy.data.actions["Walk"]
     assert bpy.ops.mocycle.extract_cycle(method="centroid") == {"FINISHED"}
     assert facts(walk.animation_data.action)["method"] == "centroid"
