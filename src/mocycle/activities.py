@@ -817,14 +817,17 @@ def legs_repeat(motion: Motion, start: int, stop: int, period: float) -> float:
 
 
 def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
-    """Whether the legs of a gait part are like themselves one stride later, over the part and up to a stride
-    on either side: unlikeness under :data:`UNLIKE` where a stride or more of frames can be compared, under
-    :data:`UNLIKE_ONE_STEP` where less can."""
+    """Whether the legs of a gait part are like themselves one stride later, over the part (and, for a part of
+    under two strides, up to a stride on either side, so that a stride can be compared with the next):
+    unlikeness under :data:`UNLIKE` where a stride or more of frames can be compared, under
+    :data:`UNLIKE_ONE_STEP` where less can.  A part of two strides or more is judged on its own frames only:
+    in a session the frames beside it are another activity."""
     P = part.period_frames
     if not (np.isfinite(P) and P >= 2):
         return False
     lag = int(round(P))
-    lo, hi = max(0, int(part.start - P)), min(motion.n_frames, int(np.ceil(part.stop + P)))
+    reach = P if part.n_frames < 2 * P else 0
+    lo, hi = max(0, int(part.start - reach)), min(motion.n_frames, int(np.ceil(part.stop + reach)))
     X = _leg_features(motion, lo, hi)
     if X is None:
         return True  # no legs to tell by: the landings decide
