@@ -167,3 +167,19 @@ def test_a_loop_off_the_strides_or_the_takes_turn_is_refused():
     assert "stride" in failed
     good = extract_cycle(piece, phase=part_phase(right))
     assert part_checks(part_piece(motion, acts, k), good) == []
+
+
+def test_stride_phase_keeps_the_run_of_alternating_feet_inside_the_part():
+    """A landing of the same foot twice in a row (another gait's chain beside the part) starts a new run; the
+    stride line is drawn through the run holding the part, so its period stays the part's own."""
+    from mocycle.activities import Activity, stride_phase
+
+    part = Activity(start=100, stop=400, kind="walk straight", limbs="legs", period_frames=100.0)
+    frames = np.array([100, 150, 200, 250, 300, 350, 400, 420])  # 420: the left foot again, 20 frames on
+    foot = np.array([0, 1, 0, 1, 0, 1, 0, 0])
+    x, period = stride_phase(part, frames, foot, 100, 400)
+    assert period == pytest.approx(100.0)
+    assert x[0] == pytest.approx(0.0, abs=1e-9) and x[-1] == pytest.approx(299 / 100.0)
+    # without the filter the extra landing would count as a step: the line would bend
+    x2, period2 = stride_phase(part, frames[:-1], foot[:-1], 100, 400)
+    assert period2 == pytest.approx(period)

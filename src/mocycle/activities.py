@@ -1162,13 +1162,19 @@ def line_periodic(x: np.ndarray, period: float, frame_time: float, source: str, 
 def stride_phase(part: Activity, landings_frames: np.ndarray, landings_foot: np.ndarray, start: int,
                  stop: int) -> tuple[np.ndarray, float]:
     """Time in cycles ``(stop - start,)`` through the landings (take frames) that fall within a step of
-    ``[start, stop)``: a least-squares line ``t = t0 + P (k/2) + c [foot is the second one]`` over the
+    ``[start, stop)`` and alternate feet (their longest such run in the part): a least-squares line
+    ``t = t0 + P (k/2) + c [foot is the second one]`` over the
     landings' step counts ``k``, so each foot's landings are a whole cycle ``P`` apart.  Returns the time
     (cycles, frame ``start`` first) and ``P`` (frames)."""
     step = part.period_frames / 2.0 if np.isfinite(part.period_frames) else 0.0
     near = (landings_frames >= start - step) & (landings_frames <= stop + step)
     f = landings_frames[near].astype(np.float64)
     foot = landings_foot[near]
+    if f.size >= 2:  # the run of landings that alternate feet holding most of the part (another gait's
+        cuts = np.flatnonzero(foot[1:] == foot[:-1]) + 1  # landings nearby do not bend the line)
+        runs = np.split(np.arange(f.size), cuts)
+        best = max(runs, key=lambda r: (np.count_nonzero((f[r] >= start) & (f[r] < stop)), r.size))
+        f, foot = f[best], foot[best]
     if f.size < 3:
         raise MocycleError(f"a stride phase needs three landings; frames {start}-{stop} have {f.size}")
     k = np.arange(f.size, dtype=np.float64)
