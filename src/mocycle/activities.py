@@ -802,7 +802,11 @@ def _leg_features(motion: Motion, start: int, stop: int) -> np.ndarray | None:
 def _unlike(X: np.ndarray, lag: int) -> float:
     """Mean squared difference of the rows of ``X`` ``lag`` apart over twice its total variance: about 0 where
     the motion repeats at that lag, about 1 or more where it does not."""
-    var = float(X.var(axis=0).sum())
+    return _unlike_var(X, lag, float(X.var(axis=0).sum()))
+
+
+def _unlike_var(X: np.ndarray, lag: int, var: float) -> float:
+    """:func:`_unlike` with the total variance of ``X`` given (many lags of one ``X``)."""
     if not var > 0 or not 0 < lag < X.shape[0]:
         return float("nan")
     return float(((X[lag:] - X[:-lag]) ** 2).sum(axis=1).mean()) / (2.0 * var)
@@ -848,8 +852,9 @@ def legs_check(motion: Motion, start: int, stop: int, period: float) -> tuple[fl
     legs agree (or cannot tell), ``(their period, why)`` when they are most alike more than
     :data:`LEGS_OVERRULE` away from it and :data:`LEGS_BETTER` times as alike there (a landing detected early or
     late)."""
-    legs, unlike = short_period(motion, period, start, stop)
-    at = legs_repeat(motion, start, stop, period)
+    X = _leg_features(motion, start, stop)  # made once for both measures
+    legs, unlike = _short_period_of(X, period)
+    at = float("nan") if X is None else _unlike(X, int(round(period)) if np.isfinite(period) else 0)
     if not np.isfinite(legs) or abs(legs / period - 1) <= LEGS_OVERRULE:
         return float("nan"), (f"the legs agree ({legs:.2f} frames)" if np.isfinite(legs) else
                               "the legs cannot tell")
@@ -877,7 +882,11 @@ def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[f
     (:func:`_unlike` over the frames both ends cover, at least a sixth of a period of overlap), refined by a
     parabola.  ``(NaN, value)`` when the best lag is not alike (:data:`UNLIKE` or more) or no lag fits.
     Returns ``(period, unlikeness)``."""
-    X = _leg_features(motion, start, stop)
+    return _short_period_of(_leg_features(motion, start, stop), guess)
+
+
+def _short_period_of(X: np.ndarray | None, guess: float) -> tuple[float, float]:
+    """:func:`short_period` on the legs' features ``X (T, D)`` (``None``: no legs)."""
     if X is None:
         return float("nan"), float("nan")
     T = X.shape[0]
@@ -885,7 +894,8 @@ def short_period(motion: Motion, guess: float, start: int, stop: int) -> tuple[f
     lags = lags[T - lags >= np.maximum(4, lags / 6.0)]
     if lags.size < 3:
         return float("nan"), float("nan")
-    d = np.array([_unlike(X, int(lag)) for lag in lags])
+    var = float(X.var(axis=0).sum())
+    d = np.array([_unlike_var(X, int(lag), var) for lag in lags])
     if not np.isfinite(d).all():
         return float("nan"), float("nan")
     i = int(np.argmin(d))
