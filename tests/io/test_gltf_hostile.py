@@ -17,7 +17,7 @@ import mocycle
 from fuzzing import limits
 from mocycle.datasets.gltf_files import chain_document, gltf_file
 from mocycle.errors import MotionFileError
-from mocycle.io._nodes import skeleton_order, unique_names
+from mocycle.io._nodes import joint_names, skeleton_order, unique_names
 from mocycle.io.gltf_read import gltf_takes, read_gltf
 
 SECRET = b"TOKEN-5f1e2d3c4b5a"
@@ -217,6 +217,22 @@ def test_ten_thousand_nodes_read_within_ten_seconds_and_a_gigabyte(tmp_path):
         motion = read_gltf(path)
     assert motion.n_joints == 9_999 and motion.n_frames == 31  # the last node is an End Site
     assert time.perf_counter() - t0 < 10
+
+
+def test_joint_names_are_linear_in_the_nodes():
+    """The nodes outside the skeleton were looked up in a set made again per node: 20,000 nodes of one name
+    took 12 s there alone."""
+    n = 200_000
+    with limits(seconds=10):
+        names = joint_names(["joint"] * n, list(range(n // 2, n)))
+    assert names[n // 2] == "joint" and names[0] == f"joint.{n // 2}" and len(set(names)) == n
+
+
+def test_twenty_thousand_same_named_nodes_read_within_ten_seconds(tmp_path):
+    path = gltf_file(tmp_path / "same.gltf", *chain_document(20_000, names=["joint"] * 20_000))
+    with limits(headroom=1 << 30, seconds=10):
+        motion = read_gltf(path)
+    assert motion.n_joints == 19_999 and len(set(motion.skeleton.names)) == 19_999
 
 
 def test_ten_thousand_same_named_animations_list_in_linear_time(tmp_path):
