@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import builtins
 import contextlib
+import copy
 import json
 import os
 import random
@@ -109,7 +110,7 @@ def _edit_gltf(doc: dict, blob: bytearray, rng: random.Random) -> None:
         if spots:
             container, key = spots[0]
             if op == "value":
-                container[key] = rng.choice(VALUES)
+                container[key] = copy.deepcopy(rng.choice(VALUES))  # a fresh [] or {}: no list inside itself
             elif isinstance(container, dict):
                 del container[key]
             else:

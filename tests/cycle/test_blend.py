@@ -11,6 +11,7 @@ from mocycle.cycle.blend import (
     check_weights,
     cycle_seam,
     resample_cycle,
+    skeleton_differences,
     transition,
     transition_smoothness,
 )
@@ -244,3 +245,17 @@ def test_three_takes_blend_with_normalised_weights(cycles):
     assert np.isclose(r.period_frames, 0.75 * a.period_frames + 0.25 * b.period_frames)
     assert _circular(r.phase_offsets[2], -13 / a.n_frames) < 0.02
     assert r.seam()["seam_pose"] <= 1.0
+
+
+def test_rest_offsets_agree_within_the_offset_tolerance():
+    """A file's two takes may store a bone's rest offset with float32 round-off apart (RobotExpressive's palms
+    3.8e-7 m); a real difference of bone length is still named."""
+    a = humanoid_skeleton()
+    near, far = a.offsets.copy(), a.offsets.copy()
+    size = float(np.abs(a.offsets).max())
+    near[5] += 2e-6 * size
+    far[5] += 1e-3 * size
+    as_near = Skeleton(a.names, a.parents, near, a.channels, a.end_sites)
+    as_far = Skeleton(a.names, a.parents, far, a.channels, a.end_sites)
+    assert skeleton_differences(a, as_near) == []
+    assert skeleton_differences(a, as_far) == [f"joints with other rest offsets (bone lengths): {a.names[5]!r}"]

@@ -106,3 +106,33 @@ def test_blend_and_transition_take_the_phase_options(walks, tmp_path):
     done = runner.invoke(app, ["transition", str(walks[0]), str(walks[1]), "-o", str(tmp_path / "t.bvh"),
                                "--joints", "legs", "--min-periods", "2"])
     assert done.exit_code == 0, done.output
+
+
+def test_take_for_each_input():
+    from mocycle.errors import OptionError
+    from mocycle.tasks.fields import take_for_each
+
+    assert take_for_each(None, 2) == [None, None]
+    assert take_for_each("Walking", 2) == ["Walking", "Walking"]
+    assert take_for_each("Walking, Running", 2) == ["Walking", "Running"]
+    assert take_for_each("Walking,", 2) == ["Walking", None]  # an empty item: that input's default
+    with pytest.raises(OptionError, match="names 3 takes for 2 inputs"):
+        take_for_each("a,b,c", 2)
+
+
+def test_blend_and_transition_read_one_take_of_each_input(tmp_path):
+    """Two takes of one game-tool file (one cycle each): each input reads its own take; before, a repeated
+    ``--take`` kept the last for both inputs and a comma list was taken as one name."""
+    from conftest import shared_path
+
+    robot = str(shared_path("engine", "RobotExpressive.glb"))
+    for task, extra in (("blend", []), ("transition", ["--cycles", "1"])):
+        out = tmp_path / f"{task}.glb"
+        result = runner.invoke(app, [task, robot, robot, "--take", "Walking,Running", "-o", str(out), "--json",
+                                     *extra])
+        assert result.exit_code == 0, result.output
+        assert read(out).n_frames >= 20
+    result = runner.invoke(app, ["blend", robot, robot, "--take", "Walking,Running,Idle", "-o",
+                                 str(tmp_path / "x.glb")])
+    assert result.exit_code == 2 and "names 3 takes for 2 inputs" in result.output
+    assert not (tmp_path / "x.glb").exists()

@@ -11,6 +11,7 @@ from scipy.spatial.transform import Rotation
 
 import mocycle
 from mocycle.datasets import synthetic_walk, to_z_up
+from mocycle.datasets.gltf_files import chain_document, gltf_file
 from mocycle.errors import DefaultTake, MotionFileError
 from mocycle.io.gltf import body_size
 from mocycle.io.gltf_read import DEFAULT_FPS, gltf_takes, read_gltf
@@ -374,3 +375,31 @@ def test_the_vertical_and_unit_are_declared(tmp_path):
     again = mocycle.read(mocycle.write(walk, tmp_path / "walk.glb"))
     assert again.skeleton.up == pytest.approx((0.0, 0.0, 1.0), abs=1e-9)
     assert again.skeleton.metres_per_unit == pytest.approx(0.01)
+
+
+def _walk_and_slide_document():
+    """Two takes of one 3-node chain: ``turn`` turns the root; ``slide`` also moves node 1 along X."""
+    times = np.arange(31) / 30
+    doc, blob = chain_document(3, times=times, n_animations=2,
+                                                           animation_names=["turn", "slide"])
+    slide = np.stack([np.linspace(0.0, 0.05, 31), np.full(31, 0.1), np.zeros(31)], axis=1).astype("<f4")
+    doc["bufferViews"].append({"buffer": 0, "byteOffset": len(blob), "byteLength": slide.nbytes})
+    doc["accessors"].append({"bufferView": 2, "componentType": 5126, "count": 31, "type": "VEC3"})
+    blob += slide.tobytes()
+    doc["buffers"][0]["byteLength"] = len(blob)
+    doc["animations"][1]["samplers"].append({"input": 0, "output": 2, "interpolation": "LINEAR"})
+    doc["animations"][1]["channels"].append({"sampler": 1, "target": {"node": 1, "path": "translation"}})
+    return doc, blob
+
+
+def test_every_take_of_a_file_has_one_skeleton(tmp_path):
+    """A joint whose translation one take keys has position channels in every take (RobotExpressive's Walking
+    keys feet and pole targets its Running leaves still): the takes blend and join without a skeleton error."""
+    from mocycle.cycle.blend import skeleton_differences
+
+    path = gltf_file(tmp_path / "two.glb", *_walk_and_slide_document())
+    turn, slide = read_gltf(path, take="turn"), read_gltf(path, take="slide")
+    assert turn.skeleton.position_axes(1) and slide.skeleton.position_axes(1)
+    assert skeleton_differences(turn.skeleton, slide.skeleton) == []
+    bone = turn.world_positions()[:, 1] - turn.world_positions()[:, 0]
+    assert np.allclose(np.linalg.norm(bone, axis=1), 0.1, atol=1e-6)  # the turn's node 1 rests where it did

@@ -81,10 +81,16 @@ def _names(items: list[str]) -> str:
     return shown + (f" and {len(items) - MAX_LISTED} more" if len(items) > MAX_LISTED else "")
 
 
+#: Rest offsets this close (a share of the skeleton's largest offset) are the same bone: a file's takes read
+#: through float32 node transforms differ in the last digits (RobotExpressive's palms: 3.8e-7 of 1.7 units)
+OFFSET_TOLERANCE = 1e-5
+
+
 def skeleton_differences(a: Skeleton, b: Skeleton) -> list[str]:
     """What differs between two skeletons, each item naming the joints (empty when they can be blended).
 
-    Joint names, their order and parents must agree; rest offsets must agree (``np.allclose``) except for
+    Joint names, their order and parents must agree; rest offsets must agree (within :data:`OFFSET_TOLERANCE`
+    of the larger skeleton's largest offset) except for
     joints that have position channels in both skeletons, whose offset is replaced by the channels (BVH
     exporters such as Bandai Namco's write the take's start position there).
     """
@@ -103,9 +109,10 @@ def skeleton_differences(a: Skeleton, b: Skeleton) -> list[str]:
     parent = [a.names[j] for j in range(a.n_joints) if a.parents[j] != b.parents[j]]
     if parent:
         problems.append(f"joints with another parent: {_names(parent)}")
+    size = max(float(np.abs(a.offsets).max(initial=0.0)), float(np.abs(b.offsets).max(initial=0.0)))
     offset = [a.names[j] for j in range(a.n_joints)
               if not (a.position_axes(j) and b.position_axes(j))
-              and not np.allclose(a.offsets[j], b.offsets[j])]
+              and not np.allclose(a.offsets[j], b.offsets[j], rtol=0.0, atol=OFFSET_TOLERANCE * size)]
     if offset:
         problems.append(f"joints with other rest offsets (bone lengths): {_names(offset)}")
     return problems

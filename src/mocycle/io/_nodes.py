@@ -13,7 +13,8 @@ and the joints below it, with their TRS sampled at the motion's frames, and this
 Every joint's world position is therefore the file's, whatever pre/post rotations, scales (also animated or
 non-uniform) and conversions sit above it; the joints' orientations are the file's up to any shear a
 non-uniform parent scale adds (a mocycle joint cannot shear).  Joints whose offset stays still (within
-``1e-7`` of the skeleton's size) keep one constant offset; the others get a translation track and position
+``1e-7`` of the skeleton's size) keep one constant offset; the others, and every joint whose translation some
+take of the file keys (``NodeTRS.translated``: one skeleton for every take), get a translation track and position
 channels.  A leaf joint with no animation of its own becomes an End Site (its orientation moves nothing).
 """
 
@@ -66,6 +67,9 @@ class NodeTRS:
     rotation: np.ndarray | Sampled
     scale: np.ndarray | Sampled
     animated: bool = False
+    #: some take of the file keys its translation: it has position channels in every take (even one that keys
+    #: it still, or not at all), so that every take of a file has one skeleton (blend a file's walk with its run)
+    translated: bool = False
 
 
 def _matrices(node: NodeTRS, rows: slice, n: int, path=None) -> np.ndarray:
@@ -188,7 +192,7 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     for j in range(J):
         p = up[j]
         scaled_above[j] = scale_moves if p < 0 else (scaled_above[p] or len(joints[p].scale) > 1)
-        varying[j] = len(joints[j].translation) > 1 or scaled_above[j] or (j == 0 and anc_moves)
+        varying[j] = len(joints[j].translation) > 1 or scaled_above[j] or (j == 0 and anc_moves) or joints[j].translated
     K = len(keep)
     rotations = np.empty((T, K, 4))
     tracks = {new_index[j]: np.empty((T, 3)) for j in keep if varying[j]}
@@ -237,8 +241,9 @@ def motion_from_nodes(ancestors: list[NodeTRS], joints: list[NodeTRS], parents: 
     # tracks that stand still (within 1e-7 of the skeleton's size) become constant offsets
     size = max(float(np.abs(static).max(initial=0.0)), max((float(np.abs(t).max()) for t in tracks.values()),
                                                              default=0.0), 1e-12)
+    translated = {new_index[j] for j in keep if joints[j].translated}
     for k in list(tracks):
-        if np.ptp(tracks[k], axis=0).max() <= 1e-7 * size:
+        if k not in translated and np.ptp(tracks[k], axis=0).max() <= 1e-7 * size:
             static[k] = tracks.pop(k)[0]
     offsets = static.copy()
     for k, t in tracks.items():
@@ -324,6 +329,17 @@ def _any_above(order: list[int], up: list[int], marked: np.ndarray) -> np.ndarra
     return above
 
 
+MAX_LISTED_TAKES = 20
+"""How many take names a message lists; the rest are counted (``mocycle info FILE`` lists them all)."""
+
+
+def listed(names: list[str]) -> str:
+    """``names`` joined for a message: the first :data:`MAX_LISTED_TAKES`, then how many more."""
+    shown = ", ".join(names[:MAX_LISTED_TAKES])
+    more = len(names) - MAX_LISTED_TAKES
+    return shown + (f" and {more} more (mocycle info lists them all)" if more > 0 else "")
+
+
 def choose_take(names: list[str], take, path, noun: str, none_held: str) -> int | None:
     """The index of the take (an animation stack, a glTF animation) called ``take`` (its name, or its index as
     text) among ``names``; ``None`` when the file holds none and none was asked for, 0 when none was asked for.
@@ -339,7 +355,7 @@ def choose_take(names: list[str], take, path, noun: str, none_held: str) -> int 
         return names.index(text)
     if text.isdigit() and int(text) < len(names):
         return int(text)
-    raise MotionFileError(f"no {noun} named {text!r}; the file holds: {', '.join(names)}", path)
+    raise MotionFileError(f"no {noun} named {text!r}; the file holds: {listed(names)}", path)
 
 
 def member_nodes(members: list[int], parents, node_trs) -> tuple[list, list, list[int]]:

@@ -43,7 +43,16 @@ import numpy as np
 from ..errors import DefaultTake, MocycleError, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
-from ._nodes import NodeTRS, choose_take, joint_names, member_nodes, motion_from_nodes, skeleton_order, unique_names
+from ._nodes import (
+    NodeTRS,
+    choose_take,
+    joint_names,
+    listed,
+    member_nodes,
+    motion_from_nodes,
+    skeleton_order,
+    unique_names,
+)
 from .fbx_scan import opened
 
 __all__ = ["DEFAULT_FPS", "fbx_takes", "read_fbx"]
@@ -295,7 +304,7 @@ class _Scene:
                   for k, name in enumerate(self.stack_names) if k != chosen]
         why = "the first that moves the skeleton" if self.moves(chosen) else "the first: no take moves the skeleton"
         warnings.warn(f"{self.path}: read take {self.stack_names[chosen]!r} ({why}); the file also holds "
-                      f"{', '.join(others)}: choose one with --take", DefaultTake, stacklevel=4)
+                      f"{listed(others)}: choose one with --take", DefaultTake, stacklevel=4)
         return chosen
 
     def still_leaves(self) -> set[int]:

@@ -48,6 +48,7 @@ from ._nodes import (
     Sampled,
     choose_take,
     joint_names,
+    listed,
     member_nodes,
     motion_from_nodes,
     skeleton_order,
@@ -493,25 +494,29 @@ def _sampler(keys: np.ndarray, values: np.ndarray, interpolation: str, rotation:
     return sample
 
 
+def _distinct(all_keys: list[np.ndarray]) -> list[np.ndarray]:
+    """The key arrays of ``all_keys`` once each (channels that share an input accessor share its array)."""
+    return list({id(k): k for k in all_keys}.values())
+
+
 def _grid_step(all_keys: list[np.ndarray]) -> float | None:
     """The step (seconds) of the one regular grid, from the animation's first key, that every key time lies
     on (within 1e-3 of a step), or ``None``."""
-    start = min(float(k[0]) for k in all_keys)
+    all_keys = _distinct(all_keys)
     steps = np.concatenate([np.diff(k) for k in all_keys if len(k) > 1] or [np.zeros(0)])
     steps = steps[steps > 0]
     if not len(steps):
         return None
     step = float(np.median(steps))
-    if not step > 0 or not all(np.allclose((k - start) / step, np.round((k - start) / step), rtol=0, atol=1e-3)
-                               for k in all_keys):
-        return None
-    return step
+    return step if step > 0 and _on_grid(all_keys, 1.0 / step) else None
 
 
 def _on_grid(all_keys: list[np.ndarray], rate: float) -> bool:
-    """Whether every key time lies on the frames of ``rate`` from the animation's first key."""
-    start = min(float(k[0]) for k in all_keys)
-    return all(np.allclose((k - start) * rate, np.round((k - start) * rate), rtol=0, atol=1e-3) for k in all_keys)
+    """Whether every key time lies on the frames of ``rate`` from the animation's first key (within 1e-3 of
+    a frame)."""
+    joined = np.concatenate(_distinct(all_keys))
+    frames = (joined - joined.min()) * rate
+    return bool(np.all(np.abs(frames - np.round(frames)) <= 1e-3))
 
 
 def _rate_of(step: float | None) -> float | None:
@@ -523,13 +528,30 @@ def _rate_of(step: float | None) -> float | None:
     return float(round(rate)) if abs(rate - round(rate)) < 1e-4 * rate and round(rate) > 0 else rate
 
 
+MAX_CANDIDATE_RATES = 8
+"""How many of the animations' own key rates (the most common) :func:`_file_rate` weighs: a file of
+thousands of animations each keyed at its own rate costs one pass per candidate, not per animation."""
+
+
 def _file_rate(keys_by_animation: list[list[np.ndarray]]) -> float | None:
-    """The file's frame rate: among the key rates of its animations, the one on whose frames the keys of the
-    most animations lie (the lower on a tie); ``None`` when no animation keys each frame."""
-    rates = sorted({r for keys in keys_by_animation if keys for r in [_rate_of(_grid_step(keys))] if r})
+    """The file's frame rate: among the key rates of its animations (the :data:`MAX_CANDIDATE_RATES` most
+    common), the one on whose frames the keys of the most animations lie (the lower on a tie); ``None`` when
+    no animation keys each frame.  Animations that share their key arrays are weighed once, times their count."""
+    shared: dict[tuple[int, ...], tuple[list[np.ndarray], int]] = {}
+    for keys in keys_by_animation:
+        if keys:
+            keys = _distinct(keys)
+            sign = tuple(sorted(id(k) for k in keys))
+            shared[sign] = (keys, shared.get(sign, (keys, 0))[1] + 1)
+    own: dict[float, int] = {}
+    for keys, count in shared.values():
+        rate = _rate_of(_grid_step(keys))
+        if rate:
+            own[rate] = own.get(rate, 0) + count
+    rates = sorted(sorted(own, key=lambda r: (-own[r], r))[:MAX_CANDIDATE_RATES])
     if not rates:
         return None
-    return max(rates, key=lambda r: (sum(bool(keys) and _on_grid(keys, r) for keys in keys_by_animation), -r))
+    return max(rates, key=lambda r: (sum(count for keys, count in shared.values() if _on_grid(keys, r)), -r))
 
 
 def _skeleton_nodes(f: _File, parents: np.ndarray, animated: set[int]) -> list[int]:
@@ -611,16 +633,17 @@ def _channels(f: _File, index: int, n_nodes: int, values: bool = True, inputs: d
     return out
 
 
-def _targets(f: _File, n_nodes: int) -> set[int]:
-    """The nodes that a channel of any animation moves (``translation``, ``rotation`` or ``scale``): the JSON
-    only, no data read."""
-    out = set()
+def _targets(f: _File, n_nodes: int) -> dict[int, set[str]]:
+    """The nodes that a channel of any animation moves, each with the paths keyed (``translation``,
+    ``rotation``, ``scale``): the JSON only, no data read."""
+    out: dict[int, set[str]] = {}
     for anim in _animations(f):
         for ch in _list(getattr(anim, "channels", None), "animation.channels", f.path):
             target = getattr(ch, "target", None)
             node = getattr(target, "node", None)
-            if getattr(target, "path", None) in _PATHS and node is not None:
-                out.add(_int(node, "channels.target.node", f.path, 0, n_nodes - 1))
+            path = getattr(target, "path", None)
+            if path in _PATHS and node is not None:
+                out.setdefault(_int(node, "channels.target.node", f.path, 0, n_nodes - 1), set()).add(path)
     return out
 
 
@@ -645,7 +668,7 @@ def _default_take(f: _File, body: set[int], n_nodes: int, names: list[str]) -> t
     if len(names) > 1:
         others = [f"{name!r}" + (" (still)" if k in still else "") for k, name in enumerate(names) if k != chosen]
         why = "the first: no animation moves the skeleton" if chosen in still else "the first that moves the skeleton"
-        warnings.warn(f"{f.path}: read take {names[chosen]!r} ({why}); the file also holds {', '.join(others)}: "
+        warnings.warn(f"{f.path}: read take {names[chosen]!r} ({why}); the file also holds {listed(others)}: "
                       f"choose one with --take", DefaultTake, stacklevel=3)
     return chosen, channels
 
@@ -672,7 +695,9 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
     f = _File(p)
     parents = _parents(f)
     N = len(parents)
-    targets = _targets(f, N)  # every take's: the same skeleton and End Sites for each
+    keyed = _targets(f, N)  # every take's: the same skeleton and End Sites for each
+    targets = set(keyed)
+    translated = {i for i, paths in keyed.items() if "translation" in paths}  # and the same position channels
     members = _skeleton_nodes(f, parents, targets)
     names = _names(f) if _animations(f) else []
     body = set(members)  # the skeleton's nodes and the nodes above it
@@ -714,7 +739,9 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
     def node_trs(i: int) -> NodeTRS:
         if i not in trs:
             t, q, s = _rest_trs(f, i)
-            trs[i] = NodeTRS(node_names[i], t[None], q[None], s[None], animated=i in targets)
+            trs[i] = NodeTRS(
+                node_names[i], t[None], q[None], s[None], animated=i in targets, translated=i in translated
+            )
         return trs[i]
 
     used = set(members) | _above(members[0], parents)

@@ -44,6 +44,7 @@ class Options(fields.CycleOptions):
     root: str = fields.root("inplace", "inplace (on the spot) or motion (moves on by the blended stride).")
     cycles: int = fields.cycles(1, "Repeat the loop this many times in the output.")
     align: bool = option(True, "Search each take's phase offset against the first.", Flag())
+    take: str | None = fields.takes()
 
 
 def run(takes: Sequence, options: Options | None = None) -> Report:
@@ -62,7 +63,8 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
             raise OptionError("weights", f"needs {len(takes)} numbers, one per take; got {len(o.weights)}")
         check_weights(o.weights, len(takes))  # refuse bad weights before the (slower) extraction
     with Recorder() as rec:
-        motions = [load(t, o.amc_fps, o.take) for t in takes]
+        motions = [load(t, o.amc_fps, k) for t, k in zip(takes, fields.take_for_each(o.take, len(takes)),
+                                                          strict=True)]
         labels = [label_of(t, k) for k, t in enumerate(takes)]
         with rec.part("cycle"):
             cycles = take_cycles(motions, labels, o)

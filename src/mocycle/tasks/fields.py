@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..defaults import AMC_FPS, CYCLE_METHODS, HARMONIC_MODELS, MIN_PERIODS, ROOT_MODES, SWING_THRESHOLD
+from ..errors import OptionError
 from .options import Choice, Flag, Integer, Options, Real, Text, option
 
 __all__ = ["AMC_FPS", "CycleOptions", "MIN_PERIODS", "SWING_THRESHOLD", "amc_fps", "classes", "cycles", "delay",
@@ -24,6 +25,24 @@ def amc_fps():
 def take():
     return option(None, "Which take of a glTF or FBX input to read: an animation's (FBX: animation stack's) name or "
                         "0-based index, as mocycle info lists them; default the first that moves the skeleton.", Text())
+
+
+def takes():
+    return option(None, "Which take of each glTF or FBX input to read: one name or 0-based index for every input, "
+                        "or one per input separated by commas (e.g. Walking,Running), as mocycle info lists them; "
+                        "default the first that moves the skeleton.", Text())
+
+
+def take_for_each(take: str | None, n: int) -> list[str | None]:
+    """The take to read from each of ``n`` inputs: ``take`` for every one, or, when it holds commas, its items
+    one per input (an empty item: that input's default take)."""
+    if take is None or "," not in take:
+        return [take] * n
+    items = [t.strip() for t in take.split(",")]
+    if len(items) != n:
+        raise OptionError("take", f"names {len(items)} takes for {n} inputs; give one take for every input, or "
+                                  f"one per input separated by commas; got {take!r}")
+    return [t or None for t in items]
 
 
 def method(help: str = "How each take's cycle is extracted: harmonic (regression), centroid (paper 001) or cut."):

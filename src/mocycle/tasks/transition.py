@@ -23,6 +23,7 @@ class Options(fields.CycleOptions):
 
     cycles: int = fields.cycles(3, "Cycles over which the weight moves from the first to the second.")
     root: str = fields.root("motion", "motion (travels on) or inplace (on the spot).")
+    take: str | None = fields.takes()
 
 
 def run(takes: Sequence, options: Options | None = None) -> Report:
@@ -37,7 +38,8 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     with Recorder() as rec:
         labels = [label_of(t, k) for k, t in enumerate(takes)]
         with rec.part("cycle"):
-            a, b = take_cycles([load(t, o.amc_fps, o.take) for t in takes], labels, o)
+            a, b = take_cycles([load(t, o.amc_fps, k) for t, k in zip(takes, fields.take_for_each(o.take, 2),
+                                                                         strict=True)], labels, o)
         result = transition(a, b, o.cycles, root=o.root, labels=labels, force=o.force)
         facts = {**result.to_dict(), "root": o.root, "smoothness": transition_smoothness(result)}
         with rec.part("feet"):
