@@ -45,7 +45,7 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion
-from .feet import Foot, body_height, chain_joints, chain_positions, find_feet, up_axis
+from .feet import ChainArray, Foot, body_height, chain_joints, chain_positions, find_feet, up_axis
 from .smooth import gaussian, minimum
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
@@ -158,7 +158,7 @@ def _durations(mask: np.ndarray, min_contact: int, min_gap: int) -> np.ndarray:
 
 
 def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, smooth: float = SMOOTH_SECONDS,
-                       positions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                       positions: np.ndarray | ChainArray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Height above the lowest level ``(T, C)``, horizontal speed ``(T, C)`` and vertical speed ``(T, C)``
     (units/s) of ``joints``.
 
@@ -213,7 +213,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
                     speed: float = CONTACT_SPEED, rise: float = CONTACT_RISE, release: float = RELEASE,
                     min_contact: float = MIN_CONTACT,
                     min_gap: float = MIN_GAP, travel: float = TRAVEL_SHARE, up: np.ndarray | None = None,
-                    relax: bool = True, positions: np.ndarray | None = None) -> Contacts:
+                    relax: bool = True, positions: np.ndarray | ChainArray | None = None) -> Contacts:
     """Contacts of every contact joint of ``feet`` (default: :func:`find_feet`; a string names them).
 
     ``height``: fraction of the body height above the joint's floor (:func:`local_floor`); ``speed``: body heights per
