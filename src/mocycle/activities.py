@@ -116,7 +116,7 @@ class Activity:
     #: whether the legs stand over the part (known for the parts without gait)
     legs_still: bool = True
     #: the phase of the part's frames (frame ``start`` first), a PeriodicMotion, once known
-    periodic: object = field(default=None, repr=False)
+    periodic: PeriodicMotion | None = field(default=None, repr=False)
     #: the whole take is one cycle (a game clip): its frames are the loop (:func:`one_cycle`)
     one_cycle: bool = False
 
@@ -254,7 +254,7 @@ def _gait_chains(landings: Landings, fps: float, least: int = 3) -> list[np.ndar
 def stride_periods(landings: Landings, fps: float, start: int = 0, stop: int | None = None) -> list[int]:
     """The strides (frames from a foot's landing to its next, the other foot landing once between, each step
     of plausible length) whose landings lie in frames ``start .. stop``."""
-    out = []
+    out: list[int] = []
     for chain in _gait_chains(landings, fps):
         f = landings.frames[chain]
         f = f[(f >= start) & (f <= (stop if stop is not None else f.max()))]
@@ -490,7 +490,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     heading = heading_degrees(motion)
     path = _horizontal_path(motion)
     body = _body_height(motion)
-    parts: list[Activity] = []
+    parts = []
     stepped = []  # the landings of the gait chains: a stride phase is a line through these only
     for chain in _gait_chains(landings, fps, least=2):
         stepped.append(chain)
@@ -755,7 +755,7 @@ def _gait_part(kind, f, chain, i, j, landings, strides, heading, path, fps) -> A
     a, b = int(f[i]), int(f[j])
     rows = strides[max(0, i - 1): j]  # the strides that overlap steps i .. j-1
     period = float(np.median(rows[:, 0]))
-    own = {}
+    own: dict[str, list[int]] = {}
     for k in range(i, j + 1):
         own.setdefault(landings.sides[landings.foot[chain[k]]], []).append(int(f[k]))
     return Activity(start=a, stop=b, kind=kind, limbs="legs", period_frames=period,
@@ -780,7 +780,7 @@ def _one_step_part(motion: Motion, chain, landings: Landings, heading, path, bod
     way = "straight" if abs(per_stride) <= TURN_DEG else ("turning left" if per_stride > 0 else "turning right")
     down = landings.down[lo:hi]
     gait = gait_of(float(np.mean(down == 0)), float(np.mean(down >= 2)), speed, body)
-    own = {}
+    own: dict[str, list[int]] = {}
     for k in chain:
         own.setdefault(landings.sides[landings.foot[k]], []).append(int(landings.frames[k]))
     return Activity(start=a, stop=b, kind=f"{gait} {way}", limbs="legs", period_frames=period, speed=speed,
@@ -1222,9 +1222,10 @@ def parts_phase(acts: Activities) -> PhaseResult:
     take's frames (NaN outside the part) and its excitation in take frames: the same parts ``mocycle loop``
     loops."""
     T = acts.n_frames
-    classes = []
+    classes: list[PeriodicMotion] = []
     for p in acts.loopable():
         pm = p.periodic
+        assert pm is not None  # a part loops only with its phase found (_decide, _other, _or_one_cycle)
         coords, unwrapped = np.full(T, np.nan), np.full(T, np.nan)
         coords[p.start:p.stop], unwrapped[p.start:p.stop] = pm.coords, pm.unwrapped
         classes.append(replace(pm, coords=coords, unwrapped=unwrapped,

@@ -45,7 +45,7 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion
-from .feet import Foot, body_height, chain_joints, chain_positions, find_feet, up_axis
+from .feet import ChainArray, Foot, body_height, chain_joints, chain_positions, find_feet, up_axis
 from .smooth import gaussian, minimum
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
@@ -98,7 +98,7 @@ class Contacts:
 
     def foot_mask(self, f: int) -> np.ndarray:
         """``(T,)`` True while foot ``f`` touches the floor (ankle or toe)."""
-        return self.mask[:, [c for c, g in enumerate(self.foot_of) if g == f]].any(axis=1)
+        return self.mask[:, [c for c, g in enumerate(self.foot_of) if g == f]].any(axis=1)  # type: ignore[return-value]  # numpy stubs: any(axis=) of a 2-D array is an array
 
     def foot_ranges(self, f: int) -> list[tuple[int, int]]:
         return ranges(self.foot_mask(f))
@@ -127,11 +127,11 @@ class Contacts:
 
 
 def _as_lists(rs: list[tuple[int, int]], period: int | None) -> list[list[int]]:
-    rs = [list(r) for r in rs]
-    if period and len(rs) >= 2 and rs[0][0] == 0 and rs[-1][1] == period:
-        first = rs.pop(0)
-        rs[-1][1] = period + first[1]
-    return rs
+    out = [list(r) for r in rs]
+    if period and len(out) >= 2 and out[0][0] == 0 and out[-1][1] == period:
+        first = out.pop(0)
+        out[-1][1] = period + first[1]
+    return out
 
 
 def _hysteresis(on: np.ndarray, keep: np.ndarray) -> np.ndarray:
@@ -158,7 +158,7 @@ def _durations(mask: np.ndarray, min_contact: int, min_gap: int) -> np.ndarray:
 
 
 def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, smooth: float = SMOOTH_SECONDS,
-                       positions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                       positions: np.ndarray | ChainArray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Height above the lowest level ``(T, C)``, horizontal speed ``(T, C)`` and vertical speed ``(T, C)``
     (units/s) of ``joints``.
 
@@ -188,7 +188,7 @@ def local_floor(h: np.ndarray, fps: float) -> np.ndarray:
     return np.minimum(minimum(h, max(1, int(round(FLOOR_SECONDS * fps)))), FLOOR_DRIFT)
 
 
-def _travel_speed(motion: Motion, W: np.ndarray, up: np.ndarray) -> np.ndarray:
+def _travel_speed(motion: Motion, W: np.ndarray | ChainArray, up: np.ndarray) -> np.ndarray:
     """``(T,)`` horizontal speed of the travel joint (units/s), averaged by a Gaussian of ``TRAVEL_SECONDS``."""
     if motion.n_frames < 2:
         return np.zeros(motion.n_frames)
@@ -213,7 +213,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
                     speed: float = CONTACT_SPEED, rise: float = CONTACT_RISE, release: float = RELEASE,
                     min_contact: float = MIN_CONTACT,
                     min_gap: float = MIN_GAP, travel: float = TRAVEL_SHARE, up: np.ndarray | None = None,
-                    relax: bool = True, positions: np.ndarray | None = None) -> Contacts:
+                    relax: bool = True, positions: np.ndarray | ChainArray | None = None) -> Contacts:
     """Contacts of every contact joint of ``feet`` (default: :func:`find_feet`; a string names them).
 
     ``height``: fraction of the body height above the joint's floor (:func:`local_floor`); ``speed``: body heights per
@@ -242,11 +242,11 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
     # a foot under a running body is planted when it is slow for the body: a fitted or resampled stance
     # glides at a share of the travel speed
     body_speed = travel * _travel_speed(motion, W, up) / body
-    speed = np.maximum(speed, body_speed)
+    slow_below = np.maximum(speed, body_speed)  # (T,): the speed threshold, raised under a running body
     n_contact, n_gap = (max(1, int(round(s * motion.fps))) for s in (min_contact, min_gap))
 
     def find(h, v, vu, rise):
-        return _find(h, v, vu, height, speed, rise, release, n_contact, n_gap)
+        return _find(h, v, vu, height, slow_below, rise, release, n_contact, n_gap)
 
     mask = find(h, v, vu, rise)
     if relax:
@@ -256,7 +256,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
         for f in range(len(feet)):
             cols = [c for c, g in enumerate(foot_of) if g == f]
             if not mask[:, cols].any():
-                mask[:, cols] = _relaxed(h[:, cols], v[:, cols], vu[:, cols], speed, rise, body_speed,
+                mask[:, cols] = _relaxed(h[:, cols], v[:, cols], vu[:, cols], slow_below, rise, body_speed,
                                          lows[cols] - np.array([ground[kind[c]] for c in cols]), find)
     return Contacts(feet, joints, foot_of, mask, up, body, motion.frame_time)
 

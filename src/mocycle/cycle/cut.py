@@ -46,19 +46,19 @@ def cut_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, p
     if not np.isfinite(best[0]):
         raise MocycleError(f"the longest excited region ({e - s} frames) is too short to cut a cycle of "
                            f"{N:.1f} frames")
-    _, a, lag = best
-    b = a + lag
-    w = int(min(round(blend * lag), a - s))
+    _, a, period = best
+    b = a + period
+    w = int(min(round(blend * period), a - s))
     Pc, Lc = P[a:b].copy(), L[a:b].copy()
     drift = L[b] - L[a]
     if w >= 1:
-        k = np.arange(lag - w, lag)
-        t = _smoothstep((k - (lag - w) + 1) / (w + 1))[:, None]
-        src = a + k - lag
+        k = np.arange(period - w, period)
+        t = _smoothstep((k - (period - w) + 1) / (w + 1))[:, None]
+        src = a + k - period
         Pc[k] = (1 - t) * P[a + k] + t * P[src]
         Lc[k] = (1 - t) * L[a + k] + t * (L[src] + drift)
     x = axis.x[axis.frames()]
-    positions = np.mod(x - axis.x[a], 1.0) * lag
+    positions = np.mod(x - axis.x[a], 1.0) * period
     return Cycle(space=space, P=Pc, L=Lc, drift=drift, method="cut", model=None, n_harmonics=None, axis=axis,
                  positions=positions, periodic=periodic)
 

@@ -235,6 +235,7 @@ class HarmonicRegression:
         if pos.rows < p:
             raise MocycleError(f"K = {K} harmonics need at least {p} frames; got {pos.rows} "
                                f"(K <= {max_harmonics(pos.rows)})")
+        assert first is not None and moving is not None  # pos.rows >= p > 0: pass 1 read a frame
         D = first.size
         for xd, dY, ddY in derivatives():
             if not xd.size:

@@ -238,7 +238,9 @@ def _glb_pieces(gl, blob: _Blob):
 def _stick_figure(points: np.ndarray, parents: np.ndarray, size: float):
     """An octahedral bone from each parent to each child (rest positions ``points (N, 3)``), weighted to the
     parent: positions ``(V, 3)``, parent joint per vertex ``(V,)``, triangle indices ``(F*3,)``."""
-    pos, joint, tris = [], [], []
+    pos: list[np.ndarray] = []
+    joint: list[int] = []
+    tris: list[int] = []
     for c in range(len(points)):
         p = parents[c]
         if p < 0:

@@ -412,7 +412,7 @@ def _subsets(motion: Motion, joints) -> list[tuple[str | Iterable[str] | None, s
     """The joint selections to try, with their labels: the given one, or the whole body then legs, arms."""
     if joints is not None:
         return [(joints, joints if isinstance(joints, str) else ",".join(joints))]
-    tries: list[tuple[str | None, str]] = [(None, "all")]
+    tries: list[tuple[str | Iterable[str] | None, str]] = [(None, "all")]
     for group in SUBSETS:
         try:
             motion.skeleton.select(group)

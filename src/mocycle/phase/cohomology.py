@@ -61,7 +61,7 @@ MIN_FRAMES = 20
 FULL_MATRIX_ROWS = 512
 
 
-def rips_h1(dist: np.ndarray, prime: int) -> tuple[np.ndarray, list[np.ndarray]]:
+def rips_h1(dist: np.ndarray, prime: int) -> tuple[np.ndarray, Sequence[np.ndarray]]:
     """H1 of the Vietoris-Rips filtration of a distance matrix with Z/p coefficients, by ripser's compiled core.
 
     ``dist``: ``(L, L)`` symmetric, zero diagonal.  Returns the bars ``(n, 2)`` (birth, death) and one cocycle
@@ -90,12 +90,13 @@ def rips_h1(dist: np.ndarray, prime: int) -> tuple[np.ndarray, list[np.ndarray]]
     return np.asarray(bars, dtype=float).reshape(-1, 2), cocycles
 
 
-class _Cocycles(Sequence):
+class _Cocycles(Sequence[np.ndarray]):
     """ripser's flat cocycle lists as ``(n, 3)`` integer arrays ``[i, j, value mod p]``, each converted when it is
     first read (a fit reads the chosen bars' only, 1 or 2 of some 70)."""
 
     def __init__(self, flat: list, prime: int):
-        self._flat, self._prime, self._done = flat, prime, {}
+        self._flat, self._prime = flat, prime
+        self._done: dict[int, np.ndarray] = {}
 
     def __len__(self) -> int:
         return len(self._flat)
@@ -332,8 +333,8 @@ def _is_cocycle(Z: np.ndarray, adjacent: np.ndarray) -> bool:
     exact32 = Z.shape[0] * (3.0 * float(np.abs(Z).max(initial=0.0))) ** 2 < 2.0**24
     dtype = np.float32 if exact32 else np.float64
     Z = Z.astype(dtype)
-    A = adjacent.astype(dtype)
-    B = A * Z  # z on the edges
+    A: np.ndarray = adjacent.astype(dtype)
+    B: np.ndarray = A * Z  # z on the edges
     B2 = B * Z
     Zca = Z.T  # z(c, a) at [a, c]
     # Σ_b A_ab A_bc (z_ab + z_bc + z_ca)² at [a, c]
