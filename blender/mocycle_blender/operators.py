@@ -155,7 +155,7 @@ def _failure(op, exc) -> Said:
     itself, cut to a line; the whole message and every check's reason in the detail."""
     action, first = getattr(op, "_action", None), getattr(op, "_first", None)
     name = f"{action.name}: " if action is not None else ""
-    text = words.hints(" ".join(str(exc).split()))  # a hint ("option force") as the option's name, not a flag
+    text = words.hints(" ".join(str(exc).split()))  # a hint ("option 'force'") as the option's name, not a flag
     if isinstance(exc, OptionError):  # the option as the operator labels it
         prop = op.rna_type.properties.get(exc.parameter)
         text = f"{prop.name if prop else exc.parameter}: {exc.reason}"

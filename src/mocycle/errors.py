@@ -16,7 +16,7 @@ from os import PathLike
 class Hint:
     """What would help, named in the library's own terms: an ``Options`` field (``option``) and, when it
     matters, the value to give it.  A message below the front ends says it as ``str(hint)``,
-    ``"option force"`` or ``"option model = M2"``, never as a CLI flag; each front end renders it in its own
+    ``"option 'force'"`` or ``"option 'model' = M2"``, never as a CLI flag; each front end renders it in its own
     terms with :func:`render_hints` (the CLI as ``--force`` / ``--model M2``, Blender and the studio as the
     field's name)."""
 
@@ -24,11 +24,11 @@ class Hint:
     value: object | None = None
 
     def __str__(self) -> str:
-        return f"option {self.option}" + ("" if self.value is None else f" = {self.value}")
+        return f"option '{self.option}'" + ("" if self.value is None else f" = {self.value}")
 
 
 #: a :class:`Hint` as it stands in a message (messages reach the front ends as text: a report's warnings)
-HINT = re.compile(r"\boption ([a-z][a-z0-9_]*)(?: = ([^\s;,()]+))?")
+HINT = re.compile(r"\boption '([a-z][a-z0-9_]*)'(?: = ([^\s;,()]+))?")
 
 
 def render_hints(text: str, name: Callable[[str, str | None], str]) -> str:

@@ -155,7 +155,7 @@ def option_message(exc: OptionError, command: str | None = None) -> str:
 
 
 def as_flags(text: str, command: str | None = None) -> str:
-    """A library message with its hints (:class:`mocycle.errors.Hint`, ``option force``) said as the flags
+    """A library message with its hints (:class:`mocycle.errors.Hint`, ``option 'force'``) said as the flags
     that set them (``--force``, ``--model M2``)."""
     if "option " not in str(text):
         return str(text)

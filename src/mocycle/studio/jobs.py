@@ -216,7 +216,7 @@ class Jobs:
             job.status = "cancelled" if job.cancelled() else "done"
             job.progress = 1.0
         except LoopRefused as exc:  # a result that fails its own checks: refused, with the reason
-            job.status, job.error = "refused", words.hints(str(exc))  # option force -> Force: no CLI flags here
+            job.status, job.error = "refused", words.hints(str(exc))  # option 'force' -> Force: no CLI flags here
             job.result = {"facts": {"refused": True, "reason": job.error,
                                     "failed_checks": [f.to_dict() for f in exc.failed]}}
         except Exception as exc:  # the page shows the message; the server keeps serving

@@ -61,7 +61,7 @@ def number(value, digits: int = 2, unit: str = "") -> str | None:
 
 
 def hints(text: str) -> str:
-    """A library message with its hints (``option force``, ``option model = M2``: :class:`mocycle.errors.Hint`)
+    """A library message with its hints (``option 'force'``, ``option 'model' = M2``: :class:`mocycle.errors.Hint`)
     said as the option's name, as a panel or form labels it (``Force``, ``Model set to M2``), never a CLI flag."""
     from ..errors import render_hints
 
