@@ -57,7 +57,10 @@ def shared_data() -> Path:
 # every command end to end against the recorded outputs, the batch runner's dask clusters, the fuzzers
 # (hypothesis under memory and time limits), hostile command lines, the studio's server, fresh interpreters
 # (start-up, threads, import orders) and the few tests over ten seconds each on a busy machine.
-SLOW = ("tests/batch/", "tests/cli_json/", "_fuzz.py", "tests/test_cli_hostile.py", "tests/test_startup.py",
+SLOW = ("tests/batch/", "tests/cli_json/", "_fuzz.py", "tests/test_cli_hostile.py",
+        # start-up: `mocycle --help` importing no numpy and the command table are cheap (<0.5 s) and stay in the
+        # fast tier; the runs of a whole loop and of a misspelt command in fresh interpreters (~3 s each) do not
+        "tests/test_startup.py::test_loop_loads_only_what_a_loop_uses", "tests/test_startup.py::test_a_misspelt",
         "tests/test_threads.py", "tests/test_cli_polish.py", "tests/studio/test_studio_api.py",
         "::test_codec_modules_import_in_any_order", "::test_writing_holds_one_piece_of_text_at_a_time_not_the_take",
         "::test_a_long_query_is_measured_on_evenly_spread_windows_and_still_finds_itself")

@@ -155,7 +155,7 @@ def _failure(op, exc) -> Said:
     itself, cut to a line; the whole message and every check's reason in the detail."""
     action, first = getattr(op, "_action", None), getattr(op, "_first", None)
     name = f"{action.name}: " if action is not None else ""
-    text = " ".join(str(exc).split())
+    text = words.hints(" ".join(str(exc).split()))  # a hint ("option 'force'") as the option's name, not a flag
     if isinstance(exc, OptionError):  # the option as the operator labels it
         prop = op.rna_type.properties.get(exc.parameter)
         text = f"{prop.name if prop else exc.parameter}: {exc.reason}"
@@ -268,7 +268,7 @@ class _Task(bpy.types.Operator):
             self.report({"ERROR"}, said.message)
             return {"CANCELLED"}
         for w in getattr(self, "_warnings", ()):
-            self.report({"WARNING"}, words.brief(w))
+            self.report({"WARNING"}, words.brief(words.hints(w)))
         self.report({"INFO"}, said.message)
         return {"FINISHED"}
 

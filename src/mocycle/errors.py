@@ -6,7 +6,34 @@ input, with one message that names the file, the line and what was expected.
 
 from __future__ import annotations
 
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
 from os import PathLike
+
+
+@dataclass(frozen=True)
+class Hint:
+    """What would help, named in the library's own terms: an ``Options`` field (``option``) and, when it
+    matters, the value to give it.  A message below the front ends says it as ``str(hint)``,
+    ``"option 'force'"`` or ``"option 'model' = M2"``, never as a CLI flag; each front end renders it in its own
+    terms with :func:`render_hints` (the CLI as ``--force`` / ``--model M2``, Blender and the studio as the
+    field's name)."""
+
+    option: str
+    value: object | None = None
+
+    def __str__(self) -> str:
+        return f"option '{self.option}'" + ("" if self.value is None else f" = {self.value}")
+
+
+#: a :class:`Hint` as it stands in a message (messages reach the front ends as text: a report's warnings)
+HINT = re.compile(r"\boption '([a-z][a-z0-9_]*)'(?: = ([^\s;,()]+))?")
+
+
+def render_hints(text: str, name: Callable[[str, str | None], str]) -> str:
+    """``text`` with each hint in it said as ``name(option, value)`` (``value`` None when the hint has none)."""
+    return HINT.sub(lambda m: name(m.group(1), m.group(2)), str(text))
 
 
 class MocycleError(Exception):

@@ -40,7 +40,7 @@ def test_feet_are_found_on_every_naming(rig):
 def test_named_feet_and_a_clear_error_when_none_are_found():
     neutral = {n: f"j{i}" for i, n in enumerate(humanoid_skeleton().names)}
     skel = _renamed(neutral)
-    with pytest.raises(MocycleError, match="no left and right foot.*--foot-joints"):
+    with pytest.raises(MocycleError, match="no left and right foot.*option 'foot_joints'"):
         find_feet(skel)
     ankle, toe = neutral["LeftFoot"], neutral["LeftToeBase"]
     feet = find_feet(skel, f"{ankle}:{toe},{neutral['RightFoot']}")

@@ -59,7 +59,7 @@ def test_a_wrong_period_fits_worse_than_a_plain_cut_and_is_refused(walk, wrong_p
     with pytest.raises(LoopRefused, match="worse than a plain cut of 60 frames.*period found .* wrong") as info:
         check_loop(walk, cycle)
     assert info.value.failed[0].name == "fit"
-    with pytest.warns(MocycleWarning, match="fails the loop check.*fit.*--force"):
+    with pytest.warns(MocycleWarning, match="fails the loop check.*fit.*option 'force'"):
         assert check_loop(walk, cycle, force=True)
 
 

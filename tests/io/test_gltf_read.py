@@ -165,7 +165,7 @@ def test_several_animations_by_name(tmp_path):
                                           ("second", "LINEAR", [0.0, 2.0], [turn(0), turn(60)])])
     assert gltf_takes(path) == ["first", "second"]
     with pytest.warns(DefaultTake, match=r"read take 'first' \(the first that moves the skeleton\); the file also "
-                                         r"holds 'second': choose one with --take"):
+                                         r"holds 'second': choose one with option 'take'"):
         assert read_gltf(path, fps=10).n_frames == 11
     second = read_gltf(path, take="second", fps=10)
     assert second.n_frames == 21 and tip_angle(second)[-1] == pytest.approx(60, abs=1e-4)

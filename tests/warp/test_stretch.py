@@ -246,9 +246,10 @@ def test_stretch_rejects_bad_input():
         stretch_motion(take, 2.0, window="big")
     with pytest.raises(MocycleError, match="positive"):
         stretch_motion(take, -1.0)
-    with pytest.raises(NoPeriodicMotion, match="no periodic motion to stretch.*--force"):
+    with pytest.raises(NoPeriodicMotion, match="no periodic motion to stretch.*option 'force'"):
         stretch_motion(synthetic_still(200).motion, 2.0)
-    with pytest.warns(MocycleWarning, match="--force"), pytest.raises(MocycleError, match="does not look periodic"):
+    with pytest.warns(MocycleWarning, match="option 'force'"), \
+            pytest.raises(MocycleError, match="does not look periodic"):
         stretch_motion(synthetic_still(200).motion, 2.0, force=True)
 
 

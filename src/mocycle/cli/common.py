@@ -21,7 +21,7 @@ import typer.main
 from typer.core import TyperCommand, TyperGroup
 
 from .. import __version__
-from ..errors import LoopRefused, MocycleError, MocycleWarning, NoPeriodicMotion, OptionError
+from ..errors import LoopRefused, MocycleError, MocycleWarning, NoPeriodicMotion, OptionError, render_hints
 from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_declaration, flag_of, old_flag_warning
 from ..tasks.spec import MOTION_SUFFIXES, SPECS
 from ..text import json_text, printable
@@ -154,6 +154,19 @@ def option_message(exc: OptionError, command: str | None = None) -> str:
     return f"{flags(command).get(exc.parameter, exc.parameter)} {exc.reason}"
 
 
+def as_flags(text: str, command: str | None = None) -> str:
+    """A library message with its hints (:class:`mocycle.errors.Hint`, ``option 'force'``) said as the flags
+    that set them (``--force``, ``--model M2``)."""
+    if "option " not in str(text):
+        return str(text)
+    names = flags(command)
+
+    def name(option: str, value: str | None) -> str:
+        return names.get(option, "--" + option.replace("_", "-")) + ("" if value is None else f" {value}")
+
+    return render_hints(text, name)
+
+
 def friendly(func: Callable) -> Callable:
     """Run a command: MocycleError -> one 'error:' line and exit 1 (2 for a bad option value, 3 for
     NoPeriodicMotion and LoopRefused); warnings (the command's and its reports') -> 'warning:' lines."""
@@ -170,7 +183,7 @@ def friendly(func: Callable) -> Callable:
                 raise typer.Exit(EXIT_USAGE) from None
             except MocycleError as exc:
                 _print_warnings(caught)
-                message = _naming_the_input(str(exc), kwargs)
+                message = _naming_the_input(as_flags(str(exc), func.__name__), kwargs)
                 err.print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
                 refused = isinstance(exc, (NoPeriodicMotion, LoopRefused))
                 raise typer.Exit(EXIT_NOT_FOUND if refused else EXIT_ERROR) from None
@@ -210,13 +223,13 @@ def _print_warnings(caught) -> None:
         if issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)) or str(w.message) in said:
             continue  # each said once, however often it was raised
         said.add(str(w.message))
-        err.print(f"[yellow]warning:[/] {escape(str(w.message))}", markup=True, soft_wrap=True)
+        err.print(f"[yellow]warning:[/] {escape(as_flags(str(w.message)))}", markup=True, soft_wrap=True)
 
 
 def print_warnings(report) -> None:
     """The warnings a task recorded in its report, as 'warning:' lines."""
     for text in report.warnings:
-        err.print(f"[yellow]warning:[/] {escape(text)}", markup=True, soft_wrap=True)
+        err.print(f"[yellow]warning:[/] {escape(as_flags(text, report.task))}", markup=True, soft_wrap=True)
 
 
 def _version(value: bool):

@@ -207,7 +207,7 @@ def _by_name(skeleton: Skeleton) -> list[Foot]:
         have = ", ".join(skeleton.names[f.ankle] for f in feet.values()) or "none"
         raise MocycleError(
             f"no left and right foot found by name (foot joints found: {have}); name them as "
-            f"ANKLE[:TOE],ANKLE[:TOE] (option --foot-joints); joints are: {_listed(skeleton)}")
+            f"ANKLE[:TOE],ANKLE[:TOE] (option 'foot_joints'); joints are: {_listed(skeleton)}")
     return [feet["left"], feet["right"]]
 
 

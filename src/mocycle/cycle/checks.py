@@ -209,7 +209,7 @@ def check_loop(motion: Motion, cycle: Cycle, metrics: dict | None = None, force:
     where = f"{label}: " if label else ""
     text = "; ".join(f"{f.name}: {f.reason}" for f in failed)
     if not force:
-        raise LoopRefused(f"{where}not a loop ({text}); --force writes it anyway", failed)
+        raise LoopRefused(f"{where}not a loop ({text}); option 'force' writes it anyway", failed)
     warnings.warn(f"{where}kept although it fails the loop check(s) {', '.join(f.name for f in failed)} "
-                  f"(--force): {text}", MocycleWarning, stacklevel=2)
+                  f"(option 'force'): {text}", MocycleWarning, stacklevel=2)
     return failed

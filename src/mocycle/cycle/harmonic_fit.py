@@ -119,7 +119,7 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     x = axis.x[frames]
     if model != "M2" and sum(e - s - 2 * HALF for s, e in _derivative_regions(axis)) < max(2 * K, 1):
         raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the excited "
-                           f"regions are too short: use --model M2 or fewer harmonics")
+                           f"regions are too short: use option 'model' = M2 or fewer harmonics")
     # On a part of under SHORT_PERIODS periods a linear term fitted beside all the harmonics trades off against
     # them (a turn that speeds up and slows down came out 40 % too fast): there the drift per period is fitted
     # with few harmonics (short_drift), and the harmonics fit what is left.

@@ -330,14 +330,15 @@ def _any_above(order: list[int], up: list[int], marked: np.ndarray) -> np.ndarra
 
 
 MAX_LISTED_TAKES = 20
-"""How many take names a message lists; the rest are counted (``mocycle info FILE`` lists them all)."""
+"""How many take names a message lists; the rest are counted (``mocycle info FILE``, ``gltf_takes`` and
+``fbx_takes`` list them all)."""
 
 
 def listed(names: list[str]) -> str:
     """``names`` joined for a message: the first :data:`MAX_LISTED_TAKES`, then how many more."""
     shown = ", ".join(names[:MAX_LISTED_TAKES])
     more = len(names) - MAX_LISTED_TAKES
-    return shown + (f" and {more} more (mocycle info lists them all)" if more > 0 else "")
+    return shown + (f" and {more} more" if more > 0 else "")
 
 
 def choose_take(names: list[str], take, path, noun: str, none_held: str) -> int | None:

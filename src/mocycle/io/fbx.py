@@ -304,7 +304,7 @@ class _Scene:
                   for k, name in enumerate(self.stack_names) if k != chosen]
         why = "the first that moves the skeleton" if self.moves(chosen) else "the first: no take moves the skeleton"
         warnings.warn(f"{self.path}: read take {self.stack_names[chosen]!r} ({why}); the file also holds "
-                      f"{listed(others)}: choose one with --take", DefaultTake, stacklevel=4)
+                      f"{listed(others)}: choose one with option 'take'", DefaultTake, stacklevel=4)
         return chosen
 
     def still_leaves(self) -> set[int]:

@@ -180,7 +180,7 @@ def _units(scale, size: float) -> tuple[str, float]:
             lo, hi = PLAUSIBLE_HEIGHT_M
             if not lo <= size * UNITS[unit] <= hi:
                 warnings.warn(f"glTF units: the body is {size:.4g} units tall; no common unit makes that a person "
-                              f"({size * UNITS[unit]:.3g} m in {unit}); pass --gltf-scale (metres per unit)",
+                              f"({size * UNITS[unit]:.3g} m in {unit}); pass option 'gltf_scale' (metres per unit)",
                               MocycleWarning, stacklevel=3)
             return unit, UNITS[unit]
     try:

@@ -669,7 +669,7 @@ def _default_take(f: _File, body: set[int], n_nodes: int, names: list[str]) -> t
         others = [f"{name!r}" + (" (still)" if k in still else "") for k, name in enumerate(names) if k != chosen]
         why = "the first: no animation moves the skeleton" if chosen in still else "the first that moves the skeleton"
         warnings.warn(f"{f.path}: read take {names[chosen]!r} ({why}); the file also holds {listed(others)}: "
-                      f"choose one with --take", DefaultTake, stacklevel=3)
+                      f"choose one with option 'take'", DefaultTake, stacklevel=3)
     return chosen, channels
 
 

@@ -98,6 +98,6 @@ def keyframe_density(motion: Motion, ratio: float | str = "auto", scheme: str = 
     if not auto and per is not None and per < KEYS_PER_PERIOD:
         warnings.warn(f"{k} keyframes of {n} frames is one every {n / k:.0f} frames, {per:.1f} per period of the "
                       f"take's {period:.0f}-frame rhythm (fewer than {KEYS_PER_PERIOD}): the motion will alias "
-                      f"(frozen limbs, gliding); --ratio auto keeps {KEYS_PER_PERIOD} per period", MocycleWarning,
-                      stacklevel=2)
+                      f"(frozen limbs, gliding); option 'ratio' = auto keeps {KEYS_PER_PERIOD} per period",
+                      MocycleWarning, stacklevel=2)
     return KeyDensity(int(k), period, None if per is None else float(np.round(per, 3)), rule)

@@ -50,7 +50,7 @@ from starlette.staticfiles import StaticFiles
 
 from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
-from ..tasks import author
+from ..tasks import author, words
 from ..tasks.report import Labelled
 from ..tasks.spec import SPECS
 from . import validate as v
@@ -192,7 +192,8 @@ class Studio:
             f = report.facts
             view, view_facts = loop_view(report)
             return {"report": report, "view": view, "take": take, "files": Downloads(self.files), "facts": {
-                "loop": loop_summary(f), "options": o.to_dict(), "warnings": list(report.warnings),
+                "loop": loop_summary(f), "options": o.to_dict(),
+                "warnings": [words.hints(w) for w in report.warnings],
                 "failed_checks": f["failed_checks"], "forced": bool(f["failed_checks"]),
                 "frames_out": f["frames_out"], "phase": take_phase(report), "excitation": strip_excitation(report),
                 "parts": strip_parts(report),
@@ -245,7 +246,7 @@ class Studio:
         kept = {"take": take.id, "motion": report.motions["authored"], "report": report,
                 "files": Downloads(self.files)}
         facts = {k: val for k, val in report.facts.items() if k != "trajectory"}
-        warnings, timings = list(report.warnings), dict(report.timings_s)
+        warnings, timings = [words.hints(w) for w in report.warnings], dict(report.timings_s)
         self.strokes.put(sid, kept, held_bytes(kept, self._shared()))
         del report, kept
         release_memory()  # what the work made and dropped

@@ -216,11 +216,11 @@ class Jobs:
             job.status = "cancelled" if job.cancelled() else "done"
             job.progress = 1.0
         except LoopRefused as exc:  # a result that fails its own checks: refused, with the reason
-            job.status, job.error = "refused", str(exc)
-            job.result = {"facts": {"refused": True, "reason": str(exc),
+            job.status, job.error = "refused", words.hints(str(exc))  # option 'force' -> Force: no CLI flags here
+            job.result = {"facts": {"refused": True, "reason": job.error,
                                     "failed_checks": [f.to_dict() for f in exc.failed]}}
         except Exception as exc:  # the page shows the message; the server keeps serving
-            job.status, job.error = "failed", str(exc) or type(exc).__name__
+            job.status, job.error = "failed", words.hints(str(exc)) or type(exc).__name__
             if not isinstance(exc, (ValueError, MocycleError)):
                 traceback.print_exc()
 

@@ -56,7 +56,8 @@ def edit_swing(motion: Motion, seg: Segmentation, joint: str | int, swing: int, 
         raise MocycleError(f"joint {name!r} has no swings; joints with swings: "
                            f"{', '.join(sorted({s.name for s in seg.swings})) or 'none'}")
     if not 0 <= swing < len(swings):
-        raise MocycleError(f"joint {name!r} has {len(swings)} swings (0-{len(swings) - 1}); got --swing {swing}")
+        raise MocycleError(f"joint {name!r} has {len(swings)} swings (0-{len(swings) - 1}); "
+                           f"got option 'swing' = {swing}")
     angle_scale = _validate.real("angle_scale", angle_scale, 0.0, 10.0)
     duration_scale = _validate.real("duration_scale", duration_scale, 0.05, 20.0)
     sw = swings[swing]
@@ -85,11 +86,11 @@ def edit_swing(motion: Motion, seg: Segmentation, joint: str | int, swing: int, 
         new_end = sw.start + int(round(duration_scale * length))
         if new_end > limit:
             room = (limit - sw.start) / max(length, 1)
-            raise MocycleError(f"--duration-scale {duration_scale:g} makes swing {swing} of {name!r} end at frame "
-                               f"{new_end}, past {'its next swing at frame' if nxt else 'the last frame'} "
+            raise MocycleError(f"option 'duration_scale' = {duration_scale:g} makes swing {swing} of {name!r} end at "
+                               f"frame {new_end}, past {'its next swing at frame' if nxt else 'the last frame'} "
                                f"{limit}; the largest scale here is {room:.3g}")
         if new_end <= sw.start:
-            raise MocycleError(f"--duration-scale {duration_scale:g} shrinks swing {swing} of {name!r} "
+            raise MocycleError(f"option 'duration_scale' = {duration_scale:g} shrinks swing {swing} of {name!r} "
                                f"({length + 1} frames) to nothing; the smallest scale here is {1 / max(length, 1):.3g}")
         # old time for each new frame in start..limit: the swing stretched, the rest squeezed to keep `limit`
         new = np.arange(sw.start, limit + 1, dtype=float)

@@ -162,7 +162,7 @@ def choose_joints(motion: Motion, joints: str | Iterable[str] | None = None, min
     if joints is not None:
         chosen = skel.select(joints)
         if not chosen:
-            raise MocycleError("--joints selected no joint")
+            raise MocycleError("option 'joints' selected no joint")
         return chosen
     pats = [p.lower() for p in exclude]
     major = [j for j, n in enumerate(skel.names) if not any(fnmatch.fnmatch(n.lower(), p) for p in pats)]

@@ -58,3 +58,15 @@ def number(value, digits: int = 2, unit: str = "") -> str | None:
     if not math.isfinite(v):
         return None
     return f"{v:.{digits}f}" + (f" {unit}" if unit else "")
+
+
+def hints(text: str) -> str:
+    """A library message with its hints (``option 'force'``, ``option 'model' = M2``: :class:`mocycle.errors.Hint`)
+    said as the option's name, as a panel or form labels it (``Force``, ``Model set to M2``), never a CLI flag."""
+    from ..errors import render_hints
+
+    def name(option: str, value: str | None) -> str:
+        label = option.replace("_", " ").capitalize()
+        return label if value is None else f"{label} set to {value}"
+
+    return render_hints(text, name)

@@ -573,8 +573,8 @@ def stretch_motion(motion: Motion, factor: float, window: str | int = "auto", fo
     if not regions:
         if not force:
             raise NoPeriodicMotion(f"no periodic motion to stretch ({reason}): warping would repeat what happens "
-                                   f"once; --force warps the whole take anyway")
-        warnings.warn(f"the take has no periodic motion ({reason}); warping it whole (--force) repeats what "
+                                   f"once; option 'force' warps the whole take anyway")
+        warnings.warn(f"the take has no periodic motion ({reason}); warping it whole (option 'force') repeats what "
                       f"happens once", MocycleWarning, stacklevel=2)
         new, report = _warp_take(motion, factor, window)
         return new, replace(report, factor=factor, forced=True)
