@@ -198,7 +198,7 @@ def test_the_declared_unit_wins_and_a_moving_ik_target_is_no_body():
 
 def test_a_body_of_no_known_unit_is_warned_about():
     walk = synthetic_walk(n_frames=30).motion
-    with pytest.warns(mocycle.MocycleWarning, match="--gltf-scale"):
+    with pytest.warns(mocycle.MocycleWarning, match="option 'gltf_scale'"):
         gltf_frame(scaled(walk, 1e4))
 
 
