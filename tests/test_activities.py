@@ -83,6 +83,10 @@ def test_the_default_loop_is_one_part_and_says_which_and_why(tmp_path):
     assert [p["kind"] for p in facts["parts"] if p["loop"]] == ["walk straight", "walk turning left", "walk straight"]
     most = max(p["n_periods"] for p in facts["parts"])
     assert facts["parts"][chosen["part"]]["n_periods"] == most
+    # the reason says what would write the others in the library's words; the terminal says it as a flag
+    assert "(option 'part' = all writes every one)" in facts["reason"]
+    table = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "again.bvh")])
+    assert table.exit_code == 0 and "(--part all writes every one)" in table.stdout
 
 
 @pytest.mark.parametrize("hand", ["right", "both"])

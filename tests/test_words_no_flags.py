@@ -52,7 +52,7 @@ def test_no_cli_flag_in_library_messages():
 
 
 def test_front_ends_render_a_hint_in_their_own_terms():
-    from mocycle.cli.common import as_flags
+    from mocycle.tasks.flags import as_flags
 
     text = f"take 0: not a loop (seam: ...); {Hint('force')} writes it anyway"
     assert text.endswith("; option 'force' writes it anyway")
@@ -68,7 +68,7 @@ def test_front_ends_render_a_hint_in_their_own_terms():
 def test_every_hint_names_an_option_the_cli_knows():
     """A hint in a library message names an ``Options`` field (or a front-end option the CLI declares): renaming
     the field without the message would leave the CLI printing a flag that does not exist."""
-    from mocycle.cli.common import flags
+    from mocycle.tasks.flags import flags
     from mocycle.errors import HINT
 
     known = set(flags()) | {"force", "take"}  # --force and --take: the CLI's own flags of every task that reads

@@ -178,7 +178,7 @@ def _failure(op, exc) -> Said:
                    f"does not loop: {d['reason']}")
             message = f"{name}{_part(d, first)} {why}"
         else:
-            message = name + _nothing(facts.get("reason") or text, parts)
+            message = name + _nothing(words.hints(facts.get("reason") or text), parts)
         return Said(message, detail=_with_note(detail + _parts_detail(parts, first) + force, first))
     if isinstance(exc, LoopRefused) and exc.failed:  # blend, transition: which action's cycle, and why
         labels = sorted((a.name for a in getattr(op, "_actions", ())), key=len, reverse=True)

@@ -12,7 +12,7 @@ from mocycle.batch.commands import COMMANDS, check_suffix
 from mocycle.batch.discover import Take
 from mocycle.batch.take import Job, fresh_record, process, status_of
 from mocycle.datasets import synthetic_nonperiodic, synthetic_walk
-from mocycle.errors import DataError, LoopRefused, MocycleError, MotionFileError, NoPeriodicMotion, OptionError
+from mocycle.errors import DataError, Hint, LoopRefused, MocycleError, MotionFileError, NoPeriodicMotion, OptionError
 
 
 @pytest.fixture(scope="module")
@@ -63,11 +63,13 @@ def test_refused_and_no_periodic_motion_and_bugs_are_rows_not_exceptions(tmp_pat
     assert (tmp_path / "out" / "walk.bvh").exists()
 
     def refuse(path, options):
-        raise LoopRefused("the seam jumps 4.2x the median step", failed=["seam"])
+        raise LoopRefused(f"the seam jumps 4.2x the median step; {Hint('force')} writes it anyway", failed=["seam"])
 
     monkeypatch.setattr(tasks.loop, "run", refuse)
     row = process(job, _take(walk_file))
-    assert (row["status"], row["message"], row["outputs"]) == ("refused", "the seam jumps 4.2x the median step", [])
+    # batch runs from a shell: the library's hint is said as the loop command's flag
+    assert (row["status"], row["message"], row["outputs"]) == \
+        ("refused", "the seam jumps 4.2x the median step; --force writes it anyway", [])
     assert not (tmp_path / "out" / "walk.bvh").exists()  # the tree agrees with the row
 
     monkeypatch.setattr(tasks.loop, "run", lambda path, options: 1 / 0)

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
+from ..tasks.flags import as_flags
 from ..tasks.options import Options
 from ..tasks.spec import row_figures
 from ..text import json_text, path_hex, printable
@@ -167,6 +168,9 @@ def _process(job: Job, take: Take) -> dict:
             written = []
     row["warnings"] += [str(w.message) for w in caught if not issubclass(w.category, DeprecationWarning)
                         and str(w.message) not in row["warnings"]]
+    # a batch is run from a shell: a message's hints (option 'force') said as the command's flags (--force)
+    row["message"] = as_flags(row["message"], job.command)
+    row["warnings"] = [as_flags(w, job.command) for w in row["warnings"]]
     row["outputs"] = [printable(p.relative_to(job.outdir).as_posix()) for p in written]
     record = job.record_path(take)
     try:

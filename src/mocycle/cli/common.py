@@ -21,8 +21,9 @@ import typer.main
 from typer.core import TyperCommand, TyperGroup
 
 from .. import __version__
-from ..errors import LoopRefused, MocycleError, MocycleWarning, NoPeriodicMotion, OptionError, render_hints
-from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_declaration, flag_of, old_flag_warning
+from ..errors import LoopRefused, MocycleError, MocycleWarning, NoPeriodicMotion, OptionError
+from ..tasks.flags import as_flags, option_message
+from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_declaration, old_flag_warning
 from ..tasks.spec import MOTION_SUFFIXES, SPECS
 from ..text import json_text, printable
 
@@ -135,36 +136,6 @@ FORCE_HELP = "Allow an output to replace one of the input files."
 EXIT_ERROR = 1
 EXIT_USAGE = 2  # a bad option value (typer/click use 2 for usage errors too)
 EXIT_NOT_FOUND = 3  # the input is fine but holds no periodic motion, or its cycle is not a loop
-
-
-def flags(command: str | None = None) -> dict[str, str]:
-    """Parameter names of the library -> the CLI flag that sets them (every task option, a few library names);
-    ``command``: the task whose own flags win where two tasks name one parameter differently (``loop``'s
-    ``which`` is ``--part``, ``blend``'s ``--class``). Asked only when an option is refused."""
-    names = {f.name: flag_of(f) for spec in SPECS.values() if spec.cli for f in dataclasses.fields(spec.options)}
-    if command in SPECS:
-        names.update({f.name: flag_of(f) for f in dataclasses.fields(SPECS[command].options)})
-    names.update({"n_classes": "--classes", "seed": "--seed-projection", "count": "--cycles",
-                  "window": "--window", "gltf_scale": "--gltf-scale", "gltf_up": "--gltf-up"})
-    return names
-
-
-def option_message(exc: OptionError, command: str | None = None) -> str:
-    """The error with the flag instead of the library's parameter name (``--cycles must be ...``)."""
-    return f"{flags(command).get(exc.parameter, exc.parameter)} {exc.reason}"
-
-
-def as_flags(text: str, command: str | None = None) -> str:
-    """A library message with its hints (:class:`mocycle.errors.Hint`, ``option 'force'``) said as the flags
-    that set them (``--force``, ``--model M2``)."""
-    if "option " not in str(text):
-        return str(text)
-    names = flags(command)
-
-    def name(option: str, value: str | None) -> str:
-        return names.get(option, "--" + option.replace("_", "-")) + ("" if value is None else f" {value}")
-
-    return render_hints(text, name)
 
 
 def friendly(func: Callable) -> Callable:

@@ -10,7 +10,7 @@ import typer
 from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 from ..tasks.loop import METRIC_LABELS
-from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line
+from .common import as_flags, check_output, escape, out, print_json, print_warnings, task_command, timing_line
 
 
 @task_command("loop")
@@ -97,7 +97,7 @@ def _print_parts(path: Path, facts: dict) -> None:
             what = (f"{p['n_periods']:.1f} cycles of {p['period_frames']:.1f} frames"
                     if p["loop"] and p["period_frames"] else escape(p["reason"]))
             out.print(f"  part {k}: frames {a}-{b}, {p['kind']}: {what}", soft_wrap=True)
-    out.print(escape(facts["reason"]), soft_wrap=True)
+    out.print(escape(as_flags(facts["reason"], "loop")), soft_wrap=True)
     for d in facts["not_looped"]:
         if str(d["reason"]).startswith("refused"):
             out.print(f"  part {d['part']} ({d['kind']}) not looped: {escape(d['reason'])}", soft_wrap=True)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from functools import partial
 
 from ..defaults import TIME_AXES
-from ..errors import LoopRefused, MocycleError, NoPeriodicMotion, OptionError
+from ..errors import Hint, LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from . import fields
 from .options import Choice, Flag, Integer, Text, option
 from .report import Recorder, Report, label_of, load
@@ -344,7 +344,7 @@ def _chosen_reason(loops, parts, everything) -> str:
         return parts[0].reason if parts[0].one_cycle else "the take does one thing: it is one part, looped"
     others = sum(1 for p in parts if p.loop) - 1
     return (f"looped part {f['part']} ({f['kind']}, frames {f['frames'][0]}-{f['frames'][1]}): the steady part with "
-            f"the most cycles" + (f"; {others} other part(s) can loop too (--part all writes every one)"
+            f"the most cycles" + (f"; {others} other part(s) can loop too ({Hint('part', 'all')} writes every one)"
                                   if others > 0 else ""))
 
 
