@@ -68,8 +68,8 @@ def test_front_ends_render_a_hint_in_their_own_terms():
 def test_every_hint_names_an_option_the_cli_knows():
     """A hint in a library message names an ``Options`` field (or a front-end option the CLI declares): renaming
     the field without the message would leave the CLI printing a flag that does not exist."""
-    from mocycle.tasks.flags import flags
     from mocycle.errors import HINT
+    from mocycle.tasks.flags import flags
 
     known = set(flags()) | {"force", "take"}  # --force and --take: the CLI's own flags of every task that reads
     found = []

@@ -11,11 +11,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import MocycleError
+from ..suffixes import MOTION_READ_SUFFIXES
 
 #: the suffixes of the files that hold a take (``.amc`` with its ``.asf`` beside it)
-TAKE_SUFFIXES = (".bvh", ".amc", ".fbx", ".glb", ".gltf")
 
-__all__ = ["TAKE_SUFFIXES", "Take", "find_takes"]
+__all__ = ["Take", "find_takes"]
 
 
 @dataclass(frozen=True)
@@ -110,7 +110,7 @@ def _walk(root: Path, skip: Path | None) -> tuple[list[Path], list[tuple[Path, s
                 is_dir = False
             if is_dir:
                 below.append(p)
-            elif p.suffix.lower() in TAKE_SUFFIXES:
+            elif p.suffix.lower() in MOTION_READ_SUFFIXES:
                 why = problem_of(p)
                 if why is None:
                     files.append(p)
@@ -175,10 +175,10 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
             root = _abs(p)
             files, problems = _walk(root, _below(skip, root))
             if not files and not problems:
-                raise MocycleError(f"{item}: no {', '.join(TAKE_SUFFIXES)} files in this folder")
+                raise MocycleError(f"{item}: no {', '.join(MOTION_READ_SUFFIXES)} files in this folder")
         elif p.exists():
-            if p.suffix.lower() not in TAKE_SUFFIXES:
-                raise MocycleError(f"{item}: not a take; batch reads {', '.join(TAKE_SUFFIXES)} files")
+            if p.suffix.lower() not in MOTION_READ_SUFFIXES:
+                raise MocycleError(f"{item}: not a take; batch reads {', '.join(MOTION_READ_SUFFIXES)} files")
             why = problem_of(_abs(p))
             if why is not None:
                 raise MocycleError(f"{item}: {why}")
@@ -186,7 +186,7 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
         elif _magic(item):
             root = _abs(_root_of_pattern(item))
             matched = [_abs(f) for f in sorted(glob.glob(item, recursive=True))]
-            matched = [f for f in matched if f.suffix.lower() in TAKE_SUFFIXES and not f.name.startswith(".")
+            matched = [f for f in matched if f.suffix.lower() in MOTION_READ_SUFFIXES and not f.name.startswith(".")
                        and not _inside(f, _below(skip, root)) and not f.is_dir()]
             files, problems = [], []
             for f in matched:
@@ -196,7 +196,7 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
                 else:
                     problems.append((f, why))
             if not files and not problems:
-                raise MocycleError(f"{item}: the pattern matches no {', '.join(TAKE_SUFFIXES)} file")
+                raise MocycleError(f"{item}: the pattern matches no {', '.join(MOTION_READ_SUFFIXES)} file")
         elif os.path.islink(item):
             raise MocycleError(f"{item}: {problem_of(Path(item))}")
         else:

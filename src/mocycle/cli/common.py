@@ -22,9 +22,10 @@ from typer.core import TyperCommand, TyperGroup
 
 from .. import __version__
 from ..errors import LoopRefused, MocycleError, MocycleWarning, NoPeriodicMotion, OptionError
+from ..suffixes import MOTION_WRITE_SUFFIXES
 from ..tasks.flags import as_flags, option_message
 from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_declaration, old_flag_warning
-from ..tasks.spec import MOTION_SUFFIXES, SPECS
+from ..tasks.spec import SPECS
 from ..text import json_text, printable
 
 #: the module of ``mocycle.cli`` that defines each task's command (the command is made from the task's spec)
@@ -483,7 +484,7 @@ def check_motion_output(path: Path | None, inputs=(), force: bool = False, optio
 
     from ..io.gltf import check_options
 
-    check_output(path, inputs, force, MOTION_SUFFIXES, option)
+    check_output(path, inputs, force, MOTION_WRITE_SUFFIXES, option)
     check_options(gltf_scale, gltf_up)
     if path is not None and path.suffix.lower() == ".glb" and importlib.util.find_spec("pygltflib") is None:
         raise MocycleError(f"{path}: writing .glb files needs pygltflib: pip install 'mocycle[gltf]'")

@@ -33,21 +33,15 @@ from pathlib import Path
 
 from ..errors import MotionFileError
 from ..motion import Motion
+from ..suffixes import MOTION_READ_SUFFIXES, MOTION_WRITE_SUFFIXES, MULTI_TAKE_SUFFIXES, READ_SUFFIXES, WRITE_SUFFIXES
 from ..text import indented_json
 from .asfamc import AMC_FPS, read_amc, read_asf, read_asfamc
 from .atomic import atomic_write
 from .bvh import parse_bvh, read_bvh, write_bvh
 
-__all__ = ["AMC_FPS", "MOTION_WRITE_SUFFIXES", "READ_SUFFIXES", "TAKE_SUFFIXES", "WRITE_SUFFIXES", "parse_bvh", "read",
-           "read_amc", "read_asf", "read_asfamc", "read_bvh", "read_motion", "takes", "write", "write_bvh"]
-
-MOTION_SUFFIXES = (".bvh", ".amc", ".glb", ".gltf", ".fbx")
-#: the motion files that may hold several takes (animations, animation stacks)
-TAKE_SUFFIXES = (".glb", ".gltf", ".fbx")
-READ_SUFFIXES = (".bvh", ".amc", ".glb", ".gltf", ".fbx", ".mck", ".mosw", ".json")
-WRITE_SUFFIXES = (".bvh", ".glb", ".mck", ".mosw", ".json")
-#: the files a Motion is written as
-MOTION_WRITE_SUFFIXES = (".bvh", ".glb")
+__all__ = ["AMC_FPS", "MOTION_READ_SUFFIXES", "MOTION_WRITE_SUFFIXES", "MULTI_TAKE_SUFFIXES", "READ_SUFFIXES",
+           "WRITE_SUFFIXES", "parse_bvh", "read", "read_amc", "read_asf", "read_asfamc", "read_bvh", "read_motion",
+           "takes", "write", "write_bvh"]
 
 
 def _suffix(p: Path, known: tuple[str, ...], what: str) -> str:
@@ -65,7 +59,7 @@ def takes(path: str | os.PathLike) -> list[str]:
     """The names of the takes (glTF animations, FBX animation stacks) a motion file holds; one for other files
     (its stem)."""
     p = Path(path)
-    suffix = _suffix(p, MOTION_SUFFIXES, "mocycle reads motions from")
+    suffix = _suffix(p, MOTION_READ_SUFFIXES, "mocycle reads motions from")
     if suffix in (".glb", ".gltf"):
         from .gltf_read import gltf_takes
 
@@ -101,7 +95,7 @@ def read_motion(path: str | os.PathLike, *, asf: str | os.PathLike | None = None
         (the message names the file and the line).
     """
     p = Path(path)
-    suffix = _suffix(p, MOTION_SUFFIXES, "mocycle reads motions from")
+    suffix = _suffix(p, MOTION_READ_SUFFIXES, "mocycle reads motions from")
     if suffix in (".glb", ".gltf"):
         from .gltf_read import read_gltf
 
@@ -168,7 +162,7 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None, fps: 
     """
     p = Path(path)
     suffix = _suffix(p, READ_SUFFIXES, "mocycle reads")
-    if suffix in MOTION_SUFFIXES:
+    if suffix in MOTION_READ_SUFFIXES:
         return read_motion(p, asf=asf, fps=fps, take=take, sample_fps=sample_fps)
     if suffix == ".mck":
         raise MotionFileError("holds a keyframe-compressed take, which io does not build: read it with "

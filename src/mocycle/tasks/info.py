@@ -86,10 +86,10 @@ def take_names(item, chosen: str | None, motion: Motion | None = None) -> dict:
     its name with the ``motion``, ``motion.cache("take")``); nothing for other inputs."""
     from pathlib import Path
 
-    from ..io import TAKE_SUFFIXES, takes
+    from ..io import MULTI_TAKE_SUFFIXES, takes
     from .report import is_motion
 
-    if is_motion(item) or Path(item).suffix.lower() not in TAKE_SUFFIXES:
+    if is_motion(item) or Path(item).suffix.lower() not in MULTI_TAKE_SUFFIXES:
         return {}
     names = takes(item)
     known = None if motion is None else motion.cache("take")

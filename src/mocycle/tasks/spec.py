@@ -24,10 +24,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["SPECS", "Output", "Spec", "row_figures"]
+from ..suffixes import MOTION_WRITE_SUFFIXES
 
-#: the file suffixes of a written motion (``mocycle.io.write``); the first is the default
-MOTION_SUFFIXES = (".bvh", ".glb")
+__all__ = ["SPECS", "Output", "Spec", "row_figures"]
 
 
 @dataclass(frozen=True)
@@ -146,7 +145,7 @@ def _skate(facts: Mapping):
 
 
 def _motion(role: str, help: str, **kwargs) -> Output:
-    return Output(role, "motion", MOTION_SUFFIXES, help=help, **kwargs)
+    return Output(role, "motion", MOTION_WRITE_SUFFIXES, help=help, **kwargs)
 
 
 SPECS: dict[str, Spec] = {s.name: s for s in (
