@@ -259,3 +259,14 @@ def test_rest_offsets_agree_within_the_offset_tolerance():
     as_far = Skeleton(a.names, a.parents, far, a.channels, a.end_sites)
     assert skeleton_differences(a, as_near) == []
     assert skeleton_differences(a, as_far) == [f"joints with other rest offsets (bone lengths): {a.names[5]!r}"]
+
+
+def test_a_blended_cycle_summarises_without_a_phase():
+    """A blend has no one take's phase (``Cycle.periodic`` is None): its summary says so by leaving the phase's
+    provenance out instead of failing (found by mypy once cycle.blend was type-checked)."""
+    a = extract_cycle(synthetic_walk(n_frames=300, period_s=1.0).motion)
+    b = extract_cycle(synthetic_walk(n_frames=300, period_s=0.8, phase0=0.4).motion)
+    blended = blend_cycles([a, b], [0.5, 0.5]).cycle
+    assert blended.periodic is None
+    facts = blended.to_dict()
+    assert facts["method"] == "blend" and facts["cycle_frames"] == blended.n_frames

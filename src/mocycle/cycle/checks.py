@@ -66,7 +66,7 @@ class FailedCheck:
         return {"check": self.name, "value": self.value, "limit": self.limit, "reason": self.reason}
 
 
-def _plain_cut_error(Y: np.ndarray, period: float, differences: dict | None = None) -> tuple[float, int]:
+def _plain_cut_error(Y: np.ndarray | MetricRows, period: float, differences: dict | None = None) -> tuple[float, int]:
     """Template error of the best plain cut of ``Y (M, D)`` with a lag within :data:`CUT_SPAN` of ``period``.
 
     The cut is frames ``a .. a+lag-1`` between the two windows (a fifth of a period wide) that are most
@@ -122,7 +122,7 @@ def moving_columns(Y: np.ndarray) -> np.ndarray:
 
 
 def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = None,
-                   features: np.ndarray | None = None) -> tuple[float, float]:
+                   features: np.ndarray | MetricRows | None = None) -> tuple[float, float]:
     """``(template error of the best plain cut, its length in frames)`` on the cycle's longest excited
     region: the better of cuts near the cycle's period and near the region's own autocorrelation period
     (paper 004 eq. 1 on the pose features; independent of the phase).  ``reference`` changes nothing

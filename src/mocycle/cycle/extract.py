@@ -9,6 +9,8 @@ import time
 import warnings
 from collections.abc import Iterable
 
+import numpy as np
+
 from .. import defaults
 from ..errors import MocycleError, MocycleWarning, NoPeriodicMotion
 from ..motion import Motion
@@ -19,7 +21,7 @@ from .cut import clip_cycle, cut_cycle
 from .harmonic import MODELS
 from .harmonic_fit import harmonic_cycle
 from .metric_rows import loop_blocks, metric_features
-from .representation import CycleSpace
+from .representation import CycleSpace, EncodedRows
 from .result import Cycle, _check_choice
 from .seam import calmest_start
 from .timeaxis import TIME_AXES
@@ -104,6 +106,7 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", h
         warnings.warn(f"only {axis.n_periods:.2f} periods found (fewer than {FEW_PERIODS}); the cycle rests on "
                       f"little evidence", MocycleWarning, stacklevel=2)
     space = CycleSpace.fit(motion)
+    P: np.ndarray | EncodedRows
     if method == "harmonic" and model == "M1" and motion.n_frames * space.n_periodic * 8 > LAZY_P_BYTES:
         P, L = space.encode_rows(motion)  # the fit reads P's rows block by block: made as read, never held
     else:
@@ -114,11 +117,14 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", h
     if method == "harmonic":
         cycle = harmonic_cycle(space, P, Q, axis, periodic, model, harmonics, calmest=True)
     elif method == "centroid":
+        assert isinstance(P, np.ndarray)  # rows made as read are for the harmonic fit only
         cycle = centroid_cycle(space, P, Q, axis, periodic)
         cycle = cycle.rolled(calmest_start(*loop_blocks(cycle)))
     elif method == "clip":
+        assert isinstance(P, np.ndarray)
         cycle = clip_cycle(space, P, Q, axis, periodic)
     else:
+        assert isinstance(P, np.ndarray)
         cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion))
     path, drift = space.bend(cycle.L, cycle.drift, space.heading_trend(L[:, 3], axis.period_frames)[0])
     cycle = cycle.on_path(path, drift)  # the same P: the same rotation matrices

@@ -13,7 +13,7 @@ from ..phase.analysis import PeriodicMotion
 from .differences import HALF, central_acceleration, central_velocity
 from .harmonic import MODELS, ROWS, HarmonicRegression, max_harmonics
 from .metric_rows import loop_blocks
-from .representation import CycleSpace
+from .representation import CycleSpace, EncodedRows
 from .result import Cycle, _check_choice
 from .seam import calmest_start
 from .timeaxis import TimeAxis
@@ -26,7 +26,7 @@ SHORT_PERIODS = 3.0
 DRIFT_HARMONICS = 2
 
 
-def _derivative_part(Y: np.ndarray, axis: TimeAxis, s: int, e: int, r0: int, r1: int):
+def _derivative_part(Y: np.ndarray | EncodedRows, axis: TimeAxis, s: int, e: int, r0: int, r1: int):
     """Velocities and accelerations per period (eq. 3.23-3.25) of region ``[s, e)``'s interior rows ``r0 .. r1-1``
     (frames ``s + HALF + r0 ..``): ``(x, dY, ddY)``, each row read from the stencil's ``2 * HALF + 1`` frames."""
     a, b = s + r0, s + r1 + 2 * HALF  # the frames the rows' stencils read
@@ -64,7 +64,7 @@ def _derivative_rows(Y: np.ndarray, axis: TimeAxis):
     return xs, dY, ddY
 
 
-def _derivative_blocks(Y: np.ndarray, axis: TimeAxis, rows: int = ROWS):
+def _derivative_blocks(Y: np.ndarray | EncodedRows, axis: TimeAxis, rows: int = ROWS):
     """:func:`_derivative_rows` as :meth:`HarmonicRegression.fit_blocks` reads them: a function returning a new
     iterator of ``(x, dY, ddY)`` blocks of at most ``rows`` rows, each made from its frames of ``Y`` when it
     is read (a long take's ``(T, D)`` velocities and accelerations are never held whole).  Rows that fit in
@@ -77,7 +77,7 @@ def _derivative_blocks(Y: np.ndarray, axis: TimeAxis, rows: int = ROWS):
     return lambda: (_derivative_part(Y, axis, *part) for part in parts)
 
 
-def _position_blocks(Y: np.ndarray, axis: TimeAxis, rows: int = ROWS):
+def _position_blocks(Y: np.ndarray | EncodedRows, axis: TimeAxis, rows: int = ROWS):
     """A function returning a new iterator of ``(x, Y)`` blocks over the axis' frames (views of ``Y``: the
     frames are never copied)."""
     return lambda: ((axis.x[r:min(r + rows, e)], Y[r:min(r + rows, e)]) for s, e in axis.regions
@@ -105,8 +105,9 @@ def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
     return int(n_harmonics)
 
 
-def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, periodic: PeriodicMotion,
-                   model: str = "M1", n_harmonics: int | str = "auto", *, calmest: bool = False) -> Cycle:
+def harmonic_cycle(space: CycleSpace, P: np.ndarray | EncodedRows, L: np.ndarray, axis: TimeAxis,
+                   periodic: PeriodicMotion, model: str = "M1", n_harmonics: int | str = "auto", *,
+                   calmest: bool = False) -> Cycle:
     """Fit ``P`` periodically and ``L`` with a linear term on ``axis``, sample one period at ``N`` frames.
 
     With ``calmest`` the cycle starts at its calmest point, chosen to a tenth of a frame; without, at phase 0
@@ -132,6 +133,7 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
         fit_l = HarmonicRegression(K, model, linear=linear).fit_blocks(_position_blocks(L, axis),
                                                                        _derivative_blocks(L, axis))
     else:
+        assert isinstance(P, np.ndarray)  # rows made as read are for M1 only (cycle.extract)
         xd, dP, ddP = _derivative_rows(P, axis) if model != "M2" else (None, None, None)
         _, dL, ddL = _derivative_rows(L, axis) if model != "M2" else (None, None, None)
         fit_p = HarmonicRegression(K, model).fit(x, _rows(P, axis, frames), xd, dP, ddP)

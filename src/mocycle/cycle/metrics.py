@@ -117,7 +117,7 @@ _ROWS = 8192
 _SPLINE_ROWS = 2048
 
 
-def regression_errors(Y: np.ndarray, C: np.ndarray, positions: np.ndarray, regions, frames: np.ndarray,
+def regression_errors(Y: np.ndarray | MetricRows, C: np.ndarray, positions: np.ndarray, regions, frames: np.ndarray,
                       frame_time: float, rate: float) -> tuple[float, float, float]:
     """Eq. 4.1-4.3 (unweighted): the cycle ``C (N, D)`` read at ``positions`` (cycle frames) against ``Y``.
 
@@ -152,7 +152,7 @@ def regression_errors(Y: np.ndarray, C: np.ndarray, positions: np.ndarray, regio
     return rms[0], rms[1], rms[2]
 
 
-def template_error(Y: np.ndarray, C: np.ndarray) -> tuple[float, int]:
+def template_error(Y: np.ndarray | MetricRows, C: np.ndarray) -> tuple[float, int]:
     """Eq. 4.4-4.5: slide the repeated cycle ``C (N, D)`` along ``Y (M, D)``; (RMS error, best offset n).
 
     The ``(M, N)`` distances are computed block by block of rows (twice: to choose ``n``, then its error)."""
@@ -184,7 +184,7 @@ def template_error(Y: np.ndarray, C: np.ndarray) -> tuple[float, int]:
     return float(np.sqrt(sq / M)), n                                         # eq. 4.5
 
 
-def jerk_ratio(Y_regions: list[np.ndarray], C: np.ndarray, frame_time: float) -> float:
+def jerk_ratio(Y_regions: list[np.ndarray] | list[MetricRows], C: np.ndarray, frame_time: float) -> float:
     """RMS jerk of the looped cycle over the RMS jerk of the input regions (paper 001 §6.3)."""
     width = FORWARD_3.size - 1  # rows lost at the end of each region
     total, rows = 0.0, 0
@@ -265,7 +265,7 @@ def foot_sliding(motion: Motion, up: np.ndarray | None = None, positions: np.nda
     W = motion.world_positions(end_sites=True) if positions is None else positions
     feet = foot_points(motion, up, W)
     body = np.ptp(W.mean(axis=0) @ up)
-    speeds = []
+    per_foot = []
     for f in feet:
         p = W[:, f]
         h = p @ up
@@ -273,14 +273,14 @@ def foot_sliding(motion: Motion, up: np.ndarray | None = None, positions: np.nda
         contact = down[:-1] & down[1:]
         step = np.diff(p, axis=0)
         horiz = step - np.outer(step @ up, up)
-        speeds.append(np.linalg.norm(horiz, axis=1)[contact] / motion.frame_time)
-    speeds = np.concatenate(speeds)
+        per_foot.append(np.linalg.norm(horiz, axis=1)[contact] / motion.frame_time)
+    speeds = np.concatenate(per_foot)
     return float(speeds.mean()) if speeds.size else float("nan")
 
 
 def _skate(motion: Motion, up: np.ndarray, positions: np.ndarray | None = None) -> float:
     try:
-        return skate(motion, up=up, positions=positions)
+        return skate(motion, up=up, positions=positions)  # type: ignore[return-value]  # a float: not per_joint
     except MocycleError:  # no feet found by name
         return float("nan")
 

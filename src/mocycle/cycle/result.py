@@ -54,7 +54,7 @@ class Cycle:
     n_harmonics: int | None
     axis: TimeAxis
     positions: np.ndarray
-    periodic: PeriodicMotion
+    periodic: PeriodicMotion | None  # None: a blend of cycles (no one take's phase)
     regression: HarmonicRegression | None = field(default=None, repr=False)
     seconds: float = 0.0
     #: ``space.project(P)`` ``(N, J, 3, 3)`` when the maker has it (rows of a finer sampling of the same fit):
@@ -229,7 +229,7 @@ class Cycle:
             "time_axis": self.axis.method,
             "travel_per_cycle": self.drift[:3].tolist(),
             "turn_per_cycle_deg": float(np.degrees(self.drift[3])),
-            **self.periodic.provenance(),
+            **(self.periodic.provenance() if self.periodic is not None else {}),  # a blend has no one phase
         }
 
 
