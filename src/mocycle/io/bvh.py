@@ -30,6 +30,7 @@ import re
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
+from typing import NoReturn
 
 import numpy as np
 
@@ -156,7 +157,7 @@ def _decode(data: str | bytes) -> str:
 class _Header:
     """Line-by-line parser of the HIERARCHY section."""
 
-    def __init__(self, path):
+    def __init__(self, path) -> None:
         self.path = path
         self.names: list[str] = []
         self.known: set[str] = set()
@@ -195,6 +196,7 @@ class _Header:
             return
         if len(self.names) != 0 and not self.stack:
             raise self.error(lineno, "found a second ROOT; only one skeleton per file is supported")
+        assert name is not None  # a ROOT or JOINT line always names its joint
         self.names.append(name)
         self.parents.append(parent)
         self.offsets.append(None)
@@ -244,12 +246,13 @@ class _Header:
         elif key == "END" and len(words) >= 2 and words[1].upper() == "SITE":
             if not (self.stack and self.stack[-1][0] == "joint"):
                 raise self.error(lineno, "End Site outside of a JOINT block")
-            name = s.split(None, 2)[2].strip() if len(words) > 2 else None
-            self.pending = ("end", self.stack[-1][1], name)
+            site_name = s.split(None, 2)[2].strip() if len(words) > 2 else None
+            self.pending = ("end", self.stack[-1][1], site_name)
         elif key == "OFFSET":
             if not self.stack:
                 raise self.error(lineno, "OFFSET outside of a ROOT, JOINT or End Site block")
-            vals = self.numbers(lineno, words[1:], 3, "OFFSET")
+            x, y, z = self.numbers(lineno, words[1:], 3, "OFFSET")
+            vals = (x, y, z)
             kind, idx = self.stack[-1]
             if kind == "end":
                 self.end_offset = vals
@@ -289,7 +292,9 @@ class _Header:
         if not self.names:
             raise self.error(lineno, "no ROOT joint in HIERARCHY")
         try:
-            return Skeleton(tuple(self.names), self.parents, self.offsets, tuple(self.channels),
+            # every joint has its OFFSET by now (close_node refuses one without)
+            return Skeleton(tuple(self.names), np.asarray(self.parents), np.asarray(self.offsets, dtype=np.float64),
+                            tuple(self.channels),
                             tuple(self.end_sites))
         except MocycleError as exc:
             raise self.error(lineno, str(exc)) from None
@@ -350,7 +355,7 @@ def _parse_rows(lines: list[str], start: int, n_channels: int, path) -> np.ndarr
     return values
 
 
-def _find_bad_row(body: list[str], start: int, n_channels: int, path) -> None:
+def _find_bad_row(body: list[str], start: int, n_channels: int, path) -> NoReturn:
     """Raise the error for the first malformed frame row."""
     for k, line in enumerate(body):
         words = line.split()
@@ -550,10 +555,10 @@ def one_word_names(skeleton: Skeleton) -> tuple[list[str], list[str | None], lis
             changed.append((name, word))
     sites: list[str | None] = []
     for site in skeleton.end_sites:
-        word = "_".join(site.name.split()) if site.name else site.name
-        sites.append(word or None)
-        if site.name and word != site.name:
-            changed.append((site.name, str(word)))
+        site_word = "_".join(site.name.split()) if site.name else site.name
+        sites.append(site_word or None)
+        if site.name and site_word != site.name:
+            changed.append((site.name, str(site_word)))
     return joints, sites, changed
 
 
@@ -563,8 +568,8 @@ def bvh_chunks(motion: Motion, names: tuple[list[str], list[str | None]] | None 
     skeleton's as BVH holds them: :func:`bvh_skeleton`, then :func:`one_word_names`)."""
     skel = motion.skeleton
     if names is None:
-        joints, sites, _ = one_word_names(bvh_skeleton(skel))
-        names = (joints, sites)
+        joint_words, site_words, _ = one_word_names(bvh_skeleton(skel))
+        names = (joint_words, site_words)
     joint_names, site_names = names
     out = io.StringIO()
     out.write("HIERARCHY\n")

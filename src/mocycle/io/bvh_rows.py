@@ -17,7 +17,7 @@ from __future__ import annotations
 import importlib.util
 import os
 import sys
-from collections.abc import Iterator
+from collections.abc import Generator
 
 import numpy as np
 
@@ -49,7 +49,7 @@ def _installed() -> bool:
         return False
 
 
-def row_chunks(path: str | os.PathLike, offset: int, n_channels: int) -> Iterator[np.ndarray]:
+def row_chunks(path: str | os.PathLike, offset: int, n_channels: int) -> Generator[np.ndarray, None, None]:
     """The rows from byte ``offset`` of ``path`` on as ``(n, n_channels)`` float64 arrays, in file order.
 
     Raises :class:`Unreadable` (possibly after some chunks) when the rows are not plain; a null (an empty
