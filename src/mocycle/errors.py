@@ -81,12 +81,18 @@ class DefaultTake(MocycleWarning):
 
 
 class NoPeriodicMotion(MocycleError):
-    """The input is fine but holds no periodic motion (the CLI exits with code 3)."""
+    """The input is fine but holds no periodic motion (the CLI exits with code 3).  ``facts``: the task's facts
+    when a task raised it (its parts and why none looped), else None."""
+
+    facts: dict | None = None
 
 
 class LoopRefused(MocycleError):
     """A cycle was made but fails the checks of a loop (:mod:`mocycle.cycle.checks`); the CLI exits with
-    code 3 and ``--force`` writes it anyway.  ``failed``: the failed checks, each with its reason."""
+    code 3 and the option ``force`` writes it anyway.  ``failed``: the failed checks, each with its reason;
+    ``facts``: the task's facts when a task raised it (its parts and why each did not loop), else None."""
+
+    facts: dict | None = None
 
     def __init__(self, message: str, failed=()):
         super().__init__(message)

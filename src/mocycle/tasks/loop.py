@@ -3,14 +3,19 @@
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import partial
+from typing import TYPE_CHECKING
 
 from ..defaults import TIME_AXES
 from ..errors import Hint, LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from . import fields
 from .options import Choice, Flag, Integer, Text, option
 from .report import Recorder, Report, label_of, load
+
+if TYPE_CHECKING:  # the part pieces come with numpy; the task loads them when it runs
+    from ..cycle.parts import PartPiece
 
 #: the loop metrics (``facts["metrics"]``): key -> (label, unit)
 METRIC_LABELS = {
@@ -49,16 +54,21 @@ def parse_range(text: str | None, n_frames: int) -> tuple[int, int]:
     return start, stop
 
 
-def _range_text(name: str, value):
-    if value is None or value == "":
-        return None
-    if not isinstance(value, str) or ":" not in value:
-        raise OptionError(name, f"must look like START:STOP (frame numbers); got {value!r}")
-    parse_range(value, 2**62)  # the syntax; the bounds are checked against the take
-    return value
+@dataclass(frozen=True)
+class FrameRange:
+    """A range of frames as text, ``START:STOP`` (either may be left out or negative), or None: the syntax is
+    checked here, the bounds against the take when it is read."""
 
+    def __call__(self, name: str, value) -> str | None:
+        if value is None or value == "":
+            return None
+        if not isinstance(value, str) or ":" not in value:
+            raise OptionError(name, f"must look like START:STOP (frame numbers); got {value!r}")
+        parse_range(value, 2**62)
+        return value
 
-_range_text.schema = lambda: {"anyOf": [{"type": "string", "pattern": r"^-?\d*:-?\d*$"}, {"type": "null"}]}
+    def schema(self) -> dict:
+        return {"anyOf": [{"type": "string", "pattern": r"^-?\d*:-?\d*$"}, {"type": "null"}]}
 
 
 @dataclass(frozen=True)
@@ -69,7 +79,7 @@ class Options(fields.CycleOptions):
     method: str = fields.method("harmonic (regression), centroid (paper 001) or cut (baseline).")
     model: str = fields.model("Harmonic model: M1 (FGLS-weighted positions, velocities, accelerations), M2 "
                               "(positions only; velocity/acceleration off), M3 (unweighted).")
-    which: int | str | None = option(
+    which: int | str | None = option(  # type: ignore[assignment]  # loop's part may also be 'all'
         None, "Which part of the take to loop: its number in the parts listed (0-based; default: the steady part "
               "with the most cycles), or 'all': one file per part that loops, named OUT.part<k>-<kind>.bvh (kind: "
               "walk-straight, walk-turning-left, run-..., arms, periodic).",
@@ -78,7 +88,7 @@ class Options(fields.CycleOptions):
                                 "worse than a plain cut, seam jumps); a warning names the check. It also lets an "
                                 "output replace an input file.", Flag())
     root: str = fields.root("inplace", "inplace (walks on the spot, facing kept) or motion (moves on).")
-    frame_range: str | None = option(None, "Use frames START:STOP of the take.", _range_text, flag="--range")
+    frame_range: str | None = option(None, "Use frames START:STOP of the take.", FrameRange(), flag="--range")
     step: int = option(1, "Find the phase on every STEP-th frame (faster on long takes).", Integer(1))
     cycles: int = fields.cycles(1, "Repeat the cycle this many times in the output.")
     time_axis: str = option("smooth", "Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) "
@@ -182,9 +192,9 @@ def run(take, options: Options | None = None, *, deliver=None) -> Report:
                                    f"not loop: {d['reason']}" for d in failures)
             else:
                 reason = nothing_to_loop(acts)
-            exc = NoPeriodicMotion(reason)
-            exc.facts = _facts("no-periodic-motion", reason, [], not_looped, acts, start)
-            raise exc
+            none_found = NoPeriodicMotion(reason)
+            none_found.facts = _facts("no-periodic-motion", reason, [], not_looped, acts, start)
+            raise none_found
     motions["input"] = motion
     facts = _facts("ok", _chosen_reason(loops, parts, everything), loops, not_looped, acts, start)
     return rec.report("loop", facts, motions, cycles if everything else (cycles[0] if cycles else None), extras)
@@ -198,12 +208,12 @@ PARALLEL_FRAMES = 20_000
 class _Job:
     """One part to loop, with all it needs: sent as it is to another process or a dask worker."""
 
-    piece: object   # mocycle.cycle.parts.PartPiece
+    piece: PartPiece
     options: Options
     label: str
     role: str
     first: int      # the range's first frame in the file (frames in the facts are the file's)
-    deliver: object = None
+    deliver: Callable[[Report], dict] | None = None
 
 
 @dataclass
