@@ -88,6 +88,26 @@ STILL_DEG = 4.0
 #: A motion without gait (arms, the whole body) must be seen to repeat: at least this many periods, so that it is
 #: compared with itself a whole period later (a raised and lowered hand winds once, a wave many times).
 MIN_REPEATS = 2.0
+#: Two stretches of frames a lag apart are compared only where they overlap by at least this many frames and
+#: one frame per ``LAG_PER_OVERLAP`` frames of the lag (fewer frames say nothing of a repeat).
+MIN_OVERLAP_FRAMES, LAG_PER_OVERLAP = 4, 6.0
+#: The legs' own period is sought within these shares of the landings' (a stride's period, not a step's or two
+#: strides').
+PERIOD_SEARCH = (0.75, 1.33)
+#: A one-cycle clip's wrap is looked for between these shares of its length (a cycle that repeats within the
+#: clip is more than one cycle), and its ends are the mean step of its first two and last two frames.
+ONE_CYCLE_LAGS = (0.3, 0.8)
+#: A motion without gait repeats no faster than this many seconds a period (faster is tremor or noise).
+MIN_REPEAT_S = 0.25
+#: ... its frames repeat where they are like themselves a period later (repetition distance under this)
+ALIKE = 0.5
+#: ... and move: at least this share of the largest local speed of those frames (not a gesture's stillness).
+BUSY_SHARE = 0.2
+
+
+def _least_overlap(lag):
+    """The fewest frames (a number or an array, as ``lag``) two stretches ``lag`` frames apart must share."""
+    return np.maximum(MIN_OVERLAP_FRAMES, lag / LAG_PER_OVERLAP)
 
 
 @dataclass(kw_only=True)
@@ -569,7 +589,7 @@ def one_cycle(motion: Motion) -> int | None:
     if ends < MOVING_WRAP * float(np.percentile(steps, 90)):
         return None  # it rests where it starts and ends: a gesture, not a cycle
 
-    lags = np.arange(max(2, int(0.3 * T)), int(0.8 * T) + 1)
+    lags = np.arange(max(2, int(ONE_CYCLE_LAGS[0] * T)), int(ONE_CYCLE_LAGS[1] * T) + 1)
     if lags.size and min(_unlike(X, int(lag)) for lag in lags) < UNLIKE_ONE_STEP:
         return None  # it repeats within itself: more than one cycle (the parts say how many)
 
@@ -836,7 +856,7 @@ def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
     if X is None:
         return True  # no legs to tell by: the landings decide
     overlap = X.shape[0] - lag
-    if overlap < max(4, lag / 6.0):
+    if overlap < _least_overlap(lag):
         return False
     return _unlike(X, lag) < (UNLIKE if overlap >= lag else UNLIKE_ONE_STEP)
 
@@ -890,8 +910,8 @@ def _short_period_of(X: np.ndarray | None, guess: float) -> tuple[float, float]:
     if X is None:
         return float("nan"), float("nan")
     T = X.shape[0]
-    lags = np.arange(max(2, int(np.floor(0.75 * guess))), int(np.ceil(1.33 * guess)) + 1)
-    lags = lags[T - lags >= np.maximum(4, lags / 6.0)]
+    lags = np.arange(max(2, int(np.floor(PERIOD_SEARCH[0] * guess))), int(np.ceil(PERIOD_SEARCH[1] * guess)) + 1)
+    lags = lags[T - lags >= _least_overlap(lags)]
     if lags.size < 3:
         return float("nan"), float("nan")
     var = float(X.var(axis=0).sum())
@@ -1075,18 +1095,18 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
 
     X, _ = pose_matrix(piece, rep="expmap", root="drop", joints=joints, normalize=False, weights=None)
     V = np.diff(X, axis=0)
-    min_lag = max(2, int(round(0.25 * piece.fps)))
+    min_lag = max(2, int(round(MIN_REPEAT_S * piece.fps)))
     if V.shape[0] < 2 * min_lag + 2:
         return None
     P = autocorrelation_period(V, min_lag=min_lag)
     if not np.isfinite(P):
         return None
     w = max(3, int(round(P)))
-    alike = repetition_distance(V, P, smooth=w) < 0.5
+    alike = repetition_distance(V, P, smooth=w) < ALIKE
     energy = moving_average((V ** 2).sum(axis=1), w)
     if not alike.any():
         return None
-    busy = energy > 0.2 * energy[alike].max()  # a fifth of the repeating motion's own speed: not a gesture's
+    busy = energy > BUSY_SHARE * energy[alike].max()
     good = alike & busy
     runs = _true_runs(good)
     if not runs:

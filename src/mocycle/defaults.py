@@ -9,6 +9,9 @@ modules that own each default re-export it under the same name.
 AMC_FPS = 120.0
 #: A periodic motion must wind at least this often over the take; :mod:`mocycle.phase.analysis`.
 MIN_PERIODS = 1.2
+#: Harmonics K of the harmonic regression (the thesis' K); :mod:`mocycle.cycle.harmonic_fit` caps it by the
+#: frames a take has ('auto').
+HARMONICS = 20
 #: Acceptable Swing Error of a swing segmentation (paper: 0.4); :mod:`mocycle.swings.segment`.
 SWING_THRESHOLD = 0.4
 

@@ -142,7 +142,7 @@ class HarmonicRegression:
 
     Parameters
     ----------
-    n_harmonics : K (the thesis used 20).
+    n_harmonics : K (the thesis used 20: :data:`mocycle.defaults.HARMONICS`).
     model : ``"M1"`` (FGLS-weighted, default), ``"M2"`` (positions only) or ``"M3"`` (unweighted).
     linear : add the linear term ``l_j x`` (eq. 3.27) for curves that drift (root translation, heading).
 
@@ -154,7 +154,7 @@ class HarmonicRegression:
     ``sqrt(alpha)``, ``sqrt(gamma)``).
     """
 
-    def __init__(self, n_harmonics: int = 20, model: str = "M1", linear: bool = False):
+    def __init__(self, n_harmonics: int = defaults.HARMONICS, model: str = "M1", linear: bool = False):
         self.n_harmonics = n_harmonics
         self.model = model
         self.linear = linear

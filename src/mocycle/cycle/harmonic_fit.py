@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate
+from .. import _validate, defaults
 from ..errors import MocycleError
 from ..phase.analysis import PeriodicMotion
 from .differences import HALF, central_acceleration, central_velocity
@@ -18,7 +18,7 @@ from .result import Cycle, _check_choice
 from .seam import calmest_start
 from .timeaxis import TimeAxis
 
-DEFAULT_HARMONICS = 20   # the thesis' K
+DEFAULT_HARMONICS = defaults.HARMONICS  # the thesis' K
 SUBFRAMES = 10           # the harmonic cycle's start is chosen to a tenth of a frame
 #: Fewer periods than this: the path's drift is fitted with few harmonics (:func:`short_drift`).
 SHORT_PERIODS = 3.0

@@ -4,7 +4,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..defaults import AMC_FPS, CYCLE_METHODS, HARMONIC_MODELS, MIN_PERIODS, ROOT_MODES, SWING_THRESHOLD
+from ..defaults import (
+    AMC_FPS,
+    CYCLE_METHODS,
+    HARMONIC_MODELS,
+    HARMONICS,
+    MIN_PERIODS,
+    ROOT_MODES,
+    SWING_THRESHOLD,
+)
 from ..errors import OptionError
 from .options import Choice, Flag, Integer, Options, Real, Text, option
 
@@ -54,7 +62,7 @@ def model(help: str = "Harmonic model: M1, M2 or M3 (see mocycle loop)."):
 
 
 def harmonics():
-    return option("auto", "Harmonics K: 'auto' (20, capped by the frames) or a number.",
+    return option("auto", f"Harmonics K: 'auto' ({HARMONICS}, capped by the frames) or a number.",
                   Integer(1, words={"auto": "auto"}))
 
 
