@@ -5,9 +5,10 @@ from __future__ import annotations
 import time
 import warnings
 
+from ..defaults import FEET_MODES
 from ..errors import MocycleError, MocycleWarning
 
-FEET_MODES = ("auto", "lock", "keep")
+__all__ = ["FEET_HELP", "FEET_MODES", "FOOT_JOINTS_HELP", "clean_feet", "lock_motion", "travels"]
 FEET_HELP = ("lock (feet held still on the floor during each contact; in place they slide back at the treadmill "
              "speed), keep (as fitted) or auto (lock with --root motion when feet are found, else keep).")
 FOOT_JOINTS_HELP = ("Name the feet when the name patterns fail: ANKLE[:TOE],ANKLE[:TOE] (e.g. "
