@@ -28,19 +28,14 @@ from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_declarati
 from ..tasks.spec import SPECS
 from ..text import json_text, printable
 
-#: the module of ``mocycle.cli`` that defines each task's command (the command is made from the task's spec)
-_TASK_MODULES = {"info": "info", "phase": "phase", "loop": "loop", "blend": "blend", "transition": "blend",
-                 "stretch": "stretch", "swings": "swings", "search": "swings", "edit": "swings",
-                 "compress": "keyframes", "decompress": "keyframes", "project": "keyframes"}
-
 #: sub-command -> (the module of ``mocycle.cli`` that defines it, the first paragraph of its help), in the
 #: order ``mocycle --help`` lists them: the tasks' from their specs, then the front end's own commands.
 #: tests/test_startup.py checks both against the commands themselves.
 COMMANDS = {
-    "info": (_TASK_MODULES["info"], SPECS["info"].summary),
+    "info": (SPECS["info"].cli_module, SPECS["info"].summary),
     "convert": ("convert", "Convert ASF/AMC, FBX or glTF to BVH or glTF (.glb), or rewrite a BVH (optionally a "
                            "frame range, another fps)."),
-    **{name: (module, SPECS[name].summary) for name, module in _TASK_MODULES.items() if name != "info"},
+    **{name: (spec.cli_module, spec.summary) for name, spec in SPECS.items() if spec.cli and name != "info"},
     "batch": ("batch", "Run one command over many takes on dask.distributed; a row per take in "
                        "OUTDIR/results.csv and .json."),
     "studio": ("studio", "Review loops on a library of takes and author new motion on the spatial-keyframe plane, "

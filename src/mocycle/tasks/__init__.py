@@ -21,10 +21,9 @@ from .fields import AMC_FPS, SWING_THRESHOLD
 from .options import Options, option, schema
 from .report import Report
 
-#: the tasks, in the order front ends list them; each module is imported on first use (``tasks.loop``), so
-#: that a front end pays only for the task it runs (``docs/performance.md``)
-NAMES = ("info", "phase", "loop", "blend", "transition", "stretch", "swings", "search", "edit", "compress",
-         "decompress", "project")
+# The tasks are the specs' (:data:`mocycle.tasks.spec.SPECS`, in the order front ends list them); each module is
+# imported on first use (``tasks.loop``), so that a front end pays only for the task it runs
+# (``docs/performance.md``).
 
 if TYPE_CHECKING:  # what __getattr__ gives, for IDEs and type checkers; at run time each loads on first use
     from types import ModuleType
@@ -35,10 +34,12 @@ if TYPE_CHECKING:  # what __getattr__ gives, for IDEs and type checkers; at run 
 
 
 def __getattr__(name: str):
-    if name in NAMES:
+    from .spec import SPECS
+
+    if name in SPECS:
         return importlib.import_module(f"{__name__}.{name}")
     if name == "TASKS":  # task name -> its module (each has ``Options`` and ``run``)
-        return {n: importlib.import_module(f"{__name__}.{n}") for n in NAMES}
+        return {n: importlib.import_module(f"{__name__}.{n}") for n in SPECS}
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

@@ -84,7 +84,8 @@ class Spec:
     imports : the modules it imports when it runs (batch preloads them in its workers).
     batch : ``mocycle batch`` runs it (it takes one file).
     studio : the fields of its ``Options`` the studio's forms show (the others keep their defaults).
-    cli : it is a ``mocycle`` command.
+    cli : it is a ``mocycle`` command; ``command_module``: the module of ``mocycle.cli`` that defines it (its
+        typer command is made from this spec there), default the task's name.
     facts : the keys every report of the task has in ``facts`` (its shape; ``tests/tasks/test_spec.py``
         runs each task and checks), and ``optional_facts`` the few it adds only when asked (the optimised
         projection, the takes of a glTF or FBX file).
@@ -99,6 +100,7 @@ class Spec:
     batch: bool = False
     studio: tuple[str, ...] = ()
     cli: bool = True
+    command_module: str = ""
     facts: tuple[str, ...] = ()
     optional_facts: tuple[str, ...] = ()
 
@@ -111,6 +113,11 @@ class Spec:
     def options(self) -> type:
         """The task's ``Options`` class: its fields are the options of every front end."""
         return self.module.Options
+
+    @property
+    def cli_module(self) -> str:
+        """The module of ``mocycle.cli`` that defines the command."""
+        return self.command_module or self.name
 
     def writes_motion(self) -> bool:
         return any(o.writes == "motion" for o in self.outputs)
@@ -189,7 +196,8 @@ SPECS: dict[str, Spec] = {s.name: s for s in (
                 "turn_per_cycle_deg", "weights")),
     Spec("transition", "A motion that starts as the first take's cycle and ends as the second's (paper 001 §4.5, "
                        "a homotopy).",
-         inputs=("first", "second"), outputs=(_motion("transition", "The transition as a .bvh or .glb file."),),
+         inputs=("first", "second"), command_module="blend",
+         outputs=(_motion("transition", "The transition as a .bvh or .glb file."),),
          facts=("cycles", "feet", "frames", "input_periods_frames", "period_frames_end", "period_frames_start",
                 "phase_offset", "root", "smoothness")),
     Spec("stretch", "Lengthen a take by time-frequency warping: its cycles are replicated, not slowed down.",
@@ -215,14 +223,15 @@ SPECS: dict[str, Spec] = {s.name: s for s in (
                 "per_angle_error_deg", "per_joint", "ratio_bvh", "ratio_raw", "raw_float32_bytes",
                 "segmentation_error", "threshold")),
     Spec("search", "Rank the takes of a folder by how alike their swings are to an example (query by example).",
-         inputs=("query", "folder"),
+         inputs=("query", "folder"), command_module="swings",
          facts=("indexed", "query", "results")),
     Spec("edit", "Scale the angle or the duration of one swing of one joint and write the edited motion.",
-         outputs=(_motion("edited", "Edited motion (.bvh or .glb)."),),
+         outputs=(_motion("edited", "Edited motion (.bvh or .glb)."),), command_module="swings",
          facts=("angle_deg", "angle_scale", "duration_scale", "end", "joint", "start", "swing")),
     Spec("compress", "Compress a take to keyframes (and a 2-D trajectory for the spatial scheme); report error "
                      "and size.",
          outputs=(Output("result", "compressed", (".mck",), help="The .mck file to write."),),
+         command_module="keyframes",
          figures={"frames": lambda f: f["frames"], "keyframes": lambda f: f["keyframes"],
                   "keys_per_period": lambda f: f["keys_per_period"],
                   "error_per_frame_per_joint": lambda f: f["error_per_frame_per_joint"],
@@ -233,10 +242,10 @@ SPECS: dict[str, Spec] = {s.name: s for s in (
                 "keyframe_ratio", "keyframes", "keyframes_set_by", "keys_per_period", "period_frames", "ratio",
                 "real_ratio")),
     Spec("decompress", "Rebuild a take from its keyframes; the keyframes come back exactly (unless --feet lock).",
-         outputs=(_motion("motion", "The .bvh or .glb file to write."),),
+         outputs=(_motion("motion", "The .bvh or .glb file to write."),), command_module="keyframes",
          facts=("feet", "frames", "keyframes", "keyframes_exact", "scheme")),
     Spec("project", "Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take.",
-         studio=("projection", "select", "ratio", "seed_projection", "optimize"),
+         studio=("projection", "select", "ratio", "seed_projection", "optimize"), command_module="keyframes",
          facts=("frames", "keyframes", "points", "projection", "select", "stress"),
          optional_facts=("points_optimized", "stress_optimized")),
     Spec("author", "A new motion from a stroke drawn on a take's spatial-keyframe plane (thesis chapter 5).",
