@@ -150,7 +150,7 @@ def friendly(func: Callable) -> Callable:
                 raise typer.Exit(EXIT_USAGE) from None
             except MocycleError as exc:
                 _print_warnings(caught)
-                message = _naming_the_input(as_flags(str(exc), func.__name__), kwargs)
+                message = _naming_the_input(as_flags(str(exc), func.__name__), kwargs, func.__name__)
                 err.print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
                 refused = isinstance(exc, (NoPeriodicMotion, LoopRefused))
                 raise typer.Exit(EXIT_NOT_FOUND if refused else EXIT_ERROR) from None
@@ -158,7 +158,7 @@ def friendly(func: Callable) -> Callable:
                 _print_warnings(caught)
                 message = _naming_the_input("out of memory: the input or the options ask for more memory than this "
                                             "process may use (MOCYCLE_MAX_FRAMES lowers what a file may claim)",
-                                            kwargs)
+                                            kwargs, func.__name__)
                 err.print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
                 raise typer.Exit(EXIT_ERROR) from None
         _print_warnings(caught)
@@ -167,15 +167,18 @@ def friendly(func: Callable) -> Callable:
     return wrapper
 
 
-#: The command arguments that name input files.
-INPUT_ARGUMENTS = ("path", "query", "first", "second", "paths")
+def _input_arguments(command: str | None) -> tuple[str, ...]:
+    """The arguments of ``command`` that name its inputs: its spec's (``Spec.inputs``), else ``path``/``paths``
+    (``convert``, ``report``)."""
+    spec = SPECS.get(command or "")
+    return tuple(a.lstrip("*") for a in spec.inputs) if spec is not None else ("path", "paths")
 
 
-def _naming_the_input(message: str, kwargs: dict) -> str:
+def _naming_the_input(message: str, kwargs: dict, command: str | None = None) -> str:
     """``message`` with the input file in front when it names none of the command's files (so that in
     ``blend`` or ``transition`` the user can tell which take is meant).  Option errors stay as they are."""
     inputs = []
-    for key in INPUT_ARGUMENTS:
+    for key in _input_arguments(command):
         value = kwargs.get(key)
         inputs += [str(v) for v in value] if isinstance(value, (list, tuple)) else [str(value)] if value else []
     files = inputs + [str(v) for v in kwargs.values() if isinstance(v, Path)]
