@@ -24,7 +24,7 @@ from .. import __version__
 from ..errors import LoopRefused, MocycleError, MocycleWarning, NoPeriodicMotion, OptionError
 from ..suffixes import MOTION_WRITE_SUFFIXES
 from ..tasks.flags import as_flags, option_message
-from ..tasks.options import MISSING, Choice, Flag, Integer, Real, flag_declaration, old_flag_warning
+from ..tasks.options import MISSING, flag_declaration, old_flag_warning
 from ..tasks.spec import SPECS
 from ..text import json_text, printable
 
@@ -230,8 +230,8 @@ def flag(options_cls, name: str, *short: str, **kwargs) -> typer.models.OptionIn
     f = _field(options_cls, name)
     names = flag_declaration(f)
     check = f.metadata.get("check")
-    if isinstance(check, Choice) and "metavar" not in kwargs:  # --method <harmonic|centroid|cut>
-        kwargs["metavar"] = f"<{'|'.join(check.choices)}>"
+    if check is not None and check.metavar() and "metavar" not in kwargs:
+        kwargs["metavar"] = check.metavar()
     return typer.Option(names, *short, help=f.metadata.get("help", ""), **kwargs)
 
 
@@ -245,13 +245,9 @@ def cli_type(f: dataclasses.Field) -> object:
     """The type the CLI parses an Options field's flag as: ``bool`` for an on/off field, ``int``/``float`` for
     a plain number, else text (words such as ``auto`` or a list of joints); the Options check the value."""
     check = f.metadata.get("check")
-    kind: type = str
-    if isinstance(check, Flag):
+    kind = check.parses_as() if check is not None else str
+    if kind is bool:
         return bool
-    if isinstance(check, Integer) and not check.words:
-        kind = int
-    elif isinstance(check, Real) and not check.words:
-        kind = float
     return kind | None if f.default is None else kind
 
 

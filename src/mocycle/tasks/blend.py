@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from ..errors import OptionError
 from . import fields
 from .fields import take_cycles
-from .options import Flag, option
+from .options import Constraint, Flag, option
 from .report import Recorder, Report, label_of, load
 
 LABELS = {
@@ -21,8 +21,15 @@ LABELS = {
 }
 
 
-def _weights(name: str, value):
+@dataclass(frozen=True)
+class Weights(Constraint):
     """None, or a tuple of numbers >= 0 (a text such as ``"0.7,0.3"`` is split at the commas)."""
+
+    def __call__(self, name: str, value):
+        return _weights(name, value)
+
+
+def _weights(name: str, value):
     if value is None:
         return None
     items = value.split(",") if isinstance(value, str) else value
@@ -40,7 +47,7 @@ class Options(fields.CycleOptions):
     """Options of ``blend`` (and how each take's cycle is found: :class:`~mocycle.tasks.fields.CycleOptions`)."""
 
     weights: tuple[float, ...] | None = option(
-        None, "One weight >= 0 per take, comma-separated (normalised to sum 1); default equal.", _weights)
+        None, "One weight >= 0 per take, comma-separated (normalised to sum 1); default equal.", Weights())
     root: str = fields.root("inplace", "inplace (on the spot) or motion (moves on by the blended stride).")
     cycles: int = fields.cycles(1, "Repeat the loop this many times in the output.")
     align: bool = option(True, "Search each take's phase offset against the first.", Flag())

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from ..defaults import TIME_AXES
 from ..errors import Hint, LoopRefused, MocycleError, NoPeriodicMotion, OptionError
 from . import fields
-from .options import Choice, Flag, Integer, Text, option
+from .options import Choice, Constraint, Flag, Integer, Text, option
 from .report import Recorder, Report, label_of, load
 
 if TYPE_CHECKING:  # the part pieces come with numpy; the task loads them when it runs
@@ -55,7 +55,7 @@ def parse_range(text: str | None, n_frames: int) -> tuple[int, int]:
 
 
 @dataclass(frozen=True)
-class FrameRange:
+class FrameRange(Constraint):
     """A range of frames as text, ``START:STOP`` (either may be left out or negative), or None: the syntax is
     checked here, the bounds against the take when it is read."""
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import typing
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import MISSING, dataclass, field
 
 from .. import _validate
@@ -21,11 +21,33 @@ __all__ = ["Choice", "Flag", "Integer", "Options", "Real", "Text", "option", "sc
 
 
 # -- constraints (what a field accepts; each normalises and can describe itself) ------------------------------
+class Constraint:
+    """What a field accepts, declared once for every front end: called as ``check(name, value)`` it returns the
+    value normalised or raises :class:`~mocycle.errors.OptionError`; ``schema()`` describes it (the studio's
+    forms, Blender's properties); ``parses_as()`` is the type a text front end (the CLI) reads the value as
+    before the check, and ``metavar()`` how it shows the value in help (``None``: its default)."""
+
+    def parses_as(self) -> type:
+        return str
+
+    def __call__(self, name: str, value) -> object:
+        raise NotImplementedError
+
+    def schema(self) -> dict:
+        return {}  # nothing said beyond the field's type and default
+
+    def metavar(self) -> str | None:
+        return None
+
+
 @dataclass(frozen=True)
-class Choice:
+class Choice(Constraint):
     """One of a few words."""
 
     choices: tuple[str, ...]
+
+    def metavar(self) -> str | None:
+        return f"<{'|'.join(self.choices)}>"  # --method <harmonic|centroid|cut>
 
     def __call__(self, name: str, value):
         return _validate.choice(name, value, self.choices)
@@ -35,13 +57,16 @@ class Choice:
 
 
 @dataclass(frozen=True)
-class Integer:
+class Integer(Constraint):
     """An integer in ``[low, high]``, or one of ``words`` (mapped to what they stand for)."""
 
     low: int | None = None
     high: int | None = None
     words: Mapping[str, object] = field(default_factory=dict)
     optional: bool = False  # None is allowed (no value)
+
+    def parses_as(self) -> type:
+        return str if self.words else int  # words such as 'auto' are text
 
     def __call__(self, name: str, value):
         if value is None and self.optional:
@@ -62,7 +87,7 @@ class Integer:
 
 
 @dataclass(frozen=True)
-class Real:
+class Real(Constraint):
     """A finite number in an interval (``low_open``/``high_open``: the end is excluded), or one of ``words``."""
 
     low: float | None = None
@@ -70,6 +95,9 @@ class Real:
     low_open: bool = False
     high_open: bool = False
     words: tuple[str, ...] = ()
+
+    def parses_as(self) -> type:
+        return str if self.words else float
 
     def __call__(self, name: str, value):
         if isinstance(value, str) and value in self.words:
@@ -93,8 +121,11 @@ class Real:
 
 
 @dataclass(frozen=True)
-class Flag:
+class Flag(Constraint):
     """True or False."""
+
+    def parses_as(self) -> type:
+        return bool
 
     def __call__(self, name: str, value) -> bool:
         if isinstance(value, bool):
@@ -106,7 +137,7 @@ class Flag:
 
 
 @dataclass(frozen=True)
-class Text:
+class Text(Constraint):
     """Free text (e.g. joint names, a file pattern); ``optional``: None allowed."""
 
     optional: bool = True
@@ -120,9 +151,6 @@ class Text:
 
     def schema(self) -> dict:
         return {"anyOf": [{"type": "string"}, {"type": "null"}]} if self.optional else {"type": "string"}
-
-
-Constraint = Callable[[str, object], object]
 
 
 def option(default=MISSING, help: str = "", check: Constraint | None = None, *, flag: str | None = None,
