@@ -109,7 +109,9 @@ class PoseDecoder:
         Non-feature parts come from the template frame by frame when T matches,
         otherwise from its mean pose (rotations) and first frame (root).
         """
-        quats, (static, tracks) = self.decode_arrays(X)
+        quats, translations = self.decode_arrays(X)
+        assert translations is not None  # asked for (translations=True)
+        static, tracks = translations
         tpl = self.template
         return Motion(tpl.skeleton, quats, static, tpl.frame_time if frame_time is None else frame_time,
                       tracks=tracks, copy=False)  # decode_arrays made them: handed over, not copied
@@ -145,6 +147,7 @@ class PoseDecoder:
         col = 0
         skel = tpl.skeleton
         if self.root == "heading":  # the travel joint's columns hold its tilt: start from the template's
+            assert self.frame is not None  # pose_matrix gives root="heading" its frame
             tilt = self.frame.tilt(tpl)[0]
             quats[:, self.travel] = tilt if same_length else Rotation.from_quat(tilt).mean().as_quat()
         if self.rep == "euler":
@@ -175,6 +178,7 @@ class PoseDecoder:
             v = raw(col, col + 3)
             tracks[self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
         elif self.root == "heading":
+            assert self.frame is not None  # pose_matrix gives root="heading" its frame
             _, psi = self.frame.tilt(tpl[:1])
             psi = psi[0] + np.concatenate([[0.0], np.cumsum(raw(col + 3, col + 4, slice(1, None))[:, 0])])
             quats[:, self.travel] = self.frame.turn(quats[:, self.travel], psi)
@@ -295,6 +299,7 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
     out = None  # the feature matrix, when a part is written straight into it
     tilt = None
     if root == "heading":
+        assert frame is not None  # pose_matrix gives root="heading" its frame
         tilt, psi = frame.tilt(motion)
 
     def rotations(group: list[int]) -> np.ndarray:
@@ -330,6 +335,7 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
         v = np.diff(p, axis=0) if T > 1 else np.zeros((1, 3))
         parts.append(np.concatenate([v[:1], v]) if T > 1 else v)
     elif root == "heading":
+        assert frame is not None  # as above
         if T > 1:
             mid = 0.5 * (psi[1:] + psi[:-1])
             v = np.c_[frame.to_local(np.diff(motion.joint_translations(travel), axis=0), mid), np.diff(psi)]
@@ -448,8 +454,8 @@ def pose_matrix(
     if not isinstance(motion, Motion):
         raise MocycleError(f"pose_matrix needs a Motion; got {type(motion).__name__}")
     skel = motion.skeleton
-    chosen = skel.select(joints)
-    chosen = tuple(j for j in chosen if skel.euler_order(j))
+    selected = skel.select(joints)
+    chosen = tuple(j for j in selected if skel.euler_order(j))
     if not chosen and root == "drop":
         raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
     travel = motion.travel_joint

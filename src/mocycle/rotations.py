@@ -165,9 +165,10 @@ def continuous_euler_blocks(quats: np.ndarray, order: str, joints=None, block: i
 
 def _euler_setup(quats: np.ndarray, order: str, joints):
     """``(sel, T, N, k, full order)`` of :func:`continuous_euler`'s arguments."""
-    sel = slice(None) if joints is None else np.asarray(joints, dtype=np.intp).reshape(-1)
-    N = quats.shape[1] if joints is None else sel.size
-    return sel, quats.shape[0], N, len(order), _full_order(order)
+    if joints is None:
+        return slice(None), quats.shape[0], quats.shape[1], len(order), _full_order(order)
+    sel = np.asarray(joints, dtype=np.intp).reshape(-1)
+    return sel, quats.shape[0], sel.size, len(order), _full_order(order)
 
 
 def _primary_euler(quats: np.ndarray, rows: slice, sel, full: str) -> np.ndarray:
@@ -639,10 +640,10 @@ def fast_nearest_rotation(M: np.ndarray, max_iterations: int = 30, tol: float = 
         x[bad] = np.eye(3).ravel()  # these go to the SVD below
     X = x
     active = np.arange(X.shape[0])  # the matrices still moving; the others are left out of later steps
-    x = list(X.T)  # 9 arrays (n_active,)
+    xs = list(X.T)  # 9 arrays (n_active,)
     last = np.zeros(X.shape[0], dtype=bool)  # one more step after settling
     for _ in range(max_iterations):
-        a, b, c, d, e, f, g, h, i = x
+        a, b, c, d, e, f, g, h, i = xs
         # cofactor matrix (= det · X⁻ᵀ)
         C = [e * i - f * h, f * g - d * i, d * h - e * g,
              c * h - b * i, a * i - c * g, b * g - a * h,
@@ -650,9 +651,9 @@ def fast_nearest_rotation(M: np.ndarray, max_iterations: int = 30, tol: float = 
         det = np.maximum(a * C[0] + b * C[1] + c * C[2], 1e-300)
         gam = det ** (-1.0 / 3.0)
         k = 1.0 / (gam * det)
-        new = [0.5 * (gam * xv + k * cv) for xv, cv in zip(x, C, strict=True)]
-        move = np.abs(new[0] - x[0])
-        for nv, xv in zip(new[1:], x[1:], strict=True):
+        new = [0.5 * (gam * xv + k * cv) for xv, cv in zip(xs, C, strict=True)]
+        move = np.abs(new[0] - xs[0])
+        for nv, xv in zip(new[1:], xs[1:], strict=True):
             np.maximum(move, np.abs(nv - xv), out=move)
         done = last[active]
         last[active] = move < tol
@@ -664,9 +665,9 @@ def fast_nearest_rotation(M: np.ndarray, max_iterations: int = 30, tol: float = 
             keep = ~done
             active = active[keep]
             new = [v[keep] for v in new]
-        x = new
+        xs = new
     else:
-        X[active] = np.stack(x, axis=1)
+        X[active] = np.stack(xs, axis=1)
     cols = [X[:, 0::3], X[:, 1::3], X[:, 2::3]]  # XᵀX - I, entry by entry: 1e-12 or to the SVD
     err = np.zeros(X.shape[0])
     for m in range(3):

@@ -151,6 +151,21 @@ def test_skate_counts_feet_gliding_on_the_floor():
     assert find_feet(still.skeleton)[0].side == "left"
 
 
+def test_skate_on_a_leg_chain_needs_the_body_height():
+    """A leg chain's positions (ChainArray) measure the same skate as the whole body's, given the body height;
+    without it skate says so (body_height cannot read a chain)."""
+    from mocycle.contacts import body_height
+    from mocycle.contacts.feet import chain_joints, chain_positions, leg_joints
+
+    walk = synthetic_walk(n_frames=120, fps=60, seed=5).motion
+    feet = find_feet(walk.skeleton)
+    W = chain_positions(walk, chain_joints(walk, leg_joints(feet)))
+    body = body_height(walk)
+    assert skate(walk, feet, positions=W, body=body) == pytest.approx(skate(walk, feet, body=body), rel=1e-9)
+    with pytest.raises(TypeError, match="body"):
+        skate(walk, feet, positions=W)
+
+
 def test_far_from_its_holds_a_leg_is_unchanged():
     """With one contact per foot kept, the legs far from it (beyond the low frames, the blend and the
     swing bridge) keep their rotations exactly, and the held joints stand still to 1e-6."""

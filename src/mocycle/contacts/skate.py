@@ -11,18 +11,37 @@ glides while it is down counts fully, one that lifts away counts less and less.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Literal, overload
 
 import numpy as np
 
 from ..motion import Motion
-from .feet import Foot, body_height, find_feet, leg_joints, up_axis
+from .feet import ChainArray, Foot, body_height, find_feet, leg_joints, up_axis
 
 SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual absolute H
 
 
+@overload
+def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = SKATE_HEIGHT,
+          up: np.ndarray | None = None, per_joint: Literal[False] = False,
+          positions: np.ndarray | ChainArray | None = None, body: float | None = None) -> float: ...
+
+
+@overload
+def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = SKATE_HEIGHT,
+          up: np.ndarray | None = None, per_joint: Literal[True],
+          positions: np.ndarray | ChainArray | None = None, body: float | None = None) -> dict[str, float]: ...
+
+
+@overload
 def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = SKATE_HEIGHT,
           up: np.ndarray | None = None, per_joint: bool = False,
-          positions: np.ndarray | None = None, body: float | None = None) -> float | dict[str, float]:
+          positions: np.ndarray | ChainArray | None = None, body: float | None = None) -> float | dict[str, float]: ...
+
+
+def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: float = SKATE_HEIGHT,
+          up: np.ndarray | None = None, per_joint: bool = False,
+          positions: np.ndarray | ChainArray | None = None, body: float | None = None) -> float | dict[str, float]:
     """The skate measure of the module docstring (units/s); ``per_joint=True``: a dict joint name -> value.
     ``positions``: ``motion.world_positions(end_sites=True)`` when the caller has it (saves recomputing); with
     ``body``, the body height in file units (e.g. ``Contacts.body`` of the same rig), any world positions
@@ -30,7 +49,12 @@ def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: f
     if feet is None or isinstance(feet, str):
         feet = find_feet(motion.skeleton, feet)
     up = up_axis(motion) if up is None else np.asarray(up, dtype=np.float64)
-    H = height * (body_height(motion, up, positions) if body is None else float(body))
+    if body is not None:
+        H = height * float(body)
+    elif isinstance(positions, ChainArray):  # body_height slices whole-body positions
+        raise TypeError("skate: a chain's positions (ChainArray) need the body height (body)")
+    else:
+        H = height * body_height(motion, up, positions)
     joints = [j for f in feet for j in f.contact_joints]
     if motion.n_frames < 2:
         return {motion.skeleton.names[j]: 0.0 for j in joints} if per_joint else 0.0

@@ -280,7 +280,7 @@ def foot_sliding(motion: Motion, up: np.ndarray | None = None, positions: np.nda
 
 def _skate(motion: Motion, up: np.ndarray, positions: np.ndarray | None = None) -> float:
     try:
-        return skate(motion, up=up, positions=positions)  # type: ignore[return-value]  # a float: not per_joint
+        return skate(motion, up=up, positions=positions)
     except MocycleError:  # no feet found by name
         return float("nan")
 

@@ -172,11 +172,11 @@ class AsfSkeleton:
                 offsets[i + 1] = vectors[joint_of[p] - 1]
         has_child = set(self.parents)
         end_sites = tuple(
-            EndSite(parent=i + 1, offset=tuple(float(v) for v in vectors[i]))
+            EndSite(parent=i + 1, offset=(float(vectors[i, 0]), float(vectors[i, 1]), float(vectors[i, 2])))
             for i, b in enumerate(self.bones) if b not in has_child
         )
         channels = (ROOT_CHANNELS,) + (BONE_CHANNELS,) * self.n_bones
-        return Skeleton((ROOT,) + self.bones, parents, offsets, channels, end_sites)
+        return Skeleton((ROOT,) + self.bones, np.asarray(parents), offsets, channels, end_sites)
 
 
 # --------------------------------------------------------------------------
@@ -421,15 +421,16 @@ def _parse_asf(text: str, path) -> AsfSkeleton:
             else:
                 units[low] = tokens[1]
         elif section == "root":
+            assert root is not None  # made when the :root section starts
             args = tokens[1:]
             if low == "order":
-                order = tuple(a.upper() for a in args)
-                bad = [a for a in order if a not in _ROOT_ORDER_TOKENS]
-                if bad or len(set(order)) != len(order):
+                root_order = tuple(a.upper() for a in args)
+                bad = [a for a in root_order if a not in _ROOT_ORDER_TOKENS]
+                if bad or len(set(root_order)) != len(root_order):
                     raise MotionFileError(
                         "root order: expected each of TX TY TZ RX RY RZ at most once, "
                         f"got {' '.join(args)!r}", path, num)
-                root["order"] = order
+                root["order"] = root_order
             elif low == "axis":
                 if len(args) != 1:
                     raise MotionFileError("root axis: expected one order such as XYZ", path, num)
@@ -519,6 +520,7 @@ def _finish_bone(bone: _Bone, bones: dict[str, _Bone], path) -> None:
     for attr in ("name", "direction", "length"):
         if getattr(bone, attr) is None:
             raise MotionFileError(f"the bone block has no {attr!r} line", path, bone.line)
+    assert bone.name is not None  # checked just above
     if bone.name in bones:
         raise MotionFileError(
             f"bone {bone.name!r} is defined twice (first at line {bones[bone.name].line})",

@@ -20,6 +20,7 @@ import threading
 import time
 from collections.abc import Iterable
 from pathlib import Path
+from typing import IO
 
 #: A leftover temporary file without a process id in its name counts as stale after this many seconds.
 STALE_AFTER_S = 3600.0
@@ -70,7 +71,8 @@ def atomic_write(path: str | os.PathLike, data: str | bytes | Iterable[str] | It
     fd, tmp = tempfile.mkstemp(prefix=f"{_temporary_prefix(path.name)}{os.getpid()}.", suffix=".tmp",
                                dir=path.parent or ".")
     try:
-        with os.fdopen(fd, mode, **({} if mode == "wb" else {"encoding": "utf-8", "newline": ""})) as fh:
+        fh: IO = os.fdopen(fd, "wb") if mode == "wb" else os.fdopen(fd, "w", encoding="utf-8", newline="")
+        with fh:
             if isinstance(data, str | bytes):
                 fh.write(data)
             else:

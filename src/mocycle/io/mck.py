@@ -173,8 +173,9 @@ def _check_header(header, z: Inflater) -> dict:
         raise z.error(f"n_frames must be a whole number >= 2; found {str(n_frames)[:40]!r}")
     if type(frame_time) not in (int, float):
         raise z.error(f"frame_time must be a number of seconds; found {str(frame_time)[:40]!r}")
-    if frame_time_problem(frame_time):
-        raise z.error(frame_time_problem(frame_time))
+    problem = frame_time_problem(frame_time)
+    if problem:
+        raise z.error(problem)
     scheme = header["scheme"]
     if scheme not in SCHEMES:
         raise z.error(f"unknown scheme {str(scheme)[:40]!r}; expected one of {', '.join(SCHEMES)}")

@@ -67,6 +67,7 @@ class Compressed:
     def rotations(self) -> np.ndarray:
         """``(T, J, 4)`` rebuilt local rotations."""
         if self.scheme == "spatial":
+            assert self.points is not None  # compress and read_compressed give the spatial scheme its points
             q, _ = reconstruct_spatial(self.key_idx, self.key_quats, self.points)
             return q
         return interpolate_rotations(self.skeleton, self.key_idx, self.key_quats, self.n_frames, self.scheme)
@@ -166,11 +167,13 @@ def compress(motion: Motion, ratio: float | str | None = "auto", count: int | No
         _validate.choice("projection", projection, PROJECTIONS)
     _validate.choice("seed", seed, ONE_STEP)
     n = motion.n_frames
-    if count is None and isinstance(ratio, str):
+    if count is not None:
+        k = keyframe_count(n, count=count)
+    elif isinstance(ratio, str):
         k = keyframe_density(motion, ratio, scheme).count
     else:
-        k = keyframe_count(n, ratio=None if count is not None else ratio, count=count)
-        if count is None and scheme == "spatial":
+        k = keyframe_count(n, ratio=ratio)
+        if scheme == "spatial":
             k = max(k, min(n, SPATIAL_MIN_KEYS))
     space = PoseSpace(motion.rotations, joint_weights(motion.skeleton)) if space is None else space
     points = None

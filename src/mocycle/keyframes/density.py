@@ -84,7 +84,7 @@ def keyframe_density(motion: Motion, ratio: float | str = "auto", scheme: str = 
     auto = isinstance(ratio, str)
     if auto and ratio != "auto":
         raise OptionError("ratio", f"must be 'auto' or a number in (0, 1]; got {ratio!r}")
-    k = keyframe_count(n, ratio=THESIS_RATIO if auto else ratio)
+    k = keyframe_count(n, ratio=THESIS_RATIO if isinstance(ratio, str) else ratio)  # a str is "auto" here
     rule = "ratio"
     period = rhythm_period(motion)
     if auto and period is not None:

@@ -140,11 +140,12 @@ def _euler_near(quats: np.ndarray, order: str, ref: np.ndarray) -> np.ndarray:
     for c in cands:
         c = c - 2 * np.pi * np.round((c - ref) / (2 * np.pi))
         d = np.sum((c - ref) ** 2, axis=-1, keepdims=True)
-        if best is None:
+        if best is None or best_d is None:  # the first candidate (the two are set together)
             best, best_d = c, d
         else:
             best = np.where(d < best_d, c, best)
             best_d = np.minimum(d, best_d)
+    assert best is not None  # cands holds a
     return best
 
 

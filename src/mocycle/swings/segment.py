@@ -130,6 +130,7 @@ def grow_swings(axes: np.ndarray, error: np.ndarray, eligible: np.ndarray, thres
                 break
             go_left = er is None or (el is not None and el <= er)
             e = el if go_left else er
+            assert e is not None  # the side chosen is open (both closed broke out above)
             if (total + e) / (count + 1) > threshold:
                 break
             total += e

@@ -109,5 +109,6 @@ def for_output(report, role: str, path: str | os.PathLike, closing_frame: bool |
     motion = report.motions[role]
     if closing:
         facts = clip_of(report, role, p.stem)
+        assert facts.cycles is not None and facts.root is not None  # a loop's clip has its options' cycles, root
         motion = closed_loop(cycle_of(report, role), facts.cycles, facts.root, motion)
     return motion, (clip_of(report, role, p.stem, closing) if glb else None)

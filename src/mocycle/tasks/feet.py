@@ -32,7 +32,7 @@ def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=N
             if root == "motion":
                 warnings.warn(f"feet not locked: {exc}", MocycleWarning, stacklevel=2)
             mode = "keep"
-    facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
+    facts: dict[str, object] = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
              "largest_leg_step_before": None, "largest_leg_step_after": None, "clearance": None, "seconds": 0.0}
     if mode == "keep":
         return cycle, facts, None
@@ -95,7 +95,7 @@ def lock_motion(motion, mode: str, foot_joints: str | None, moves: bool, hand_ov
             if moves:
                 warnings.warn(f"feet not locked: {exc}", MocycleWarning, stacklevel=2)
             mode = "keep"
-    facts = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
+    facts: dict[str, object] = {"mode": mode, "contacts": None, "skate_before": None, "skate_after": None,
              "largest_leg_step_before": None, "largest_leg_step_after": None, "clearance": None, "seconds": 0.0}
     if mode == "keep":
         return motion, facts

@@ -222,7 +222,7 @@ def schema(options_cls: type[Options]) -> dict:
     props, required = {}, []
     for f in dataclasses.fields(options_cls):
         check = f.metadata.get("check")
-        prop = dict(check.schema()) if hasattr(check, "schema") else {}
+        prop = dict(check.schema()) if check is not None and hasattr(check, "schema") else {}
         prop["description"] = f.metadata.get("help", "")
         prop["x-flag"] = flag_of(f)
         hint = hints.get(f.name, "")

@@ -10,7 +10,7 @@ import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Literal, NamedTuple
 
 from ..defaults import AMC_FPS
 from ..threads import limited
@@ -75,7 +75,7 @@ class Recorder:
         self._t0 = time.perf_counter()
         return self
 
-    def __exit__(self, kind, value, traceback) -> bool:
+    def __exit__(self, kind, value, traceback) -> Literal[False]:
         self.timings_s["total"] = time.perf_counter() - self._t0
         self._catcher.__exit__(kind, value, traceback)
         kept = [w for w in self._caught if not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning))]
@@ -124,12 +124,14 @@ def is_motion(item) -> bool:
     return motion is not None and isinstance(item, motion.Motion)
 
 
-def load(item: Motion | str | os.PathLike, amc_fps: float = AMC_FPS, take: str | None = None) -> Motion:
+def load(item: Motion | Labelled | str | os.PathLike, amc_fps: float = AMC_FPS, take: str | None = None) -> Motion:
     """A task input: a :class:`Motion` as is, or a motion file read (``amc_fps``: AMC files only; ``take``: the
     animation of a glTF or FBX file)."""
     if isinstance(item, Labelled):
         return item.motion
-    if is_motion(item):
+    from ..motion import Motion  # what is_motion tests; mocycle.io, read next otherwise, imports it too
+
+    if isinstance(item, Motion):
         return item
     from ..io import read_motion
 

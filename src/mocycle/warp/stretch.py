@@ -323,14 +323,15 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
     if window == "auto":
         limit = T // 2
         found = {g: group_cycle(X[:, c]) if c.size else float("nan") for g, c in cols.items()}
-        for g, c in found.items():
-            if np.isfinite(c):
+        group_cycles: dict[str, float] = {}  # the groups with a cycle of their own
+        for g, cycle in found.items():
+            if np.isfinite(cycle):
                 A = X[:, cols[g]]
                 sd = A.std(axis=0)
-                cycles[g], windows[g] = c, refine_window(A[:, sd >= WEAK_CURVE * sd.max()], c)
-        if cycles:  # a still or aperiodic group borrows the largest cycle (and its window) of the others
-            lender = max(cycles, key=cycles.get)
-            fallback, fallback_window = cycles[lender], windows[lender]
+                group_cycles[g], windows[g] = cycle, refine_window(A[:, sd >= WEAK_CURVE * sd.max()], cycle)
+        if group_cycles:  # a still or aperiodic group borrows the largest cycle (and its window) of the others
+            lender = max(group_cycles, key=lambda g: group_cycles[g])
+            fallback, fallback_window = group_cycles[lender], windows[lender]
         else:  # no group has a cycle: the whole pose matrix (autocorrelation summed over every curve)
             fallback = autocorrelation_period(X) if X.shape[1] else float("nan")
             if not np.isfinite(fallback):
@@ -339,9 +340,9 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
                                    f"(1 to {limit})")
             fallback_window = refine_window(X, fallback)
         for g in groups:
-            if g not in cycles:
-                cycles[g], windows[g] = float(fallback), fallback_window
-        cycles = {g: float(cycles[g]) for g in groups}
+            if g not in group_cycles:
+                group_cycles[g], windows[g] = float(fallback), fallback_window
+        cycles = {g: float(group_cycles[g]) for g in groups}
         windows = {g: int(windows[g]) for g in groups}
     else:
         N = _window(window, T)
@@ -374,8 +375,8 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
         for N, parts in by_window.items():
             plain = np.concatenate(parts)
             for c0 in range(0, plain.size, LCT_COLUMNS):  # the columns the transform takes at a time (memory)
-                cs = plain[c0:c0 + LCT_COLUMNS]
-                Y[:, cs] = warp_curves(X[:, cs], factor, N)
+                block = plain[c0:c0 + LCT_COLUMNS]
+                Y[:, block] = warp_curves(X[:, block], factor, N)
     del X  # the input's curves: not needed to decode (memory)
     quats, _ = decoder.decode_arrays(Y, translations=False)
     del Y
@@ -509,7 +510,7 @@ def _fade(warped: Motion, target: Motion, at_start: bool, n: int) -> Motion:
     q = warped.rotations.copy()
     q[rows] = quat_multiply(quat_exp(w[:, None, None] * diff[None]), q[rows])
     tracks = {}
-    for j in np.flatnonzero(dt.any(axis=1)):  # the joints whose translations differ at the join
+    for j in np.flatnonzero(dt.any(axis=1)).tolist():  # the joints whose translations differ at the join
         tracks[j] = np.array(warped.joint_translations(j))
         tracks[j][rows] += w[:, None] * dt[j]
     return warped.replace(rotations=q, tracks=tracks, copy=False)
