@@ -329,6 +329,13 @@ def _any_above(order: list[int], up: list[int], marked: np.ndarray) -> np.ndarra
     return above
 
 
+#: the frame rate of a take whose keys lie on no regular grid (unless the caller says otherwise), glTF and FBX
+DEFAULT_FPS = 30.0
+#: key rates below this (frames per second) are taken for sparse authored keys: sampled at DEFAULT_FPS instead
+MIN_KEY_RATE = 12.0
+#: the largest glTF or FBX file read (bytes): a glTF's buffers and an FBX scene are read into memory
+MAX_FILE_BYTES = 2**31
+
 MAX_LISTED_TAKES = 20
 """How many take names a message lists; the rest are counted (``mocycle info FILE``, ``gltf_takes`` and
 ``fbx_takes`` list them all)."""

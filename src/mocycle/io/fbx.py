@@ -44,6 +44,9 @@ from ..errors import DefaultTake, MocycleError, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
 from ._nodes import (
+    DEFAULT_FPS,
+    MAX_FILE_BYTES,
+    MIN_KEY_RATE,
     NodeTRS,
     choose_take,
     joint_names,
@@ -57,11 +60,6 @@ from .fbx_scan import opened
 
 __all__ = ["DEFAULT_FPS", "fbx_takes", "read_fbx"]
 
-DEFAULT_FPS = 30.0
-#: key rates below this (frames per second) are taken for sparse authored keys: sampled at DEFAULT_FPS instead
-MIN_KEY_RATE = 12.0
-#: the largest file read (bytes)
-MAX_FILE_BYTES = 2**31
 #: the binding's CoordinateAxis values, in order: +X, -X, +Y, -Y, +Z, -Z (then UNKNOWN)
 _AXES = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0), (0.0, 0.0, -1.0))
 

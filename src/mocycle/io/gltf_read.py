@@ -44,6 +44,9 @@ from ..errors import DefaultTake, MocycleWarning, MotionFileError
 from ..limits import check_frames, frame_time_problem
 from ..motion import Motion
 from ._nodes import (
+    DEFAULT_FPS,
+    MAX_FILE_BYTES,
+    MIN_KEY_RATE,
     NodeTRS,
     Sampled,
     choose_take,
@@ -57,13 +60,6 @@ from ._nodes import (
 from .regular import read_regular
 
 __all__ = ["DEFAULT_FPS", "gltf_takes", "read_gltf"]
-
-#: the frame rate of an animation whose keys lie on no regular grid (unless ``fps`` says otherwise)
-DEFAULT_FPS = 30.0
-#: key rates below this (frames per second) are taken for sparse authored keys: sampled at DEFAULT_FPS instead
-MIN_KEY_RATE = 12.0
-#: the largest file read whole (bytes): a glTF's buffers are read into memory
-MAX_FILE_BYTES = 2**31
 
 _COMPONENTS = {5120: ("i1", 127.0), 5121: ("u1", 255.0), 5122: ("<i2", 32767.0), 5123: ("<u2", 65535.0),
                5125: ("<u4", None), 5126: ("<f4", None)}
