@@ -2,7 +2,7 @@
 #   make demo   set up .venv and run the main job on the built-in synthetic walk
 #               (the core needs numpy, scipy, scikit-learn, ripser; ".[test]" also pulls the
 #               cli and plot extras, typer/rich and matplotlib, which the demo and the tests use)
-#   make check  the fast tier, before each commit (a few minutes): ruff, mypy on the core, and the unit
+#   make check  the fast tier, before each commit (a few minutes): ruff, mypy on the whole package, and the unit
 #               tests without Blender, a browser, Node.js or the slow ones (pytest -m "not browser and not slow and not node")
 #   make test   lint with ruff, run the whole suite with numpy 2.x (.venv) and again
 #               with numpy 1.26 (.venv-numpy1, the line Blender 4.2-5.0 bundle), then the Blender

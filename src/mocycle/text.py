@@ -124,7 +124,7 @@ def json_text(facts, indent: int | None = 2) -> str:
 _SURROGATE_ESCAPE = re.compile(r"\\u[dD][89a-fA-F]")
 
 
-def _cleaned(facts):
+def _cleaned(facts: object) -> object:
     """``facts`` as JSON takes them: numpy values as Python's, non-finite numbers as ``None`` (their paths under
     ``"null_because_not_finite"`` of a dict at the top), lone surrogates escaped (:func:`unicode_clean`)."""
     import numpy as np

@@ -52,7 +52,8 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
     if take_timeout_s is not None and not (take_timeout_s >= 0 and take_timeout_s < float("inf")):
         raise MocycleError(f"the take timeout must be a number of seconds >= 0; got {take_timeout_s!r}")
     if any(f.name == "workers" for f in dataclasses.fields(options)):  # each take runs on one worker process
-        options = dataclasses.replace(options, workers=1, scheduler=None)
+        one_worker: dict[str, object] = {"workers": 1, "scheduler": None}  # fields of that task's Options only
+        options = dataclasses.replace(options, **one_worker)
     job = Job(command=command, options=options, outdir=outdir, suffix=suffix, timeout_s=take_timeout_s or None,
               run_id=uuid.uuid4().hex)
     _refuse_overwriting_inputs(job, takes)
@@ -64,11 +65,11 @@ def run_batch(command: str, inputs: list, outdir: str | Path, options: Options, 
         rows[row_key(row)] = row
     if resume:
         for take in takes:
-            row = fresh_record(job, take) if take.problem is None else None
-            if row is not None:
-                rows[take_key(take)] = {**row, "resumed": True}
+            record = fresh_record(job, take) if take.problem is None else None
+            if record is not None:
+                rows[take_key(take)] = {**record, "resumed": True}
     todo = [t for t in takes if take_key(t) not in rows]
-    run = {"engine": None, "scheduler": None, "workers": 0, "worker_start": None}
+    run: dict[str, object] = {"engine": None, "scheduler": None, "workers": 0, "worker_start": None}
     with ExitStack() as stack:
         if todo and scheduler is None:  # the workers' imports begin now, while this process imports dask
             stack.enter_context(forkserver.warm_workers(COMMANDS[command].imports))
@@ -150,6 +151,7 @@ def check_collisions(job: Job, takes: list[Take]) -> None:
         rel = printable(take.rel.as_posix())
         claim(job.record_path(take), f"the record of {rel}")
         if job.suffix:
+            assert output is not None  # a suffix is an output's (check_suffix)
             target = take.output(job.outdir, job.suffix)
             claim(target, f"the output of {rel}")
             every = output.every_target(target, job.options)  # --part all: one file per part, parts unknown yet

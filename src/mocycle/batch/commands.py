@@ -85,7 +85,9 @@ def motion_targets(report, target: Path) -> dict[str, Path]:
     """The motions a report holds that batch writes, by role, and where: ``target``, or with ``--part all``
     each loop's file as ``mocycle loop`` names it (:meth:`mocycle.tasks.spec.Output.targets` of the task's
     output)."""
-    return COMMANDS[report.task].output.targets(report, target)
+    output = COMMANDS[report.task].output
+    assert output is not None  # only a command that writes motions is asked
+    return output.targets(report, target)
 
 
 def part_rows(command: Command, facts: Mapping) -> list[dict]:

@@ -203,7 +203,7 @@ def find_takes(inputs: list[str | os.PathLike], outdir: str | os.PathLike | None
             raise MocycleError(f"{item}: no such file or folder")
         found += [(f, root, None) for f in files] + [(f, root, why) for f, why in problems]
     base = Path(os.path.commonpath([str(root) for _, root, _ in found]))
-    takes = {}
+    takes: dict[Path, Take] = {}
     for f, _, why in found:  # the same path named twice is one take; links of other names are takes of their own
         takes.setdefault(f, Take(source=f, rel=f.relative_to(base), problem=why))
     out = sorted(takes.values(), key=lambda t: str(t.rel))

@@ -194,10 +194,11 @@ def base_row(job: Job, take: Take) -> dict:
     """The row of a take before it runs. ``file`` and ``rel`` are the paths as printable text
     (:func:`mocycle.text.printable`: a byte that is not UTF-8 as ``\\xNN``, control characters escaped); when
     that differs from the real name (a name that is not UTF-8), ``file_hex`` holds the path's bytes in hex."""
-    row = {"file": printable(take.source), "rel": printable(take.rel.as_posix()), "status": "ok", "message": "",
-           "figures": {}, "seconds": None, "wall_seconds": None, "outputs": [], "warnings": [], "facts": None,
-           "worker": None, "options_hash": job.options_hash,
-           "record": printable(job.record_path(take).relative_to(job.outdir).as_posix())}
+    row: dict[str, object] = {
+        "file": printable(take.source), "rel": printable(take.rel.as_posix()), "status": "ok", "message": "",
+        "figures": {}, "seconds": None, "wall_seconds": None, "outputs": [], "warnings": [], "facts": None,
+        "worker": None, "options_hash": job.options_hash,
+        "record": printable(job.record_path(take).relative_to(job.outdir).as_posix())}
     if path_hex(take.source) is not None:
         row["file_hex"] = path_hex(take.source)
     return row
@@ -248,6 +249,7 @@ def _write_outputs(job: Job, command, take: Take, report, write, written: list[P
     """Write the take's outputs; ``written`` gets each file as soon as it is whole."""
     if command.writes is None:
         return
+    assert job.suffix is not None  # a command that writes a file has a suffix (check_suffix)
     target = take.output(job.outdir, job.suffix)
     target.parent.mkdir(parents=True, exist_ok=True)
     if command.writes == "motion":

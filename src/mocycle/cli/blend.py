@@ -26,11 +26,14 @@ def blend(
     Exit code 0 on success, 3 when a take holds no periodic motion or its cycle fails a loop check (see
     mocycle loop; --force uses it anyway), 1 for bad input, 2 for a bad option.
     """
+    from ..cycle.blend import BlendedCycle
+
     check_output(plot, paths, force, ".png", "--plot")
     report = tasks.blend.run(paths, options)
     print_warnings(report)
     written = write(report)["loop"][1]
     result = report.result
+    assert isinstance(result, BlendedCycle)  # what tasks.blend makes
     if plot is not None:
         import numpy as np
 
@@ -88,9 +91,11 @@ def transition(
     print_warnings(report)
     write(report)
     if plot is not None:
+        from ..cycle.blend import Transition
         from ..viz import plot_curves
 
         tr = report.result
+        assert isinstance(tr, Transition)  # what tasks.transition makes
         plot_curves([("transition", tr.motion, tr.phase)], plot, weights=tr.weights, xlabel="phase (cycles)",
                     title=f"transition {first.name} -> {second.name} over {options.cycles} cycle(s)")
     facts = {"files": [str(first), str(second)], "output": str(output), **report.facts, "seconds": report.seconds}

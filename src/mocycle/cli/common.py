@@ -65,7 +65,9 @@ class LazyGroup(TyperGroup):
     def get_command(self, ctx, cmd_name: str):
         if cmd_name not in self.commands and cmd_name in COMMANDS:
             load_commands([cmd_name])
-            self.commands.update(typer.main.get_command(app).commands)
+            group = typer.main.get_command(app)
+            assert isinstance(group, TyperGroup)  # the app's cls, a LazyGroup
+            self.commands.update(group.commands)
         return self.commands.get(cmd_name)
 
     def resolve_command(self, ctx, args):

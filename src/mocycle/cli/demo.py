@@ -28,6 +28,7 @@ def demo(
 ):
     """Loop the built-in synthetic walk: write the take, its cycle (BVH) and the loop plot."""
     from .. import tasks
+    from ..cycle.result import Cycle
     from ..datasets import synthetic_walk
     from ..tasks.loop import METRIC_LABELS
     from ..viz import plot_loop
@@ -48,6 +49,7 @@ def demo(
               f"tempo +10 % over the take; true period {true_period:.1f} frames")
     report = tasks.loop.run(motion, tasks.loop.Options(cycles=4, root="motion"))
     cycle, metrics = report.result, report.facts["metrics"]
+    assert isinstance(cycle, Cycle)  # one loop asked for: the report's result is its cycle
     loop_file = write(cycle.motion("inplace"), out_dir / "walk_cycle.bvh")
     walk_file = write(report.motions["loop"], out_dir / "walk_cycle_x4.bvh")
     plot = plot_loop(motion, cycle, out_dir / "walk_cycle.png", title="mocycle demo: synthetic walk")

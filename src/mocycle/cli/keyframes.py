@@ -82,6 +82,7 @@ def project(
     report = tasks.project.run(path, options)
     print_warnings(report)
     r, arrays = report.facts, report.result
+    assert isinstance(arrays, dict)  # tasks.project's points, keyframes and optimised points
     if plot is not None:
         from ..viz.keyframes import plot_projection
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated
 
@@ -10,6 +11,7 @@ import typer
 from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 from ..tasks.loop import METRIC_LABELS
+from ..tasks.report import Report
 from .common import as_flags, check_output, escape, out, print_json, print_warnings, task_command, timing_line
 
 
@@ -38,22 +40,26 @@ def loop(
     try:  # without plots each loop is written as soon as it is made, and let go (a long session's hundreds)
         report = tasks.loop.run(path, options, deliver=None if plots else write)
     except (NoPeriodicMotion, LoopRefused) as exc:
-        if as_json and getattr(exc, "facts", None) is not None:  # the same shape, status and reason: exit 3
+        if as_json and exc.facts is not None:  # the same shape, status and reason: exit 3
             print_json({"file": str(path), **exc.facts})
         raise
     everything = options.which == "all"
     loops = report.facts["loops"]
     roles = [f["role"] for f in loops]
-    if feet_plot is not None and any(report.extras[r]["contacts"] is None for r in roles):
+    if feet_plot is not None and any(_extra(report, r)["contacts"] is None for r in roles):
         # refused before any file is written
         raise MocycleError("--feet-plot needs locked feet (--feet lock, or auto with --root motion)")
     print_warnings(report)
     if plots:  # every cycle was made and checked before writing; one file per loop (OUT.part<k>-...)
         files = {role: (str(target), written.n_frames, report.motions[role].n_frames != written.n_frames)
                  for role, (target, written) in write(report).items()}
-        cycles_made = report.result if everything else [report.result]
+        if everything:
+            assert isinstance(report.result, list)  # --part all: the cycle of each loop
+            cycles_made: list[object] = report.result
+        else:
+            cycles_made = [report.result]
     else:
-        files = {role: w for r in roles for role, w in report.extras[r]["written"].items()}
+        files = {role: w for r in roles for role, w in _extra(report, r)["written"].items()}
         cycles_made = [None] * len(loops)
     shown = []
     for facts, cycle in zip(loops, cycles_made, strict=True):
@@ -63,7 +69,7 @@ def loop(
         images = []
         if feet_plot is not None:
             images.append(feet_plot.with_suffix(f".{tag}.png") if tag else feet_plot)
-            _plot_feet(report.extras[role]["fitted"], cycle, report.extras[role]["contacts"], images[-1],
+            _plot_feet(_extra(report, role)["fitted"], cycle, _extra(report, role)["contacts"], images[-1],
                        f"{path.name}: feet locked")
         if plot is not None:
             from ..viz import plot_loop
@@ -87,7 +93,14 @@ def loop(
     out.print(timing_line(report))
 
 
-def _print_parts(path: Path, facts: dict) -> None:
+def _extra(report: Report, role: str) -> dict:
+    """What tasks.loop keeps beside a loop (its fitted cycle and contacts, or what was written of it)."""
+    extra = report.extras[role]
+    assert isinstance(extra, dict)
+    return extra
+
+
+def _print_parts(path: Path, facts: Mapping) -> None:
     """The take's parts, one line each, and which one was looped and why."""
     parts = facts["parts"]
     if len(parts) > 1:

@@ -44,14 +44,18 @@ def stretch(
         return
     from rich.table import Table
 
+    from ..warp.stretch import StretchReport
+
     r = report.facts
+    stretched = report.result
+    assert isinstance(stretched, StretchReport)  # what tasks.stretch makes
     out.print(f"[bold]{escape(path)}[/]: {r['frames_in']} frames -> {escape(output)}: {r['frames_out']} frames "
               f"(factor {r['factor']:g}, {r['fps']:.6g} fps)", soft_wrap=True)
     table = Table(title="windows (frames)")
     for col in ("group", "window", "cycle found", "joints"):
         table.add_column(col, justify="left" if col in ("group", "joints") else "right")
     for g, n in r["windows"].items():
-        cycle = report.result.cycles[g]
+        cycle = stretched.cycles[g]
         table.add_row(escape(g), str(n), "given" if cycle is None else f"{cycle:.2f}", str(r["joints_per_group"][g]))
     out.print(table)
     if r["periodic_regions"]:

@@ -35,10 +35,13 @@ def swings(
 
     The table lists each joint's swing indices (0-based, in time order): what `mocycle edit --swing` takes.
     """
+    from ..segmentation import Segmentation
+
     check_output(plot, [path], force, ".png", "--plot")
     report = tasks.swings.run(path, options)
     print_warnings(report)
     seg, r = report.result, report.facts
+    assert isinstance(seg, Segmentation)  # what tasks.swings makes (or reads from a .mosw)
     written = []
     if write(report):
         written.append(f"{output} ({seg.n_swings} swings)")

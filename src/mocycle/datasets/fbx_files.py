@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import struct
 import zlib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -182,7 +183,7 @@ def _p(name: str, kind: str, *values) -> Node:
 
 
 def chain_scene(n_bones: int = 3, frames: int = 31, fps: int = 30, names: list[str] | None = None,
-                extra: list[Node] = ()) -> list[Node]:
+                extra: Sequence[Node] = ()) -> list[Node]:
     """An armature (a null) holding a chain of ``n_bones`` bones, each 10 units above its parent along Y, and one
     animation stack ``walk`` of ``frames`` frames at ``fps`` in which the first bone turns 0 -> 90 degrees about X
     (linear keys).  ``names``: the bones' names (default ``bone0``, ``bone1``, ...); ``extra``: more records put
@@ -237,7 +238,7 @@ def read_records(data: bytes) -> tuple[int, list[Node]]:
     fields = struct.Struct("<QQQB" if version >= 7500 else "<IIIB")
 
     def records(at: int, end: int) -> tuple[list[Node], int]:
-        out = []
+        out: list[Node] = []
         while at + fields.size <= end:
             stop, n_props, props_len, name_len = fields.unpack_from(data, at)
             if stop == 0:

@@ -107,7 +107,7 @@ def humanoid_skeleton() -> Skeleton:
     Xrotation``; most joints ``ZYX`` rotations, the arms and forearms ``ZXY``
     and the neck ``YXZ``.  End Sites sit on the head top, hands and toes.
     """
-    parents = [-1 if p is None else _IX[p] for _, p, _, _ in _JOINTS]
+    parents = np.array([-1 if p is None else _IX[p] for _, p, _, _ in _JOINTS], dtype=np.int64)
     offsets = np.array([o for _, _, o, _ in _JOINTS], dtype=np.float64)
     sites = tuple(EndSite(_IX[p], off, name) for p, off, name in _END_SITES)
     return Skeleton(_NAMES, parents, offsets, tuple(c for *_, c in _JOINTS), sites)
@@ -655,6 +655,7 @@ def synthetic_walk_then_run(n_walk: int = 600, n_run: int = 600, fps: float = 60
     inside = (w > 0.0) & (w < 1.0)
     skel = walk.motion.skeleton
     J = skel.n_joints
+    assert walk.euler_deg is not None and run.euler_deg is not None  # synthetic gaits keep their channels
 
     # rotations: channel values of whichever gait is active, slerp inside the blend
     chan = np.where((w < 0.5)[:, None, None], walk.euler_deg, run.euler_deg)
@@ -945,13 +946,14 @@ def synthetic_walk_then_wave(walk_s: float = 4.0, stop_s: float = 0.8, wave_s: f
     ``unwrapped_phase`` counts cycles in the walk and waves (from 0) in the waving; ``heading_deg`` zeros.
     """
     fps = _validate.positive("fps", fps)
-    for name, v in (("walk_s", walk_s), ("stop_s", stop_s), ("wave_s", wave_s)):
-        _validate.positive(name, v)
+    for name, seconds in (("walk_s", walk_s), ("stop_s", stop_s), ("wave_s", wave_s)):
+        _validate.positive(name, seconds)
     if not np.isfinite(noise_deg) or noise_deg < 0:
         raise MocycleError(f"noise_deg must be >= 0; got {noise_deg!r}")
     n_walk, n_stop, n_wave = (max(1, int(round(v * fps))) for v in (walk_s, stop_s, wave_s))
     walk = synthetic_walk(n_walk + n_stop, fps, period_s=period_s)
     wave = synthetic_wave(n_wave, fps, hand=hand, wave_period_s=wave_period_s, raise_s=0.5, noise_deg=0.0)
+    assert walk.euler_deg is not None and wave.euler_deg is not None  # both keep their channels
     skel = walk.motion.skeleton
     J = skel.n_joints
     T, _ = _check(n_walk + n_stop + n_wave, fps)

@@ -211,7 +211,9 @@ class Studio:
             return data
         motion = take.motion(self.amc_fps)
         report = tasks.project.run(motion, o)
-        data = plane_payload(motion, report.result, {**report.facts, "seconds": report.seconds})
+        arrays = report.result
+        assert isinstance(arrays, dict)  # tasks.project's points, keyframes and optimised points
+        data = plane_payload(motion, arrays, {**report.facts, "seconds": report.seconds})
         self._planes.put(key, data, len(data))
         return data
 

@@ -113,7 +113,9 @@ class Access:
         return f"{host}:{self.port}" if self.port is not None else host
 
     def _has_token(self, value: str | None) -> bool:
-        return bool(value) and hmac.compare_digest(value.encode("utf-8", "replace"), self.token.encode())
+        if not value:
+            return False
+        return hmac.compare_digest(value.encode("utf-8", "replace"), self.token.encode())
 
     def _problem(self, scope, headers: dict) -> tuple[int, str] | None:
         problem = self._host_problem(headers)

@@ -38,6 +38,7 @@ def held_bytes(obj, skip=(), _seen=None, _depth=0) -> int:
         return len(obj)
     if isinstance(obj, np.ndarray):
         return obj.nbytes
+    items: list[object] | tuple[object, ...]
     if isinstance(obj, dict):
         items = list(obj.values())
     elif isinstance(obj, (list, tuple)):

@@ -10,6 +10,8 @@ head, or the connection is closed.
 
 from __future__ import annotations
 
+import asyncio
+
 import h11
 from uvicorn.protocols.http.h11_impl import H11Protocol
 
@@ -29,9 +31,9 @@ class HeaderTimeout(H11Protocol):
 
     header_timeout_s = HEADER_TIMEOUT_S
 
-    def connection_made(self, transport) -> None:  # type: ignore[override]
+    def connection_made(self, transport) -> None:
         super().connection_made(transport)
-        self._head_timer = None
+        self._head_timer: asyncio.TimerHandle | None = None
         self._arm()
 
     def _arm(self) -> None:
@@ -39,8 +41,9 @@ class HeaderTimeout(H11Protocol):
         self._head_timer = self.loop.call_later(self.header_timeout_s, self._too_slow)
 
     def _disarm(self) -> None:
-        if getattr(self, "_head_timer", None) is not None:
-            self._head_timer.cancel()
+        timer = getattr(self, "_head_timer", None)
+        if timer is not None:
+            timer.cancel()
             self._head_timer = None
 
     def _too_slow(self) -> None:

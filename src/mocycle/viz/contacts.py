@@ -34,7 +34,7 @@ def plot_contacts(motion, contacts, path: str | os.PathLike, title: str = "", be
         ax.plot(frames, h[:, c], color="tab:blue", lw=1.2, label="height")
         ax2 = ax.twinx()
         ax2.plot(frames, v[:, c], color="tab:red", lw=1.0, label="speed")
-        if hb is not None:
+        if hb is not None and vb is not None:
             ax.plot(frames, hb[:, c], color="tab:blue", lw=0.8, ls="--")
             ax2.plot(frames, vb[:, c], color="tab:red", lw=0.8, ls="--")
         ax.set_ylabel(f"{names[contacts.joints[c]]}\nheight", fontsize=8)
