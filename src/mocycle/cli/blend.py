@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line
+from .common import check_output, escape, out, print_feet, print_json, print_warnings, task_command, timing_line
 
 PLOT_HELP = "Write a PNG: the most moving joint curves of the blend and of the inputs' cycles, phase-aligned."
 
@@ -64,7 +64,7 @@ def blend(
               f"turn {facts['turn_per_cycle_deg']:.3g}°")
     seam = facts["seam"]
     out.print(f"  seam jump: pose {seam['seam_pose']:.3g}, velocity {seam['seam_velocity']:.3g} (× median step)")
-    _print_feet(facts["feet"])
+    print_feet(facts["feet"])
     out.print(f"wrote {escape(output)}: {facts['frames_out']} frames ({options.cycles} cycle(s), root "
               f"{options.root})", soft_wrap=True)
     if plot is not None:
@@ -109,13 +109,8 @@ def transition(
     sm = facts["smoothness"]
     out.print(f"  largest step {sm['step_local']:.3g} × its neighbours' median (inputs {sm['input_step_local']:.3g}); "
               f"largest velocity change {sm['velocity_local']:.3g} × (inputs {sm['input_velocity_local']:.3g})")
-    _print_feet(facts["feet"])
+    print_feet(facts["feet"])
     out.print(f"wrote {escape(output)}: {facts['frames']} frames (root {options.root})", soft_wrap=True)
     if plot is not None:
         out.print(f"wrote {escape(plot)}", soft_wrap=True)
     out.print(timing_line(report))
-
-
-def _print_feet(feet: dict) -> None:
-    if feet["mode"] == "lock":
-        out.print(f"  feet locked: skate {feet['skate_before']:.4g} -> {feet['skate_after']:.4g} units/s")

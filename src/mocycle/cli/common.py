@@ -198,6 +198,14 @@ def _print_warnings(caught) -> None:
         err.print(f"[yellow]warning:[/] {escape(as_flags(str(w.message)))}", markup=True, soft_wrap=True)
 
 
+def print_feet(feet: Mapping, note: str = "", tail: str = "") -> None:
+    """The line a command that writes motion prints when it locked the feet (its report's ``feet`` facts):
+    ``note`` after "feet locked", ``tail`` after the skate figures."""
+    if feet["mode"] == "lock":
+        out.print(f"  feet locked{note}: skate {feet['skate_before']:.4g} -> {feet['skate_after']:.4g} units/s{tail}",
+                  soft_wrap=True)
+
+
 def print_warnings(report) -> None:
     """The warnings a task recorded in its report, as 'warning:' lines."""
     for text in report.warnings:

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line
+from .common import check_output, escape, out, print_feet, print_json, print_warnings, task_command, timing_line
 
 
 @task_command("compress")
@@ -65,9 +65,7 @@ def decompress(
         print_json({**r, "seconds": report.seconds})
         return
     out.print(f"{escape(output)}: {r['frames']} frames rebuilt from {r['keyframes']} keyframes ({r['scheme']})")
-    if r["feet"]["mode"] == "lock":
-        out.print(f"  feet locked: skate {r['feet']['skate_before']:.4g} -> {r['feet']['skate_after']:.4g} units/s "
-                  "(the keyframes near contacts changed with them)")
+    print_feet(r["feet"], tail=" (the keyframes near contacts changed with them)")
 
 
 @task_command("project")

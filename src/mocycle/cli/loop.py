@@ -12,7 +12,17 @@ from .. import tasks
 from ..errors import LoopRefused, MocycleError, NoPeriodicMotion
 from ..tasks.loop import METRIC_LABELS
 from ..tasks.report import Report
-from .common import as_flags, check_output, escape, out, print_json, print_warnings, task_command, timing_line
+from .common import (
+    as_flags,
+    check_output,
+    escape,
+    out,
+    print_feet,
+    print_json,
+    print_warnings,
+    task_command,
+    timing_line,
+)
 
 
 @task_command("loop")
@@ -153,7 +163,6 @@ def _print_loop(facts: dict) -> None:
     if f["mode"] == "lock":
         spans = "; ".join(f"{escape(side)} {' '.join(f'{a}-{b}' for a, b in v['contacts'])}" for side, v in
                           f["contacts"].items())
-        out.print(f"  feet locked (contacts, cycle frames: {spans}); skate {f['skate_before']:.4g} -> "
-                  f"{f['skate_after']:.4g} units/s in {f['seconds']:.2f} s", soft_wrap=True)
+        print_feet(f, note=f" (contacts, cycle frames: {spans})", tail=f" in {f['seconds']:.2f} s")
     out.print(f"wrote {escape(facts['output'])}: {facts['frames_out']} frames ({facts['cycles']} cycle(s), root "
               f"{facts['root']})", soft_wrap=True)

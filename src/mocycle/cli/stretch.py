@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_json, print_warnings, task_command, timing_line
+from .common import check_output, escape, out, print_feet, print_json, print_warnings, task_command, timing_line
 
 
 @task_command("stretch")
@@ -64,8 +64,7 @@ def stretch(
             f"{s}:{e} -> {a}:{b}" for (s, e), (a, b) in zip(r["periodic_regions"], r["periodic_regions_out"],
                                                              strict=True))
             + (f"; {kept} frame(s) kept as captured" if kept else ""), soft_wrap=True)
-    if r["feet"]["mode"] == "lock":
-        out.print(f"  feet locked: skate {r['feet']['skate_before']:.4g} -> {r['feet']['skate_after']:.4g} units/s")
+    print_feet(r["feet"])
     if r["trend_curves"]:
         out.print(f"  warped as line + residual: {escape(', '.join(r['trend_curves']))}", soft_wrap=True)
     if plot is not None:
