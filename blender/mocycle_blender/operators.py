@@ -117,12 +117,6 @@ def _seam(value) -> str:
     return "not measured" if text is None else f"{text} (about 1 is seamless)"
 
 
-def _skate(feet: dict, metrics: dict | None = None):
-    """The loop's foot skate: after locking when the feet were locked, else as fitted (None: not measured)."""
-    after = feet.get("skate_after")
-    return after if after is not None else (metrics or {}).get("skate")
-
-
 def _parts_detail(parts: list[dict], first: int) -> list[str]:
     lines = []
     for k, p in enumerate(parts):
@@ -331,7 +325,7 @@ def _extract_cycle(self, context, arm):
                            wrap=closing_frame(cycle, options.cycles, options.root), travel=options.root == "motion")
     _keep_facts(new, report)
     rig_assign(arm, new)
-    skate = _skate(f["feet"], f["metrics"])
+    skate = words.written_skate(f["feet"], f["metrics"])
     self._warnings = report.warnings
     others = sum(1 for p in f["parts"] if p["loop"]) - 1
     why = ("the part picked" if options.which is not None else

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..suffixes import MOTION_WRITE_SUFFIXES
+from .words import written_skate
 
 __all__ = ["SPECS", "Output", "Spec", "row_figures"]
 
@@ -145,10 +146,9 @@ def _loop(facts: Mapping) -> Mapping:
 
 
 def _skate(facts: Mapping):
-    """Foot skate of the cycle written, units/s: after locking when the feet were locked, else as fitted."""
+    """Foot skate of the cycle written, units/s (:func:`~mocycle.tasks.words.written_skate`)."""
     f = _loop(facts)
-    locked = f["feet"].get("skate_after") if isinstance(f.get("feet"), Mapping) else None
-    return locked if locked is not None else f["metrics"]["skate"]
+    return written_skate(f.get("feet"), f["metrics"])
 
 
 def _motion(role: str, help: str, **kwargs) -> Output:

@@ -70,3 +70,10 @@ def hints(text: str) -> str:
         return label if value is None else f"{label} set to {value}"
 
     return render_hints(text, name)
+
+
+def written_skate(feet, metrics) -> float | None:
+    """The foot skate (units/s) of the loop written: after locking when the feet were locked (``feet``: a
+    report's ``feet`` facts), else as fitted (``metrics``' ``skate``); ``None`` when not measured."""
+    after = feet.get("skate_after") if isinstance(feet, dict) else None
+    return after if after is not None else (metrics or {}).get("skate")
