@@ -11,7 +11,7 @@ from ..errors import OptionError
 from . import fields
 from .fields import take_cycles
 from .options import Constraint, Flag, option
-from .report import Recorder, Report, label_of, load
+from .report import Recorder, Report, label_of, load_each
 
 LABELS = {
     "weights": ("weights", ""), "input_periods_frames": ("periods", "frames"), "period_frames": ("period", "frames"),
@@ -26,20 +26,17 @@ class Weights(Constraint):
     """None, or a tuple of numbers >= 0 (a text such as ``"0.7,0.3"`` is split at the commas)."""
 
     def __call__(self, name: str, value):
-        return _weights(name, value)
-
-
-def _weights(name: str, value):
-    if value is None:
-        return None
-    items = value.split(",") if isinstance(value, str) else value
-    try:
-        w = tuple(float(v) for v in items)
-    except (TypeError, ValueError):
-        w = ()
-    if not w or not all(math.isfinite(x) and x >= 0 for x in w):
-        raise OptionError(name, f"must be comma-separated numbers >= 0, one per take (e.g. 0.7,0.3); got {value!r}")
-    return w
+        if value is None:
+            return None
+        items = value.split(",") if isinstance(value, str) else value
+        try:
+            w = tuple(float(v) for v in items)
+        except (TypeError, ValueError):
+            w = ()
+        if not w or not all(math.isfinite(x) and x >= 0 for x in w):
+            raise OptionError(name, f"must be comma-separated numbers >= 0, one per take (e.g. 0.7,0.3); got "
+                                    f"{value!r}")
+        return w
 
 
 @dataclass(frozen=True)
@@ -70,8 +67,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
             raise OptionError("weights", f"needs {len(takes)} numbers, one per take; got {len(o.weights)}")
         check_weights(o.weights, len(takes))  # refuse bad weights before the (slower) extraction
     with Recorder() as rec:
-        motions = [load(t, o.amc_fps, k) for t, k in zip(takes, fields.take_for_each(o.take, len(takes)),
-                                                          strict=True)]
+        motions = load_each(takes, o.amc_fps, o.take)
         labels = [label_of(t, k) for k, t in enumerate(takes)]
         with rec.part("cycle"):
             cycles = take_cycles(motions, labels, o)

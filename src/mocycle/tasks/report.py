@@ -138,6 +138,14 @@ def load(item: Motion | Labelled | str | os.PathLike, amc_fps: float = AMC_FPS, 
     return read_motion(item, fps=amc_fps, take=take)
 
 
+def load_each(items, amc_fps: float = AMC_FPS, take: str | None = None) -> list[Motion]:
+    """Each input of a task that takes several (:func:`load`), each with its own take: ``take`` for every one,
+    or one per input separated by commas (:func:`~mocycle.tasks.fields.take_for_each`)."""
+    from .fields import take_for_each
+
+    return [load(item, amc_fps, k) for item, k in zip(items, take_for_each(take, len(items)), strict=True)]
+
+
 def label_of(item, k: int = 0) -> str:
     """How messages name an input: its path, its label (:class:`Labelled`), or ``take k`` for a motion in
     memory."""

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from ..errors import OptionError
 from . import fields
 from .fields import take_cycles
-from .report import Recorder, Report, label_of, load
+from .report import Recorder, Report, label_of, load_each
 
 LABELS = {
     "period_frames_start": ("period at the start", "frames"), "period_frames_end": ("period at the end", "frames"),
@@ -38,8 +38,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     with Recorder() as rec:
         labels = [label_of(t, k) for k, t in enumerate(takes)]
         with rec.part("cycle"):
-            a, b = take_cycles([load(t, o.amc_fps, k) for t, k in zip(takes, fields.take_for_each(o.take, 2),
-                                                                         strict=True)], labels, o)
+            a, b = take_cycles(load_each(takes, o.amc_fps, o.take), labels, o)
         result = transition(a, b, o.cycles, root=o.root, labels=labels, force=o.force)
         facts = {**result.to_dict(), "root": o.root, "smoothness": transition_smoothness(result)}
         with rec.part("feet"):
