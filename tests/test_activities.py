@@ -16,6 +16,7 @@ from mocycle.activities import segment_activities, short_period
 from mocycle.cli import app
 from mocycle.datasets import (
     synthetic_gesture,
+    synthetic_run,
     synthetic_still,
     synthetic_walk,
     synthetic_walk_then_wave,
@@ -187,3 +188,45 @@ def test_stride_phase_keeps_the_run_of_alternating_feet_inside_the_part():
     # without the filter the extra landing would count as a step: the line would bend
     x2, period2 = stride_phase(part, frames[:-1], foot[:-1], 100, 400)
     assert period2 == pytest.approx(period)
+
+
+def _steps(motion):
+    from mocycle.activities import find_landings
+
+    L = find_landings(motion)
+    return np.stack([L.frames, L.foot], axis=1)
+
+
+def test_a_walk_too_short_to_be_seen_repeating_loops_when_its_feet_land_a_period_apart():
+    """A stretch whose chain of landings broke (a landing missed) is looked at without gait: 1.9 strides are too
+    few to be seen to repeat on their own (MIN_REPEATS), but the feet landing a stride apart see it repeat."""
+    from mocycle.activities import _decide, _other
+
+    fps, period = 60.0, 1.0
+    walk = synthetic_walk(n_frames=int(1.9 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
+    options = {"joints": None, "step": 1}
+    blind = _other(walk, 0, walk.n_frames, 1.2, True, options)
+    _decide(blind, 1.2)
+    assert not any(p.loop for p in blind)
+    seen = _other(walk, 0, walk.n_frames, 1.2, True, options, steps=_steps(walk))
+    _decide(seen, 1.2)
+    looped = [p for p in seen if p.loop]
+    assert len(looped) == 1 and looped[0].in_step, [(p.kind, p.reason) for p in seen]
+    assert looped[0].period_frames == pytest.approx(period * fps, rel=0.08)
+    assert "the feet landing a period apart" in looped[0].reason
+
+
+def test_feet_that_land_at_another_pace_than_the_body_repeats_make_a_transition():
+    """Where the feet land at another pace than the period found (a walk slowing into a run), the stretch is no
+    one motion: a transition, not a loop."""
+    from mocycle.activities import _other
+
+    fps, period = 60.0, 0.7
+    run = synthetic_run(n_frames=int(3 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
+    steps = _steps(run)
+    slow = steps.copy()
+    slow[:, 0] = np.minimum(run.n_frames - 1, (steps[:, 0] - steps[0, 0]) * 1.4 + steps[0, 0]).astype(int)
+    parts = _other(run, 0, run.n_frames, 1.2, True, {"joints": None, "step": 1}, steps=slow)
+    assert not any(p.loop for p in parts)
+    assert any(p.kind == "transition" and "the gait changes here" in p.reason for p in parts), \
+        [(p.kind, p.reason) for p in parts]

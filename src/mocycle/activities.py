@@ -97,6 +97,9 @@ PERIOD_SEARCH = (0.75, 1.33)
 #: A one-cycle clip's wrap is looked for between these shares of its length (a cycle that repeats within the
 #: clip is more than one cycle), and its ends are the mean step of its first two and last two frames.
 ONE_CYCLE_LAGS = (0.3, 0.8)
+#: Feet that land a period apart, each foot's landings within this share of a period found without gait, step in
+#: time with it (a landing is found within a frame or two: a tenth of a stride at 30 fps).
+IN_STEP = 0.1
 #: A motion without gait repeats no faster than this many seconds a period (faster is tremor or noise).
 MIN_REPEAT_S = 0.25
 #: ... its frames repeat where they are like themselves a period later (repetition distance under this)
@@ -139,6 +142,9 @@ class Activity:
     periodic: PeriodicMotion | None = field(default=None, repr=False)
     #: the whole take is one cycle (a game clip): its frames are the loop (:func:`one_cycle`)
     one_cycle: bool = False
+    #: a part without gait whose feet land in step with its period (each foot's landings a period apart,
+    #: :func:`_in_step`): the landings see it repeat, so it needs the gait's cycles, not :data:`MIN_REPEATS`
+    in_step: bool = False
 
     @property
     def n_frames(self) -> int:
@@ -541,7 +547,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     parts.sort(key=lambda p: p.start)
     _reach(motion, parts, T)
     parts = [q for p in parts for q in (_split_turns(p, heading, path, fps) if " " not in p.kind else [p])]
-    parts = _fill(motion, parts, min_periods, options, map)
+    parts = _fill(motion, parts, landings, min_periods, options, map)
     keep = np.sort(np.concatenate(stepped)) if stepped else np.zeros(0, dtype=np.intp)
     steps = Landings(landings.frames[keep], landings.foot[keep], landings.sides, landings.down)
     gait = [p for p in parts if p.gait and p.n_periods >= min_periods]
@@ -553,7 +559,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
         for p in gait:
             _asked_phase(motion, p, min_periods, options)
     _decide(parts, min_periods)
-    parts = _second_look(motion, parts, min_periods, options, map)
+    parts = _second_look(motion, parts, landings, min_periods, options, map)
     parts = _or_one_cycle(motion, parts, landings)
     return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True, reason=_listing(parts),
                       landings=landings)
@@ -638,7 +644,7 @@ def _or_one_cycle(motion: Motion, parts: list[Activity], landings: Landings | No
     return [part]
 
 
-def _second_look(motion: Motion, parts: list[Activity], min_periods: float, options: dict,
+def _second_look(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float, options: dict,
                  map=map) -> list[Activity]:
     """Frames where steps were seen but no gait part loops (landings missed on a rig whose feet slide, a
     stumble) looked at again as frames without gait (:func:`_other`, through ``map``): each run of neighbouring
@@ -654,8 +660,8 @@ def _second_look(motion: Motion, parts: list[Activity], min_periods: float, opti
         k = max(j, k + 1)
     again = [r for r in runs if not r[0].loop and any(p.landings for p in r)
              and (r[-1].stop - r[0].start) * motion.frame_time >= MIN_OTHER_S]
-    found = map(_gap_parts, [_Gap(motion[r[0].start:r[-1].stop], r[0].start, min_periods, True, options)
-                             for r in again])
+    found = map(_gap_parts, [_Gap(motion[r[0].start:r[-1].stop], r[0].start, min_periods, True, options,
+                                  _steps_in(landings, r[0].start, r[-1].stop)) for r in again])
     instead = {}
     for r, new in zip(again, found, strict=True):
         _decide(new, min_periods)
@@ -752,7 +758,7 @@ def _decide(parts: list[Activity], min_periods: float) -> None:
         if p.kind in ("gesture", "standing", "transition") and not p.gait:
             p.loop = False
             continue
-        least = min_periods if p.gait else max(min_periods, MIN_REPEATS)
+        least = min_periods if p.gait or p.in_step else max(min_periods, MIN_REPEATS)
         n = p.n_periods
         p.loop = bool(p.periodic is not None and np.isfinite(n) and n >= least)
         if p.loop:
@@ -979,9 +985,10 @@ def _repeating_reach(motion: Motion, part: Activity, want: int, edge: int) -> in
     return edge - int(bad[0]) if bad.size else want
 
 
-def _fill(motion: Motion, parts: list[Activity], min_periods: float, options: dict, map=map) -> list[Activity]:
+def _fill(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float, options: dict,
+          map=map) -> list[Activity]:
     """The parts with the frames between them (and before the first, after the last) as parts of their own,
-    each stretch looked at on its own (:func:`_other`, through ``map``)."""
+    each stretch looked at on its own (:func:`_other`, through ``map``) with the landings in it."""
     T = motion.n_frames
     gaps, at = [], 0
     for p in [*parts, None]:
@@ -990,7 +997,8 @@ def _fill(motion: Motion, parts: list[Activity], min_periods: float, options: di
             gaps.append((at, stop))
         if p is not None:
             at = p.stop
-    found = map(_gap_parts, [_Gap(motion[a:b], a, min_periods, bool(parts), options) for a, b in gaps])
+    found = map(_gap_parts, [_Gap(motion[a:b], a, min_periods, bool(parts), options, _steps_in(landings, a, b))
+                             for a, b in gaps])
     out = [*parts, *(q for qs in found for q in qs)]
     return sorted(out, key=lambda q: q.start)
 
@@ -1004,22 +1012,61 @@ class _Gap:
     min_periods: float
     gait_near: bool
     options: dict
+    #: the landings in the stretch: rows (frame of the stretch, foot) ``(n, 2)``
+    steps: np.ndarray | None = None
+
+
+def _steps_in(landings: Landings | None, a: int, b: int) -> np.ndarray:
+    """The landings in frames ``a .. b-1`` as rows (frame - ``a``, foot index) ``(n, 2)``."""
+    if landings is None:
+        return np.zeros((0, 2), dtype=np.intp)
+    inside = (landings.frames >= a) & (landings.frames < b)
+    return np.stack([landings.frames[inside] - a, landings.foot[inside]], axis=1).astype(np.intp)
+
+
+def _foot_periods(steps: np.ndarray | None, start: int, stop: int, fps: float) -> np.ndarray:
+    """The strides of ``steps`` (rows (frame, foot) in frame order) over frames ``start .. stop-1``: frames from a
+    landing to the same foot's next where the other foot lands once between, each step :data:`MIN_STEP_S` ..
+    :data:`MAX_STEP_S` long (a landing missed or a foot that shuffles makes no stride)."""
+    if steps is None or steps.shape[0] < 3:
+        return np.zeros(0)
+    f, foot = steps[:, 0].astype(np.float64), steps[:, 1]
+    d1, d2 = f[1:-1] - f[:-2], f[2:] - f[1:-1]
+    lo, hi = MIN_STEP_S * fps, MAX_STEP_S * fps
+    ok = (foot[:-2] == foot[2:]) & (foot[1:-1] != foot[:-2]) & (d1 >= lo) & (d1 <= hi) & (d2 >= lo) & (d2 <= hi)
+    ok &= (f[2:] > start) & (f[:-2] < stop - 1)
+    return (f[2:] - f[:-2])[ok]
+
+
+def _in_step(periods: np.ndarray, period: float) -> bool | None:
+    """Whether feet whose strides last ``periods`` frames (:func:`_foot_periods`) step in time with a motion of
+    ``period`` frames: their median within :data:`IN_STEP` of it and every one within :data:`TEMPO_CHANGE` (a
+    stride blended across a take's border may stray); ``None`` when the feet make no stride."""
+    if periods.size == 0:
+        return None
+    off = np.abs(periods / period - 1.0)
+    return bool(abs(float(np.median(periods)) / period - 1.0) <= IN_STEP and np.all(off <= TEMPO_CHANGE))
 
 
 def _gap_parts(gap: _Gap) -> list[Activity]:
     """:func:`_other` of a stretch between gait parts, in the take's frames."""
-    out = _other(gap.motion, 0, gap.motion.n_frames, gap.min_periods, gap.gait_near, gap.options)
+    out = _other(gap.motion, 0, gap.motion.n_frames, gap.min_periods, gap.gait_near, gap.options, steps=gap.steps)
     for q in out:
         q.start, q.stop = q.start + gap.offset, q.stop + gap.offset
     return out
 
 
 def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near: bool, options: dict,
-           when: str = "") -> list[Activity]:
+           when: str = "", steps: np.ndarray | None = None) -> list[Activity]:
     """Frames ``start .. stop-1`` without gait: an arms part, a periodic part, a gesture, standing or a short
     transition between gait parts.  What lies before and after a repeating region is looked at again the same
     way (a wave, then a dance step), so that every repeating motion without gait is a part of its own.
-    ``when``: ``"before"``/``"after"`` for the frames beside a repeating region."""
+    ``when``: ``"before"``/``"after"`` for the frames beside a repeating region.
+
+    ``steps``: the landings in ``motion`` (rows (frame, foot)).  Where the feet land in the frames, they are
+    evidence of their own: a motion whose feet land a period apart (:func:`_in_step`: a gait whose chain of
+    landings broke, a landing missed) repeats as surely as a gait, with ``min_periods`` cycles; one whose feet
+    land at another pace than its period is no one motion (a walk slowing into a run) and is a transition."""
     n = stop - start
     if n < MIN_OTHER_S * motion.fps:
         if when:
@@ -1034,7 +1081,8 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
     if float(np.sort(spread)[-min(3, spread.size)]) < STILL_DEG:  # fewer than three joints move
         return [Activity(start=start, stop=stop, kind="standing", limbs="none",
                          reason="the actor stands: nothing moves enough to loop")]
-    found = _periodic_in(piece, spread, min_periods, options)
+    stepping = _foot_periods(steps, start, stop, motion.fps).size > 0
+    found = _periodic_in(piece, spread, min_periods, options, stepping)
     if found is not None:  # what repeats must move: noise while the actor stands still after a gesture does not
         a, b = found[3]
         if float(_rotation_spread(piece[a:b]).max()) < STILL_DEG:
@@ -1046,12 +1094,20 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
     limbs, kind, pm, (s, e) = found
     out = []
     if s > 0:
-        out.extend(_other(motion, start, start + s, min_periods, gait_near, options, "before"))
-    out.append(Activity(start=start + s, stop=start + e, kind=kind, limbs=limbs, period_frames=pm.period_frames,
-                        loop=True, periodic=pm, legs_still=still,
-                        reason=f"{kind}: {(e - s) / pm.period_frames:.1f} periods of {pm.period_frames:.1f} frames"))
+        out.extend(_other(motion, start, start + s, min_periods, gait_near, options, "before", steps))
+    feet = _foot_periods(steps, start + s, start + e, motion.fps) if kind == "periodic" else np.zeros(0)
+    in_step = _in_step(feet, pm.period_frames)
+    why = f"{kind}: {(e - s) / pm.period_frames:.1f} periods of {pm.period_frames:.1f} frames"
+    if in_step is False:
+        out.append(Activity(start=start + s, stop=start + e, kind="transition", limbs="none", legs_still=still,
+                            reason=f"the feet land {', '.join(f'{d:.0f}' for d in feet)} frames apart where the body "
+                                   f"repeats every {pm.period_frames:.1f}: the gait changes here, no one motion"))
+    else:
+        out.append(Activity(start=start + s, stop=start + e, kind=kind, limbs=limbs, period_frames=pm.period_frames,
+                            loop=True, periodic=pm, legs_still=still, in_step=bool(in_step),
+                            reason=why + (", the feet landing a period apart" if in_step else "")))
     if e < n:
-        out.extend(_other(motion, start + e, stop, min_periods, gait_near, options, "after"))
+        out.extend(_other(motion, start + e, stop, min_periods, gait_near, options, "after", steps))
     return out
 
 
@@ -1124,12 +1180,13 @@ def _true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
 
 
-def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float, options: dict):
+def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float, options: dict, stepping: bool = False):
     """``(limbs, kind, PeriodicMotion, (start, stop))`` of the motion repeating in ``piece`` (frames of the
     piece; the PeriodicMotion is on those frames): the arm joints that move and the whole body, the arms first
     where the legs stand (a wave), the body first where they move (a dance step; the arms then, for a wave
     among other movements), or the joints of ``options["joints"]``; ``None`` when nothing repeats.
-    ``options``: :func:`~mocycle.phase.find_phase`'s, and ``step``."""
+    ``options``: :func:`~mocycle.phase.find_phase`'s, and ``step``.  ``stepping``: the feet land in the piece,
+    so a region of ``min_periods`` is looked at (the landings then say whether it repeats, :func:`_other`)."""
     options = dict(options)
     step = int(options.pop("step", 1) or 1)
     chosen = options.pop("joints", None)
@@ -1139,7 +1196,7 @@ def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float, options:
         moving = _moving_arm_joints(piece.skeleton, spread)
         arms = [(moving, "arms")] if moving else []
         tries = arms + [(None, "periodic")] if _legs_still(piece.skeleton, spread) else [(None, "periodic")] + arms
-    least = max(min_periods, MIN_REPEATS)
+    least = min_periods if stepping else max(min_periods, MIN_REPEATS)
     for joints, kind in tries:
         region = _repeating_region(piece, joints, least)
         if region is None:
