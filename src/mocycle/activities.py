@@ -42,7 +42,7 @@ from . import _validate
 from .axes import vertical_axis
 from .contacts import body_height, find_feet, up_axis
 from .contacts.detect import heights_and_speeds, local_floor
-from .contacts.feet import chain_joints, chain_positions
+from .contacts.legs import chain_joints, chain_positions
 from .defaults import MIN_PERIODS
 from .errors import MocycleError, NoPeriodicMotion
 from .features import HeadingFrame, pose_matrix
