@@ -148,7 +148,7 @@ def trust_inputs(data: Path, quick: bool) -> list[Path]:
 
 def gait_period(motion) -> float:
     """The legs' own period (frames): windowed circular autocorrelation of the legs' rotations, lags >= 0.25 s."""
-    X, _ = pose_matrix(motion, rep="quatlog", root="drop", joints="legs")
+    X, _ = pose_matrix(motion, rep="quatlog", root_features="drop", joints="legs")
     if X.shape[0] < 8:
         return float("nan")
     return autocorrelation_period(X, min_lag=max(2, int(round(0.25 / motion.frame_time))))

@@ -3,7 +3,7 @@
     python benchmarks/phase.py [--quick] [--data DIR]
 
 Every tool gets the same prepared point cloud: ``pose_matrix(motion,
-rep="expmap", root="velocity", normalize=True, weights="bone")`` projected on
+rep="expmap", root_features="velocity", normalize=True, weights="bone")`` projected on
 8 principal components.  Inputs: seeded synthetic walks of 300, 600, 1200 and
 2400 frames (1 degree of angle noise) with their true phase, and the walks and
 runs of ../shared/data (bandai dataset-1 walk/run takes, 30 fps; cmu-iclone
@@ -76,7 +76,7 @@ def prepare(motion) -> np.ndarray:
 
     from mocycle.features import pose_matrix
 
-    X, _ = pose_matrix(motion, rep="expmap", root="velocity", normalize=True, weights="bone")
+    X, _ = pose_matrix(motion, rep="expmap", root_features="velocity", normalize=True, weights="bone")
     return PCA(n_components=min(PCA_DIMS, *X.shape), svd_solver="full").fit_transform(X)
 
 

@@ -25,7 +25,7 @@ Figures, each as result / input:
 * jump: the largest frame-to-frame step (signals: |x[t+1] - x[t]|; takes: the largest angle between
   consecutive local rotations of any joint).  Goal: at most 1.5 (concatenation fails this at the joins).
 
-Takes are measured on their rotation curves (``pose_matrix(rep="quatlog", root="drop")``).  Rows for a set
+Takes are measured on their rotation curves (``pose_matrix(rep="quatlog", root_features="drop")``).  Rows for a set
 of takes give the median and, in brackets, the worst value; ``ok`` counts the takes meeting all three goals.
 """
 
@@ -155,7 +155,7 @@ def load_take(path: Path):
 def curves(motion) -> np.ndarray:
     from mocycle.features import pose_matrix
 
-    X, _ = pose_matrix(motion, rep="quatlog", root="drop")
+    X, _ = pose_matrix(motion, rep="quatlog", root_features="drop")
     return X
 
 

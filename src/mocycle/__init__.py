@@ -4,7 +4,7 @@ The public surface most users need::
 
     import mocycle
     motion = mocycle.read("walk.bvh")          # BVH, or ASF+AMC via mocycle.io.read_asfamc
-    X, decoder = mocycle.pose_matrix(motion, rep="expmap", root="velocity")
+    X, decoder = mocycle.pose_matrix(motion, rep="expmap", root_features="velocity")
     mocycle.write(decoder.decode(X), "copy.bvh")
 """
 

@@ -84,3 +84,18 @@ def real(name: str, value, low: float | None = None, high: float | None = None, 
 def positive(name: str, value) -> float:
     """A finite number > 0."""
     return real(name, value, 0, low_open=True)
+
+
+def renamed(old: str, new: str, old_value, new_value, default=None, *, stacklevel: int = 3):
+    """The value of a keyword argument renamed from ``old`` to ``new``: ``old_value`` (given under the old name,
+    with a ``DeprecationWarning``; for one release) unless ``new_value`` is given too (not ``default``), then
+    an OptionError; else ``new_value``."""
+    if old_value is None:
+        return new_value
+    if new_value is not default:
+        raise OptionError(old, f"is the old name of {new}; give {new} only")
+    import warnings
+
+    warnings.warn(f"{old} is now called {new}; {old} is accepted until the next release", DeprecationWarning,
+                  stacklevel=stacklevel)
+    return old_value

@@ -42,7 +42,7 @@ from . import _validate
 from .axes import vertical_axis
 from .contacts import body_height, find_feet, up_axis
 from .contacts.detect import heights_and_speeds, local_floor
-from .contacts.feet import chain_joints, chain_positions
+from .contacts.legs import chain_joints, chain_positions
 from .defaults import MIN_PERIODS
 from .errors import MocycleError, NoPeriodicMotion
 from .features import HeadingFrame, pose_matrix
@@ -584,7 +584,7 @@ def one_cycle(motion: Motion) -> int | None:
     T = motion.n_frames
     if T < 8:
         return None
-    X, _ = pose_matrix(motion, rep="expmap", root="drop", joints=None, normalize=False, weights=None)
+    X, _ = pose_matrix(motion, rep="expmap", root_features="drop", joints=None, normalize=False, weights=None)
     if not float(np.degrees(np.sqrt(X.var(axis=0).sum()))) >= STILL_DEG:
         return None  # nothing moves
     steps = np.linalg.norm(np.diff(X, axis=0), axis=1)
@@ -818,7 +818,7 @@ def _leg_features(motion: Motion, start: int, stop: int) -> np.ndarray | None:
     """The legs' rotation vectors ``(stop - start, D)`` (no root, not normalised), ``None`` without legs."""
 
     try:
-        X, _ = pose_matrix(motion[start:stop], rep="expmap", root="drop", joints="legs", normalize=False,
+        X, _ = pose_matrix(motion[start:stop], rep="expmap", root_features="drop", joints="legs", normalize=False,
                            weights=None)
     except MocycleError:
         return None
@@ -1149,7 +1149,7 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
     local speed among those frames: a big gesture beside a small wave does not hide it), their longest run.
     ``None`` when it holds fewer than ``least`` periods."""
 
-    X, _ = pose_matrix(piece, rep="expmap", root="drop", joints=joints, normalize=False, weights=None)
+    X, _ = pose_matrix(piece, rep="expmap", root_features="drop", joints=joints, normalize=False, weights=None)
     V = np.diff(X, axis=0)
     min_lag = max(2, int(round(MIN_REPEAT_S * piece.fps)))
     if V.shape[0] < 2 * min_lag + 2:

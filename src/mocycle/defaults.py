@@ -40,5 +40,5 @@ ROOT_MODES = ("inplace", "motion")
 #: phase to time; :mod:`mocycle.cycle.timeaxis`.
 TIME_AXES = ("smooth", "rank", "gmm", "line")
 #: what a task that writes motion does with the feet (lock them on the floor, keep them as made, or lock when
-#: the root moves and feet are found); :mod:`mocycle.tasks.feet`.
+#: the root moves and feet are found); :mod:`mocycle.tasks.feet_option`.
 FEET_MODES = ("auto", "lock", "keep")

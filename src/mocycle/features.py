@@ -13,7 +13,8 @@ Representations of the joint rotations (``rep``):
 ``rotmat``    the 9 entries of the rotation matrix (decoding projects back to
               the nearest rotation)
 
-Root translation (``root``): ``keep`` (positions), ``velocity`` (first
+Root translation (``root_features``; not a loop's ``root``, which says whether the written loop travels):
+``keep`` (positions), ``velocity`` (first
 differences per frame; row 0 repeats row 1), ``heading`` or ``drop``.
 ``heading`` is paper 001 §4.1 in full: root position *and orientation* as
 first differences, so nothing depends on where the actor faces.  The root's
@@ -56,7 +57,8 @@ from .rotations import (
 )
 
 REPS = ("euler", "expmap", "quatlog", "rotmat")
-ROOTS = ("keep", "velocity", "heading", "drop")
+ROOT_FEATURES = ("keep", "velocity", "heading", "drop")
+ROOTS = ROOT_FEATURES  # the old name
 #: frames decoded at a time by :meth:`PoseDecoder.decode_arrays` (its temporaries stay a block's size)
 DECODE_BLOCK = 8192
 _AXES = ("x", "y", "z")
@@ -70,19 +72,19 @@ class PoseDecoder:
     ----------
     template : the motion that was encoded; joints that are not features
         (unselected joints, non-root translations, a dropped root) come from it.
-    rep, root : the representation and root handling used.
+    rep, root_features : the representation and root handling used.
     joints : indices of the joints whose rotations are columns.
     columns : a name per column, e.g. ``"LeftUpLeg:rx"``, ``"root:vz"``.
     dof_joint : ``(D,)`` joint index per column (root translation columns: 0).
     mean, scale : ``(D,)``: ``X = (raw - mean) / scale``.
     reference : ``(J, 4)`` reference quaternions of the ``quatlog`` rep.
     travel : the joint whose translation the root columns hold.
-    frame : with ``root="heading"``, the :class:`HeadingFrame` used.
+    frame : with ``root_features="heading"``, the :class:`HeadingFrame` used.
     """
 
     template: Motion
     rep: str
-    root: str
+    root_features: str
     joints: tuple[int, ...]
     columns: tuple[str, ...]
     dof_joint: np.ndarray
@@ -100,7 +102,7 @@ class PoseDecoder:
         """The pose matrix of another motion with the same skeleton, same transform."""
         if not motion.skeleton.same_as(self.template.skeleton):
             raise MocycleError("cannot encode a motion whose skeleton differs from the template's")
-        raw = _raw_features(motion, self.rep, self.root, self.joints, self.reference, self.travel, self.frame)
+        raw = _raw_features(motion, self.rep, self.root_features, self.joints, self.reference, self.travel, self.frame)
         return (raw - self.mean) / self.scale
 
     def decode(self, X: np.ndarray, frame_time: float | None = None) -> Motion:
@@ -146,8 +148,8 @@ class PoseDecoder:
             tracks = {}
         col = 0
         skel = tpl.skeleton
-        if self.root == "heading":  # the travel joint's columns hold its tilt: start from the template's
-            assert self.frame is not None  # pose_matrix gives root="heading" its frame
+        if self.root_features == "heading":  # the travel joint's columns hold its tilt: start from the template's
+            assert self.frame is not None  # pose_matrix gives root_features="heading" its frame
             tilt = self.frame.tilt(tpl)[0]
             quats[:, self.travel] = tilt if same_length else Rotation.from_quat(tilt).mean().as_quat()
         if self.rep == "euler":
@@ -172,13 +174,13 @@ class PoseDecoder:
                     quats[rows, js] = matrix_quats(nearest_rotations(block.reshape(-1, n, 3, 3)))
             col += width * n
         start = tpl.joint_translations(self.travel)[0]
-        if self.root == "keep" and translations:
+        if self.root_features == "keep" and translations:
             tracks[self.travel] = raw(col, col + 3)
-        elif self.root == "velocity" and translations:
+        elif self.root_features == "velocity" and translations:
             v = raw(col, col + 3)
             tracks[self.travel] = start + np.concatenate([np.zeros((1, 3)), np.cumsum(v[1:], axis=0)])
-        elif self.root == "heading":
-            assert self.frame is not None  # pose_matrix gives root="heading" its frame
+        elif self.root_features == "heading":
+            assert self.frame is not None  # pose_matrix gives root_features="heading" its frame
             _, psi = self.frame.tilt(tpl[:1])
             psi = psi[0] + np.concatenate([[0.0], np.cumsum(raw(col + 3, col + 4, slice(1, None))[:, 0])])
             quats[:, self.travel] = self.frame.turn(quats[:, self.travel], psi)
@@ -190,7 +192,7 @@ class PoseDecoder:
 
 @dataclass(frozen=True, eq=False)
 class HeadingFrame:
-    """The travel joint's heading about the vertical and the frame it defines (``root="heading"``).
+    """The travel joint's heading about the vertical and the frame it defines (``root_features="heading"``).
 
     ``up``: the vertical axis ``(3,)`` in the travel joint's parent frame; ``e1``, ``e2``: a horizontal
     basis there; ``forward``: the vector in the travel joint's own frame whose horizontal direction is the
@@ -291,15 +293,15 @@ def column_sums_of_squares(X: np.ndarray) -> np.ndarray:
     return sums
 
 
-def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
+def _raw_features(motion: Motion, rep: str, root_features: str, joints: tuple[int, ...],
                   reference: np.ndarray, travel: int, frame: HeadingFrame | None = None) -> np.ndarray:
     T = motion.n_frames
     js = list(joints)
     parts = []
     out = None  # the feature matrix, when a part is written straight into it
     tilt = None
-    if root == "heading":
-        assert frame is not None  # pose_matrix gives root="heading" its frame
+    if root_features == "heading":
+        assert frame is not None  # pose_matrix gives root_features="heading" its frame
         tilt, psi = frame.tilt(motion)
 
     def rotations(group: list[int]) -> np.ndarray:
@@ -315,7 +317,7 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
     elif rep == "expmap":
         if js == list(range(motion.n_joints)):  # every joint: no (T, J, 4) copy; each joint's curve is its own
             # written straight into the feature matrix: no (T, 3J) part joined to the root's afterwards
-            out = np.empty((T, len(_columns(motion, rep, root, joints)[0])))
+            out = np.empty((T, len(_columns(motion, rep, root_features, joints)[0])))
             v = continuous_rotvec(motion.rotations, out=out[:, :3 * len(js)].reshape(T, len(js), 3))
             if tilt is not None:
                 v[:, travel] = continuous_rotvec(tilt[:, None])[:, 0]
@@ -328,13 +330,13 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
         parts.append(0.5 * continuous_rotvec(rel).reshape(T, -1))
     else:
         parts.append(Rotation.from_quat(rotations(js).reshape(-1, 4)).as_matrix().reshape(T, -1))
-    if root == "keep":
+    if root_features == "keep":
         parts.append(motion.joint_translations(travel))
-    elif root == "velocity":
+    elif root_features == "velocity":
         p = motion.joint_translations(travel)
         v = np.diff(p, axis=0) if T > 1 else np.zeros((1, 3))
         parts.append(np.concatenate([v[:1], v]) if T > 1 else v)
-    elif root == "heading":
+    elif root_features == "heading":
         assert frame is not None  # as above
         if T > 1:
             mid = 0.5 * (psi[1:] + psi[:-1])
@@ -354,7 +356,7 @@ def _raw_features(motion: Motion, rep: str, root: str, joints: tuple[int, ...],
     return np.concatenate(parts, axis=1) if parts else np.zeros((T, 0))
 
 
-def _columns(motion: Motion, rep: str, root: str, joints) -> tuple[list[str], list[int]]:
+def _columns(motion: Motion, rep: str, root_features: str, joints) -> tuple[list[str], list[int]]:
     skel = motion.skeleton
     names: list[str] = []
     owner: list[int] = []
@@ -369,11 +371,11 @@ def _columns(motion: Motion, rep: str, root: str, joints) -> tuple[list[str], li
         for j in joints:
             names += [f"{skel.names[j]}:{lab}" for lab in labels]
             owner += [j] * len(labels)
-    if root == "heading":  # velocity in the heading frame, heading rate
+    if root_features == "heading":  # velocity in the heading frame, heading rate
         names += [f"root:h{a}" for a in _AXES] + ["root:dheading"]
         owner += [0, 0, 0, 0]
-    elif root != "drop":
-        prefix = "v" if root == "velocity" else ""
+    elif root_features != "drop":
+        prefix = "v" if root_features == "velocity" else ""
         names += [f"root:{prefix}{a}" for a in _AXES]
         owner += [0, 0, 0]
     return names, owner
@@ -411,18 +413,21 @@ def _joint_weights(motion: Motion, weights, joints) -> np.ndarray:
 def pose_matrix(
     motion: Motion,
     rep: str = "expmap",
-    root: str = "velocity",
+    root_features: str = "velocity",
     joints: str | Iterable[str] | None = None,
     weights: str | Mapping[str, float] | np.ndarray | None = None,
     normalize: bool = False,
     reference: Motion | np.ndarray | None = None,
+    *,
+    root: str | None = None,
 ) -> tuple[np.ndarray, PoseDecoder]:
     """The pose matrix X (T×D) of ``motion`` and a decoder back to a Motion.
 
     Parameters
     ----------
     rep : ``"euler"``, ``"expmap"``, ``"quatlog"`` or ``"rotmat"`` (module notes).
-    root : ``"keep"``, ``"velocity"``, ``"heading"`` or ``"drop"`` for the root (module notes).
+    root_features : ``"keep"``, ``"velocity"``, ``"heading"`` or ``"drop"``: how the root enters the features
+        (module notes); ``root`` is its old name, accepted with a DeprecationWarning until the next release.
     joints : joint names, glob patterns or group names (``"legs"``, ``"arms"``,
         ``"spine"``), a comma-separated string or a list; ``None``: every joint
         with rotation channels.
@@ -442,7 +447,7 @@ def pose_matrix(
     >>> import numpy as np
     >>> from mocycle.datasets import synthetic_walk
     >>> walk = synthetic_walk(n_frames=300, fps=60).motion
-    >>> X, decoder = pose_matrix(walk, rep="expmap", root="velocity", joints="legs")
+    >>> X, decoder = pose_matrix(walk, rep="expmap", root_features="velocity", joints="legs")
     >>> X.shape, decoder.columns[:2]
     ((300, 27), ('LeftUpLeg:rx', 'LeftUpLeg:ry'))
     >>> back = decoder.decode(X)                   # the motion again
@@ -450,16 +455,17 @@ def pose_matrix(
     True
     """
     _validate.choice("rep", rep, REPS)
-    _validate.choice("root", root, ROOTS)
+    root_features = _validate.renamed("root", "root_features", root, root_features, "velocity")
+    _validate.choice("root_features", root_features, ROOT_FEATURES)
     if not isinstance(motion, Motion):
         raise MocycleError(f"pose_matrix needs a Motion; got {type(motion).__name__}")
     skel = motion.skeleton
     selected = skel.select(joints)
     chosen = tuple(j for j in selected if skel.euler_order(j))
-    if not chosen and root == "drop":
+    if not chosen and root_features == "drop":
         raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
     travel = motion.travel_joint
-    frame = HeadingFrame.fit(motion) if root == "heading" else None
+    frame = HeadingFrame.fit(motion) if root_features == "heading" else None
     if rep == "quatlog":
         if reference is None:
             ref = mean_rotations(motion.rotations)
@@ -473,8 +479,8 @@ def pose_matrix(
                 raise MocycleError(f"reference must be a Motion or ({skel.n_joints}, 4) quaternions")
     else:
         ref = np.tile([0.0, 0.0, 0.0, 1.0], (skel.n_joints, 1))
-    raw = _raw_features(motion, rep, root, chosen, ref, travel, frame)
-    columns, owner = _columns(motion, rep, root, chosen)
+    raw = _raw_features(motion, rep, root_features, chosen, ref, travel, frame)
+    columns, owner = _columns(motion, rep, root_features, chosen)
     owner_arr = np.asarray(owner, dtype=np.int64)
     D = raw.shape[1]
     mean = np.zeros(D)
@@ -489,7 +495,7 @@ def pose_matrix(
     w = _joint_weights(motion, weights, chosen)
     scale = scale / w[owner_arr]
     X = np.divide(centred, scale, out=centred if normalize else None)
-    decoder = PoseDecoder(template=motion, rep=rep, root=root, joints=chosen, columns=tuple(columns),
+    decoder = PoseDecoder(template=motion, rep=rep, root_features=root_features, joints=chosen, columns=tuple(columns),
                           dof_joint=owner_arr, mean=mean, scale=scale, reference=ref, travel=travel,
                           frame=frame)
     return X, decoder

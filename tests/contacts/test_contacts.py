@@ -155,7 +155,7 @@ def test_skate_on_a_leg_chain_needs_the_body_height():
     """A leg chain's positions (ChainArray) measure the same skate as the whole body's, given the body height;
     without it skate says so (body_height cannot read a chain)."""
     from mocycle.contacts import body_height
-    from mocycle.contacts.feet import chain_joints, chain_positions, leg_joints
+    from mocycle.contacts.legs import chain_joints, chain_positions, leg_joints
 
     walk = synthetic_walk(n_frames=120, fps=60, seed=5).motion
     feet = find_feet(walk.skeleton)

@@ -4,9 +4,9 @@ over: the same motion, to the bit, as with the whole take's transforms in one ar
 import numpy as np
 import pytest
 
-import mocycle.contacts.feet as feet_module
+import mocycle.contacts.legs as legs_module
 from mocycle.contacts import detect_contacts, lock_feet
-from mocycle.contacts.feet import chain_joints, chain_transforms, leg_joints
+from mocycle.contacts.legs import chain_joints, chain_transforms, leg_joints
 from mocycle.datasets import synthetic_walk
 from mocycle.motion import EndSite, Motion, Skeleton
 
@@ -35,7 +35,7 @@ def test_feet_locked_a_block_at_a_time_are_locked_as_in_one_array(monkeypatch, t
     part_whole = lock_feet(m, contacts, frames=slice(40, 250), transforms=chain_transforms(m, chain))
     assert np.abs(whole.rotations - m.rotations).max() > 1e-3  # the lock changes the legs
     assert np.abs(whole.translations - m.translations).max() > 1e-3  # and moves the travel joint
-    monkeypatch.setattr(feet_module, "POSITIONS_BLOCK", 37)  # nine blocks, the last one short
+    monkeypatch.setattr(legs_module, "POSITIONS_BLOCK", 37)  # nine blocks, the last one short
     blocked = lock_feet(m, contacts)
     np.testing.assert_array_equal(blocked.rotations, whole.rotations)
     np.testing.assert_array_equal(blocked.translations, whole.translations)

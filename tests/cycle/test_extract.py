@@ -47,7 +47,7 @@ def test_harmonic_m1_cycle_is_smooth_and_loops(walk):
     assert m["seam_pose"] <= 1.0 and m["seam_velocity"] <= 1.0
     assert m["seam_pose_local"] < 1.5 and m["seam_velocity_local"] < 1.5
     assert m["jerk_ratio"] < 0.3  # noise makes the capture's jerk large; the fitted cycle has little
-    assert cycle.n_harmonics == 20 and cycle.model == "M1"
+    assert cycle.harmonics == 20 and cycle.model == "M1"
 
 
 def test_root_motion_travels_one_stride_per_cycle_and_inplace_stays(walk):

@@ -117,3 +117,24 @@ def test_still_columns_are_their_constant_exactly():
         fine = np.linspace(0, 1, 97)
         assert np.array_equal(both.predict(fine)[:, [1, 3]], np.tile([0.3, -1.7], (97, 1)))
         np.testing.assert_allclose(both.predict(fine)[:, [0, 2]], alone.predict(fine), rtol=1e-12, atol=1e-12)
+
+
+def test_n_harmonics_is_the_old_name_of_harmonics():
+    # K, the number of harmonics, is called harmonics everywhere; the old keyword works for one release
+    import warnings
+
+    from mocycle.errors import OptionError
+
+    x = np.linspace(0, 2, 60, endpoint=False)
+    with pytest.warns(DeprecationWarning, match="n_harmonics is now called harmonics"):
+        old = HarmonicRegression(n_harmonics=5)
+    assert old.harmonics == 5
+    with pytest.warns(DeprecationWarning):
+        assert old.n_harmonics == 5
+    with pytest.warns(DeprecationWarning):
+        assert np.array_equal(harmonic_basis(x, n_harmonics=3), harmonic_basis(x, 3))
+    with pytest.raises(OptionError, match="give harmonics only"):
+        HarmonicRegression(6, n_harmonics=5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert HarmonicRegression(harmonics=4).harmonics == 4

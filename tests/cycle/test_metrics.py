@@ -127,7 +127,7 @@ def test_loop_metrics_has_every_number_the_cli_prints():
 def test_foot_metrics_from_positions_the_caller_has_are_the_same():
     """loop_metrics runs forward kinematics once per motion and hands the positions on: the same numbers as
     each metric computing its own."""
-    from mocycle.contacts.feet import body_height
+    from mocycle.contacts.legs import body_height
     from mocycle.contacts.skate import skate
 
     walk = synthetic_walk(n_frames=240, fps=60, seed=2).motion

@@ -27,7 +27,7 @@ def circ_diff(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def walk_pose(n_frames: int, period_frames: float, fps: float = 60.0, **kw) -> np.ndarray:
     take = synthetic_walk(n_frames, fps=fps, period_s=period_frames / fps, **kw)
-    X, _ = pose_matrix(take.motion, rep="expmap", root="velocity")
+    X, _ = pose_matrix(take.motion, rep="expmap", root_features="velocity")
     return X
 
 

@@ -124,7 +124,7 @@ def test_fundamental_cycles_in_one_fft_are_autocorrelation_period_of_each_column
     from mocycle.phase.period import autocorrelation_period
 
     walk = synthetic_walk(n_frames=[171, 300, 457][seed], fps=60, noise_deg=1.0, seed=seed).motion
-    X, _ = pose_matrix(walk, rep="quatlog", root="drop")
+    X, _ = pose_matrix(walk, rep="quatlog", root_features="drop")
     X = np.concatenate([X, np.random.default_rng(seed).normal(size=(X.shape[0], 3)), np.ones((X.shape[0], 1))], 1)
     X[:, -2] = np.nan  # a column with a NaN has no cycle
     expected = [autocorrelation_period(X[:, d], min_strength=0.3) if np.ptp(X[:, d]) > 0 else np.nan
@@ -189,8 +189,8 @@ def test_stretching_a_walk_that_ends_mid_cycle_keeps_speed_cycle_and_smoothness(
     take = synthetic_walk(290, fps=60, period_s=0.95, noise_deg=0.5, seed=3).motion
     out, report = stretch_motion(take, 2.5)
     assert report.frames_out == 725
-    X, _ = pose_matrix(take, rep="quatlog", root="drop")
-    Y, _ = pose_matrix(out, rep="quatlog", root="drop")
+    X, _ = pose_matrix(take, rep="quatlog", root_features="drop")
+    Y, _ = pose_matrix(out, rep="quatlog", root_features="drop")
     hip = int(np.argmax(X.std(axis=0)))
     assert abs(dominant_frequency(Y[:, hip]) / dominant_frequency(X[:, hip]) - 1) < 0.05
     assert abs(Y[:, hip].std() / X[:, hip].std() - 1) < 0.1
@@ -278,8 +278,8 @@ def test_real_bandai_walk():
     out, report = stretch_motion(take, 2.0)
     assert report.frames_out == 2 * take.n_frames
     assert all(30 <= w <= 35 for w in report.windows.values()), report.windows  # one stride, ~1.07 s at 30 fps
-    X, _ = pose_matrix(take, rep="quatlog", root="drop")
-    Y, _ = pose_matrix(out, rep="quatlog", root="drop")
+    X, _ = pose_matrix(take, rep="quatlog", root_features="drop")
+    Y, _ = pose_matrix(out, rep="quatlog", root_features="drop")
     f_in = dominant_frequency(X[:, np.argmax(X.std(axis=0))])
     f_out = dominant_frequency(Y[:, np.argmax(X.std(axis=0))])
     assert abs(f_out / f_in - 1) < 0.05
@@ -329,8 +329,8 @@ def test_a_standing_start_is_kept_as_captured_and_only_the_walk_is_stretched():
 
     assert standing(out) <= standing(take) + 5       # not a second standing start
     # no pop at the join: the largest frame step is an ordinary one
-    X, _ = pose_matrix(take, rep="quatlog", root="drop")
-    Y, _ = pose_matrix(out, rep="quatlog", root="drop")
+    X, _ = pose_matrix(take, rep="quatlog", root_features="drop")
+    Y, _ = pose_matrix(out, rep="quatlog", root_features="drop")
     assert max_step(Y) <= 1.5 * max_step(X)
     steps = np.linalg.norm(np.diff(out.root_positions, axis=0), axis=1)
     assert steps.max() <= 1.5 * np.linalg.norm(np.diff(take.root_positions, axis=0), axis=1).max()
@@ -344,8 +344,8 @@ def test_a_walk_that_stops_keeps_its_ending_and_walks_further():
     assert s == 0 and e <= ending.n_frames - stand + 30
     # the walk grows by whole strides (60 frames), so that it ends as captured: about 1.5 times the take
     assert abs(out.n_frames - 1.5 * ending.n_frames) <= 30 and (out.n_frames - ending.n_frames) % 60 == 0
-    X, _ = pose_matrix(ending, rep="quatlog", root="drop")
-    Y, _ = pose_matrix(out, rep="quatlog", root="drop")
+    X, _ = pose_matrix(ending, rep="quatlog", root_features="drop")
+    Y, _ = pose_matrix(out, rep="quatlog", root_features="drop")
     assert max_step(Y) <= 1.5 * max_step(X)                                   # no pop where the walk stops
     assert np.abs(Y).max(axis=0).max() <= 1.05 * np.abs(X).max(axis=0).max()  # and no pose it never had
     n_end = ending.n_frames - e

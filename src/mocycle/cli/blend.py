@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_feet, print_json, print_warnings, task_command, timing_line
+from .common import check_output, escape, out, print_closing, print_feet, print_json, print_warnings, task_command
 
 PLOT_HELP = "Write a PNG: the most moving joint curves of the blend and of the inputs' cycles, phase-aligned."
 
@@ -67,9 +67,7 @@ def blend(
     print_feet(facts["feet"])
     out.print(f"wrote {escape(output)}: {facts['frames_out']} frames ({options.cycles} cycle(s), root "
               f"{options.root})", soft_wrap=True)
-    if plot is not None:
-        out.print(f"wrote {escape(plot)}", soft_wrap=True)
-    out.print(timing_line(report))
+    print_closing(report, plot)
 
 
 @task_command("transition")
@@ -111,6 +109,4 @@ def transition(
               f"largest velocity change {sm['velocity_local']:.3g} × (inputs {sm['input_velocity_local']:.3g})")
     print_feet(facts["feet"])
     out.print(f"wrote {escape(output)}: {facts['frames']} frames (root {options.root})", soft_wrap=True)
-    if plot is not None:
-        out.print(f"wrote {escape(plot)}", soft_wrap=True)
-    out.print(timing_line(report))
+    print_closing(report, plot)

@@ -392,10 +392,14 @@ def _listed(value) -> list:
     return [] if value is None else list(value) if isinstance(value, (list, tuple)) else [value]
 
 
-def timing_line(report) -> str:
-    """``time 2.42 s`` (with the labelled parts when there are several)."""
+def print_closing(report, *written: object) -> None:
+    """A command's last lines: ``wrote X`` for each file it wrote besides its outputs (its plots; ``None``, one
+    not asked for, is passed over), then ``time 2.42 s`` (with the labelled parts when there are several)."""
+    for thing in written:
+        if thing is not None:
+            out.print(f"wrote {escape(thing)}", soft_wrap=True)
     parts = [f"{k} {v:.2f} s" for k, v in report.timings_s.items() if k != "total"]
-    return f"  time {report.seconds:.2f} s" + (f" ({', '.join(parts)})" if parts else "")
+    out.print(f"  time {report.seconds:.2f} s" + (f" ({', '.join(parts)})" if parts else ""))
 
 
 def print_json(facts: Mapping, indent: int | None = 2) -> None:

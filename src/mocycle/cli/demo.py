@@ -54,7 +54,7 @@ def demo(
     walk_file = write(report.motions["loop"], out_dir / "walk_cycle_x4.bvh")
     plot = plot_loop(motion, cycle, out_dir / "walk_cycle.png", title="mocycle demo: synthetic walk")
     out.print(f"  found {cycle.n_periods:.2f} periods of {cycle.period_frames:.2f} frames; cycle of "
-              f"{cycle.n_frames} frames by harmonic regression M1, K = {cycle.n_harmonics}")
+              f"{cycle.n_frames} frames by harmonic regression M1, K = {cycle.harmonics}")
     for key in ("template_error", "jerk_ratio", "seam_pose", "seam_velocity", "foot_sliding",
                 "input_foot_sliding"):
         label, unit = METRIC_LABELS[key]

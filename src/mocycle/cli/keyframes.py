@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_feet, print_json, print_warnings, task_command, timing_line
+from .common import check_output, escape, out, print_closing, print_feet, print_json, print_warnings, task_command
 
 
 @task_command("compress")
@@ -101,6 +101,4 @@ def project(
     out.print(f"  stress (eq. 4.1): {r['stress']:.4g}" + (
         f", optimised {r['stress_optimized']:.4g}" if "stress_optimized" in r else ""))
     out.print(f"  keyframes: {', '.join(map(str, r['keyframes']))}", soft_wrap=True)
-    if plot is not None:
-        out.print(f"wrote {escape(plot)}", soft_wrap=True)
-    out.print(timing_line(report))
+    print_closing(report, plot)

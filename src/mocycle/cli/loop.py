@@ -17,11 +17,11 @@ from .common import (
     check_output,
     escape,
     out,
+    print_closing,
     print_feet,
     print_json,
     print_warnings,
     task_command,
-    timing_line,
 )
 
 
@@ -100,7 +100,7 @@ def loop(
         _print_loop(facts)
         for image in images:
             out.print(f"wrote {escape(image)}", soft_wrap=True)
-    out.print(timing_line(report))
+    print_closing(report)
 
 
 def _extra(report: Report, role: str) -> dict:

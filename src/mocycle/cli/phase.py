@@ -14,10 +14,10 @@ from .common import (
     err,
     escape,
     out,
+    print_closing,
     print_json,
     print_warnings,
     task_command,
-    timing_line,
 )
 
 
@@ -75,4 +75,4 @@ def _print_phase(path: Path, report) -> None:
     for c in facts["classes"]:
         out.print(f"  part {c['part']} period: {escape(c['period_reason'])}", soft_wrap=True)
     out.print(f"  why: {escape(facts['reason'])}", soft_wrap=True)
-    out.print(timing_line(report))
+    print_closing(report)

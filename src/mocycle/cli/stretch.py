@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_feet, print_json, print_warnings, task_command, timing_line
+from .common import check_output, escape, out, print_closing, print_feet, print_json, print_warnings, task_command
 
 
 @task_command("stretch")
@@ -67,6 +67,4 @@ def stretch(
     print_feet(r["feet"])
     if r["trend_curves"]:
         out.print(f"  warped as line + residual: {escape(', '.join(r['trend_curves']))}", soft_wrap=True)
-    if plot is not None:
-        out.print(f"wrote {escape(plot)}", soft_wrap=True)
-    out.print(timing_line(report))
+    print_closing(report, plot)

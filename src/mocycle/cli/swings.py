@@ -8,15 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import (
-    check_output,
-    escape,
-    out,
-    print_json,
-    print_warnings,
-    task_command,
-    timing_line,
-)
+from .common import check_output, escape, out, print_closing, print_json, print_warnings, task_command
 
 _FACT_KEYS = ("joints", "n_swings", "segmentation_error", "per_angle_error_deg", "geodesic_error_deg",
               "compressed_bytes", "raw_float32_bytes")
@@ -75,9 +67,7 @@ def swings(
     out.print(f"  compressed {r['compressed_bytes']} bytes = {r['ratio_raw']:.3f} of the raw float32 "
               f"channels ({r['raw_float32_bytes']} bytes)"
               + (f", {r['ratio_bvh']:.3f} of the BVH text" if r["ratio_bvh"] else ""))
-    for line in written:
-        out.print(f"wrote {escape(line)}", soft_wrap=True)
-    out.print(timing_line(report))
+    print_closing(report, *written)
 
 
 @task_command("search")
@@ -102,7 +92,7 @@ def search(
         table.add_row(str(hit["rank"]), f"{hit['score']:.3f}", f"{hit['offset_s']:+.2f}",
                       escape(Path(hit["path"]).name))
     out.print(table)
-    out.print(timing_line(report))
+    print_closing(report)
 
 
 @task_command("edit")

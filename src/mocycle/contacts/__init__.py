@@ -5,7 +5,7 @@ nothing here knows of cycles.
 """
 
 from .detect import Contacts, detect_contacts, ranges
-from .feet import Foot, body_height, find_feet, up_axis
+from .legs import Foot, body_height, find_feet, up_axis
 from .lock import lock_feet
 from .plant import floor_height, foot_points, plant_lowest_foot
 from .skate import largest_leg_step, skate

@@ -24,7 +24,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..motion import Motion
-from .feet import Foot, body_height, find_feet, up_axis
+from .legs import Foot, body_height, find_feet, up_axis
 
 SWING_SPEED = 0.5       # body heights/s: a foot moving faster than this (and not planted) is swinging
 SWING_QUANTILE = 0.25   # the clearance: this quantile of a swinging foot's height above its floor
@@ -40,7 +40,7 @@ def swing_clearance(motion: Motion | Sequence[Motion], feet: Sequence[Foot] | st
     several takes, e.g. the two takes of a blend, the mean of theirs).  0 for a joint that hardly swings.
     ``up``, ``body``: the vertical and the body height (file units) when the caller has them (the same rig's)."""
     from .detect import heights_and_speeds, local_floor
-    from .feet import chain_joints, chain_positions
+    from .legs import chain_joints, chain_positions
 
     if not isinstance(motion, Motion):
         return np.mean([swing_clearance(m, feet, up=up, body=body, quantile=quantile) for m in motion], axis=0)

@@ -45,7 +45,7 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion
-from .feet import ChainArray, Foot, body_height, chain_joints, chain_positions, find_feet, up_axis
+from .legs import ChainArray, Foot, body_height, chain_joints, chain_positions, find_feet, up_axis
 from .smooth import gaussian, minimum
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
@@ -221,7 +221,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
     over ``TRAVEL_SECONDS``), ``rise``: body heights per second (vertical); ``release``: hysteresis factor (> 1);
     ``min_contact``, ``min_gap``: seconds; ``relax``: a foot with no contact at all is looked at again with
     the rules for a rolling stance (:func:`_relaxed`); ``positions``: world positions ``(T, J, 3)`` of at
-    least the feet's chains and the travel joint (:func:`~mocycle.contacts.feet.chain_transforms`), when the
+    least the feet's chains and the travel joint (:func:`~mocycle.contacts.legs.chain_transforms`), when the
     caller has them.
     """
     if not (height > 0 and speed > 0 and rise > 0 and release >= 1 and min_contact >= 0 and min_gap >= 0

@@ -61,7 +61,7 @@ from ..motion import Motion
 from ..rotations import axis_rotations
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
-from .feet import ChainArray, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
+from .legs import ChainArray, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
 from .smooth import maximum, uniform
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact

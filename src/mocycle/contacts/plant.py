@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion, chain_kinematics_blocks
-from .feet import find_feet, up_axis
+from .legs import find_feet, up_axis
 
 
 def foot_points(motion: Motion, foot_joints: str | None = None) -> np.ndarray:

@@ -16,7 +16,7 @@ from typing import Literal, overload
 import numpy as np
 
 from ..motion import Motion
-from .feet import ChainArray, Foot, body_height, find_feet, leg_joints, up_axis
+from .legs import ChainArray, Foot, body_height, find_feet, leg_joints, up_axis
 
 SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual absolute H
 
@@ -45,7 +45,7 @@ def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: f
     """The skate measure of the module docstring (units/s); ``per_joint=True``: a dict joint name -> value.
     ``positions``: ``motion.world_positions(end_sites=True)`` when the caller has it (saves recomputing); with
     ``body``, the body height in file units (e.g. ``Contacts.body`` of the same rig), any world positions
-    ``[frames, joints]`` holding the contact joints (a leg chain's, :func:`~mocycle.contacts.feet.chain_transforms`)."""
+    ``[frames, joints]`` holding the contact joints (a leg chain's, :func:`~mocycle.contacts.legs.chain_transforms`)."""
     if feet is None or isinstance(feet, str):
         feet = find_feet(motion.skeleton, feet)
     up = up_axis(motion) if up is None else np.asarray(up, dtype=np.float64)

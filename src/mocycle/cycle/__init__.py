@@ -5,7 +5,7 @@ from .blend import BlendedCycle, Transition, blend_cycles, transition
 from .centroid import centroid_cycle
 from .cut import cut_cycle
 from .extract import METHODS, cycle_phase, extract_cycle
-from .feet import lock_cycle
+from .foot_lock import lock_cycle
 from .harmonic import MODELS, HarmonicRegression, harmonic_basis
 from .harmonic_fit import harmonic_cycle
 from .metrics import loop_metrics

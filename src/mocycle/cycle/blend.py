@@ -465,7 +465,7 @@ def blend_cycles(takes: Sequence[Motion | Cycle], weights=None, *, align: bool =
     drift = w @ np.stack([loop.drift for loop in loops])
     L = drifting_L(space.up, L, drift)               # the Cycle convention: L carries its drift
     axis = TimeAxis(x=grid.copy(), regions=((0, N),), period_frames=period, method="blend")
-    cycle = Cycle(space=space, P=P, L=L, drift=drift, method="blend", model=None, n_harmonics=None, axis=axis,
+    cycle = Cycle(space=space, P=P, L=L, drift=drift, method="blend", model=None, harmonics=None, axis=axis,
                   positions=np.arange(N, dtype=np.float64), periodic=None)
     start = calmest_start(*loop_blocks(cycle)) if roll else 0
     cycle = cycle.rolled(start)

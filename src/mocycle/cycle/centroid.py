@@ -53,5 +53,5 @@ def centroid_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAx
     Pn = _circular_resample(P[frames][nearest].mean(axis=1), N, shift=-0.5)
     Ln = _circular_resample(flat[nearest].mean(axis=1), N, shift=-0.5) + np.outer(np.arange(N) / N, drift)
     positions = np.mod((cdf(phi) * n_samples - 0.5) * N / n_samples, N)
-    return Cycle(space=space, P=Pn, L=Ln, drift=drift, method="centroid", model=None, n_harmonics=None, axis=axis,
+    return Cycle(space=space, P=Pn, L=Ln, drift=drift, method="centroid", model=None, harmonics=None, axis=axis,
                  positions=positions, periodic=periodic)

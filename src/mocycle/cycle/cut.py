@@ -59,7 +59,7 @@ def cut_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, p
         Lc[k] = (1 - t) * L[a + k] + t * (L[src] + drift)
     x = axis.x[axis.frames()]
     positions = np.mod(x - axis.x[a], 1.0) * period
-    return Cycle(space=space, P=Pc, L=Lc, drift=drift, method="cut", model=None, n_harmonics=None, axis=axis,
+    return Cycle(space=space, P=Pc, L=Lc, drift=drift, method="cut", model=None, harmonics=None, axis=axis,
                  positions=positions, periodic=periodic)
 
 
@@ -76,4 +76,4 @@ def clip_cycle(space: CycleSpace, P: np.ndarray, L: np.ndarray, axis: TimeAxis, 
     x = axis.x[axis.frames()]
     positions = np.mod(x - axis.x[0], 1.0) * N
     return Cycle(space=space, P=P[:N].copy(), L=L[:N].copy(), drift=drift, method="clip", model=None,
-                 n_harmonics=None, axis=axis, positions=positions, periodic=periodic)
+                 harmonics=None, axis=axis, positions=positions, periodic=periodic)

@@ -85,7 +85,7 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", h
     >>> from mocycle.datasets import synthetic_walk
     >>> walk = synthetic_walk(n_frames=300, fps=60, period_s=1.0).motion
     >>> cycle = extract_cycle(walk, method="harmonic", model="M1")
-    >>> cycle.n_frames, cycle.n_harmonics
+    >>> cycle.n_frames, cycle.harmonics
     (60, 20)
     >>> cycle.motion("inplace").n_frames, cycle.repeat(3, root="motion").n_frames
     (60, 180)

@@ -34,29 +34,34 @@ _SOLVE_BLOCK = 64
 WEIGHT_LIMIT = 1e8  # alpha, gamma are clipped here: a DOF whose derivatives fit perfectly stays solvable
 
 
-def harmonic_basis(x: np.ndarray, n_harmonics: int, derivative: int = 0, linear: bool = False) -> np.ndarray:
+def harmonic_basis(x: np.ndarray, harmonics: int | None = None, derivative: int = 0, linear: bool = False, *,
+                   n_harmonics: int | None = None) -> np.ndarray:
     """Design matrix ``(M, 2K+1[+1])`` of the model or of its 1st/2nd derivative in ``x`` (periods).
 
-    Columns: ``1, sin(2 pi x), cos(2 pi x), ..., sin(2 pi K x), cos(2 pi K x)[, x]``.
+    Columns: ``1, sin(2 pi x), cos(2 pi x), ..., sin(2 pi K x), cos(2 pi K x)[, x]``; K, the number of
+    harmonics, is ``harmonics`` (``n_harmonics`` is its old name, accepted with a DeprecationWarning).
     """
+    harmonics = _validate.renamed("n_harmonics", "harmonics", n_harmonics, harmonics)
+    if harmonics is None:
+        raise TypeError("harmonic_basis() needs harmonics")
     x = np.asarray(x, dtype=np.float64).reshape(-1)
-    w = 2.0 * np.pi * np.arange(1, n_harmonics + 1)
+    w = 2.0 * np.pi * np.arange(1, harmonics + 1)
     arg = np.outer(x, w)
     s, c = np.sin(arg), np.cos(arg)
-    cols = np.empty((x.size, 2 * n_harmonics + 1 + int(linear)))
+    cols = np.empty((x.size, 2 * harmonics + 1 + int(linear)))
     if derivative == 0:
         cols[:, 0] = 1.0
-        cols[:, 1:2 * n_harmonics + 1:2], cols[:, 2:2 * n_harmonics + 1:2] = s, c
+        cols[:, 1:2 * harmonics + 1:2], cols[:, 2:2 * harmonics + 1:2] = s, c
         if linear:
             cols[:, -1] = x
     elif derivative == 1:
         cols[:, 0] = 0.0
-        cols[:, 1:2 * n_harmonics + 1:2], cols[:, 2:2 * n_harmonics + 1:2] = w * c, -w * s
+        cols[:, 1:2 * harmonics + 1:2], cols[:, 2:2 * harmonics + 1:2] = w * c, -w * s
         if linear:
             cols[:, -1] = 1.0
     elif derivative == 2:
         cols[:, 0] = 0.0
-        cols[:, 1:2 * n_harmonics + 1:2], cols[:, 2:2 * n_harmonics + 1:2] = -w ** 2 * s, -w ** 2 * c
+        cols[:, 1:2 * harmonics + 1:2], cols[:, 2:2 * harmonics + 1:2] = -w ** 2 * s, -w ** 2 * c
         if linear:
             cols[:, -1] = 0.0
     else:
@@ -142,7 +147,8 @@ class HarmonicRegression:
 
     Parameters
     ----------
-    n_harmonics : K (the thesis used 20: :data:`mocycle.defaults.HARMONICS`).
+    harmonics : K, the number of harmonics (the thesis used 20: :data:`mocycle.defaults.HARMONICS`);
+        ``n_harmonics`` is its old name, accepted with a DeprecationWarning until the next release.
     model : ``"M1"`` (FGLS-weighted, default), ``"M2"`` (positions only) or ``"M3"`` (unweighted).
     linear : add the linear term ``l_j x`` (eq. 3.27) for curves that drift (root translation, heading).
 
@@ -154,14 +160,24 @@ class HarmonicRegression:
     ``sqrt(alpha)``, ``sqrt(gamma)``).
     """
 
-    def __init__(self, n_harmonics: int = defaults.HARMONICS, model: str = "M1", linear: bool = False):
-        self.n_harmonics = n_harmonics
+    def __init__(self, harmonics: int = defaults.HARMONICS, model: str = "M1", linear: bool = False, *,
+                 n_harmonics: int | None = None):
+        self.harmonics = _validate.renamed("n_harmonics", "harmonics", n_harmonics, harmonics, defaults.HARMONICS)
         self.model = model
         self.linear = linear
 
+    @property
+    def n_harmonics(self) -> int:
+        """The old name of :attr:`harmonics` (K, the number of harmonics): a DeprecationWarning, for one release."""
+        import warnings
+
+        warnings.warn("n_harmonics is now called harmonics; n_harmonics is accepted until the next release",
+                      DeprecationWarning, stacklevel=2)
+        return self.harmonics
+
     def _check(self, x, Y, xd, dY, ddY):
         _validate.choice("model", self.model, MODELS)
-        K = _validate.integer("n_harmonics", self.n_harmonics, 1)
+        K = _validate.integer("harmonics", self.harmonics, 1)
         x = np.asarray(x, dtype=np.float64).reshape(-1)
         Y = np.asarray(Y, dtype=np.float64)
         Y = Y[:, None] if Y.ndim == 1 else Y
@@ -191,7 +207,7 @@ class HarmonicRegression:
         x, Y, xd, dY, ddY = self._check(x, Y, xd, dY, ddY)
         if self.model == "M1":
             return self.fit_blocks(_array_blocks(x, Y), _array_blocks(xd, dY, ddY))
-        P = harmonic_basis(x, self.n_harmonics, 0, self.linear)
+        P = harmonic_basis(x, self.harmonics, 0, self.linear)
         still = np.all(Y == Y[:1], axis=0)
         if still.any():
             self._fit_moving(~still, P, xd, Y, dY, ddY)
@@ -215,7 +231,7 @@ class HarmonicRegression:
             if derivatives is None:
                 return self.fit(x, Y)
             return self.fit(x, Y, *(np.concatenate(part) for part in zip(*derivatives(), strict=True)))
-        K = _validate.integer("n_harmonics", self.n_harmonics, 1)
+        K = _validate.integer("harmonics", self.harmonics, 1)
         if derivatives is None:
             raise MocycleError(f"model {self.model} needs velocities and accelerations (xd, dY, ddY)")
         lin, p = self.linear, 2 * K + 1 + int(self.linear)
@@ -263,7 +279,7 @@ class HarmonicRegression:
         """Column sums of squared residuals ``(D,)`` over ``blocks()``: of the positions' design (``(x, Y)``
         blocks, ``coef``) or, with ``coef2``, of the velocities' and the accelerations' (``(xd, dY, ddY)``
         blocks; two sums).  ``cols``/``cols2``: only these columns of the design (and rows of ``coef``)."""
-        K, lin = self.n_harmonics, self.linear
+        K, lin = self.harmonics, self.linear
         first, second = 0.0, 0.0
         for block in blocks():
             x = block[0]
@@ -280,7 +296,7 @@ class HarmonicRegression:
 
     def _fit_all(self, P, xd, Y, dY, ddY) -> None:
         """``coef_``, ``alpha_``, ``gamma_``, ``sigma2_`` of every column of ``Y`` (design ``P`` of the positions)."""
-        K, lin, D = self.n_harmonics, self.linear, Y.shape[1]
+        K, lin, D = self.harmonics, self.linear, Y.shape[1]
         if self.model == "M2":
             self.coef_ = np.linalg.lstsq(P, Y, rcond=None)[0]
             self.alpha_, self.gamma_ = np.zeros(D), np.zeros(D)
@@ -297,11 +313,11 @@ class HarmonicRegression:
         :meth:`predict` gives ``c`` exactly), with the weights a still curve gets (``alpha_``, ``gamma_``
         0, or 1 for M3) and no error."""
         D = Y.shape[1]
-        sub = HarmonicRegression(self.n_harmonics, self.model, self.linear)
+        sub = HarmonicRegression(self.harmonics, self.model, self.linear)
         if moving.any():
             sub._fit_all(P, xd, Y[:, moving], None if dY is None else dY[:, moving],
                          None if ddY is None else ddY[:, moving])
-        p = 2 * self.n_harmonics + 1 + int(self.linear)
+        p = 2 * self.harmonics + 1 + int(self.linear)
         self.coef_ = np.zeros((p, D))
         self.coef_[0] = Y[0]
         still_weight = 1.0 if self.model == "M3" else 0.0
@@ -315,7 +331,7 @@ class HarmonicRegression:
     def _fit_fgls(self, positions, derivatives, pos: _DesignSums, vel: _DesignSums, acc: _DesignSums) -> None:
         """M1: group variances from separate OLS fits (eq. 3.11-3.13), then WLS (eq. 3.19), all DOFs at once,
         from the designs' sums of pass 1 and the OLS residuals of pass 2."""
-        K = self.n_harmonics
+        K = self.harmonics
         (cp, bp), (cv, bv), (ca, ba) = pos.least_squares(), vel.least_squares(), acc.least_squares()
         sp = self._sq_sums(positions, bp, cols=cp)
         sv, sa = self._sq_sums(derivatives, bv, ba, cols=cv, cols2=ca)
@@ -344,7 +360,7 @@ class HarmonicRegression:
         rp = np.sqrt(_column_sq_sums(P, self.coef_, Y).sum() / Y.shape[0])
         if xd is None or dY is None:
             return np.array([rp, np.nan, np.nan])
-        K, lin = self.n_harmonics, self.linear
+        K, lin = self.harmonics, self.linear
         a = np.sqrt(self.alpha_ if self.model != "M2" else np.ones_like(self.alpha_))
         g = np.sqrt(self.gamma_ if self.model != "M2" else np.ones_like(self.gamma_))
         rv = np.sqrt((a**2 * _column_sq_sums(harmonic_basis(xd, K, 1, lin), self.coef_, dY)).sum() / dY.shape[0])
@@ -358,7 +374,7 @@ class HarmonicRegression:
         """
         if not hasattr(self, "coef_"):
             raise MocycleError("fit the regression before predicting")
-        B = harmonic_basis(x, self.n_harmonics, derivative, self.linear)
+        B = harmonic_basis(x, self.harmonics, derivative, self.linear)
         coef = self.coef_
         if self.linear and not drift:
             coef = coef.copy()

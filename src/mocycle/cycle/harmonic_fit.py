@@ -92,31 +92,33 @@ def _rows(Y: np.ndarray, axis: TimeAxis, frames: np.ndarray) -> np.ndarray:
     return Y[frames]
 
 
-def _harmonics(n_harmonics, n_rows: int, cycle_frames: int) -> int:
+def _harmonics(harmonics, n_rows: int, cycle_frames: int) -> int:
     limit = max_harmonics(n_rows, cycle_frames)
-    if n_harmonics in (None, "auto"):
+    if harmonics in (None, "auto"):
         if limit < 1:
             raise MocycleError(f"too few frames for a harmonic fit: {n_rows} frames, {cycle_frames} per cycle")
         return min(DEFAULT_HARMONICS, limit)
-    n_harmonics = _validate.integer("n_harmonics", n_harmonics, 1)
-    if n_harmonics > limit:
-        raise MocycleError(f"K = {n_harmonics} harmonics is too many for {n_rows} frames with {cycle_frames} "
+    harmonics = _validate.integer("harmonics", harmonics, 1)
+    if harmonics > limit:
+        raise MocycleError(f"K = {harmonics} harmonics is too many for {n_rows} frames with {cycle_frames} "
                            f"frames per cycle: K must be <= {limit} (2K+1 <= frames and K < frames per cycle / 2)")
-    return int(n_harmonics)
+    return int(harmonics)
 
 
 def harmonic_cycle(space: CycleSpace, P: np.ndarray | EncodedRows, L: np.ndarray, axis: TimeAxis,
-                   periodic: PeriodicMotion, model: str = "M1", n_harmonics: int | str = "auto", *,
-                   calmest: bool = False) -> Cycle:
+                   periodic: PeriodicMotion, model: str = "M1", harmonics: int | str = "auto", *,
+                   calmest: bool = False, n_harmonics: int | str | None = None) -> Cycle:
     """Fit ``P`` periodically and ``L`` with a linear term on ``axis``, sample one period at ``N`` frames.
 
     With ``calmest`` the cycle starts at its calmest point, chosen to a tenth of a frame; without, at phase 0
-    of the axis.
+    of the axis.  ``harmonics``: K, the number of harmonics, or ``"auto"`` (``n_harmonics`` is its old name,
+    accepted with a DeprecationWarning until the next release).
     """
+    harmonics = _validate.renamed("n_harmonics", "harmonics", n_harmonics, harmonics, "auto")
     _check_choice(model, MODELS, "model")
     frames = axis.frames()
     N = int(round(axis.period_frames))
-    K = _harmonics(n_harmonics, frames.size, N)
+    K = _harmonics(harmonics, frames.size, N)
     x = axis.x[frames]
     if model != "M2" and sum(e - s - 2 * HALF for s, e in _derivative_regions(axis)) < max(2 * K, 1):
         raise MocycleError(f"model {model} needs velocities on at least {2 * K} frames (K = {K}); the excited "
@@ -149,7 +151,7 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray | EncodedRows, L: np.ndarray
     if calmest:  # start at the calmest step, between frames too
         fine = x0 + np.arange(SUBFRAMES * N) / (SUBFRAMES * N)
         trial = Cycle(space=space, P=fit_p.predict(fine), L=path(fine), drift=drift,
-                      method="harmonic", model=model, n_harmonics=K, axis=axis, positions=np.zeros(0),
+                      method="harmonic", model=model, harmonics=K, axis=axis, positions=np.zeros(0),
                       periodic=periodic)
         start = calmest_start(*loop_blocks(trial), stride=SUBFRAMES)
         x0 += start / (SUBFRAMES * N)
@@ -160,24 +162,27 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray | EncodedRows, L: np.ndarray
     else:
         P, projected = fit_p.predict(x0 + np.arange(N) / N), None
     xs = x0 + np.arange(N) / N
-    return Cycle(space=space, P=P, L=path(xs), drift=drift, method="harmonic", model=model, n_harmonics=K,
+    return Cycle(space=space, P=P, L=path(xs), drift=drift, method="harmonic", model=model, harmonics=K,
                  axis=axis, positions=np.mod(x - x0, 1.0) * N, periodic=periodic, regression=fit_p,
                  projected=projected)
 
 
-def short_drift(L: np.ndarray, axis: TimeAxis, n_harmonics: int = DRIFT_HARMONICS) -> np.ndarray:
+def short_drift(L: np.ndarray, axis: TimeAxis, harmonics: int = DRIFT_HARMONICS, *,
+                n_harmonics: int | None = None) -> np.ndarray:
     """``(D,)`` change per period of the curves ``L (T, D)`` along ``axis`` on a part of few periods: their
     change between the ends of the longest region over the periods between, once the stride's sway (a line
-    and ``n_harmonics`` harmonics fitted by least squares; only the harmonics are taken out) is removed.
+    and ``harmonics`` harmonics fitted by least squares; only the harmonics are taken out) is removed
+    (``n_harmonics``: the old name of ``harmonics``, accepted with a DeprecationWarning until the next release).
 
     With the cycle's full set of harmonics beside it, a linear term on 1-3 periods trades off against them
     (a turn that speeds up and slows down came out 40 % too fast); a line through a turn that starts and
     ends gently is steeper than the turn made over the part; the bare ends carry the sway of the stride.
     So: the ends (a tenth of a period each), less the sway."""
+    harmonics = _validate.renamed("n_harmonics", "harmonics", n_harmonics, harmonics, DRIFT_HARMONICS)
     s, e = max(axis.regions, key=lambda r: r[1] - r[0])
     x = axis.x[s:e]
     Y = np.asarray(L[s:e], dtype=np.float64)
-    waves = [f(2 * np.pi * k * x) for k in range(1, n_harmonics + 1) for f in (np.cos, np.sin)]
+    waves = [f(2 * np.pi * k * x) for k in range(1, harmonics + 1) for f in (np.cos, np.sin)]
     B = np.column_stack([np.ones_like(x), x, *waves])
     if B.shape[0] > B.shape[1]:
         coef, *_ = np.linalg.lstsq(B, Y, rcond=None)

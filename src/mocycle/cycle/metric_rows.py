@@ -28,11 +28,11 @@ def metric_features(motion: Motion, *, rows: slice = slice(None)) -> np.ndarray:
     the same wrap-free space the cycle is regressed in (:class:`~mocycle.cycle.representation.CycleSpace`),
     and no reference pose moves a distance in it.  ``rows``: only these frames (a slice), without copying
     the motion.  Computed block by block of frames: the same numbers as
-    ``pose_matrix(motion, rep="rotmat", root="drop")[0] / √2``.
+    ``pose_matrix(motion, rep="rotmat", root_features="drop")[0] / √2``.
     """
     joints = _rotation_joints(motion.skeleton)
     if not joints:
-        return pose_matrix(motion, rep="rotmat", root="drop")[0]  # raises: no features
+        return pose_matrix(motion, rep="rotmat", root_features="drop")[0]  # raises: no features
     quats = motion.rotations[rows]
     T = quats.shape[0]
     out = np.empty((T, 9 * len(joints)))

@@ -51,7 +51,7 @@ class Cycle:
     drift: np.ndarray
     method: str
     model: str | None
-    n_harmonics: int | None
+    harmonics: int | None
     axis: TimeAxis
     positions: np.ndarray
     periodic: PeriodicMotion | None  # None: a blend of cycles (no one take's phase)
@@ -109,6 +109,15 @@ class Cycle:
     @property
     def n_frames(self) -> int:
         return self.P.shape[0]
+
+    @property
+    def n_harmonics(self) -> int | None:
+        """The old name of :attr:`harmonics` (K, the number of harmonics): a DeprecationWarning, for one release."""
+        import warnings
+
+        warnings.warn("n_harmonics is now called harmonics; n_harmonics is accepted until the next release",
+                      DeprecationWarning, stacklevel=2)
+        return self.harmonics
 
     def rotation_matrices(self, count: int = 1) -> np.ndarray:
         """``space.project(P)`` ``(N, J, 3, 3)`` (read-only), made once, repeated ``count`` times (a new array):
@@ -225,7 +234,7 @@ class Cycle:
             "n_periods": self.n_periods,
             "method": self.method,
             "model": self.model,
-            "harmonics": self.n_harmonics,
+            "harmonics": self.harmonics,
             "time_axis": self.axis.method,
             "travel_per_cycle": self.drift[:3].tolist(),
             "turn_per_cycle_deg": float(np.degrees(self.drift[3])),

@@ -3,7 +3,7 @@
 ``find_phase(motion)`` is what ``mocycle phase`` and the cycle extraction call:
 
 1. prepare the input (paper 001 §4.1, §5.1; KTH thesis §3.8, ch. 4): root
-   position and heading as first differences (``root="heading"``: nothing
+   position and heading as first differences (``root_features="heading"``: nothing
    depends on where the actor faces), optional joint subset, per-DOF
    normalisation, bone-length weights, PCA to a few dimensions, optional
    delay embedding;
@@ -66,20 +66,23 @@ MIN_PERIODS = defaults.MIN_PERIODS
 
 
 def phase_features(motion: Motion, *, joints: str | Iterable[str] | None = None, pca: int | str | None = "auto",
-                   delay: int = 0, rep: str = "expmap", root: str = "heading", normalize: bool = True,
-                   weights: str | None = "bone") -> np.ndarray:
+                   delay: int = 0, rep: str = "expmap", root_features: str = "heading", normalize: bool = True,
+                   weights: str | None = "bone", root: str | None = None) -> np.ndarray:
     """The point cloud for circular coordinates: ``(T - delay, D)``.
 
     Defaults: rotation vectors, the root's tilt, its velocity in its heading frame and its heading rate
-    (:func:`~mocycle.features.pose_matrix` ``root="heading"``; the heading rate at half weight), z-scored and
+    (:func:`~mocycle.features.pose_matrix` ``root_features="heading"``; the heading rate at half weight), z-scored
+    and
     weighted by
     bone length, projected on the first 8 principal components (``pca="auto"``;
     ``None`` or ``0`` keeps every dimension), no delay embedding here
     (``find_phase`` uses ``delay=2``, as the KTH thesis did: on the shared
     takes it finds 41 of 43 walks and runs against 35 without).
     """
-    X, decoder = pose_matrix(motion, rep=rep, root=root, joints=joints, weights=weights, normalize=normalize)
-    if root == "heading":  # one angle whose first difference doubles the capture noise: half weight
+    root_features = _validate.renamed("root", "root_features", root, root_features, "heading")
+    X, decoder = pose_matrix(motion, rep=rep, root_features=root_features, joints=joints, weights=weights,
+                             normalize=normalize)
+    if root_features == "heading":  # one angle whose first difference doubles the capture noise: half weight
         X[:, decoder.columns.index("root:dheading")] *= HEADING_RATE_WEIGHT
     # Constant columns (joints that never move) carry no phase, and LAPACK's SVD
     # takes seconds instead of milliseconds on exactly constant columns.
@@ -426,12 +429,13 @@ def _subsets(motion: Motion, joints) -> list[tuple[str | Iterable[str] | None, s
 def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Iterable[str] | None = None,
                pca: int | str | None = "auto", delay: int = 2, n_landmarks: int = 120,
                scale: str | float = "auto", min_periods: float = MIN_PERIODS, rep: str = "expmap",
-               root: str = "heading", normalize: bool = True, weights: str | None = "bone",
-               keep_features: bool = False) -> PhaseResult:
+               root_features: str = "heading", normalize: bool = True, weights: str | None = "bone",
+               keep_features: bool = False, root: str | None = None) -> PhaseResult:
     """Periodic motions of ``motion`` with their phase per frame and their periods.
 
     ``classes``: ``"auto"`` or how many; ``joints`` (``None``: the whole body, then legs, then arms until
-    one shows a periodic motion), ``pca``, ``delay``, ``rep``, ``root``, ``normalize`` and ``weights``
+    one shows a periodic motion), ``pca``, ``delay``, ``rep``, ``root_features`` (``root`` its old name,
+    accepted with a DeprecationWarning until the next release), ``normalize`` and ``weights``
     shape the input (:func:`phase_features`); ``n_landmarks``, ``scale`` and ``min_periods`` (how often a
     coordinate must wind over the take to count, >= 1) go to :class:`~.cohomology.CohomologyFit`;
     ``keep_features`` keeps the point cloud in ``result.features`` (for plots; off by default so results
@@ -460,6 +464,7 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
     if not isinstance(motion, Motion):
         raise MocycleError(f"find_phase needs a Motion; got {type(motion).__name__}")
     min_periods = _validate.real("min_periods", min_periods, 1.0)  # periods over the take
+    root_features = _validate.renamed("root", "root_features", root, root_features, "heading")
     if motion.n_frames < MIN_FRAMES + delay:
         # valid input, too short to hold a repeat: the same outcome as no periodic motion (CLI exit 3)
         raise NoPeriodicMotion(f"no periodic motion found: finding a phase needs at least {MIN_FRAMES + delay} "
@@ -471,7 +476,8 @@ def find_phase(motion: Motion, *, classes: int | str = "auto", joints: str | Ite
     legs = legs_period(motion, curves) if legs_ids.size else float("nan")
     tries, kept = [], None
     for subset, label in _subsets(motion, joints):
-        X = phase_features(motion, joints=subset, pca=pca, delay=delay, rep=rep, root=root, normalize=normalize,
+        X = phase_features(motion, joints=subset, pca=pca, delay=delay, rep=rep, root_features=root_features,
+                           normalize=normalize,
                            weights=weights)
         try:
             estimator = CohomologyFit(n_landmarks=n_landmarks, scale=scale, n_classes=classes,

@@ -37,6 +37,7 @@ import time
 import traceback
 import weakref
 from dataclasses import dataclass
+from http import HTTPStatus
 from pathlib import Path
 
 import numpy as np
@@ -155,13 +156,13 @@ class Studio:
     def take(self, take_id: str) -> Take:
         take = self.takes.get(v.path_id("take", take_id))
         if take is None:
-            raise v.NotFound(f"no take {take_id}")
+            raise v.HTTPProblem(f"no take {take_id}", HTTPStatus.NOT_FOUND)
         return take
 
     def job(self, job_id: str):
         v.path_id("job", job_id)
         job = self.interactive.get(job_id) or self.analysis.get(job_id)
-        return job if job is not None else self.interactive.find(job_id)  # Gone or NotFound
+        return job if job is not None else self.interactive.find(job_id)  # GONE or NOT_FOUND
 
     def stroke_of(self, stroke_id: str) -> dict:
         v.path_id("stroke", stroke_id)
@@ -169,9 +170,10 @@ class Studio:
         if s is not None:
             return s
         if self.strokes.was_evicted(stroke_id):
-            raise v.Gone(f"stroke {stroke_id} is gone: only the last {self.limits.max_strokes} authored "
-                         "animations are kept (and as many as fit the studio's memory budget); draw it again")
-        raise v.NotFound(f"no stroke {stroke_id}")
+            raise v.HTTPProblem(f"stroke {stroke_id} is gone: only the last {self.limits.max_strokes} authored "
+                                "animations are kept (and as many as fit the studio's memory budget); draw it again",
+                                HTTPStatus.GONE)
+        raise v.HTTPProblem(f"no stroke {stroke_id}", HTTPStatus.NOT_FOUND)
 
     def motion_bytes(self, take: Take) -> bytes:
         """The take's payload, made once (while it stays among the last few asked for)."""
@@ -400,14 +402,15 @@ async def _body(request: Request) -> dict:
     try:  # the Guard cut it off past the body limit (413)
         raw = await asyncio.wait_for(request.body(), BODY_TIMEOUT_S)
     except TimeoutError:
-        raise v.TimedOut(f"the request body did not arrive within {BODY_TIMEOUT_S:g} s") from None
+        raise v.HTTPProblem(f"the request body did not arrive within {BODY_TIMEOUT_S:g} s",
+                            HTTPStatus.REQUEST_TIMEOUT) from None
     return v.parse_body(raw)
 
 
 def _suffix(request) -> str:
     suffix = "." + request.path_params["suffix"]
     if suffix not in DOWNLOADS:
-        raise v.NotFound(f"no {suffix[:20]} download (only {', '.join(DOWNLOADS)})")
+        raise v.HTTPProblem(f"no {suffix[:20]} download (only {', '.join(DOWNLOADS)})", HTTPStatus.NOT_FOUND)
     return suffix
 
 

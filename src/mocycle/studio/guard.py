@@ -24,12 +24,13 @@ from __future__ import annotations
 import hmac
 import ipaddress
 import secrets
+from http import HTTPStatus
 from http.cookies import SimpleCookie
 
 from starlette.datastructures import MutableHeaders, QueryParams
 from starlette.responses import JSONResponse
 
-from .validate import TooLarge
+from .validate import HTTPProblem
 
 #: largest request body, bytes (a 10-minute stroke at 120 Hz is about 3 MB of JSON)
 MAX_BODY = 8 << 20
@@ -198,12 +199,13 @@ class Guard:
             if message["type"] == "http.request":
                 received += len(message.get("body", b""))
                 if received > access.max_body:
-                    raise TooLarge(f"the request body is more than {access.max_body} bytes")
+                    raise HTTPProblem(f"the request body is more than {access.max_body} bytes",
+                                      HTTPStatus.REQUEST_ENTITY_TOO_LARGE)
             return message
 
         try:
             await self.app(scope, receive_limited, send_guarded)
-        except TooLarge as exc:
+        except HTTPProblem as exc:
             if started:
                 raise
-            await JSONResponse({"error": str(exc)}, status_code=413)(scope, receive, send_guarded)
+            await JSONResponse({"error": str(exc)}, status_code=exc.status)(scope, receive, send_guarded)

@@ -15,12 +15,13 @@ import threading
 import traceback
 from collections import OrderedDict
 from dataclasses import dataclass, field
+from http import HTTPStatus
 
 import numpy as np
 
 from ..errors import LoopRefused, MocycleError
 from ..tasks import words
-from .validate import Busy, Gone, NotFound
+from .validate import HTTPProblem
 
 #: jobs held before they are reached, cancelled ones included: at most this many times ``max_pending``
 LIVE_FACTOR = 4
@@ -73,7 +74,7 @@ def release_memory() -> None:
 
 class Held:
     """Items by id, least recently used first out past ``max_items`` or ``max_bytes`` (each item's size given
-    when stored); ``get`` of an evicted id raises :class:`Gone`, of an unknown id :class:`NotFound`."""
+    when stored); ``get`` of an evicted id raises :class:`HTTPProblem` ``GONE``, of an unknown id ``NOT_FOUND``."""
 
     def __init__(self, kind: str, max_items: int, max_bytes: int):
         self.kind, self.max_items, self.max_bytes = kind, max_items, max_bytes
@@ -179,11 +180,12 @@ class Jobs:
         with self._lock:
             waiting = sum(not j.cancelled() for j in self._live.values())  # a cancelled one ends when reached
             if self.max_pending is not None and waiting >= self.max_pending:
-                raise Busy(f"{waiting} jobs are waiting or running; at most {self.max_pending} "
-                           "(wait for one to finish or cancel it)")
+                raise HTTPProblem(f"{waiting} jobs are waiting or running; at most {self.max_pending} "
+                                  "(wait for one to finish or cancel it)", HTTPStatus.TOO_MANY_REQUESTS)
             if self.max_pending is not None and len(self._live) >= LIVE_FACTOR * self.max_pending:
                 # cancelled jobs wait to be reached too: bounded all the same (submit and cancel in a loop)
-                raise Busy(f"{len(self._live)} jobs, some cancelled, are waiting to be reached; try again shortly")
+                raise HTTPProblem(f"{len(self._live)} jobs, some cancelled, are waiting to be reached; try again "
+                                  "shortly", HTTPStatus.TOO_MANY_REQUESTS)
             job = Job(id=f"{self._prefix}{next(self._ids)}", kind=kind)
             self._live[job.id] = job
         self._queue.put((job, fn))
@@ -231,14 +233,14 @@ class Jobs:
         return job if job is not None else self.finished.peek(job_id)
 
     def find(self, job_id: str) -> Job:
-        """The job, or :class:`Gone` (finished and evicted) or :class:`NotFound`."""
+        """The job, or :class:`HTTPProblem` ``GONE`` (finished and evicted) or ``NOT_FOUND``."""
         job = self.get(job_id)
         if job is not None:
             return job
         if self.finished.was_evicted(job_id):
-            raise Gone(f"job {job_id} is gone: only the last {self.finished.max_items} finished jobs are kept "
-                       "(and as many as fit the studio's memory budget); run it again")
-        raise NotFound(f"no job {job_id}")
+            raise HTTPProblem(f"job {job_id} is gone: only the last {self.finished.max_items} finished jobs are "
+                              "kept (and as many as fit the studio's memory budget); run it again", HTTPStatus.GONE)
+        raise HTTPProblem(f"no job {job_id}", HTTPStatus.NOT_FOUND)
 
     def held(self) -> int:
         """How many jobs are kept (queued, running and finished)."""

@@ -97,9 +97,12 @@ class Take:
         if self.status == "refused":
             raise MocycleError(f"{self.name}: {self.error}")
         if not self._lock.acquire(timeout=READ_WAIT_S):
-            from .validate import Unavailable
+            from http import HTTPStatus
 
-            raise Unavailable(f"{self.name} is still being read; try again in a moment")
+            from .validate import HTTPProblem
+
+            raise HTTPProblem(f"{self.name} is still being read; try again in a moment",
+                              HTTPStatus.SERVICE_UNAVAILABLE)
         try:
             if self._motion is None:
                 if self._failed is not None:

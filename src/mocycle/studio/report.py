@@ -32,6 +32,14 @@ MARK = {"payload": "\x00payload\x00", "take": "\x00take\x00", "loop": "\x00loop\
 CORE_IMPORT = '"./three.core.min.js"'  # three.module.min.js imports the core by a relative path
 
 
+def _player_markup() -> str:
+    """The studio page's player (viewer, transport, phase strip), as ``static/index.html`` writes it: one
+    markup for both pages, which ``player.js`` and ``report.js`` find by the same ids."""
+    page = (STATIC / "index.html").read_text(encoding="utf-8")
+    start, end = page.index("<!-- player:"), page.index("<!-- /player -->")
+    return page[page.index("\n", start) + 1:end].rstrip()
+
+
 def _module_text(name: str) -> str:
     text = (STATIC / MODULES[name]).read_text(encoding="utf-8")
     if name == "three":
@@ -106,13 +114,7 @@ main {{ grid-template-columns: minmax(420px, 1fr) 360px; }}
 <header><h1>mocycle report</h1><span>{html.escape(title)}</span><span id="status"></span></header>
 <main>
   <section>
-    <div id="viewer" data-testid="viewer"></div>
-    <div class="transport">
-      <button id="play" type="button" data-testid="play">▶</button>
-      <input id="scrub" type="range" min="0" max="0" value="0" step="1" data-testid="scrub">
-      <span id="frame"></span>
-    </div>
-    <canvas id="phase" data-testid="phase"></canvas>
+{_player_markup()}
     <form><label>view <select id="layout"><option value="side">side by side</option>
       <option value="overlay">overlaid</option><option value="take">take only</option>
       <option value="loop">loop only</option></select></label>

@@ -3,9 +3,8 @@
 
 Every check here is explicit (no schema library): a body is parsed with a bounded depth, numbers must be
 JSON numbers (``true`` is not ``1``, ``1e9`` is not a keyframe), booleans JSON booleans, lists have bounded
-lengths, keyframes lie within the take.  The HTTP errors the handlers raise are here too, each with its
-status: :class:`BadRequest` 400, :class:`NotFound` 404, :class:`TimedOut` 408, :class:`Gone` 410,
-:class:`TooLarge` 413, :class:`Busy` 429, :class:`Unavailable` 503.
+lengths, keyframes lie within the take.  The HTTP error the handlers raise is here too: :class:`HTTPProblem`
+with its status, and :class:`BadRequest` (400) for the checks.
 """
 
 from __future__ import annotations
@@ -13,43 +12,25 @@ from __future__ import annotations
 import json
 import math
 import re
+from http import HTTPStatus
 
 from ..errors import MocycleError
 from ..tasks.spec import SPECS
 
 
 class HTTPProblem(MocycleError):
-    """A request the studio answers with ``status`` and the message (JSON ``{"error": message}``)."""
+    """A request the studio answers with ``status`` and the message (JSON ``{"error": message}``): one class,
+    the status named by :class:`http.HTTPStatus` where it is raised (``NOT_FOUND``: no such take, job, stroke
+    or download; ``REQUEST_TIMEOUT``: a body too slow; ``GONE``: evicted; ``REQUEST_ENTITY_TOO_LARGE``;
+    ``TOO_MANY_REQUESTS``: too many jobs; ``SERVICE_UNAVAILABLE``: a take still being read)."""
 
-    status = 400
+    def __init__(self, message: str, status: HTTPStatus = HTTPStatus.BAD_REQUEST):
+        super().__init__(message)
+        self.status = int(status)
 
 
 class BadRequest(HTTPProblem):
-    status = 400
-
-
-class NotFound(HTTPProblem):
-    status = 404
-
-
-class TimedOut(HTTPProblem):
-    status = 408
-
-
-class Gone(HTTPProblem):
-    status = 410
-
-
-class TooLarge(HTTPProblem):
-    status = 413
-
-
-class Busy(HTTPProblem):
-    status = 429
-
-
-class Unavailable(HTTPProblem):
-    status = 503
+    """400: the request itself is wrong (what every check here raises)."""
 
 
 #: most keyframes a request may name; most samples a stroke may have (a 10-minute stroke at 120 Hz is 72,000)
@@ -113,7 +94,7 @@ def parse_body(raw: bytes) -> dict:
 def path_id(kind: str, value: str) -> str:
     """A take, job or stroke id from the URL (``t3``, ``j12``, ``s4``), else 404."""
     if not _ID[kind].fullmatch(value):
-        raise NotFound(f"no {kind} {value[:40]!r}")
+        raise HTTPProblem(f"no {kind} {value[:40]!r}", HTTPStatus.NOT_FOUND)
     return value
 
 

@@ -64,7 +64,7 @@ def run(inputs, options: Options | None = None) -> Report:
     rate; ``facts["trajectory"]`` the stroke resampled per frame."""
     from ..contacts import floor_height, plant_lowest_foot
     from ..keyframes import author_motion, resample_stroke
-    from .feet import lock_motion, travels
+    from .feet_option import lock_motion, travels
 
     o = options or Options()
     take, stroke = inputs

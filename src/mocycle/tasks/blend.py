@@ -56,7 +56,7 @@ def run(takes: Sequence, options: Options | None = None) -> Report:
     ``motions["loop"]`` is it repeated ``cycles`` times. Raises NoPeriodicMotion when a take has no cycle and
     LoopRefused when a take's cycle fails a loop check (``force``: a warning instead)."""
     from ..cycle.blend import blend_cycles, check_weights, cycle_seam
-    from .feet import clean_feet
+    from .feet_option import clean_feet
 
     o = options or Options()
     takes = list(takes)

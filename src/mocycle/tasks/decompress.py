@@ -28,7 +28,7 @@ def run(source, options: Options | None = None) -> Report:
     """The take rebuilt (``motions["motion"]``); with ``feet="keep"`` (default) the keyframes come back exactly,
     with ``feet="lock"`` its feet are locked (``facts["keyframes_exact"]`` is then False)."""
     from ..keyframes import read_compressed
-    from .feet import lock_motion
+    from .feet_option import lock_motion
 
     options = options or Options()
     with Recorder() as rec:

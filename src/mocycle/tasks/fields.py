@@ -131,13 +131,13 @@ def take_cycles(motions, labels, options) -> list:
 
 
 def feet(help: str | None = None):
-    from .feet import FEET_HELP, FEET_MODES
+    from .feet_option import FEET_HELP, FEET_MODES
 
     return option("auto", help or FEET_HELP, Choice(FEET_MODES))
 
 
 def foot_joints():
-    from .feet import FOOT_JOINTS_HELP
+    from .feet_option import FOOT_JOINTS_HELP
 
     return option(None, FOOT_JOINTS_HELP, Text())
 

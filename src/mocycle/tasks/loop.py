@@ -374,7 +374,7 @@ def _loop_one(piece, o, label, timer):
     """A part's loop (:func:`~mocycle.cycle.parts.loop_piece`), its feet and its facts (frames of the range).
     Returns ``(facts, repeated cycle, extras, cycle)``; raises LoopRefused and MocycleError."""
     from ..cycle.parts import loop_piece
-    from .feet import clean_feet
+    from .feet_option import clean_feet
 
     looped = loop_piece(piece, method=o.method, model=o.model, harmonics=o.harmonics, time_axis=o.time_axis,
                         force=o.force, label=label, timer=timer)

@@ -44,7 +44,7 @@ def run(take, options: Options) -> Report:
     (:func:`_repeated_clip`)."""
     from ..activities import one_cycle
     from ..warp import stretch_motion
-    from .feet import lock_motion, travels
+    from .feet_option import lock_motion, travels
 
     with Recorder() as rec:
         motion = load(take, options.amc_fps, options.take)

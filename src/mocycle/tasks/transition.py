@@ -29,7 +29,7 @@ class Options(fields.CycleOptions):
 def run(takes: Sequence, options: Options | None = None) -> Report:
     """A motion that starts as the first take's cycle and ends as the second's (``motions["transition"]``)."""
     from ..cycle.blend import transition, transition_smoothness
-    from .feet import lock_motion
+    from .feet_option import lock_motion
 
     o = options or Options()
     takes = list(takes)

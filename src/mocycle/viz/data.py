@@ -72,8 +72,8 @@ def loop_plot_data(motion, cycle, n_joints: int = 3) -> dict:
         cycle_xy = np.c_[np.r_[C[:, 0], C[:1, 0]], np.zeros(len(C) + 1)]
     # The curves are what an animator reads: rotation-vector components about the mean pose (a joint turning
     # a full circle shows its turn as a 360° jump there; the PCA above has none).
-    V, decoder = pose_matrix(motion, rep="quatlog", root="drop", reference=ref)
-    V, Vc = 2.0 * V, 2.0 * pose_matrix(inplace, rep="quatlog", root="drop", reference=ref)[0]
+    V, decoder = pose_matrix(motion, rep="quatlog", root_features="drop", reference=ref)
+    V, Vc = 2.0 * V, 2.0 * pose_matrix(inplace, rep="quatlog", root_features="drop", reference=ref)[0]
     spread = np.ptp(V[frames], axis=0)
     cols = np.argsort(spread)[::-1][:n_joints]
     curves = [{"name": decoder.columns[col], "cycle_deg": np.degrees(np.tile(Vc[:, col], 2)),
@@ -145,9 +145,9 @@ def curves_plot_data(series, n_joints: int = 3) -> dict:
     """
     first = series[0][1]
     ref = mean_rotations(first.rotations)
-    names = pose_matrix(first[:1], rep="quatlog", root="drop", reference=ref)[1].columns
+    names = pose_matrix(first[:1], rep="quatlog", root_features="drop", reference=ref)[1].columns
     # rotation vectors about the first motion's mean pose (2 x quaternion log, rad): angles a plot can label
-    feats = [2.0 * pose_matrix(m, rep="quatlog", root="drop", reference=ref)[0] for _, m, _ in series]
+    feats = [2.0 * pose_matrix(m, rep="quatlog", root_features="drop", reference=ref)[0] for _, m, _ in series]
     cols = np.argsort(np.ptp(feats[0], axis=0))[::-1][:n_joints]
     out = []
     for (label, motion, x), F in zip(series, feats, strict=True):

@@ -309,7 +309,7 @@ def _warp_take(motion: Motion, factor: float, window: str | int = "auto",
     n_out = _frames_out(T, factor, motion.n_joints)
     skel = motion.skeleton
     groups = joint_groups(skel)
-    X, decoder = pose_matrix(motion, rep="quatlog", root="drop")
+    X, decoder = pose_matrix(motion, rep="quatlog", root_features="drop")
     owner = decoder.dof_joint
     group_of = np.empty(skel.n_joints, dtype=object)
     for g, js in groups.items():

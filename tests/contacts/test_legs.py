@@ -83,13 +83,13 @@ def test_feet_on_every_shared_rig():
 
 
 def test_leg_positions_block_by_block_are_the_forward_kinematics_of_the_whole_take(monkeypatch):
-    import mocycle.contacts.feet as feet_module
-    from mocycle.contacts.feet import chain_joints, chain_positions, chain_transforms, leg_joints
+    import mocycle.contacts.legs as legs_module
+    from mocycle.contacts.legs import chain_joints, chain_positions, chain_transforms, leg_joints
 
     walk = synthetic_walk(n_frames=250, fps=60, noise_deg=2.0, seed=3).motion
     chain = chain_joints(walk, leg_joints(find_feet(walk.skeleton)))
     Rw, W = chain_transforms(walk, chain)
-    monkeypatch.setattr(feet_module, "POSITIONS_BLOCK", 64)  # four blocks, the last one short
+    monkeypatch.setattr(legs_module, "POSITIONS_BLOCK", 64)  # four blocks, the last one short
     blocked = chain_positions(walk, chain)
     np.testing.assert_array_equal(blocked.data, W.data)
     full = walk.world_positions()

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..contacts.clearance import swing_clearance
 from ..contacts.detect import Contacts, detect_contacts
-from ..contacts.feet import Foot, chain_joints, chain_transforms, find_feet, leg_joints
+from ..contacts.legs import Foot, chain_joints, chain_transforms, find_feet, leg_joints
 from ..contacts.lock import BLEND_SECONDS, REACH, lock_feet
 from ..motion import Motion
 from ..rotations import axis_rotations

@@ -1,4 +1,5 @@
-"""Which joints are the feet, and which way is up, on any humanoid skeleton.
+"""The legs of any humanoid skeleton: which joints are the feet, which way is up, and the legs' chains
+(their forward kinematics a block of frames at a time).
 
 A :class:`Foot` is one leg's chain for two-bone IK (hip, knee, ankle) and its
 contact joints: the ankle (heel) and, when the rig has one, the toe (ball of

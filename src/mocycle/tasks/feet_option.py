@@ -22,7 +22,7 @@ def clean_feet(cycle, mode: str, root: str, foot_joints: str | None, reference=N
     repeated twice with its root motion, and ``skate_before`` its skate on the same feet, when the caller has
     measured them (``loop_metrics`` does: its ``skate``)."""
     from ..contacts import find_feet, largest_leg_step
-    from ..cycle.feet import lock_cycle
+    from ..cycle.foot_lock import lock_cycle
 
     if mode == "auto":
         try:
@@ -55,7 +55,7 @@ def _skate(motion, contacts) -> float:
     """The skate measure of ``motion`` on the feet and vertical of ``contacts``, from the forward kinematics of
     the legs alone (its body height from some 50 frames of the whole body, as ``loop_metrics`` measures it)."""
     from ..contacts import body_height, skate
-    from ..contacts.feet import chain_joints, chain_positions
+    from ..contacts.legs import chain_joints, chain_positions
 
     joints = [j for f in contacts.feet for j in f.contact_joints]
     W = chain_positions(motion, chain_joints(motion, joints))
