@@ -193,8 +193,7 @@ def test_stride_phase_keeps_the_run_of_alternating_feet_inside_the_part():
 def _steps(motion):
     from mocycle.activities import find_landings
 
-    L = find_landings(motion)
-    return np.stack([L.frames, L.foot], axis=1)
+    return find_landings(motion)
 
 
 def test_a_walk_too_short_to_be_seen_repeating_loops_when_its_feet_land_a_period_apart():
@@ -212,21 +211,70 @@ def test_a_walk_too_short_to_be_seen_repeating_loops_when_its_feet_land_a_period
     _decide(seen, 1.2)
     looped = [p for p in seen if p.loop]
     assert len(looped) == 1 and looped[0].in_step, [(p.kind, p.reason) for p in seen]
+    assert looped[0].kind == "walk straight"  # named by its feet
     assert looped[0].period_frames == pytest.approx(period * fps, rel=0.08)
     assert "the feet landing a period apart" in looped[0].reason
 
 
-def test_feet_that_land_at_another_pace_than_the_body_repeats_make_a_transition():
-    """Where the feet land at another pace than the period found (a walk slowing into a run), the stretch is no
-    one motion: a transition, not a loop."""
-    from mocycle.activities import _other
+def test_a_walk_running_off_without_a_chain_of_landings_is_not_looped_across_the_change():
+    """Frames without a gait part where a short walk turns into a run: looked at blind, the whole body "repeats"
+    across both (one loop holding a walk and a run); with the landings, the part that loops lies in one gait."""
+    from mocycle.activities import _decide, _other
+    from mocycle.datasets import join_takes
 
-    fps, period = 60.0, 0.7
-    run = synthetic_run(n_frames=int(3 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
-    steps = _steps(run)
-    slow = steps.copy()
-    slow[:, 0] = np.minimum(run.n_frames - 1, (steps[:, 0] - steps[0, 0]) * 1.4 + steps[0, 0]).astype(int)
-    parts = _other(run, 0, run.n_frames, 1.2, True, {"joints": None, "step": 1}, steps=slow)
-    assert not any(p.loop for p in parts)
-    assert any(p.kind == "transition" and "the gait changes here" in p.reason for p in parts), \
-        [(p.kind, p.reason) for p in parts]
+    fps = 60.0
+    s = join_takes([synthetic_walk(n_frames=90, fps=fps, period_s=1.0, noise_deg=0.5, seed=1).motion,
+                    synthetic_run(n_frames=84, fps=fps, period_s=0.7, noise_deg=0.5, seed=3).motion], ["walk", "run"])
+    m = s.motion
+
+    def spans(parts):  # loops reaching beyond their main stretch by more than half a period
+        out = []
+        for p in (p for p in parts if p.loop):
+            over = [max(0, min(p.stop, e) - max(p.start, a)) for _, a, e in s.stretches]
+            if sum(over) - max(over) > 0.5 * p.period_frames:
+                out.append((p.start, p.stop))
+        return out
+
+    options = {"joints": None, "step": 1}
+    blind = _other(m, 0, m.n_frames, 1.2, True, options)
+    _decide(blind, 1.2)
+    seen = _other(m, 0, m.n_frames, 1.2, True, options, steps=_steps(m))
+    _decide(seen, 1.2)
+    assert spans(blind)  # what the landings are for: without them one loop holds both gaits
+    assert not spans(seen), [(p.kind, p.start, p.stop, p.reason) for p in seen]
+    assert any(p.loop for p in seen)
+
+
+def test_a_wave_loop_ends_where_the_wave_ends_not_in_the_slow_gesture_after_it():
+    """An arm raised at an even pace has a velocity alike itself a period later although nothing repeats: the wave
+    before it must not reach into it (the poses must come back a period later)."""
+    from mocycle.datasets import join_takes
+
+    fps = 60.0
+    takes = [synthetic_wave(n_frames=int(5 * fps), fps=fps, hand="right", wave_period_s=0.6, seed=4).motion,
+             synthetic_gesture(n_frames=int(3 * fps), fps=fps, seed=5).motion]
+    s = join_takes(takes, ["wave", "gesture"])
+    border = s.stretches[0][2]
+    arms = [p for p in segment_activities(s.motion).loopable() if p.kind == "arms"]
+    assert len(arms) == 1
+    assert arms[0].stop - border <= 0.5 * arms[0].period_frames, (arms[0].stop, border, arms[0].period_frames)
+
+
+def test_parts_cut_where_the_gait_changes_do_not_reach_across_the_change():
+    """The step across a gait change is a blend of both gaits: the parts beside it stay at their landings even
+    where the legs repeat alike on both sides (two runs of one tempo from two takes), so no loop holds it."""
+    from mocycle.activities import Activity, _reach
+
+    walk = synthetic_walk(n_frames=600, fps=60.0, period_s=1.0, noise_deg=0.5, seed=2).motion
+
+    def parts():
+        return [Activity(start=60, stop=300, kind="walk straight", period_frames=60.0),
+                Activity(start=330, stop=540, kind="walk straight", period_frames=60.0)]
+
+    free = parts()
+    _reach(walk, free, walk.n_frames)
+    assert free[0].stop > 300 or free[1].start < 330  # alike legs: without a change the parts grow over the step
+    held = parts()
+    _reach(walk, held, walk.n_frames, changes={300, 330})
+    assert (held[0].stop, held[1].start) == (300, 330)
+    assert held[0].start < 60 and held[1].stop > 540  # their other ends still reach

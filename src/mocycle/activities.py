@@ -34,6 +34,7 @@ works on a part of 1.2 cycles where the circular coordinate winds about once.
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -518,6 +519,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     body = _body_height(motion)
     parts = []
     stepped = []  # the landings of the gait chains: a stride phase is a line through these only
+    changes: set[int] = set()  # the landings where a gait changes: the parts beside them reach no further
     for chain in _gait_chains(landings, fps, least=2):
         stepped.append(chain)
         a, b = int(landings.frames[chain[0]]), int(landings.frames[chain[-1]])
@@ -541,11 +543,15 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
             # steps i .. j-1: landings f[i] .. f[j]
             parts.append(_gait_part(kinds[i][0], f, chain, i, j, landings, strides, heading, path, fps))
             # where the gait changes, the step across the change belongs to neither part (a blend of the two)
-            i = j + 1 if j in cuts and j + 2 < len(kinds) else j
+            if j in cuts and j + 2 < len(kinds):
+                changes.update((int(f[j]), int(f[j + 1])))
+                i = j + 1
+            else:
+                i = j
     # steps that land in turn but whose legs do not repeat a stride later (a wander, a stumble) are no gait
     parts = [p for p in parts if _legs_repeat_in(motion, p)]
     parts.sort(key=lambda p: p.start)
-    _reach(motion, parts, T)
+    _reach(motion, parts, T, changes)
     parts = [q for p in parts for q in (_split_turns(p, heading, path, fps) if " " not in p.kind else [p])]
     parts = _fill(motion, parts, landings, min_periods, options, map)
     keep = np.sort(np.concatenate(stepped)) if stepped else np.zeros(0, dtype=np.intp)
@@ -762,7 +768,7 @@ def _decide(parts: list[Activity], min_periods: float) -> None:
         n = p.n_periods
         p.loop = bool(p.periodic is not None and np.isfinite(n) and n >= least)
         if p.loop:
-            if p.gait:
+            if p.gait and not p.in_step:
                 p.reason = ""
             continue
         if p.gait:
@@ -935,20 +941,26 @@ def _short_period_of(X: np.ndarray | None, guess: float) -> tuple[float, float]:
     return best, float(d[i])
 
 
-def _reach(motion: Motion, parts: list[Activity], T: int) -> None:
+def _reach(motion: Motion, parts: list[Activity], T: int, changes: Collection[int] = ()) -> None:
     """Let each gait part reach up to one step before its first and after its last landing (the take starts or
     ends mid-stride; up to a stride at the take's ends), short of its neighbours and only as far as its legs
     still repeat the stride (:func:`_repeating_reach`: where the gait stops or blends into another motion, the
-    part stops); a gap smaller than a step between two parts is split."""
+    part stops); a gap smaller than a step between two parts is split.  A part that starts or ends at a landing
+    of ``changes`` (where the gait changes, :func:`_gait_changes`) stays there: the step across the change is
+    a blend of the two gaits, neither part's, even where the legs repeat alike on both sides of it."""
     for k, p in enumerate(parts):
         step = p.period_frames / 2.0
         lo = parts[k - 1].stop if k > 0 else 0
-        if k > 0 and p.start - lo < step:   # a gap under a step between parts: halve it
+        if p.start in changes:
+            pass
+        elif k > 0 and p.start - lo < step and parts[k - 1].stop not in changes:   # a gap under a step: halve it
             mid = (lo + p.start) // 2
             parts[k - 1].stop, p.start = mid, mid
         else:  # at the take's start a foot may be mid-swing: up to a stride
             want = max(lo, int(np.floor(p.start - (2 * step if k == 0 else step))))
             p.start = _repeating_reach(motion, p, want, p.start)
+        if p.stop in changes:
+            continue
         if k + 1 == len(parts):
             want = min(T, int(np.ceil(p.stop + 2 * step)))
             p.stop = _repeating_reach(motion, p, want, p.stop)
@@ -1012,25 +1024,25 @@ class _Gap:
     min_periods: float
     gait_near: bool
     options: dict
-    #: the landings in the stretch: rows (frame of the stretch, foot) ``(n, 2)``
-    steps: np.ndarray | None = None
+    #: the landings in the stretch, in its frames
+    steps: Landings | None = None
 
 
-def _steps_in(landings: Landings | None, a: int, b: int) -> np.ndarray:
-    """The landings in frames ``a .. b-1`` as rows (frame - ``a``, foot index) ``(n, 2)``."""
+def _steps_in(landings: Landings | None, a: int, b: int) -> Landings | None:
+    """The landings in frames ``a .. b-1``, in those frames (frame ``a`` first)."""
     if landings is None:
-        return np.zeros((0, 2), dtype=np.intp)
+        return None
     inside = (landings.frames >= a) & (landings.frames < b)
-    return np.stack([landings.frames[inside] - a, landings.foot[inside]], axis=1).astype(np.intp)
+    return Landings(landings.frames[inside] - a, landings.foot[inside], landings.sides, landings.down[a:b])
 
 
-def _foot_periods(steps: np.ndarray | None, start: int, stop: int, fps: float) -> np.ndarray:
-    """The strides of ``steps`` (rows (frame, foot) in frame order) over frames ``start .. stop-1``: frames from a
-    landing to the same foot's next where the other foot lands once between, each step :data:`MIN_STEP_S` ..
-    :data:`MAX_STEP_S` long (a landing missed or a foot that shuffles makes no stride)."""
-    if steps is None or steps.shape[0] < 3:
+def _foot_periods(steps: Landings | None, start: int, stop: int, fps: float) -> np.ndarray:
+    """The strides of ``steps`` over frames ``start .. stop-1``: frames from a landing to the same foot's next
+    where the other foot lands once between, each step :data:`MIN_STEP_S` .. :data:`MAX_STEP_S` long (a landing
+    missed or a foot that shuffles makes no stride)."""
+    if steps is None or steps.frames.size < 3:
         return np.zeros(0)
-    f, foot = steps[:, 0].astype(np.float64), steps[:, 1]
+    f, foot = steps.frames.astype(np.float64), steps.foot
     d1, d2 = f[1:-1] - f[:-2], f[2:] - f[1:-1]
     lo, hi = MIN_STEP_S * fps, MAX_STEP_S * fps
     ok = (foot[:-2] == foot[2:]) & (foot[1:-1] != foot[:-2]) & (d1 >= lo) & (d1 <= hi) & (d2 >= lo) & (d2 <= hi)
@@ -1057,16 +1069,18 @@ def _gap_parts(gap: _Gap) -> list[Activity]:
 
 
 def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near: bool, options: dict,
-           when: str = "", steps: np.ndarray | None = None) -> list[Activity]:
+           when: str = "", steps: Landings | None = None) -> list[Activity]:
     """Frames ``start .. stop-1`` without gait: an arms part, a periodic part, a gesture, standing or a short
     transition between gait parts.  What lies before and after a repeating region is looked at again the same
     way (a wave, then a dance step), so that every repeating motion without gait is a part of its own.
     ``when``: ``"before"``/``"after"`` for the frames beside a repeating region.
 
-    ``steps``: the landings in ``motion`` (rows (frame, foot)).  Where the feet land in the frames, they are
-    evidence of their own: a motion whose feet land a period apart (:func:`_in_step`: a gait whose chain of
-    landings broke, a landing missed) repeats as surely as a gait, with ``min_periods`` cycles; one whose feet
-    land at another pace than its period is no one motion (a walk slowing into a run) and is a transition."""
+    ``steps``: the landings in ``motion``.  Where the feet land in the frames, they are evidence of their own: a
+    motion whose feet land a period apart (:func:`_in_step`: a gait whose chain of landings broke, a landing
+    missed) repeats as surely as a gait, with ``min_periods`` cycles, and is a walk or a run named by its feet
+    (:func:`_stepping_part`); one whose legs
+    are unlike themselves a period later (:func:`legs_repeat`, :data:`UNLIKE`) while the feet step is no one
+    motion (a walk slowing into a run) and is a transition."""
     n = stop - start
     if n < MIN_OTHER_S * motion.fps:
         if when:
@@ -1082,11 +1096,23 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
         return [Activity(start=start, stop=stop, kind="standing", limbs="none",
                          reason="the actor stands: nothing moves enough to loop")]
     stepping = _foot_periods(steps, start, stop, motion.fps).size > 0
-    found = _periodic_in(piece, spread, min_periods, options, stepping)
-    if found is not None:  # what repeats must move: noise while the actor stands still after a gesture does not
-        a, b = found[3]
-        if float(_rotation_spread(piece[a:b]).max()) < STILL_DEG:
-            found = None
+
+    def look(fewer: bool):
+        """What repeats (:func:`_periodic_in`; ``fewer``: ``min_periods`` cycles may do) and whether the feet land
+        in step with it."""
+        found = _periodic_in(piece, spread, min_periods, options, fewer)
+        if found is not None:  # what repeats must move: noise while the actor stands after a gesture does not
+            a, b = found[3]
+            if float(_rotation_spread(piece[a:b]).max()) < STILL_DEG:
+                return None, None
+        if found is None or found[1] != "periodic":
+            return found, None
+        (s, e), P = found[3], found[2].period_frames
+        return found, _in_step(_foot_periods(steps, start + s, start + e, motion.fps), P)
+
+    found, in_step = look(stepping)
+    if stepping and found is not None and not in_step:  # the feet do not see it repeat: as if they did not land
+        found, in_step = look(False)
     still = _legs_still(piece.skeleton, spread)
     if found is None:
         return [Activity(start=start, stop=stop, kind="gesture", limbs="none", legs_still=still,
@@ -1095,20 +1121,47 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
     out = []
     if s > 0:
         out.extend(_other(motion, start, start + s, min_periods, gait_near, options, "before", steps))
-    feet = _foot_periods(steps, start + s, start + e, motion.fps) if kind == "periodic" else np.zeros(0)
-    in_step = _in_step(feet, pm.period_frames)
-    why = f"{kind}: {(e - s) / pm.period_frames:.1f} periods of {pm.period_frames:.1f} frames"
-    if in_step is False:
+    P = pm.period_frames
+    steps_in = kind == "periodic" and _foot_periods(steps, start + s, start + e, motion.fps).size > 0
+    legs = legs_repeat(motion, start + s, start + e, P) if steps_in else float("nan")
+    why = f"{kind}: {(e - s) / P:.1f} periods of {P:.1f} frames"
+    if np.isfinite(legs) and legs >= UNLIKE:
         out.append(Activity(start=start + s, stop=start + e, kind="transition", limbs="none", legs_still=still,
-                            reason=f"the feet land {', '.join(f'{d:.0f}' for d in feet)} frames apart where the body "
-                                   f"repeats every {pm.period_frames:.1f}: the gait changes here, no one motion"))
+                            reason=f"the feet step but the legs are unlike themselves a period ({P:.1f} frames) "
+                                   f"later: the gait changes here, no one motion"))
+    elif in_step and steps is not None:
+        out.append(_stepping_part(motion, start + s, start + e, pm, steps, why))
     else:
         out.append(Activity(start=start + s, stop=start + e, kind=kind, limbs=limbs, period_frames=pm.period_frames,
-                            loop=True, periodic=pm, legs_still=still, in_step=bool(in_step),
-                            reason=why + (", the feet landing a period apart" if in_step else "")))
+                            loop=True, periodic=pm, legs_still=still))
     if e < n:
         out.extend(_other(motion, start + e, stop, min_periods, gait_near, options, "after", steps))
     return out
+
+
+def _stepping_part(motion: Motion, start: int, stop: int, pm: PeriodicMotion, steps: Landings,
+                   why: str) -> Activity:
+    """Frames ``start .. stop-1`` of ``motion`` where the body repeats every ``pm.period_frames`` and the feet
+    (``steps``, in ``motion``'s frames) land in step with it: a gait whose chain of landings broke, named by its
+    feet (:func:`gait_of` over its frames) and its turn per cycle (:data:`TURN_DEG`), its phase ``pm``'s."""
+    P = pm.period_frames
+    piece = motion[start:stop]
+    down = steps.down[start:stop]
+    path = _horizontal_path(piece)
+    n = max(stop - start - 1, 1)
+    speed = float(np.linalg.norm(path[-1] - path[0])) * motion.fps / n
+    heading = heading_degrees(piece)
+    turn = float(heading[-1] - heading[0])
+    per_cycle = turn * P / n
+    gait = gait_of(float(np.mean(down == 0)), float(np.mean(down >= 2)), speed, _body_height(piece))
+    way = "straight" if abs(per_cycle) < TURN_DEG else ("turning left" if per_cycle > 0 else "turning right")
+    own: dict[str, list[int]] = {}
+    inside = (steps.frames >= start) & (steps.frames < stop)
+    for f, k in zip(steps.frames[inside].tolist(), steps.foot[inside].tolist(), strict=True):
+        own.setdefault(steps.sides[k], []).append(int(f))
+    return Activity(start=start, stop=stop, kind=f"{gait} {way}", limbs="legs", period_frames=P, speed=speed,
+                    turn_deg=turn, loop=True, periodic=pm, legs_still=False, in_step=True, landings=own,
+                    reason=f"{why}, the feet landing a period apart (a gait whose chain of landings broke)")
 
 
 def _rotation_spread(motion: Motion) -> np.ndarray:
@@ -1158,7 +1211,7 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
     if not np.isfinite(P):
         return None
     w = max(3, int(round(P)))
-    alike = repetition_distance(V, P, smooth=w) < ALIKE
+    alike = (repetition_distance(V, P, smooth=w) < ALIKE) & (_return_distance(X[1:], P, w) < ALIKE)
     energy = moving_average((V ** 2).sum(axis=1), w)
     if not alike.any():
         return None
@@ -1172,6 +1225,26 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
     if (e - s) < least * P:
         return None
     return s, e, float(P)
+
+
+def _return_distance(X: np.ndarray, period: float, w: int) -> np.ndarray:
+    """Per frame, how far poses ``X`` ``(T, D)`` are from coming back one ``period`` later (or earlier): the
+    squared step ``||x(t + P) - x(t)||²`` against the poses' own spread over a period about ``t`` (twice their
+    variance over ``w`` frames), the nearer side, averaged over ``w`` frames: about 0 where the motion comes
+    back to its pose (a wave's swings), 6 or more where it moves on at an even pace (an arm raised slowly,
+    whose velocity is alike a period later although nothing repeats).  ``(T,)``."""
+    T = X.shape[0]
+    P = int(round(period))
+    if T < 2 or P < 1 or P >= T:
+        return np.zeros(T)
+    mean = np.stack([moving_average(X[:, d], w) for d in range(X.shape[1])], axis=1)
+    square = np.stack([moving_average(X[:, d] ** 2, w) for d in range(X.shape[1])], axis=1)
+    spread = np.maximum((square - mean ** 2).sum(axis=1), 1e-12)
+    step = ((X[P:] - X[:-P]) ** 2).sum(axis=1)
+    d = np.full((2, T), np.inf)
+    d[0, :-P] = step / (2.0 * spread[:-P])
+    d[1, P:] = step / (2.0 * spread[P:])
+    return moving_average(d.min(axis=0), w)
 
 
 def _true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
