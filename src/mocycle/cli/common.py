@@ -212,6 +212,21 @@ def print_warnings(report) -> None:
         err.print(f"[yellow]warning:[/] {escape(as_flags(text, report.task))}", markup=True, soft_wrap=True)
 
 
+def delivered(report, write: Writer | None = None):
+    """A task's report as a command goes on with it: its warnings printed as 'warning:' lines, then, given the
+    command's ``write``, its ``--output`` written. Returns the report."""
+    print_warnings(report)
+    if write is not None:
+        write(report)
+    return report
+
+
+def print_facts(report, **more) -> None:
+    """``--json`` for a command that prints its report whole: the facts, then what the command adds (``more``:
+    the output's path), then the seconds."""
+    print_json({**report.facts, **more, "seconds": report.seconds})
+
+
 def _version(value: bool):
     if value:
         out.print(f"mocycle {__version__}")
