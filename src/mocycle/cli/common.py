@@ -390,6 +390,7 @@ def task_command(name: str, into: typer.Typer | None = None) -> Callable:
             given = {"options": options, "force": force, "write": write, **kwargs}
             return func(**{k: v for k, v in given.items() if k in own})
 
+        # typer reads a command's parameters from its signature only (docs/architecture.md says why not click's)
         command.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]
         command.__annotations__ = {p.name: p.annotation for p in params}
         del command.__wrapped__  # typer reads the signature made here, not the function's
