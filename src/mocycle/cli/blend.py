@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_closing, print_feet, print_json, print_warnings, task_command
+from .common import check_output, delivered, escape, out, print_closing, print_feet, print_json, task_command
 
 PLOT_HELP = "Write a PNG: the most moving joint curves of the blend and of the inputs' cycles, phase-aligned."
 
@@ -29,8 +29,7 @@ def blend(
     from ..cycle.blend import BlendedCycle
 
     check_output(plot, paths, force, ".png", "--plot")
-    report = tasks.blend.run(paths, options)
-    print_warnings(report)
+    report = delivered(tasks.blend.run(paths, options))
     written = write(report)["loop"][1]
     result = report.result
     assert isinstance(result, BlendedCycle)  # what tasks.blend makes
@@ -85,9 +84,7 @@ def transition(
     cycle fails a loop check (see mocycle loop), 1 for bad input, 2 for a bad option.
     """
     check_output(plot, [first, second], force, ".png", "--plot")
-    report = tasks.transition.run([first, second], options)
-    print_warnings(report)
-    write(report)
+    report = delivered(tasks.transition.run([first, second], options), write)
     if plot is not None:
         from ..cycle.blend import Transition
         from ..viz import plot_curves

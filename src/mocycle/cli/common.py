@@ -212,6 +212,21 @@ def print_warnings(report) -> None:
         err.print(f"[yellow]warning:[/] {escape(as_flags(text, report.task))}", markup=True, soft_wrap=True)
 
 
+def delivered(report, write: Writer | None = None):
+    """A task's report as a command goes on with it: its warnings printed as 'warning:' lines, then, given the
+    command's ``write``, its ``--output`` written. Returns the report."""
+    print_warnings(report)
+    if write is not None:
+        write(report)
+    return report
+
+
+def print_facts(report, **more) -> None:
+    """``--json`` for a command that prints its report whole: the facts, then what the command adds (``more``:
+    the output's path), then the seconds."""
+    print_json({**report.facts, **more, "seconds": report.seconds})
+
+
 def _version(value: bool):
     if value:
         out.print(f"mocycle {__version__}")
@@ -375,6 +390,7 @@ def task_command(name: str, into: typer.Typer | None = None) -> Callable:
             given = {"options": options, "force": force, "write": write, **kwargs}
             return func(**{k: v for k, v in given.items() if k in own})
 
+        # typer reads a command's parameters from its signature only (docs/architecture.md says why not click's)
         command.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]
         command.__annotations__ = {p.name: p.annotation for p in params}
         del command.__wrapped__  # typer reads the signature made here, not the function's

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import escape, out, print_json, print_warnings, task_command
+from .common import delivered, escape, out, print_json, task_command
 
 
 @task_command("info")
@@ -17,8 +17,7 @@ def info(
     *, options, as_json,
 ):
     """Frames, frame time, fps, duration, joints, channels, root travel and rotation ranges."""
-    report = tasks.info.run(path, options)
-    print_warnings(report)
+    report = delivered(tasks.info.run(path, options))
     facts = {**report.facts, "file": str(path), "seconds": report.seconds}
     if as_json:
         print_json(facts)

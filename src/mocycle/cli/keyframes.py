@@ -8,7 +8,17 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_closing, print_feet, print_json, print_warnings, task_command
+from .common import (
+    check_output,
+    delivered,
+    escape,
+    out,
+    print_closing,
+    print_facts,
+    print_feet,
+    print_json,
+    task_command,
+)
 
 
 @task_command("compress")
@@ -21,9 +31,7 @@ def compress(
     The default ratio 'auto' keeps enough keys for the motion's own rhythm; an explicit ratio that leaves
     fewer than 4 keys per period gets a warning.
     """
-    report = tasks.compress.run(path, options)
-    print_warnings(report)
-    write(report)
+    report = delivered(tasks.compress.run(path, options), write)
     r = report.facts
     facts = {k: r[k] for k in ("frames", "keyframes", "ratio", "period_frames", "keys_per_period", "keyframes_set_by",
                                "error_per_frame_per_joint", "compressed_bytes", "bvh_bytes")}
@@ -57,13 +65,11 @@ def decompress(
     *, options, output, as_json, write,
 ):
     """Rebuild a take from its keyframes; the keyframes come back exactly (unless --feet lock)."""
-    report = tasks.decompress.run(path, options)
-    print_warnings(report)
-    write(report)
-    r = report.facts
+    report = delivered(tasks.decompress.run(path, options), write)
     if as_json:
-        print_json({**r, "seconds": report.seconds})
+        print_facts(report)
         return
+    r = report.facts
     out.print(f"{escape(output)}: {r['frames']} frames rebuilt from {r['keyframes']} keyframes ({r['scheme']})")
     print_feet(r["feet"], tail=" (the keyframes near contacts changed with them)")
 
@@ -77,8 +83,7 @@ def project(
 ):
     """Project every pose to 2-D and pick keyframes: the spatial keyframing view of a take."""
     check_output(plot, [path], force, ".png", "--plot")
-    report = tasks.project.run(path, options)
-    print_warnings(report)
+    report = delivered(tasks.project.run(path, options))
     r, arrays = report.facts, report.result
     assert isinstance(arrays, dict)  # tasks.project's points, keyframes and optimised points
     if plot is not None:

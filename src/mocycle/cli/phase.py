@@ -8,17 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import (
-    EXIT_NOT_FOUND,
-    check_output,
-    err,
-    escape,
-    out,
-    print_closing,
-    print_json,
-    print_warnings,
-    task_command,
-)
+from .common import EXIT_NOT_FOUND, check_output, delivered, err, escape, out, print_closing, print_json, task_command
 
 
 @task_command("phase")
@@ -36,8 +26,7 @@ def phase(
     a bad option.
     """
     check_output(plot, [path], force, ".png", "--plot")
-    report = tasks.phase.run(path, options, keep_features=plot is not None)
-    print_warnings(report)
+    report = delivered(tasks.phase.run(path, options, keep_features=plot is not None))
     if plot is not None:
         from ..viz import plot_phase
 

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_closing, print_feet, print_json, print_warnings, task_command
+from .common import check_output, delivered, escape, out, print_closing, print_feet, print_json, task_command
 
 
 @task_command("stretch")
@@ -29,9 +29,7 @@ def stretch(
     (--force warps it whole anyway), 1 for bad input, 2 for a bad option.
     """
     check_output(plot, [path], force, ".png", "--plot")
-    report = tasks.stretch.run(path, options)
-    print_warnings(report)
-    write(report)
+    report = delivered(tasks.stretch.run(path, options), write)
     if plot is not None:
         from ..viz import plot_curves
 

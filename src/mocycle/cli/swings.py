@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .. import tasks
-from .common import check_output, escape, out, print_closing, print_json, print_warnings, task_command
+from .common import check_output, delivered, escape, out, print_closing, print_facts, print_json, task_command
 
 _FACT_KEYS = ("joints", "n_swings", "segmentation_error", "per_angle_error_deg", "geodesic_error_deg",
               "compressed_bytes", "raw_float32_bytes")
@@ -30,8 +30,7 @@ def swings(
     from ..segmentation import Segmentation
 
     check_output(plot, [path], force, ".png", "--plot")
-    report = tasks.swings.run(path, options)
-    print_warnings(report)
+    report = delivered(tasks.swings.run(path, options))
     seg, r = report.result, report.facts
     assert isinstance(seg, Segmentation)  # what tasks.swings makes (or reads from a .mosw)
     written = []
@@ -77,8 +76,7 @@ def search(
     *, options, as_json,
 ):
     """Rank the takes of a folder by how alike their swings are to an example (query by example)."""
-    report = tasks.search.run(query, folder, options)
-    print_warnings(report)
+    report = delivered(tasks.search.run(query, folder, options))
     if as_json:
         r = report.facts
         print_json({"query": r["query"], "indexed": r["indexed"], "seconds": report.seconds, "results": r["results"]})
@@ -101,13 +99,10 @@ def edit(
     *, options, output, as_json, write,
 ):
     """Scale the angle or the duration of one swing of one joint and write the edited motion."""
-    report = tasks.edit.run(path, options)
-    print_warnings(report)
-    write(report)
-    r = report.facts
+    report = delivered(tasks.edit.run(path, options), write)
     if as_json:
-        print_json({**r, "output": str(output), "seconds": report.seconds})
-    else:
-        o = options
-        out.print(f"{escape(o.joint)} swing {o.swing} (frames {r['start']}-{r['end']}, {r['angle_deg']:.1f} deg): "
-                  f"angle x{o.angle_scale:g}, duration x{o.duration_scale:g} -> {escape(output)}", soft_wrap=True)
+        print_facts(report, output=str(output))
+        return
+    r, o = report.facts, options
+    out.print(f"{escape(o.joint)} swing {o.swing} (frames {r['start']}-{r['end']}, {r['angle_deg']:.1f} deg): "
+              f"angle x{o.angle_scale:g}, duration x{o.duration_scale:g} -> {escape(output)}", soft_wrap=True)

@@ -20,13 +20,15 @@ channels.  A leaf joint with no animation of its own becomes an End Site (its or
 
 from __future__ import annotations
 
+import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..errors import MocycleError, MotionFileError
-from ..limits import MAX_MAGNITUDE, check_frames
+from ..errors import DefaultTake, MocycleError, MotionFileError
+from ..limits import MAX_MAGNITUDE, check_frames, frame_time_problem
 from ..motion import EndSite, Motion, Skeleton
 from ..rotations import nearest_rotations
 
@@ -341,6 +343,15 @@ MAX_LISTED_TAKES = 20
 ``fbx_takes`` list them all)."""
 
 
+def key_rate(step: float | None) -> float | None:
+    """The frame rate of one key per ``step`` seconds (rounded to a whole number within 1e-4), or ``None`` for
+    no step or sparse authored keys (fewer than :data:`MIN_KEY_RATE` a second): a take's own rate, glTF and FBX."""
+    if step is None or 1.0 / step < MIN_KEY_RATE:
+        return None
+    rate = 1.0 / step
+    return float(round(rate)) if abs(rate - round(rate)) < 1e-4 * rate and round(rate) > 0 else rate
+
+
 def listed(names: list[str]) -> str:
     """``names`` joined for a message: the first :data:`MAX_LISTED_TAKES`, then how many more."""
     shown = ", ".join(names[:MAX_LISTED_TAKES])
@@ -364,6 +375,35 @@ def choose_take(names: list[str], take, path, noun: str, none_held: str) -> int 
     if text.isdigit() and int(text) < len(names):
         return int(text)
     raise MotionFileError(f"no {noun} named {text!r}; the file holds: {listed(names)}", path)
+
+
+def default_take(names: list[str], moves: Callable[[int], bool], path, noun: str, stacklevel: int = 3) -> int:
+    """The take read when none is named: the first of ``names`` that ``moves(k)`` (moves the skeleton), else the
+    first.  When the file holds several a :class:`~mocycle.errors.DefaultTake` warning says which and why, and
+    lists the others (``(still)`` after those seen not to move); ``noun`` words the reason when none moves
+    (``take``, ``animation``).  ``stacklevel``: the warning's, counted from here."""
+    chosen = next((k for k in range(len(names)) if moves(k)), None)
+    none_moves = chosen is None
+    chosen = 0 if chosen is None else chosen
+    if len(names) > 1:
+        others = [f"{name!r}" + (" (still)" if k < chosen or none_moves else "")
+                  for k, name in enumerate(names) if k != chosen]
+        why = f"the first: no {noun} moves the skeleton" if none_moves else "the first that moves the skeleton"
+        warnings.warn(f"{path}: read take {names[chosen]!r} ({why}); the file also holds {listed(others)}: "
+                      f"choose one with option 'take'", DefaultTake, stacklevel=stacklevel)
+    return chosen
+
+
+def frame_times(start: float, end: float, rate: float, n_joints: int, path) -> np.ndarray:
+    """The times (s) of a take's frames, from ``start`` to ``end`` at ``rate`` frames a second; a frame time mocycle
+    does not read, an absurd span, or more frames than :func:`~mocycle.limits.check_frames` allows, refused."""
+    problem = frame_time_problem(1.0 / rate)
+    if problem:
+        raise MotionFileError(problem, path)
+    if not end - start < 1e9:
+        raise MotionFileError(f"the animation spans {end - start:g} s", path)
+    n_frames = check_frames(int(round((end - start) * rate)) + 1, n_joints, "the animation", path)
+    return start + np.arange(n_frames) / rate
 
 
 def member_nodes(members: list[int], parents, node_trs) -> tuple[list, list, list[int]]:

@@ -35,22 +35,22 @@ import gc
 import os
 import sys
 import traceback
-import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import DefaultTake, MocycleError, MotionFileError
-from ..limits import check_frames, frame_time_problem
+from ..errors import MocycleError, MotionFileError
+from ..limits import frame_time_problem
 from ..motion import Motion
 from ._nodes import (
     DEFAULT_FPS,
     MAX_FILE_BYTES,
-    MIN_KEY_RATE,
     NodeTRS,
     choose_take,
+    default_take,
+    frame_times,
     joint_names,
-    listed,
+    key_rate,
     member_nodes,
     motion_from_nodes,
     skeleton_order,
@@ -198,8 +198,8 @@ def _sample(times: np.ndarray, keys: np.ndarray, values: np.ndarray, rotation: b
 
 
 def regular_rate(times: np.ndarray) -> float | None:
-    """The rate (frames per second) of key times lying on one regular grid of at least :data:`MIN_KEY_RATE`
-    keys a second (rounded to a whole number within 1e-4), or ``None``."""
+    """The rate (frames per second) of key times lying on one regular grid, or ``None`` (:func:`._nodes.key_rate`:
+    at least 12 keys a second, rounded to a whole number within 1e-4)."""
     times = np.unique(times)
     if len(times) < 2:
         return None
@@ -209,10 +209,7 @@ def regular_rate(times: np.ndarray) -> float | None:
     k = (times - times[0]) / step
     if not np.allclose(k, np.round(k), rtol=0, atol=1e-3):
         return None
-    rate = 1.0 / step
-    if rate < MIN_KEY_RATE:  # a few keys far apart: authored keys, not one per frame
-        return None
-    return float(round(rate)) if abs(rate - round(rate)) < 1e-4 * rate else rate
+    return key_rate(step)  # a few keys far apart are authored keys, not one per frame: None
 
 
 class _Scene:
@@ -297,13 +294,7 @@ class _Scene:
         the file holds several takes)."""
         if take is not None or len(self.stacks) < 2:
             return choose_take(self.stack_names, take, self.path, "take", "animation stack")
-        chosen = next((k for k in range(len(self.stacks)) if self.moves(k)), 0)
-        others = [f"{name!r}" + ("" if k > chosen or self.moves(k) else " (still)")
-                  for k, name in enumerate(self.stack_names) if k != chosen]
-        why = "the first that moves the skeleton" if self.moves(chosen) else "the first: no take moves the skeleton"
-        warnings.warn(f"{self.path}: read take {self.stack_names[chosen]!r} ({why}); the file also holds "
-                      f"{listed(others)}: choose one with option 'take'", DefaultTake, stacklevel=4)
-        return chosen
+        return default_take(self.stack_names, self.moves, self.path, "take", stacklevel=5)
 
     def still_leaves(self) -> set[int]:
         """The skeleton's leaf nodes that no take of the file moves."""
@@ -373,13 +364,8 @@ def _read(fs: _Scene, take, fps) -> tuple:
             start, end = (max(start, begin), min(end, stop)) if all_times and min(end, stop) > max(start, begin) \
                 else (begin, stop)
     rate = float(rate or DEFAULT_FPS)
-    problem = frame_time_problem(1.0 / rate)
-    if problem:
-        raise MotionFileError(problem, p)
-    if not (end - start < 1e9):
-        raise MotionFileError(f"the animation spans {end - start:g} s", p)
-    T = check_frames(int(round((end - start) * rate)) + 1, len(fs.members), "the animation", p)
-    times = start + np.arange(T) / rate
+    times = frame_times(start, end, rate, len(fs.members), p)
+    T = len(times)
 
     names = joint_names([n.name for n in fs.nodes], fs.members)
     still = fs.still_leaves()

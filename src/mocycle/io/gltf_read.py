@@ -40,18 +40,18 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..errors import DefaultTake, MocycleWarning, MotionFileError
-from ..limits import check_frames, frame_time_problem
+from ..errors import MocycleWarning, MotionFileError
 from ..motion import Motion
 from ._nodes import (
     DEFAULT_FPS,
     MAX_FILE_BYTES,
-    MIN_KEY_RATE,
     NodeTRS,
     Sampled,
     choose_take,
+    default_take,
+    frame_times,
     joint_names,
-    listed,
+    key_rate,
     member_nodes,
     motion_from_nodes,
     skeleton_order,
@@ -515,15 +515,6 @@ def _on_grid(all_keys: list[np.ndarray], rate: float) -> bool:
     return bool(np.all(np.abs(frames - np.round(frames)) <= 1e-3))
 
 
-def _rate_of(step: float | None) -> float | None:
-    """The frame rate of one key per ``step`` (rounded to a whole number within 1e-4), or ``None`` for no grid
-    or sparse authored keys (fewer than :data:`MIN_KEY_RATE` a second)."""
-    if step is None or 1.0 / step < MIN_KEY_RATE:
-        return None
-    rate = 1.0 / step
-    return float(round(rate)) if abs(rate - round(rate)) < 1e-4 * rate and round(rate) > 0 else rate
-
-
 MAX_CANDIDATE_RATES = 8
 """How many of the animations' own key rates (the most common) :func:`_file_rate` weighs: a file of
 thousands of animations each keyed at its own rate costs one pass per candidate, not per animation."""
@@ -541,7 +532,7 @@ def _file_rate(keys_by_animation: list[list[np.ndarray]]) -> float | None:
             shared[sign] = (keys, shared.get(sign, (keys, 0))[1] + 1)
     own: dict[float, int] = {}
     for keys, count in shared.values():
-        rate = _rate_of(_grid_step(keys))
+        rate = key_rate(_grid_step(keys))
         if rate:
             own[rate] = own.get(rate, 0) + count
     rates = sorted(sorted(own, key=lambda r: (-own[r], r))[:MAX_CANDIDATE_RATES])
@@ -651,22 +642,16 @@ def _moves(channels: list, nodes: set[int]) -> bool:
 
 def _default_take(f: _File, body: set[int], n_nodes: int, names: list[str]) -> tuple[int, list]:
     """The first animation that moves the skeleton (``body``: its nodes and the nodes above it), or the first,
-    and its channels; a :class:`~mocycle.errors.DefaultTake` warning names it and the others."""
-    still, chosen, channels = [], None, []
-    for k in range(len(names)):
-        channels = _channels(f, k, n_nodes)
-        if _moves(channels, body):
-            chosen = k
-            break
-        still.append(k)
-    if chosen is None:
-        chosen, channels = 0, _channels(f, 0, n_nodes)
-    if len(names) > 1:
-        others = [f"{name!r}" + (" (still)" if k in still else "") for k, name in enumerate(names) if k != chosen]
-        why = "the first: no animation moves the skeleton" if chosen in still else "the first that moves the skeleton"
-        warnings.warn(f"{f.path}: read take {names[chosen]!r} ({why}); the file also holds {listed(others)}: "
-                      f"choose one with option 'take'", DefaultTake, stacklevel=3)
-    return chosen, channels
+    and its channels (:func:`._nodes.default_take`: a warning names it and the others)."""
+    seen: dict[int, list] = {}  # the channels of the animation looked at last: the one read, unless none moves
+
+    def moves(k: int) -> bool:
+        seen.clear()
+        seen[k] = _channels(f, k, n_nodes)
+        return _moves(seen[k], body)
+
+    chosen = default_take(names, moves, f.path, "animation", stacklevel=4)
+    return chosen, seen[chosen] if chosen in seen else _channels(f, chosen, n_nodes)
 
 
 def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: float | None = None) -> Motion:
@@ -718,16 +703,10 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
             if not _on_grid(keys, rate):
                 warnings.warn(f"{p}: the keys of take {names[index]!r} lie on no regular grid of the file's "  # type: ignore[index]
                               f"{rate:g} fps frames; sampled at {rate:g} fps", MocycleWarning, stacklevel=2)
-        start, end = min(float(k[0]) for k in keys), max(float(k[-1]) for k in keys)
-        problem = frame_time_problem(1.0 / rate)
-        if problem:
-            raise MotionFileError(problem, p)
-        if not end - start < 1e9:
-            raise MotionFileError(f"the animation spans {end - start:g} s", p)
-        T = check_frames(int(round((end - start) * rate)) + 1, len(members), "the animation", p)
-        times = start + np.arange(T) / rate
+        times = frame_times(min(float(k[0]) for k in keys), max(float(k[-1]) for k in keys), rate, len(members), p)
     else:
-        rate, T, times = fps or DEFAULT_FPS, 1, np.zeros(1)
+        rate, times = fps or DEFAULT_FPS, np.zeros(1)
+    T = len(times)
 
     node_names = joint_names([getattr(f.items("nodes")[i], "name", None) for i in range(N)], members)
     trs: dict[int, NodeTRS] = {}
