@@ -13,13 +13,6 @@ from .fields import take_cycles
 from .options import Constraint, Flag, option
 from .report import Recorder, Report, label_of, load_each
 
-LABELS = {
-    "weights": ("weights", ""), "input_periods_frames": ("periods", "frames"), "period_frames": ("period", "frames"),
-    "cycle_frames": ("loop", "frames"), "phase_offsets": ("phase offsets", "cycles"),
-    "travel_per_cycle": ("travel per cycle", "file units"), "turn_per_cycle_deg": ("turn per cycle", "deg"),
-    "seam": ("seam jump (pose, velocity)", "× median step"), "frames_out": ("frames written", ""),
-}
-
 
 @dataclass(frozen=True)
 class Weights(Constraint):

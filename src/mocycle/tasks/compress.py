@@ -11,16 +11,6 @@ from .options import Choice, Real, option
 from .options import Options as _Options
 from .report import Recorder, Report, is_motion, load
 
-LABELS = {
-    "frames": ("frames", ""), "keyframes": ("keyframes", ""), "ratio": ("keyframe ratio asked", ""),
-    "period_frames": ("rhythm period", "frames"), "keys_per_period": ("keys per period", ""),
-    "keyframes_set_by": ("keyframe count set by", ""),
-    "error_per_frame_per_joint": ("error per frame per joint (eq. 3.2)", "rad"),
-    "compressed_bytes": ("compressed", "bytes"), "bvh_bytes": ("BVH", "bytes"),
-    "keyframe_ratio": ("keyframes / frames", ""), "real_ratio": ("real ratio", ""),
-    "formula_ratio": ("formula 5.2/5.3 ratio (h = 0)", ""),
-}
-
 
 @dataclass(frozen=True)
 class Options(_Options):

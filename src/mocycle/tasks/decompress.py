@@ -9,8 +9,6 @@ from .options import Choice, option
 from .options import Options as _Options
 from .report import Recorder, Report
 
-LABELS = {"frames": ("frames rebuilt", ""), "keyframes": ("keyframes", ""), "scheme": ("scheme", ""),
-          "keyframes_exact": ("keyframes come back exactly", "")}
 FEET_HELP = ("keep (default: the keyframes come back exactly, the in-betweens as interpolated), lock (feet held "
              "still on the floor during each contact of the rebuilt take: in-betweens and keyframes near a "
              "contact change, so the keyframes no longer come back exactly) or auto (the same as keep).")

@@ -10,10 +10,6 @@ from .options import Integer, Real, Text, option
 from .options import Options as _Options
 from .report import Recorder, Report, is_motion, load
 
-LABELS = {"joint": ("joint", ""), "swing": ("swing (0-based)", ""), "start": ("first frame", ""),
-          "end": ("last frame", ""), "angle_deg": ("angle turned", "deg"), "angle_scale": ("angle ×", ""),
-          "duration_scale": ("duration ×", "")}
-
 
 @dataclass(frozen=True)
 class Options(_Options):

@@ -14,18 +14,6 @@ from .report import Recorder, Report, load
 if TYPE_CHECKING:
     from ..motion import Motion
 
-#: key -> (label, unit) of the figures a front end shows.
-LABELS = {
-    "frames": ("frames", ""), "frame_time": ("frame time", "s"), "fps": ("frame rate", "fps"),
-    "duration_s": ("duration", "s"), "joints": ("joints", ""), "channels": ("channels", ""),
-    "end_sites": ("end sites", ""), "travel_joint": ("travel joint", ""),
-    "root_displacement": ("travel, net", "file units"), "root_path_length": ("travel along the path", "file units"),
-    "rotation_spread_deg": ("max angle from mean pose", "deg"),
-    "rotation_range_deg": ("channel ranges (max - min)", "deg"),
-    "takes": ("takes in the file", ""), "take": ("take read", ""),
-}
-
-
 @dataclass(frozen=True)
 class Options(_Options):
     """Options of ``info``."""
@@ -35,7 +23,7 @@ class Options(_Options):
 
 
 def motion_info(motion: Motion) -> dict:
-    """The facts of a take, JSON-ready (see :data:`LABELS`)."""
+    """The facts of a take, JSON-ready."""
     import numpy as np
 
     from ..io.bvh import channel_blocks

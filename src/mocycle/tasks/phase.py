@@ -9,18 +9,6 @@ from .options import Integer, option
 from .options import Options as _Options
 from .report import Recorder, Report, load
 
-LABELS = {
-    "frames": ("frames", ""), "fps": ("frame rate", "fps"),
-    "classes": ("periodic motions, one per part that loops", ""),
-    "autocorrelation_period_frames": ("autocorrelation period (cross-check)", "frames"),
-    "reason": ("why", ""),
-}
-#: per periodic motion (each entry of ``facts["classes"]``)
-CLASS_LABELS = {
-    "birth": ("bar birth", ""), "death": ("bar death", ""), "period_frames": ("period", "frames"),
-    "period_s": ("period", "s"), "n_periods": ("periods", ""), "excitation": ("excitation", "frames"),
-}
-
 
 @dataclass(frozen=True)
 class Options(_Options):

@@ -8,10 +8,6 @@ from . import fields, keyframe_fields
 from .options import Options as _Options
 from .report import Recorder, Report, load
 
-LABELS = {"frames": ("frames", ""), "keyframes": ("keyframes (frame numbers)", ""),
-          "stress": ("stress (eq. 4.1)", ""), "stress_optimized": ("stress, optimised", ""),
-          "points": ("2-D point per frame", ""), "points_optimized": ("2-D point per frame, optimised", "")}
-
 
 @dataclass(frozen=True)
 class Options(_Options):

@@ -11,8 +11,6 @@ from .options import Integer, Real, Text, option
 from .options import Options as _Options
 from .report import Recorder, Report, is_motion, label_of, load
 
-LABELS = {"indexed": ("takes indexed", ""), "results": ("matches: rank, score, offset (s), take", "")}
-
 
 @dataclass(frozen=True)
 class Options(_Options):

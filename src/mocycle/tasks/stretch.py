@@ -9,13 +9,6 @@ from .options import Flag, Integer, Real, option
 from .options import Options as _Options
 from .report import Recorder, Report, load
 
-LABELS = {
-    "factor": ("length ratio", ""), "frames_in": ("frames in", ""), "frames_out": ("frames out", ""),
-    "windows": ("window per joint group", "frames"), "cycles": ("fundamental cycle per joint group", "frames"),
-    "trend_curves": ("warped as line + residual", ""), "periodic_regions": ("periodic regions warped", "frames"),
-    "periodic_regions_out": ("where they are in the output", "frames"), "forced": ("warped although not periodic", ""),
-}
-
 
 @dataclass(frozen=True)
 class Options(_Options):

@@ -10,14 +10,6 @@ from . import fields
 from .options import Options as _Options
 from .report import Recorder, Report, is_motion, load
 
-LABELS = {
-    "joints": ("joints segmented", ""), "n_swings": ("swings", ""),
-    "segmentation_error": ("Segmentation Error", "deg"),
-    "per_angle_error_deg": ("Segmentation Error per angle (the paper's measure)", "deg"),
-    "geodesic_error_deg": ("geodesic error per joint", "deg"),
-    "compressed_bytes": ("compressed", "bytes"), "raw_float32_bytes": ("raw float32 channels", "bytes"),
-}
-
 
 @dataclass(frozen=True)
 class Options(_Options):

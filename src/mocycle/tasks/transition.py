@@ -10,12 +10,6 @@ from . import fields
 from .fields import take_cycles
 from .report import Recorder, Report, label_of, load_each
 
-LABELS = {
-    "period_frames_start": ("period at the start", "frames"), "period_frames_end": ("period at the end", "frames"),
-    "phase_offset": ("phase offset of the second", "cycles"),
-    "smoothness": ("largest step / velocity change", "× neighbours' median"), "frames": ("frames", ""),
-}
-
 
 @dataclass(frozen=True)
 class Options(fields.CycleOptions):
