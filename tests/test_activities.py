@@ -278,3 +278,18 @@ def test_parts_cut_where_the_gait_changes_do_not_reach_across_the_change():
     _reach(walk, held, walk.n_frames, changes={300, 330})
     assert (held[0].stop, held[1].start) == (300, 330)
     assert held[0].start < 60 and held[1].stop > 540  # their other ends still reach
+
+
+def test_a_quick_wave_beside_a_slow_one_is_looped_at_its_own_period_not_twice_it():
+    """A motion repeats at twice its period too: where a slow wave sets the period of the stretch, the quick wave
+    before it must still be looped at its own period."""
+    from mocycle.datasets import join_takes
+
+    fps = 30.0
+    takes = [synthetic_wave(n_frames=int(6 * fps), fps=fps, hand="right", wave_period_s=0.6, seed=4).motion,
+             synthetic_wave(n_frames=int(8 * fps), fps=fps, hand="right", wave_period_s=1.3, seed=5).motion]
+    s = join_takes(takes, ["wave", "wave"])
+    loops = segment_activities(s.motion).loopable()
+    assert len(loops) == 2
+    assert [round(p.period_frames / fps, 1) for p in loops] == [0.6, 1.3], [(p.start, p.stop, p.period_frames)
+                                                                          for p in loops]

@@ -105,6 +105,9 @@ IN_STEP = 0.1
 MIN_REPEAT_S = 0.25
 #: ... its frames repeat where they are like themselves a period later (repetition distance under this)
 ALIKE = 0.5
+#: ... at the shortest period their own frames repeat at: a region found at a period is looked at again at its
+#: own (shorter) period at most this many times (a motion repeats at twice its period too)
+PERIOD_REFINES = 2
 #: ... and move: at least this share of the largest local speed of those frames (not a gesture's stillness).
 BUSY_SHARE = 0.2
 
@@ -1198,9 +1201,12 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
     """Where ``joints`` repeat in ``piece``: ``(start, stop, period)`` from the velocity of their rotations
     (a wave's hand swings back and forth while the arm's raise and fall happen once): the period by windowed
     autocorrelation (paper 004), the frames where the take is like itself one period later
-    (:func:`~mocycle.phase.period.repetition_distance` under a half) and moves (at least a fifth of the largest
-    local speed among those frames: a big gesture beside a small wave does not hide it), their longest run.
-    ``None`` when it holds fewer than ``least`` periods."""
+    (:func:`~mocycle.phase.period.repetition_distance` under a half) and comes back to its poses
+    (:func:`_return_distance`) and moves (at least a fifth of the largest local speed among those frames: a big
+    gesture beside a small wave does not hide it), their longest run.  A motion repeats at twice its period
+    too, so where the run's own frames repeat at a shorter period than the piece's (a quick wave beside a slow
+    one), that period and its run are taken (:data:`ALIKE`, up to :data:`PERIOD_REFINES` times).  ``None``
+    when it holds fewer than ``least`` periods."""
 
     X, _ = pose_matrix(piece, rep="expmap", root_features="drop", joints=joints, normalize=False, weights=None)
     V = np.diff(X, axis=0)
@@ -1208,23 +1214,41 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
     if V.shape[0] < 2 * min_lag + 2:
         return None
     P = autocorrelation_period(V, min_lag=min_lag)
+    found = _run_at(X, V, P)
+    for _ in range(PERIOD_REFINES):
+        if found is None:
+            break
+        s, e = found
+        if e - s - 1 < 2 * min_lag + 2:
+            break
+        own = autocorrelation_period(V[s:e - 1], min_lag=min_lag)
+        if not (np.isfinite(own) and own < (1.0 - PERIOD_AGREEMENT) * P):
+            break
+        shorter = _run_at(X, V, own)
+        if shorter is None or (shorter[1] - shorter[0]) < least * own:
+            break
+        found, P = shorter, own
+    if found is None or (found[1] - found[0]) < least * P:
+        return None
+    return found[0], found[1], float(P)
+
+
+def _run_at(X: np.ndarray, V: np.ndarray, P: float) -> tuple[int, int] | None:
+    """The longest run of frames where poses ``X`` ``(T, D)`` (velocities ``V`` ``(T-1, D)``) repeat at period
+    ``P`` and move (:func:`_repeating_region`), as ``(start, stop)``; ``None`` where none do."""
     if not np.isfinite(P):
         return None
     w = max(3, int(round(P)))
     alike = (repetition_distance(V, P, smooth=w) < ALIKE) & (_return_distance(X[1:], P, w) < ALIKE)
-    energy = moving_average((V ** 2).sum(axis=1), w)
     if not alike.any():
         return None
+    energy = moving_average((V ** 2).sum(axis=1), w)
     busy = energy > BUSY_SHARE * energy[alike].max()
-    good = alike & busy
-    runs = _true_runs(good)
+    runs = _true_runs(alike & busy)
     if not runs:
         return None
     s, e = max(runs, key=lambda r: r[1] - r[0])
-    e = min(piece.n_frames, e + 1)  # velocities: frame e + 1 ends the last one (the smoothing already reaches w/2 out)
-    if (e - s) < least * P:
-        return None
-    return s, e, float(P)
+    return s, min(X.shape[0], e + 1)  # velocities: frame e + 1 ends the last one (the smoothing reaches w/2 out)
 
 
 def _return_distance(X: np.ndarray, period: float, w: int) -> np.ndarray:
