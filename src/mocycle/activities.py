@@ -77,7 +77,12 @@ FLIGHT_SHARE = 0.05
 #: keeps a foot down at every instant and both at each hand-over (double support; 20-55 % of a stride on the
 #: shared walks as the landings' heights see it, 0-8 % on their runs).
 DOUBLE_SUPPORT_SHARE = 0.12
-#: Where the feet cannot tell (neither flight nor double support), faster than this many body heights per second
+#: Feet that show both, a flight phase and double support each on at least this share of a stride, cannot tell:
+#: a run lands one foot after the other leaves (no double support at all on the shared runs with flight), a walk
+#: keeps a foot down (no flight); both at once are contacts a rig's floating feet make unsure (CMU takes on the
+#: iClone rig: 6-37 % "flight" and 4-12 % double support while walking).
+MIXED_SHARE = 0.03
+#: Where the feet cannot tell (neither flight nor double support, or both), faster than this many body heights per second
 #: is a run (people switch from walking to running at about 2 m/s, 1.1-1.2 body heights per second).
 RUN_SPEED = 1.25
 #: Frames without gait shorter than this many seconds are transitions, not looked at for another motion.
@@ -338,10 +343,11 @@ def _stride_figures(chain, landings, heading, path, fps):
 
 def gait_of(flight: float, double: float, speed: float, body: float) -> str:
     """``"walk"`` or ``"run"``, told by the feet: a flight phase (:data:`FLIGHT_SHARE`) without double support is
-    a run, double support (:data:`DOUBLE_SUPPORT_SHARE`) without flight a walk; where the feet show neither or
-    both (contacts a rig's floating feet make unsure) the speed decides (:data:`RUN_SPEED` body heights per
-    second)."""
-    flies, both = flight >= FLIGHT_SHARE, double >= DOUBLE_SUPPORT_SHARE
+    a run, double support (:data:`DOUBLE_SUPPORT_SHARE`) without flight a walk (neither on more than
+    :data:`MIXED_SHARE` of the stride); where the feet show neither or both (contacts a rig's floating feet make
+    unsure) the speed decides (:data:`RUN_SPEED` body heights per second)."""
+    flies = flight >= FLIGHT_SHARE and double < MIXED_SHARE
+    both = double >= DOUBLE_SUPPORT_SHARE and flight < MIXED_SHARE
     if flies != both:
         return "run" if flies else "walk"
     return "run" if speed > RUN_SPEED * body else "walk"
@@ -1114,8 +1120,9 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
         return found, _in_step(_foot_periods(steps, start + s, start + e, motion.fps), P)
 
     found, in_step = look(stepping)
-    if stepping and found is not None and not in_step:  # the feet do not see it repeat: as if they did not land
-        found, in_step = look(False)
+    if stepping and found is not None and not in_step and \
+            found[3][1] - found[3][0] < max(min_periods, MIN_REPEATS) * found[2].period_frames:
+        found, in_step = look(False)  # the feet do not see so few cycles repeat: looked at as if they did not land
     still = _legs_still(piece.skeleton, spread)
     if found is None:
         return [Activity(start=start, stop=stop, kind="gesture", limbs="none", legs_still=still,
@@ -1204,9 +1211,10 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
     (:func:`~mocycle.phase.period.repetition_distance` under a half) and comes back to its poses
     (:func:`_return_distance`) and moves (at least a fifth of the largest local speed among those frames: a big
     gesture beside a small wave does not hide it), their longest run.  A motion repeats at twice its period
-    too, so where the run's own frames repeat at a shorter period than the piece's (a quick wave beside a slow
-    one), that period and its run are taken (:data:`ALIKE`, up to :data:`PERIOD_REFINES` times).  ``None``
-    when it holds fewer than ``least`` periods."""
+    too, so where the run's own frames of named ``joints`` (an arm) repeat at a shorter period than the
+    piece's (a quick wave beside a slow one), that period and its run are taken (up to :data:`PERIOD_REFINES`
+    times; the whole body's period is the cohomology's to check).  ``None`` when it holds fewer than
+    ``least`` periods."""
 
     X, _ = pose_matrix(piece, rep="expmap", root_features="drop", joints=joints, normalize=False, weights=None)
     V = np.diff(X, axis=0)
@@ -1215,7 +1223,7 @@ def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, fl
         return None
     P = autocorrelation_period(V, min_lag=min_lag)
     found = _run_at(X, V, P)
-    for _ in range(PERIOD_REFINES):
+    for _ in range(PERIOD_REFINES if joints is not None else 0):
         if found is None:
             break
         s, e = found

@@ -141,6 +141,8 @@ def test_walk_and_run_are_told_by_their_feet():
     assert gait_of(flight=0.0, double=0.27, speed=2.0, body=1.0) == "walk"    # a fast walk: double support
     assert gait_of(flight=0.0, double=0.05, speed=2.0, body=1.0) == "run"     # the feet cannot tell: speed
     assert gait_of(flight=0.3, double=0.2, speed=0.5, body=1.0) == "walk"     # feet that say both: speed
+    assert gait_of(flight=0.11, double=0.08, speed=0.9, body=1.0) == "walk"   # floating feet (iClone walk): speed
+    assert gait_of(flight=0.11, double=0.0, speed=0.9, body=1.0) == "run"     # flight and no double support at all
     fast = synthetic_walk(n_frames=240, fps=60.0, period_s=0.55, noise_deg=0.5, seed=5).motion
     assert {p.kind for p in segment_activities(fast).loopable()} == {"walk straight"}
     run = synthetic_run(n_frames=240, fps=60.0, period_s=0.9, noise_deg=0.5, seed=6).motion
