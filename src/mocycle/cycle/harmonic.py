@@ -40,9 +40,19 @@ def harmonic_basis(x: np.ndarray, n_harmonics: int, derivative: int = 0, linear:
     Columns: ``1, sin(2 pi x), cos(2 pi x), ..., sin(2 pi K x), cos(2 pi K x)[, x]``.
     """
     x = np.asarray(x, dtype=np.float64).reshape(-1)
+    return _assemble(x, *_waves(x, n_harmonics), n_harmonics, derivative, linear)
+
+
+def _waves(x: np.ndarray, n_harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+    """``sin(2 pi k x)`` and ``cos(2 pi k x)`` ``(M, K)`` for ``k = 1 .. K``: what every design of ``x`` is made of."""
+    arg = np.outer(x, 2.0 * np.pi * np.arange(1, n_harmonics + 1))
+    return np.sin(arg), np.cos(arg)
+
+
+def _assemble(x: np.ndarray, s: np.ndarray, c: np.ndarray, n_harmonics: int, derivative: int,
+              linear: bool) -> np.ndarray:
+    """:func:`harmonic_basis` of ``x`` from its :func:`_waves` ``s``, ``c``."""
     w = 2.0 * np.pi * np.arange(1, n_harmonics + 1)
-    arg = np.outer(x, w)
-    s, c = np.sin(arg), np.cos(arg)
     cols = np.empty((x.size, 2 * n_harmonics + 1 + int(linear)))
     if derivative == 0:
         cols[:, 0] = 1.0
@@ -74,7 +84,8 @@ DESIGN_CACHE_BYTES = 64 * 2**20
 class _Designs:
     """Design matrices made recently, least recently used first out, at most ``budget`` bytes: each kept
     read-only under the bytes of its ``x`` and ``(K, derivative, linear)``, so a hit is the very matrix
-    :func:`harmonic_basis` makes for those."""
+    :func:`harmonic_basis` makes for those; beside them the :func:`_waves` of each ``x`` and ``K``, which the
+    designs of every derivative, with and without the linear term, are made from."""
 
     def __init__(self, budget: int):
         import threading
@@ -91,18 +102,33 @@ class _Designs:
             if B is not None:
                 self.kept.move_to_end(key)
                 return B
-        B = harmonic_basis(x, n_harmonics, derivative, linear)
+        if derivative not in (0, 1, 2):
+            raise MocycleError(f"derivative must be 0, 1 or 2; got {derivative!r}")
+        waves_key = (key[0], key[1])
+        with self.lock:
+            waves = self.kept.get(waves_key)
+            if waves is not None:
+                self.kept.move_to_end(waves_key)
+        if waves is None:
+            waves = _waves(x, n_harmonics)
+            self._keep(waves_key, waves, waves[0].nbytes + waves[1].nbytes)
+        B = _assemble(x, *waves, n_harmonics, derivative, linear)
         B.setflags(write=False)
-        size = B.nbytes + len(key[0])
-        if size <= self.budget:
-            with self.lock:
-                if key not in self.kept:
-                    self.kept[key] = B
-                    self.held += size
-                while self.held > self.budget:
-                    old_key, old = self.kept.popitem(last=False)
-                    self.held -= old.nbytes + len(old_key[0])
+        self._keep(key, B, B.nbytes)
         return B
+
+    def _keep(self, key: tuple, value, nbytes: int) -> None:
+        size = nbytes + len(key[0])
+        if size > self.budget:
+            return
+        with self.lock:
+            if key not in self.kept:
+                self.kept[key] = value
+                self.held += size
+            while self.held > self.budget:
+                old_key, old = self.kept.popitem(last=False)
+                self.held -= len(old_key[0]) + (old.nbytes if isinstance(old, np.ndarray) else
+                                                 old[0].nbytes + old[1].nbytes)
 
 
 _DESIGNS = _Designs(DESIGN_CACHE_BYTES)
