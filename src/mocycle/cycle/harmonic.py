@@ -23,6 +23,8 @@ take's velocities and accelerations need never be held whole.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .. import _validate, defaults
@@ -92,43 +94,45 @@ class _Designs:
         from collections import OrderedDict
 
         self.budget, self.held = budget, 0
-        self.kept: OrderedDict[tuple, np.ndarray] = OrderedDict()
+        self.kept: OrderedDict[tuple, tuple[Any, int]] = OrderedDict()  # key -> (value, bytes)
         self.lock = threading.Lock()  # a dask worker runs its tasks in threads
 
     def get(self, x: np.ndarray, n_harmonics: int, derivative: int, linear: bool) -> np.ndarray:
         key = (x.tobytes(), int(n_harmonics), int(derivative), bool(linear))
-        with self.lock:
-            B = self.kept.get(key)
-            if B is not None:
-                self.kept.move_to_end(key)
-                return B
+        B: np.ndarray | None = self._get(key)
+        if B is not None:
+            return B
         if derivative not in (0, 1, 2):
             raise MocycleError(f"derivative must be 0, 1 or 2; got {derivative!r}")
         waves_key = (key[0], key[1])
-        with self.lock:
-            waves = self.kept.get(waves_key)
-            if waves is not None:
-                self.kept.move_to_end(waves_key)
+        waves: tuple[np.ndarray, np.ndarray] | None = self._get(waves_key)
         if waves is None:
             waves = _waves(x, n_harmonics)
             self._keep(waves_key, waves, waves[0].nbytes + waves[1].nbytes)
-        B = _assemble(x, *waves, n_harmonics, derivative, linear)
+        B = _assemble(x, waves[0], waves[1], n_harmonics, derivative, linear)
         B.setflags(write=False)
         self._keep(key, B, B.nbytes)
         return B
 
-    def _keep(self, key: tuple, value, nbytes: int) -> None:
+    def _get(self, key: tuple) -> Any:
+        with self.lock:
+            hit = self.kept.get(key)
+            if hit is None:
+                return None
+            self.kept.move_to_end(key)
+            return hit[0]
+
+    def _keep(self, key: tuple, value: Any, nbytes: int) -> None:
         size = nbytes + len(key[0])
         if size > self.budget:
             return
         with self.lock:
             if key not in self.kept:
-                self.kept[key] = value
+                self.kept[key] = (value, size)
                 self.held += size
             while self.held > self.budget:
-                old_key, old = self.kept.popitem(last=False)
-                self.held -= len(old_key[0]) + (old.nbytes if isinstance(old, np.ndarray) else
-                                                 old[0].nbytes + old[1].nbytes)
+                _, (_, old) = self.kept.popitem(last=False)
+                self.held -= old
 
 
 _DESIGNS = _Designs(DESIGN_CACHE_BYTES)
