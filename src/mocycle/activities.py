@@ -82,8 +82,8 @@ DOUBLE_SUPPORT_SHARE = 0.12
 #: keeps a foot down (no flight); both at once are contacts a rig's floating feet make unsure (CMU takes on the
 #: iClone rig: 6-37 % "flight" and 4-12 % double support while walking).
 MIXED_SHARE = 0.03
-#: Where the feet cannot tell (neither flight nor double support, or both), faster than this many body heights per second
-#: is a run (people switch from walking to running at about 2 m/s, 1.1-1.2 body heights per second).
+#: Where the feet cannot tell (neither flight nor double support, or both), faster than this many body heights per
+#: second is a run (people switch from walking to running at about 2 m/s, 1.1-1.2 body heights per second).
 RUN_SPEED = 1.25
 #: Frames without gait shorter than this many seconds are transitions, not looked at for another motion.
 MIN_OTHER_S = 1.0

@@ -138,3 +138,22 @@ def test_n_harmonics_is_the_old_name_of_harmonics():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert HarmonicRegression(harmonics=4).harmonics == 4
+
+
+def test_kept_designs_are_harmonic_basis_and_stay_within_their_bound(monkeypatch):
+    from mocycle.cycle import harmonic as h
+
+    designs = h._Designs(budget=200_000)
+    monkeypatch.setattr(h, "_DESIGNS", designs)
+    rng = np.random.default_rng(4)
+    axes = [rng.uniform(-2.0, 5.0, n) for n in (37, 300, 301)]
+    for _ in range(3):  # hits and misses, evictions on the way
+        for x in axes:
+            for derivative in (0, 1, 2):
+                for linear in (False, True):
+                    B = h._design(x, 7, derivative, linear)
+                    assert not B.flags.writeable
+                    assert B.tobytes() == h.harmonic_basis(x, 7, derivative, linear).tobytes()
+                    assert designs.held <= designs.budget
+    with pytest.raises(MocycleError):
+        h._design(axes[0], 7, 3)

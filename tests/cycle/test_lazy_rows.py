@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import mocycle.cycle.extract as extract_module
+import mocycle.cycle.metric_rows as metric_rows_module
 from mocycle.cycle import extract_cycle, loop_metrics
 from mocycle.cycle.checks import _lag_differences, best_cut_error, loop_checks, moving_columns
 from mocycle.cycle.metric_rows import MetricRows, metric_features
@@ -22,9 +23,31 @@ def walk():
     return Motion(take.skeleton, q, take.translations, take.frame_time)
 
 
-@pytest.fixture(autouse=True)
-def small_blocks(monkeypatch):
+@pytest.fixture(autouse=True, params=["made as read", "kept"])
+def small_blocks(monkeypatch, request):
     monkeypatch.setattr(MetricRows, "BLOCK", 64)  # several blocks, the last one short
+    if request.param == "made as read":  # no motion's rows are kept: every read makes its blocks
+        monkeypatch.setattr(metric_rows_module, "KEPT_ROWS_BYTES", 0)
+
+
+def test_kept_rows_are_the_rows_made_as_read(walk, monkeypatch):
+    monkeypatch.setattr(metric_rows_module, "KEPT_ROWS_BYTES", 32 * 2**20)
+    kept = MetricRows(walk)
+    assert kept.kept is not None and not kept.kept.flags.writeable
+    monkeypatch.setattr(metric_rows_module, "KEPT_ROWS_BYTES", 0)
+    made = MetricRows(walk)
+    assert made.kept is None
+    index = np.array([3, 3, 0, 302, 64, 65, 200])
+    for a, b in ((kept, made), (kept.moving(), made.moving()), (kept.region(30, 333), made.region(30, 333))):
+        for key in (slice(0, None), slice(10, 150), index):
+            got, want = a[key], b[key]
+            assert got.flags.writeable  # a new array, laid out as the one made (the same rounding downstream)
+            assert (got.strides, got.flags.c_contiguous, got.flags.f_contiguous) == \
+                (want.strides, want.flags.c_contiguous, want.flags.f_contiguous)
+            assert got.tobytes() == want.tobytes()
+        assert np.array_equal(a.still(), b.still())
+        assert a.spread() == b.spread()
+        assert all(x.tobytes() == y.tobytes() for x, y in zip(a.column_blocks(), b.column_blocks(), strict=True))
 
 
 def test_metric_rows_are_the_metric_features(walk):

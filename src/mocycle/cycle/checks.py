@@ -66,14 +66,16 @@ class FailedCheck:
         return {"check": self.name, "value": self.value, "limit": self.limit, "reason": self.reason}
 
 
-def _plain_cut_error(Y: np.ndarray | MetricRows, period: float, differences: dict | None = None) -> tuple[float, int]:
+def _plain_cut_error(Y: np.ndarray | MetricRows, period: float, differences: dict | None = None,
+                     errors: dict | None = None) -> tuple[float, int]:
     """Template error of the best plain cut of ``Y (M, D)`` with a lag within :data:`CUT_SPAN` of ``period``.
 
     The cut is frames ``a .. a+lag-1`` between the two windows (a fifth of a period wide) that are most
     alike ``lag`` frames apart, as :func:`~mocycle.cycle.cut.cut_cycle` picks them, without its
     cross-fade.  Returns ``(error, lag)``; NaN error when the frames hold no such pair.  ``differences``:
     lag -> :func:`_lag_differences`, filled and reused across calls on the same ``Y`` (two period estimates
-    close together search the same lags).
+    close together search the same lags); ``errors``: ``(a, lag)`` -> the template error of that cut, likewise
+    (they often choose the same cut).
     """
     M = Y.shape[0]
     if not np.isfinite(period) or period < 2:
@@ -99,7 +101,10 @@ def _plain_cut_error(Y: np.ndarray | MetricRows, period: float, differences: dic
         return float("nan"), 0
     _, a, lag = best
     a = min(a, M - lag)
-    return template_error(Y, Y[a:a + lag])[0], lag
+    errors = {} if errors is None else errors
+    if (a, lag) not in errors:
+        errors[a, lag] = template_error(Y, Y[a:a + lag])[0]
+    return errors[a, lag], lag
 
 
 def _lag_differences(Y: np.ndarray, lag: int) -> np.ndarray:
@@ -140,8 +145,9 @@ def best_cut_error(motion: Motion, cycle: Cycle, reference: np.ndarray | None = 
                               if isinstance(Y, MetricRows) else autocorrelation_period(Y, min_lag=min_lag))
     best = (float("nan"), float("nan"))
     differences: dict = {}
+    errors: dict = {}
     for p in candidates:
-        err, lag = _plain_cut_error(Y, p, differences)
+        err, lag = _plain_cut_error(Y, p, differences, errors)
         if np.isfinite(err) and not err >= best[0]:
             best = (err, float(lag))
     return best

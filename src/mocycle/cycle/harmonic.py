@@ -23,6 +23,8 @@ take's velocities and accelerations need never be held whole.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .. import _validate, defaults
@@ -45,9 +47,19 @@ def harmonic_basis(x: np.ndarray, harmonics: int | None = None, derivative: int 
     if harmonics is None:
         raise TypeError("harmonic_basis() needs harmonics")
     x = np.asarray(x, dtype=np.float64).reshape(-1)
+    return _assemble(x, *_waves(x, harmonics), harmonics, derivative, linear)
+
+
+def _waves(x: np.ndarray, harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+    """``sin(2 pi k x)`` and ``cos(2 pi k x)`` ``(M, K)`` for ``k = 1 .. K``: what every design of ``x`` is made of."""
+    arg = np.outer(x, 2.0 * np.pi * np.arange(1, harmonics + 1))
+    return np.sin(arg), np.cos(arg)
+
+
+def _assemble(x: np.ndarray, s: np.ndarray, c: np.ndarray, harmonics: int, derivative: int,
+              linear: bool) -> np.ndarray:
+    """:func:`harmonic_basis` of ``x`` from its :func:`_waves` ``s``, ``c``."""
     w = 2.0 * np.pi * np.arange(1, harmonics + 1)
-    arg = np.outer(x, w)
-    s, c = np.sin(arg), np.cos(arg)
     cols = np.empty((x.size, 2 * harmonics + 1 + int(linear)))
     if derivative == 0:
         cols[:, 0] = 1.0
@@ -67,6 +79,73 @@ def harmonic_basis(x: np.ndarray, harmonics: int | None = None, derivative: int 
     else:
         raise MocycleError(f"derivative must be 0, 1 or 2; got {derivative!r}")
     return cols
+
+
+#: Bytes of design matrices :func:`_design` keeps (per process): a fit reads its designs three times over
+#: (cross products, the ordinary fits' residuals, the weighted fit's), the two curves of a cycle share
+#: their time axis, and the sines and cosines are most of a fit's arithmetic.  64 MB holds every design of
+#: a part of about 30,000 frames; a longer one's are made again as they are read, as without the cache.
+DESIGN_CACHE_BYTES = 64 * 2**20
+
+
+class _Designs:
+    """Design matrices made recently, least recently used first out, at most ``budget`` bytes: each kept
+    read-only under the bytes of its ``x`` and ``(K, derivative, linear)``, so a hit is the very matrix
+    :func:`harmonic_basis` makes for those; beside them the :func:`_waves` of each ``x`` and ``K``, which the
+    designs of every derivative, with and without the linear term, are made from."""
+
+    def __init__(self, budget: int):
+        import threading
+        from collections import OrderedDict
+
+        self.budget, self.held = budget, 0
+        self.kept: OrderedDict[tuple, tuple[Any, int]] = OrderedDict()  # key -> (value, bytes)
+        self.lock = threading.Lock()  # a dask worker runs its tasks in threads
+
+    def get(self, x: np.ndarray, harmonics: int, derivative: int, linear: bool) -> np.ndarray:
+        key = (x.tobytes(), int(harmonics), int(derivative), bool(linear))
+        B: np.ndarray | None = self._get(key)
+        if B is not None:
+            return B
+        if derivative not in (0, 1, 2):
+            raise MocycleError(f"derivative must be 0, 1 or 2; got {derivative!r}")
+        waves_key = (key[0], key[1])
+        waves: tuple[np.ndarray, np.ndarray] | None = self._get(waves_key)
+        if waves is None:
+            waves = _waves(x, harmonics)
+            self._keep(waves_key, waves, waves[0].nbytes + waves[1].nbytes)
+        B = _assemble(x, waves[0], waves[1], harmonics, derivative, linear)
+        B.setflags(write=False)
+        self._keep(key, B, B.nbytes)
+        return B
+
+    def _get(self, key: tuple) -> Any:
+        with self.lock:
+            hit = self.kept.get(key)
+            if hit is None:
+                return None
+            self.kept.move_to_end(key)
+            return hit[0]
+
+    def _keep(self, key: tuple, value: Any, nbytes: int) -> None:
+        size = nbytes + len(key[0])
+        if size > self.budget:
+            return
+        with self.lock:
+            if key not in self.kept:
+                self.kept[key] = (value, size)
+                self.held += size
+            while self.held > self.budget:
+                _, (_, old) = self.kept.popitem(last=False)
+                self.held -= old
+
+
+_DESIGNS = _Designs(DESIGN_CACHE_BYTES)
+
+
+def _design(x, harmonics: int, derivative: int = 0, linear: bool = False) -> np.ndarray:
+    """:func:`harmonic_basis`, read-only, kept for the next call with the same arguments (:data:`_DESIGNS`)."""
+    return _DESIGNS.get(np.asarray(x, dtype=np.float64).reshape(-1), harmonics, derivative, linear)
 
 
 def max_harmonics(n_rows: int, cycle_frames: int | None = None) -> int:
@@ -207,7 +286,7 @@ class HarmonicRegression:
         x, Y, xd, dY, ddY = self._check(x, Y, xd, dY, ddY)
         if self.model == "M1":
             return self.fit_blocks(_array_blocks(x, Y), _array_blocks(xd, dY, ddY))
-        P = harmonic_basis(x, self.harmonics, 0, self.linear)
+        P = _design(x, self.harmonics, 0, self.linear)
         still = np.all(Y == Y[:1], axis=0)
         if still.any():
             self._fit_moving(~still, P, xd, Y, dY, ddY)
@@ -247,7 +326,7 @@ class HarmonicRegression:
             if first is None:
                 first, moving = Y[0].copy(), np.zeros(Y.shape[1], dtype=bool)
             moving |= (Y != first).any(axis=0)
-            pos.add(harmonic_basis(x, K, 0, lin), Y)
+            pos.add(_design(x, K, 0, lin), Y)
         if pos.rows < p:
             raise MocycleError(f"K = {K} harmonics need at least {p} frames; got {pos.rows} "
                                f"(K <= {max_harmonics(pos.rows)})")
@@ -258,8 +337,8 @@ class HarmonicRegression:
                 continue
             if dY.shape[1] != D or ddY.shape[1] != D:
                 raise MocycleError("velocities and accelerations must have the columns of Y")
-            vel.add(harmonic_basis(xd, K, 1, lin), dY)
-            acc.add(harmonic_basis(xd, K, 2, lin), ddY)
+            vel.add(_design(xd, K, 1, lin), dY)
+            acc.add(_design(xd, K, 2, lin), ddY)
         if vel.rows < 2 * K:
             raise MocycleError(f"K = {K} harmonics need velocities on at least {2 * K} frames; got {vel.rows}")
         self._fit_fgls(positions, derivatives, pos, vel, acc)
@@ -286,10 +365,10 @@ class HarmonicRegression:
             if not x.size:
                 continue
             if coef2 is None:
-                B = harmonic_basis(x, K, 0, lin)
+                B = _design(x, K, 0, lin)
                 first = first + _column_sq_sums(B if cols is None else B[:, cols], coef, block[1])
             else:
-                V, A = harmonic_basis(x, K, 1, lin), harmonic_basis(x, K, 2, lin)
+                V, A = _design(x, K, 1, lin), _design(x, K, 2, lin)
                 first = first + _column_sq_sums(V if cols is None else V[:, cols], coef, block[1])
                 second = second + _column_sq_sums(A if cols2 is None else A[:, cols2], coef2, block[2])
         return first if coef2 is None else (first, second)
@@ -302,7 +381,7 @@ class HarmonicRegression:
             self.alpha_, self.gamma_ = np.zeros(D), np.zeros(D)
             self.sigma2_ = np.full((3, D), np.nan)
             return
-        V, A = harmonic_basis(xd, K, 1, lin), harmonic_basis(xd, K, 2, lin)
+        V, A = _design(xd, K, 1, lin), _design(xd, K, 2, lin)
         self.alpha_, self.gamma_ = np.ones(D), np.ones(D)  # M3 (M1 is fitted by fit_blocks)
         self.sigma2_ = np.full((3, D), np.nan)
         self.coef_ = np.linalg.lstsq(np.vstack([P, V, A]), np.vstack([Y, dY, ddY]), rcond=None)[0]
@@ -363,8 +442,8 @@ class HarmonicRegression:
         K, lin = self.harmonics, self.linear
         a = np.sqrt(self.alpha_ if self.model != "M2" else np.ones_like(self.alpha_))
         g = np.sqrt(self.gamma_ if self.model != "M2" else np.ones_like(self.gamma_))
-        rv = np.sqrt((a**2 * _column_sq_sums(harmonic_basis(xd, K, 1, lin), self.coef_, dY)).sum() / dY.shape[0])
-        ra = np.sqrt((g**2 * _column_sq_sums(harmonic_basis(xd, K, 2, lin), self.coef_, ddY)).sum() / ddY.shape[0])
+        rv = np.sqrt((a**2 * _column_sq_sums(_design(xd, K, 1, lin), self.coef_, dY)).sum() / dY.shape[0])
+        ra = np.sqrt((g**2 * _column_sq_sums(_design(xd, K, 2, lin), self.coef_, ddY)).sum() / ddY.shape[0])
         return np.array([rp, rv, ra])
 
     def predict(self, x, derivative: int = 0, drift: bool = True) -> np.ndarray:
@@ -374,7 +453,7 @@ class HarmonicRegression:
         """
         if not hasattr(self, "coef_"):
             raise MocycleError("fit the regression before predicting")
-        B = harmonic_basis(x, self.harmonics, derivative, self.linear)
+        B = _design(x, self.harmonics, derivative, self.linear)
         coef = self.coef_
         if self.linear and not drift:
             coef = coef.copy()

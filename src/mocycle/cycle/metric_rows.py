@@ -48,6 +48,25 @@ def _rotation_joints(skeleton) -> list[int]:
     return [j for j, channels in enumerate(skeleton.channels) if any(c in ROTATION_CHANNELS for c in channels)]
 
 
+#: A motion's whole ``(T, 9J)`` metric rows are made once and kept with it (:meth:`Motion.cache` ``"metric rows"``)
+#: when they take at most this many bytes (about 20,000 frames of a 22-joint rig): the metrics and the checks of
+#: one loop read them about eight times over.  A longer motion's are made block by block as they are read.
+KEPT_ROWS_BYTES = 32 * 2**20
+
+
+def _kept_rows(motion: Motion, joints: np.ndarray) -> np.ndarray | None:
+    """``metric_features(motion)`` (read-only), kept with the motion, or ``None`` above :data:`KEPT_ROWS_BYTES`."""
+    if not joints.size or motion.n_frames * 9 * joints.size * 8 > KEPT_ROWS_BYTES:
+        return None
+
+    def make(m: Motion) -> np.ndarray:
+        rows = metric_features(m)
+        rows.setflags(write=False)
+        return rows
+
+    return motion.cache("metric rows", make)
+
+
 class MetricRows:
     """``metric_features(motion, rows=region)[:, columns]`` made a block of rows (or of columns) at a time when
     read, never held whole: a long take's ``(T, 9J)`` array (158 MB for 100k frames of 22 joints) was the
@@ -59,7 +78,10 @@ class MetricRows:
     :meth:`column_blocks` feeds :func:`~mocycle.phase.period.autocorrelation_period_of_blocks`;
     :meth:`lag_differences` gives the squared row distances ``lag`` rows apart from the quaternions
     (``||R1 - R2||²/2 = 4 sin²(θ/2) = 4 (1 - (q1·q2)²)`` per moving joint, within 1e-15 of the largest of the
-    rows' own); :meth:`spread` the RMS distance of the rows from their mean row."""
+    rows' own); :meth:`spread` the RMS distance of the rows from their mean row.
+
+    A motion of up to :data:`KEPT_ROWS_BYTES` has its rows made once and kept (``kept``: the rows of every
+    rotation joint, ``metric_features``' numbers, which are each block's); the others' are made as read."""
 
     BLOCK = 8192
 
@@ -72,27 +94,30 @@ class MetricRows:
         self.columns = np.arange(9 * self.joints.size) if columns is None else np.asarray(columns, dtype=np.intp)
         self.shape = (self.quats.shape[0], int(self.columns.size))
         self.ndim = 2
+        kept = _kept_rows(motion, self.joints)
+        self.kept = None if kept is None else kept[region]
 
-    def _like(self, quats: np.ndarray, columns: np.ndarray | None) -> MetricRows:
+    def _like(self, quats: np.ndarray, columns: np.ndarray | None, kept: np.ndarray | None) -> MetricRows:
         out = object.__new__(MetricRows)
-        out.quats, out.joints, out.every = quats, self.joints, columns is None
+        out.quats, out.joints, out.every, out.kept = quats, self.joints, columns is None, kept
         out.columns = self.columns if columns is None else columns
         out.shape, out.ndim = (quats.shape[0], int(out.columns.size)), 2
         return out
 
     def region(self, start: int, stop: int) -> MetricRows:
         """Rows ``start:stop`` as another :class:`MetricRows` (nothing is made)."""
-        return self._like(self.quats[start:stop], None if self.every else self.columns)
+        return self._like(self.quats[start:stop], None if self.every else self.columns,
+                          None if self.kept is None else self.kept[start:stop])
 
     def select(self, keep: np.ndarray) -> MetricRows:
         """The columns where the boolean ``keep`` ``(n_columns,)`` is true."""
-        return self._like(self.quats, self.columns[np.asarray(keep, dtype=bool)])
+        return self._like(self.quats, self.columns[np.asarray(keep, dtype=bool)], self.kept)
 
     def still(self) -> np.ndarray:
         """``(n_columns,)`` True where a column holds one value on every row (``np.ptp(rows, axis=0) == 0``)."""
         lo = hi = None
         for r0 in range(0, self.shape[0], self.BLOCK):
-            raw = self._raw(self.quats[r0:r0 + self.BLOCK])
+            raw = self._rows(r0, r0 + self.BLOCK)
             lo = raw.min(axis=0) if lo is None else np.minimum(lo, raw.min(axis=0))
             hi = raw.max(axis=0) if hi is None else np.maximum(hi, raw.max(axis=0))
         if lo is None:
@@ -103,6 +128,10 @@ class MetricRows:
         """Without the still columns (:func:`~mocycle.cycle.checks.moving_columns`); itself when all move."""
         still = self.still()
         return self if not still.any() else self.select(~still)
+
+    def _rows(self, r0: int, r1: int) -> np.ndarray:
+        """All 9 entries per rotation joint of rows ``r0:r1``: the kept rows (a read-only view) or made now."""
+        return self.kept[r0:r1] if self.kept is not None else self._raw(self.quats[r0:r1])
 
     def _raw(self, quats: np.ndarray, joints: np.ndarray | None = None) -> np.ndarray:
         """All 9 entries per joint (of ``joints``, default every rotation joint) of the frames ``quats``."""
@@ -121,11 +150,15 @@ class MetricRows:
             r0, r1, _ = key.indices(self.shape[0])
             if r1 <= r0:
                 return np.empty((0, self.shape[1]))
+            if self.kept is not None:  # a new array, as when made
+                return self.kept[r0:r1].copy() if self.every else self.kept[r0:r1, self.columns]
             blocks = [self._raw(self.quats[a:min(r1, a + self.BLOCK)]) for a in range(r0, r1, self.BLOCK)]
             return self._pick(blocks[0] if len(blocks) == 1 else np.concatenate(blocks, axis=0))
         index = np.asarray(key)
         if index.ndim != 1 or index.dtype.kind not in "iu":
             raise TypeError("MetricRows reads a slice of rows or a 1-D array of row indices")
+        if self.kept is not None:
+            return self._pick(np.take(self.kept, index, axis=0))
         blocks = [self._raw(np.take(self.quats, index[a:a + self.BLOCK], axis=0))
                   for a in range(0, index.size, self.BLOCK)] or [np.empty((0, 9 * self.joints.size))]
         return self._pick(blocks[0] if len(blocks) == 1 else np.concatenate(blocks, axis=0))
@@ -137,6 +170,9 @@ class MetricRows:
         M, width = self.shape[0], column_block_width(self.shape[0])
         for c0 in range(0, self.shape[1], width):
             cols = self.columns[c0:c0 + width]
+            if self.kept is not None:
+                yield self.kept[:, cols]
+                continue
             ks = np.unique(cols // 9)  # the joints (positions in self.joints) these columns belong to
             local = np.searchsorted(ks, cols // 9) * 9 + cols % 9
             out = np.empty((M, cols.size))
