@@ -1,13 +1,13 @@
 """The CPU of looping parts, without the read and the cut (issue 38): what each part costs in the workers.
 
-    python benchmarks/part_work.py SESSION.bvh [--frames 40000] [--rounds 3] [--pieces FILE]
+    python benchmarks/part_work.py SESSION.bvh [--frames 40000] [--rounds 3] [--pieces FILE] [--out DIR]
 
 Reads the take's first ``--frames`` frames, cuts them into parts (``segment_activities``) and pickles every part
 that loops as the workers receive it (``cycle.parts.PartPiece``) to ``--pieces`` (reused when it exists, so
 that two codes are timed on the same pieces); then, ``--rounds`` times in this process, loops each piece as
 ``mocycle loop --part all --root motion`` does (``tasks.loop._loop_one``) and writes it as BVH into a fresh
 temporary folder, and prints the CPU seconds (``time.process_time``) of each stage summed over the pieces, and
-the best round.  BLAS runs one thread, as in the CLI (set before numpy loads).
+the best round.  ``--out``: the loops are written there instead (to compare two codes' files).  BLAS runs one thread, as in the CLI (set before numpy loads).
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=40_000)
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--pieces", default=None, help="pickle of the pieces (default: beside the session)")
+    parser.add_argument("--out", default=None, help="folder the loops are written to (default: a temporary one)")
     args = parser.parse_args()
 
     from mocycle.io import write
@@ -61,7 +62,9 @@ def main() -> None:
             spent[name] += time.process_time() - t
 
         t0 = time.process_time()
-        with tempfile.TemporaryDirectory() as folder:
+        if args.out:
+            os.makedirs(args.out, exist_ok=True)
+        with (contextlib.nullcontext(args.out) if args.out else tempfile.TemporaryDirectory()) as folder:
             for i, piece in enumerate(pieces):
                 try:
                     _, result, _, _ = _loop_one(piece, options, "part", timer)
