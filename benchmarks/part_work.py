@@ -7,7 +7,8 @@ that loops as the workers receive it (``cycle.parts.PartPiece``) to ``--pieces``
 that two codes are timed on the same pieces); then, ``--rounds`` times in this process, loops each piece as
 ``mocycle loop --part all --root motion`` does (``tasks.loop._loop_one``) and writes it as BVH into a fresh
 temporary folder, and prints the CPU seconds (``time.process_time``) of each stage summed over the pieces, and
-the best round.  ``--out``: the loops are written there instead (to compare two codes' files).  BLAS runs one thread, as in the CLI (set before numpy loads).
+the best round.  ``--out``: the loops are written there instead (to compare two codes' files).  BLAS runs one
+thread, as in the CLI (set before numpy loads).
 """
 
 from __future__ import annotations
