@@ -231,10 +231,7 @@ class Cycle:
         return {
             "period_frames": self.period_frames,
             "cycle_frames": self.n_frames,
-            "n_periods": self.n_periods,
-            "method": self.method,
-            "model": self.model,
-            "harmonics": self.harmonics,
+            **{name: getattr(self, name) for name in ("n_periods", "method", "model", "harmonics")},
             "time_axis": self.axis.method,
             "travel_per_cycle": self.drift[:3].tolist(),
             "turn_per_cycle_deg": float(np.degrees(self.drift[3])),

@@ -42,20 +42,8 @@ import numpy as np
 from ..errors import MocycleError, MotionFileError
 from ..limits import frame_time_problem
 from ..motion import Motion
-from ._nodes import (
-    DEFAULT_FPS,
-    MAX_FILE_BYTES,
-    NodeTRS,
-    choose_take,
-    default_take,
-    frame_times,
-    joint_names,
-    key_rate,
-    member_nodes,
-    motion_from_nodes,
-    skeleton_order,
-    unique_names,
-)
+from . import _nodes
+from ._nodes import DEFAULT_FPS, MAX_FILE_BYTES, NodeTRS
 from .fbx_scan import opened
 
 __all__ = ["DEFAULT_FPS", "fbx_takes", "read_fbx"]
@@ -151,7 +139,7 @@ def _load(path: Path):
 
 
 def _stack_names(stacks) -> list[str]:
-    return unique_names([s.name for s in stacks], prefix="take")
+    return _nodes.unique_names([s.name for s in stacks], prefix="take")
 
 
 def fbx_takes(path: str | os.PathLike) -> list[str]:
@@ -209,7 +197,7 @@ def regular_rate(times: np.ndarray) -> float | None:
     k = (times - times[0]) / step
     if not np.allclose(k, np.round(k), rtol=0, atol=1e-3):
         return None
-    return key_rate(step)  # a few keys far apart are authored keys, not one per frame: None
+    return _nodes.key_rate(step)  # a few keys far apart are authored keys, not one per frame: None
 
 
 class _Scene:
@@ -234,7 +222,7 @@ class _Scene:
         bones = [i for i, n in enumerate(self.nodes) if n.attrib_type == bone]
         if not bones:
             raise MotionFileError("no bones (LimbNode, Root or Limb nodes): nothing to read as a skeleton", path)
-        self.members = skeleton_order(self.parents, self.children, bones, path)
+        self.members = _nodes.skeleton_order(self.parents, self.children, bones, path)
         self.stacks = _owned(scene.anim_stacks)
         self.stack_names = _stack_names(self.stacks)
         settings = scene.settings
@@ -293,8 +281,8 @@ class _Scene:
         """The stack called ``take``, or without one the first that moves the skeleton (said in a warning when
         the file holds several takes)."""
         if take is not None or len(self.stacks) < 2:
-            return choose_take(self.stack_names, take, self.path, "take", "animation stack")
-        return default_take(self.stack_names, self.moves, self.path, "take", stacklevel=5)
+            return _nodes.choose_take(self.stack_names, take, self.path, "take", "animation stack")
+        return _nodes.default_take(self.stack_names, self.moves, self.path, "take", stacklevel=5)
 
     def still_leaves(self) -> set[int]:
         """The skeleton's leaf nodes that no take of the file moves."""
@@ -329,13 +317,13 @@ def read_fbx(path: str | os.PathLike, *, take: str | int | None = None, fps: flo
     ufbx = _import()
     ancestors, joints, jparents, T, rate, up, unit, name = _guarded(
         p, lambda scene: _read(_Scene(ufbx, scene, p), take, fps))
-    motion = motion_from_nodes(ancestors, joints, jparents, T, 1.0 / rate, p, up=up, metres_per_unit=unit)
+    motion = _nodes.motion_from_nodes(ancestors, joints, jparents, T, 1.0 / rate, p, up=up, metres_per_unit=unit)
     motion.cache("take", lambda _: name)  # the take read (mocycle info says which)
     return motion
 
 
 def _read(fs: _Scene, take, fps) -> tuple:
-    """The skeleton's nodes sampled at the frames of the take (:func:`member_nodes`), the frame count and rate,
+    """The skeleton's nodes sampled at the frames of the take (:func:`._nodes.member_nodes`), the frame count and rate,
     the file's declared vertical and unit, and the take's name: plain data, nothing of the binding."""
     p = fs.path
     stack = fs.choose(take)
@@ -364,10 +352,10 @@ def _read(fs: _Scene, take, fps) -> tuple:
             start, end = (max(start, begin), min(end, stop)) if all_times and min(end, stop) > max(start, begin) \
                 else (begin, stop)
     rate = float(rate or DEFAULT_FPS)
-    times = frame_times(start, end, rate, len(fs.members), p)
+    times = _nodes.frame_times(start, end, rate, len(fs.members), p)
     T = len(times)
 
-    names = joint_names([n.name for n in fs.nodes], fs.members)
+    names = _nodes.joint_names([n.name for n in fs.nodes], fs.members)
     still = fs.still_leaves()
     trs: dict[int, NodeTRS] = {}
 
@@ -390,5 +378,5 @@ def _read(fs: _Scene, take, fps) -> tuple:
         trs[i] = node
         return node
 
-    ancestors, joints, jparents = member_nodes(fs.members, fs.parents, node_trs)
+    ancestors, joints, jparents = _nodes.member_nodes(fs.members, fs.parents, node_trs)
     return ancestors, joints, jparents, T, rate, fs.up, fs.unit, None if stack is None else fs.stack_names[stack]

@@ -183,16 +183,9 @@ class PeriodicMotion:
         return gmm_cdf_remap(self.coords, n_components=n_components, random_state=random_state)
 
     def to_dict(self) -> dict:
-        return {
-            "birth": self.birth,
-            "death": self.death,
-            "persistence": self.persistence,
-            "period_frames": self.period_frames,
-            "period_s": self.period_s,
-            "n_periods": self.n_periods,
-            "excitation": [[int(s), int(e)] for s, e in self.excitation],
-            **self.provenance(),
-        }
+        figures = ("birth", "death", "persistence", "period_frames", "period_s", "n_periods")
+        return {**{name: getattr(self, name) for name in figures},
+                "excitation": [[int(s), int(e)] for s, e in self.excitation], **self.provenance()}
 
     def provenance(self) -> dict:
         """How the period was decided and on which joints (the JSON fields ``loop`` reports too)."""
