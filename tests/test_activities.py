@@ -293,3 +293,35 @@ def test_a_quick_wave_beside_a_slow_one_is_looped_at_its_own_period_not_twice_it
     assert len(loops) == 2
     assert [round(p.period_frames / fps, 1) for p in loops] == [0.6, 1.3], [(p.start, p.stop, p.period_frames)
                                                                           for p in loops]
+
+
+def _stooped(motion, degrees: float):
+    """``motion`` with the spine, neck and forearms bent ``degrees`` more about their x axis at every frame: the
+    same steps, tempo and speed, another posture (another take of the same walk)."""
+    from scipy.spatial.transform import Rotation
+
+    q = motion.rotations.copy()
+    for name in ("Spine", "Spine1", "Neck", "LeftForeArm", "RightForeArm"):
+        j = motion.skeleton.index(name)
+        q[:, j] = (Rotation.from_quat(q[:, j]) * Rotation.from_euler("x", degrees, degrees=True)).as_quat()
+    return motion.replace(rotations=q)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_two_takes_of_one_walk_in_another_posture_are_two_parts(seed):
+    """Two takes of a walk at one tempo and speed, whose landings run on through the join, differ in posture
+    only: the gait changes there (the strides' mean poses), and no loop holds more than half a stride of the
+    other take.  The same walk without the change of posture stays one part."""
+    from mocycle.datasets import join_takes
+
+    fps = 60.0
+    walk = synthetic_walk(n_frames=int(12 * fps), fps=fps, period_s=1.0, noise_deg=0.5, seed=seed).motion
+    same = join_takes([walk[:370], walk[360:]], ["walk", "walk"])
+    assert [(p.kind, p.start, p.stop) for p in segment_activities(same.motion).loopable()] == \
+        [("walk straight", 0, same.motion.n_frames)]
+    s = join_takes([walk[:370], _stooped(walk, 20.0)[360:]], ["walk", "walk"])
+    border = s.stretches[0][2]
+    loops = segment_activities(s.motion).loopable()
+    assert len(loops) == 2, [(p.kind, p.start, p.stop) for p in loops]
+    assert loops[0].stop - border <= 0.5 * loops[0].period_frames
+    assert border - loops[1].start <= 0.5 * loops[1].period_frames

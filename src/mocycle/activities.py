@@ -364,41 +364,113 @@ def _step_gaits(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
 
 
 #: How much the strides of a straight gait may change, over three strides before a landing against three after,
-#: and still be one gait: in period and speed (shares) and in flight and double support (shares of a stride),
-#: each as the scale of its change.  Where the root of the sum of the squared scaled changes passes
+#: and still be one gait: in period and speed (shares), in flight and double support (shares of a stride) and in
+#: posture (the stride's mean pose, :func:`_stride_poses`, as a share of the pose's swing within a stride: how bent
+#: the knees are and where the arms are carried, what tells one take of a walk from the next at the same tempo and
+#: speed), each as the scale of its change.  Where the root of the sum of the squared scaled changes passes
 #: GAIT_CHANGE and is STEADY_SIDES times the spread within either side (a step between two steady gaits, as
 #: where one take meets the next, not the ramp of a walk that starts from standing), the gait changes there.
-STRIDE_STEPS = {"period": 0.08, "speed": 0.15, "flight": 0.12, "double support": 0.15}
+STRIDE_STEPS = {"period": 0.08, "speed": 0.15, "flight": 0.12, "double support": 0.15, "pose": 0.5}
 GAIT_CHANGE, STEADY_SIDES = 1.25, 3.0
 
 
-def _gait_changes(strides: np.ndarray) -> set[int]:
+def _stride_poses(motion: Motion, frames: np.ndarray) -> np.ndarray | None:
+    """Per stride of a chain whose landings are at ``frames`` (landing k to landing k+2): its mean pose (the
+    joints' rotation vectors, no root) divided by the pose's swing over the chain's strides (the root of the
+    median total variance within a stride), ``(n, D)``; ``None`` without rotation channels."""
+    a, b = int(frames[0]), int(frames[-1])
+    try:
+        X, _ = pose_matrix(motion[a:b], rep="expmap", root_features="drop", normalize=False, weights=None)
+    except MocycleError:
+        return None
+    f = np.asarray(frames, dtype=np.intp) - a
+    lo, hi = f[:-2], f[2:]
+    sums = np.concatenate([np.zeros((1, X.shape[1])), np.cumsum(X, axis=0)])
+    squares = np.concatenate([np.zeros((1, X.shape[1])), np.cumsum(X * X, axis=0)])
+    n = (hi - lo)[:, None].astype(np.float64)
+    mean = (sums[hi] - sums[lo]) / n
+    var = np.maximum((squares[hi] - squares[lo]) / n - mean * mean, 0.0).sum(axis=1)
+    swing = float(np.sqrt(np.median(var)))
+    return mean / swing if swing > 0 else None
+
+
+def _gait_changes(strides: np.ndarray, poses: np.ndarray | None = None) -> set[int]:
     """The landings (indices into a chain's landings; a part boundary there starts a new part at that step)
     where a straight gait changes (:data:`STRIDE_STEPS`, :data:`GAIT_CHANGE`, :data:`STEADY_SIDES`): the
-    medians of up to three strides ending at the landing and three starting there differ; of neighbouring
-    candidates, the landing where they differ most.  Turning strides are left out: a turn slows a walk, and
-    the turn's own borders are cut by :func:`_turn_runs`."""
+    medians of up to three strides ending at the landing and three starting there differ (``poses``: the
+    strides' mean poses, :func:`_stride_poses`, a change of posture counting as one more figure); of
+    candidates two strides apart or less, the landing where they differ most, moved to the neighbouring
+    landing whose parts would be steadier (:func:`_steadiest_cut`).  Turning strides are left out: a turn
+    slows a walk, and the turn's own borders are cut by :func:`_turn_runs`."""
     n = strides.shape[0]
     scale = np.array([STRIDE_STEPS["period"], STRIDE_STEPS["speed"], STRIDE_STEPS["flight"],
                       STRIDE_STEPS["double support"]])
+    figures = strides[:, [0, 2, 3, 4]]
+
+    def sides(b):
+        """The strides before landing ``b`` and after it, their medians and the scale of a change; ``None``
+        where there are too few, or a stride turns."""
+        before, after = slice(max(0, b - 4), b - 1), slice(b, b + 3)
+        if b < 2 or b - 1 - before.start < 2 or min(n, after.stop) - b < 2 or \
+                np.abs(np.concatenate([strides[before, 1], strides[after, 1]])).max() > TURN_DEG:
+            return None
+        m0, m1 = np.median(figures[before], axis=0), np.median(figures[after], axis=0)
+        if not (m0[0] > 0 and m0[1] > 0):
+            return None
+        unit = np.array([m0[0], m0[1], 1.0, 1.0]) * scale  # period and speed relative, the shares absolute
+        return before, after, m0, m1, unit
+
     score = np.zeros(n + 2)
     for b in range(2, n):  # strides k <= b - 2 end by landing b; strides k >= b start there
-        before, after = strides[max(0, b - 4): b - 1], strides[b: b + 3]
-        if before.shape[0] < 2 or after.shape[0] < 2 or \
-                np.abs(np.concatenate([before[:, 1], after[:, 1]])).max() > TURN_DEG:
+        got = sides(b)
+        if got is None:
             continue
-        fb, fa = before[:, [0, 2, 3, 4]], after[:, [0, 2, 3, 4]]
-        m0 = np.median(fb, axis=0)
-        if not (m0[0] > 0 and m0[1] > 0):
+        before, after, m0, m1, unit = got
+        # spread: the median deviation, blind to the one stride a blend may spoil
+        d = [(m1 - m0) / unit, np.median(np.abs(figures[before] - m0), axis=0) / unit,
+             np.median(np.abs(figures[after] - m1), axis=0) / unit]
+        squares = [float(np.sum(x ** 2)) for x in d]
+        if poses is not None:
+            p0, p1 = np.median(poses[before], axis=0), np.median(poses[after], axis=0)
+            for k, x in enumerate((p1 - p0, np.median(np.linalg.norm(poses[before] - p0, axis=1)),
+                                   np.median(np.linalg.norm(poses[after] - p1, axis=1)))):
+                squares[k] += float(np.sum(np.square(x))) / STRIDE_STEPS["pose"] ** 2
+        change, within_b, within_a = np.sqrt(squares)
+        if change > GAIT_CHANGE and change > STEADY_SIDES * max(within_b, within_a):
+            score[b] = change
+    # of candidates two strides or less apart (four landings), the one where the gait differs most: a stride
+    # unlike the others (the one that blends two takes) enters the comparisons of the landings that far on
+    score = np.concatenate([score, np.zeros(2)])
+    found = {b for b in range(2, n) if score[b] > 0 and score[max(0, b - 4):b].max(initial=0.0) <= score[b]
+             and score[b] > score[b + 1:b + 5].max()}
+    return {_steadiest_cut(b, strides, poses) for b in found}
+
+
+def _steadiest_cut(b: int, strides: np.ndarray, poses: np.ndarray | None) -> int:
+    """Of landings ``b - 1 .. b + 1`` of a chain (its strides' figures ``strides``, :func:`_stride_figures`, and
+    mean poses ``poses``), where to cut a gait that changes about landing ``b``: a cut at landing ``c`` drops
+    the step from landing ``c`` to ``c + 1`` (the parts end at ``c`` and start at ``c + 1``), and the step that
+    holds the change spoils both strides across it; the cut whose parts' strides (two or three on either side)
+    deviate least from their medians (in the scales of :data:`STRIDE_STEPS`) is the one that drops it."""
+    n = strides.shape[0]
+    figures = strides[:, [0, 2, 3, 4]]
+    scale = np.array([STRIDE_STEPS["period"], STRIDE_STEPS["speed"], STRIDE_STEPS["flight"],
+                      STRIDE_STEPS["double support"]])
+    cost = {}
+    for c in (b - 1, b, b + 1):
+        before, after = slice(max(0, c - 4), c - 1), slice(c + 1, min(n, c + 4))
+        if min(before.stop - before.start, after.stop - after.start) < 2:  # one stride is always steady
             continue
-        unit = np.array([m0[0], m0[1], 1.0, 1.0]) * scale  # period and speed relative, the shares absolute
-        m1 = np.median(fa, axis=0)  # spread: the median deviation, blind to the one stride a blend may spoil
-        change, within_b, within_a = (float(np.sqrt(np.sum((d / unit) ** 2))) for d in
-                                      (m1 - m0, np.median(np.abs(fb - m0), axis=0),
-                                       np.median(np.abs(fa - m1), axis=0)))
-        within = max(within_b, within_a)
-        score[b] = change if change > GAIT_CHANGE and change > STEADY_SIDES * within else 0.0
-    return {b for b in range(2, n) if score[b] > 0 and score[b] >= score[b - 1] and score[b] > score[b + 1]}
+        deviation = 0.0
+        for side in (before, after):
+            m = np.median(figures[side], axis=0)
+            unit = np.array([abs(m[0]), abs(m[1]), 1.0, 1.0]) * scale + 1e-12
+            deviation += float(np.sum(np.abs(figures[side] - m) / unit))
+            if poses is not None:
+                deviation += float(np.sum(np.linalg.norm(poses[side] - np.median(poses[side], axis=0), axis=1))) \
+                    / STRIDE_STEPS["pose"]
+        cost[c] = deviation / ((before.stop - before.start) + (after.stop - after.start))
+    return min(cost, key=lambda c: (cost[c], abs(c - b))) if cost else b
 
 
 def stride_rate(heading: np.ndarray, period: float, start: int, stop: int) -> np.ndarray:
@@ -541,7 +613,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
             continue
         strides = _stride_figures(chain, landings, heading, path, fps)
         kinds = _step_gaits(strides, body)
-        cuts = _gait_changes(strides)
+        cuts = _gait_changes(strides, _stride_poses(motion, landings.frames[chain]))
         f = landings.frames[chain]
         i = 0
         while i < len(kinds):
@@ -866,11 +938,16 @@ def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
     under two strides, up to a stride on either side, so that a stride can be compared with the next):
     unlikeness under :data:`UNLIKE` where a stride or more of frames can be compared, under
     :data:`UNLIKE_ONE_STEP` where less can.  A part of two strides or more is judged on its own frames only:
-    in a session the frames beside it are another activity."""
+    in a session the frames beside it are another activity; so is a shorter one whose own frames compare a step
+    or more and are alike (the frames beside it are looked at only where its own cannot tell)."""
     P = part.period_frames
     if not (np.isfinite(P) and P >= 2):
         return False
     lag = int(round(P))
+    if lag / 2 <= part.n_frames - lag < lag:
+        X = _leg_features(motion, part.start, part.stop)
+        if X is not None and _unlike(X, lag) < UNLIKE_ONE_STEP:
+            return True
     reach = P if part.n_frames < 2 * P else 0
     lo, hi = max(0, int(part.start - reach)), min(motion.n_frames, int(np.ceil(part.stop + reach)))
     X = _leg_features(motion, lo, hi)
