@@ -325,3 +325,16 @@ def test_two_takes_of_one_walk_in_another_posture_are_two_parts(seed):
     assert len(loops) == 2, [(p.kind, p.start, p.stop) for p in loops]
     assert loops[0].stop - border <= 0.5 * loops[0].period_frames
     assert border - loops[1].start <= 0.5 * loops[1].period_frames
+
+
+def test_return_distance_stays_a_number_where_a_period_is_over_half_the_frames():
+    """Frames with no pose a period away on either side cannot be seen to come back; the others still can (a
+    stretch of 1.5 periods whose feet step in time needs them: it was all NaN, never alike)."""
+    from mocycle.activities import ALIKE, _return_distance
+
+    t = np.arange(60, dtype=np.float64)
+    X = np.column_stack([np.sin(2 * np.pi * t / 40), np.cos(2 * np.pi * t / 40)])
+    d = _return_distance(X, 40.0, 5)
+    assert np.all(np.isfinite(d))
+    assert np.all(d[:15] < ALIKE) and np.all(d[45:] < ALIKE)  # a period apart: the same pose
+    assert np.all(d[25:35] > ALIKE)  # nothing a period away

@@ -403,47 +403,63 @@ def _gait_changes(strides: np.ndarray, poses: np.ndarray | None = None) -> set[i
     landing whose parts would be steadier (:func:`_steadiest_cut`).  Turning strides are left out: a turn
     slows a walk, and the turn's own borders are cut by :func:`_turn_runs`."""
     n = strides.shape[0]
-    scale = np.array([STRIDE_STEPS["period"], STRIDE_STEPS["speed"], STRIDE_STEPS["flight"],
-                      STRIDE_STEPS["double support"]])
-    figures = strides[:, [0, 2, 3, 4]]
-
-    def sides(b):
-        """The strides before landing ``b`` and after it, their medians and the scale of a change; ``None``
-        where there are too few, or a stride turns."""
-        before, after = slice(max(0, b - 4), b - 1), slice(b, b + 3)
-        if b < 2 or b - 1 - before.start < 2 or min(n, after.stop) - b < 2 or \
-                np.abs(np.concatenate([strides[before, 1], strides[after, 1]])).max() > TURN_DEG:
-            return None
-        m0, m1 = np.median(figures[before], axis=0), np.median(figures[after], axis=0)
-        if not (m0[0] > 0 and m0[1] > 0):
-            return None
-        unit = np.array([m0[0], m0[1], 1.0, 1.0]) * scale  # period and speed relative, the shares absolute
-        return before, after, m0, m1, unit
-
-    score = np.zeros(n + 2)
-    for b in range(2, n):  # strides k <= b - 2 end by landing b; strides k >= b start there
-        got = sides(b)
-        if got is None:
-            continue
-        before, after, m0, m1, unit = got
-        # spread: the median deviation, blind to the one stride a blend may spoil
-        d = [(m1 - m0) / unit, np.median(np.abs(figures[before] - m0), axis=0) / unit,
-             np.median(np.abs(figures[after] - m1), axis=0) / unit]
-        squares = [float(np.sum(x ** 2)) for x in d]
-        if poses is not None:
-            p0, p1 = np.median(poses[before], axis=0), np.median(poses[after], axis=0)
-            for k, x in enumerate((p1 - p0, np.median(np.linalg.norm(poses[before] - p0, axis=1)),
-                                   np.median(np.linalg.norm(poses[after] - p1, axis=1)))):
-                squares[k] += float(np.sum(np.square(x))) / STRIDE_STEPS["pose"] ** 2
-        change, within_b, within_a = np.sqrt(squares)
-        if change > GAIT_CHANGE and change > STEADY_SIDES * max(within_b, within_a):
-            score[b] = change
+    score = np.zeros(n + 6)
+    score[3:n - 1] = _change_scores(strides, poses)  # landings 3 .. n-2: two strides or more on either side
     # of candidates two strides or less apart (four landings), the one where the gait differs most: a stride
     # unlike the others (the one that blends two takes) enters the comparisons of the landings that far on
-    score = np.concatenate([score, np.zeros(2)])
     found = {b for b in range(2, n) if score[b] > 0 and score[max(0, b - 4):b].max(initial=0.0) <= score[b]
              and score[b] > score[b + 1:b + 5].max()}
     return {_steadiest_cut(b, strides, poses) for b in found}
+
+
+def _windows(values: np.ndarray) -> np.ndarray:
+    """Windows of three strides ``(n, ..., 3)``: window ``k`` holds strides ``k-1 .. k+1`` of ``values (n, ...)``,
+    NaN where they do not exist (the first and last window hold two)."""
+    pad = np.full((1, *values.shape[1:]), np.nan)
+    return np.lib.stride_tricks.sliding_window_view(np.concatenate([pad, values, pad]), 3, axis=0)
+
+
+def _median3(windows: np.ndarray) -> np.ndarray:
+    """The median over the last axis of windows of three values, a NaN among them left out (as
+    ``np.nanmedian``, without its slow path): the middle value, or the mean of the two."""
+    s = np.sort(windows, axis=-1)  # a NaN sorts last
+    return np.where(np.isnan(s[..., 2]), (s[..., 0] + s[..., 1]) / 2, s[..., 1])
+
+
+def _change_scores(strides: np.ndarray, poses: np.ndarray | None) -> np.ndarray:
+    """For landings ``3 .. n-2`` of a chain of ``n`` strides (:func:`_gait_changes`), the size of the change
+    between the strides before the landing (up to three, ending there) and after it (up to three, starting
+    there) where it passes :data:`GAIT_CHANGE` and :data:`STEADY_SIDES` times the spread within either side,
+    else 0 (and 0 where a stride of either side turns): ``(n - 4,)``."""
+    n = strides.shape[0]
+    if n < 5:
+        return np.zeros(max(0, n - 4))
+    scale = np.array([STRIDE_STEPS["period"], STRIDE_STEPS["speed"], STRIDE_STEPS["flight"],
+                      STRIDE_STEPS["double support"]])
+    landing = np.arange(3, n - 1)  # strides landing-4 .. landing-2 end by it, landing .. landing+2 start there
+    before, after = landing - 3, landing + 1  # their windows (:func:`_windows`)
+    figures = _windows(strides[:, [0, 2, 3, 4]])
+    turns = np.nan_to_num(_windows(np.abs(strides[:, 1])))
+    m0 = _median3(figures[before])
+    m1 = _median3(figures[after])
+    unit = np.column_stack([m0[:, 0], m0[:, 1], np.ones_like(m0[:, :2])]) * scale  # period, speed relative
+    with np.errstate(invalid="ignore", divide="ignore"):
+        # spread: the median deviation, blind to the one stride a blend may spoil
+        squares = [np.sum(((m1 - m0) / unit) ** 2, axis=1),
+                   np.sum((_median3(np.abs(figures[before] - m0[..., None])) / unit) ** 2, axis=1),
+                   np.sum((_median3(np.abs(figures[after] - m1[..., None])) / unit) ** 2, axis=1)]
+        if poses is not None:
+            shapes = _windows(poses)
+            p0, p1 = _median3(shapes[before]), _median3(shapes[after])
+            squares[0] = squares[0] + np.sum((p1 - p0) ** 2, axis=1) / STRIDE_STEPS["pose"] ** 2
+            for k, (side, m) in enumerate(((before, p0), (after, p1)), start=1):
+                spread = _median3(np.linalg.norm(shapes[side] - m[..., None], axis=1))
+                squares[k] = squares[k] + spread ** 2 / STRIDE_STEPS["pose"] ** 2
+        change, within_b, within_a = (np.sqrt(x) for x in squares)
+        turning = np.maximum(turns[before].max(axis=-1), turns[after].max(axis=-1)) > TURN_DEG
+        ok = ~turning & (m0[:, 0] > 0) & (m0[:, 1] > 0) & (change > GAIT_CHANGE) & \
+            (change > STEADY_SIDES * np.maximum(within_b, within_a))
+    return np.where(ok, change, 0.0)
 
 
 def _steadiest_cut(b: int, strides: np.ndarray, poses: np.ndarray | None) -> int:
@@ -604,7 +620,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     for chain in _gait_chains(landings, fps, least=2):
         stepped.append(chain)
         a, b = int(landings.frames[chain[0]]), int(landings.frames[chain[-1]])
-        if _legs_still(motion.skeleton, _rotation_spread(motion[a:b + 1])):
+        if _legs_stand(motion, a, b + 1):
             continue  # contacts that flicker while the legs stand are no steps
         if chain.size == 2:  # one step: a take (or a part) of little more than a stride
             short = _one_step_part(motion, chain, landings, heading, path, body)
@@ -718,7 +734,7 @@ def _or_one_cycle(motion: Motion, parts: list[Activity], landings: Landings | No
             gait = gait_of(float(np.mean(down == 0)), float(np.mean(down >= 2)), speed, _body_height(motion))
             way = "straight" if abs(turn) <= TURN_DEG else ("turning left" if turn > 0 else "turning right")
             kind, limbs = f"{gait} {way}", "legs"
-    if kind == "periodic" and _legs_still(motion.skeleton, _rotation_spread(motion)):
+    if kind == "periodic" and _legs_stand(motion, 0, motion.n_frames):
         kind = "arms"
     closing = period == T - 1
     why = (f"the take is one cycle of {period} frames: its last frame repeats its first (a closing frame), looped "
@@ -1253,11 +1269,23 @@ def _stepping_part(motion: Motion, start: int, stop: int, pm: PeriodicMotion, st
 
 def _rotation_spread(motion: Motion) -> np.ndarray:
     """Each joint's rotation spread ``(J,)`` in degrees: the RMS angle of its rotations from their mean."""
+    return _spread_of(motion.rotations)
 
-    q = motion.rotations
+
+def _spread_of(q: np.ndarray) -> np.ndarray:
+    """:func:`_rotation_spread` of quaternions ``q (T, J, 4)``."""
     mean = mean_rotations(q)
     ang = quat_angles(q, np.broadcast_to(mean, q.shape))
     return np.degrees(np.sqrt(np.mean(ang ** 2, axis=0)))
+
+
+def _legs_stand(motion: Motion, start: int, stop: int) -> bool:
+    """:func:`_legs_still` over frames ``start .. stop-1``, the spread measured on the leg joints only."""
+    try:
+        legs = motion.skeleton.select("legs")
+    except MocycleError:
+        return True
+    return not legs or float(_spread_of(motion.rotations[start:stop, legs]).max()) < 2 * STILL_DEG
 
 
 def _moving_arm_joints(skeleton, spread: np.ndarray) -> list[str]:
@@ -1350,7 +1378,9 @@ def _return_distance(X: np.ndarray, period: float, w: int) -> np.ndarray:
     square = np.stack([moving_average(X[:, d] ** 2, w) for d in range(X.shape[1])], axis=1)
     spread = np.maximum((square - mean ** 2).sum(axis=1), 1e-12)
     step = ((X[P:] - X[:-P]) ** 2).sum(axis=1)
-    d = np.full((2, T), np.inf)
+    # a frame with no pose a period away on either side (a period over half the frames) cannot be seen to come
+    # back: far from alike, and finite, so that the running mean stays a number
+    d = np.full((2, T), 2.0 * w / ALIKE)
     d[0, :-P] = step / (2.0 * spread[:-P])
     d[1, P:] = step / (2.0 * spread[P:])
     return moving_average(d.min(axis=0), w)
