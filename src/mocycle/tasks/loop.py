@@ -142,16 +142,20 @@ def run(take, options: Options | None = None, *, deliver=None) -> Report:
         pool = _pool(o, motion.n_frames)
         if pool is not None:
             stack.enter_context(pool)  # shut down when the loops are done, or the take refused
+        client = _client(o)
+        if client is not None:
+            stack.enter_context(client)
         with rec.part("parts"):
             acts = segment_activities(motion, min_periods=o.min_periods, joints=o.joints, classes=o.classes,
                                       pca=o.pca, delay=o.delay, step=o.step,
-                                      map=map if pool is None else partial(pool.map, chunksize=1))
+                                      map=partial(pool.map, chunksize=1) if pool is not None else
+                                      map if client is None else partial(_cluster_map, client))
         parts = acts.parts
         loops, not_looped, motions, cycles, extras, refusals = [], [], {}, [], {}, []
         tried = parts_to_try(acts, o.which)
         jobs = (_Job(part_piece(motion, acts, k), o, label, f"loop.part{k}" if everything else "loop", start,
                      deliver) for k in tried)
-        for out in _outcomes(jobs, o, tried, pool):
+        for out in _outcomes(jobs, tried, pool, client):
             for text in out.warnings:  # in part order, whichever process made them
                 warnings.warn(text, MocycleWarning, stacklevel=2)
             for name, seconds in out.timings.items():
@@ -300,17 +304,33 @@ def _pool(o: Options, n_frames: int):
                                mp_context=multiprocessing.get_context("fork" if "fork" in methods else "spawn"))
 
 
-def _outcomes(jobs, o: Options, tried: list[int], pool):
-    """Each part's :class:`_Outcome`, in the order of ``tried``: one after another, on the local ``pool``, or on
-    the dask cluster at ``o.scheduler``, each sent its part's frames only."""
-    if o.scheduler is not None and o.which == "all" and len(tried) > 1:
-        from distributed import Client
+def _client(o: Options):
+    """A dask client of the cluster at ``o.scheduler`` for ``loop --part all`` (``None`` without one): the
+    stretches the cut looks at one by one and the parts are sent there, each with its own frames."""
+    if o.scheduler is None or o.which != "all":
+        return None
+    from distributed import Client
 
-        with Client(o.scheduler, timeout="30s") as client:
-            futures = [client.submit(_outcome, job, pure=False) for job in jobs]
-            for future in futures:  # in part order, each as soon as it and those before are done
-                yield future.result()
-                future.release()
+    return Client(o.scheduler, timeout="30s")
+
+
+def _cluster_map(client, fn, items) -> list:
+    """``map(fn, items)`` on the dask cluster of ``client``, the results in the order of ``items``."""
+    futures = client.map(fn, list(items), pure=False)
+    try:
+        return client.gather(futures)
+    finally:
+        client.cancel(futures)
+
+
+def _outcomes(jobs, tried: list[int], pool, client):
+    """Each part's :class:`_Outcome`, in the order of ``tried``: one after another, on the local ``pool``, or on
+    the dask cluster of ``client``, each sent its part's frames only."""
+    if client is not None and len(tried) > 1:
+        futures = [client.submit(_outcome, job, pure=False) for job in jobs]
+        for future in futures:  # in part order, each as soon as it and those before are done
+            yield future.result()
+            future.release()
         return
     if pool is None or len(tried) < 2:
         yield from map(_outcome, jobs)
