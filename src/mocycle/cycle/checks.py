@@ -90,6 +90,7 @@ def _plain_cut_error(Y: np.ndarray | MetricRows, period: float, differences: dic
     for lag in lags:
         lag = int(lag)
         if lag not in differences:
+            assert isinstance(Y, np.ndarray)  # a MetricRows' lags were all made above
             differences[lag] = _lag_differences(Y, lag)
         d = differences[lag]
         if d.size < 2 * h + 1:
