@@ -271,6 +271,25 @@ class CycleSpace:
         return Motion(self.skeleton, quats, self.static_translations, self.frame_time, tracks=self.tracks(P, L),
                       copy=False)
 
+    def decode_repeated(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray, quats: np.ndarray,
+                        count: int) -> Motion:
+        """:meth:`decode` of ``P (N, n_periodic)`` repeated ``count`` times on the path ``L (count * N, 4)``, the
+        same Motion, from ``projected`` (:meth:`project` of ``P``, ``(N, J, 3, 3)``) and its quaternions ``quats``
+        ``(N, J, 4)`` (:func:`~mocycle.rotations.matrix_quats` of it): every joint but the travel joint has the
+        same rotations in every repeat, so only the travel joint's, turned to each frame's heading, are
+        converted (each matrix's quaternion depends on that matrix alone)."""
+        N, J, travel = P.shape[0], self.n_joints, self.travel
+        if L.shape != (count * N, self.n_drifting) or projected.shape != (N, J, 3, 3) or quats.shape != (N, J, 4):
+            raise MocycleError(f"expected L ({count * N}, 4), projected ({N}, {J}, 3, 3) and quats ({N}, {J}, 4); "
+                               f"got {L.shape}, {projected.shape}, {quats.shape}")
+        # the travel joint's matrices laid out as decode's (a view of the repeated (count N, J, 3, 3) array)
+        tiled = projected if count == 1 else np.tile(projected, (count, 1, 1, 1))
+        q = np.tile(quats, (count, 1, 1))
+        q[:, travel] = matrix_quats(self.heading_rotations(L) @ tiled[:, travel])
+        P = P if count == 1 else np.tile(P, (count, 1))
+        return Motion(self.skeleton, continuous_quats(q, inplace=True), self.static_translations, self.frame_time,
+                      tracks=self.tracks(P, L), copy=False)
+
 
 class EncodedRows:
     """The rows of :meth:`CycleSpace.encode`'s ``P`` made when read: ``rows[a:b]`` (a slice of frames) is
