@@ -411,8 +411,9 @@ def svd_nearest_rotations(M: np.ndarray) -> np.ndarray:
     return U @ Vt
 
 
-def nearest_rotations(M: np.ndarray) -> np.ndarray:
-    """Project ``(..., 3, 3)`` matrices onto the nearest rotations (Frobenius, determinant +1).
+def nearest_rotations(M: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """Project ``(..., 3, 3)`` matrices onto the nearest rotations (Frobenius, determinant +1); ``out``: a
+    C-contiguous float64 array of ``M``'s shape to write them into (returned), e.g. rows of the caller's.
 
     Matrices that are already nearly rotations (``|XᵀX - I|`` under :data:`NEAR_ORTHOGONAL` entry by entry,
     ``det > 0``: a harmonic fit of rotation matrices, a blend of nearby rotations) take Newton–Schulz
@@ -426,14 +427,18 @@ def nearest_rotations(M: np.ndarray) -> np.ndarray:
     """
     M = np.asarray(M, dtype=np.float64)
     flat = M.reshape(-1, 9)
-    out = np.empty(flat.shape)
+    if out is None:
+        out = np.empty(M.shape)
+    elif out.shape != M.shape or out.dtype != np.float64 or not out.flags.c_contiguous:
+        raise ValueError(f"out must be a C-contiguous float64 array of shape {M.shape}")
+    written = out.reshape(-1, 9)  # a view: out is contiguous
     for b in range(0, flat.shape[0], _NEAREST_BLOCK):
         block = flat[b:b + _NEAREST_BLOCK]
-        rows = out[b:b + _NEAREST_BLOCK]
+        rows = written[b:b + _NEAREST_BLOCK]
         near = _newton_schulz(block, rows)
         if not near.all():
             rows[~near] = fast_nearest_rotation(block[~near].reshape(-1, 3, 3)).reshape(-1, 9)
-    return out.reshape(M.shape)
+    return out
 
 
 #: matrices per block of :func:`nearest_rotations` (1.3-1.5x faster than one block of 50 000 near-rotations)

@@ -196,7 +196,7 @@ class CycleSpace:
         M = P[:, : 9 * J].reshape(N, J, 3, 3)
         still = np.all(P[:, : 9 * J] == P[:1, : 9 * J], axis=0).reshape(J, 9).all(axis=1) if N > 1 \
             else np.zeros(J, dtype=bool)
-        R = np.empty_like(M)
+        R = np.empty(M.shape)
         if still.any():
             R[:, still] = nearest_rotations(M[0, still])
         moving = np.flatnonzero(~still)
@@ -205,7 +205,7 @@ class CycleSpace:
         rows = max(1, PROJECT_MATRICES // max(1, moving.size))
         for r in range(0, N, rows):
             if moving.size == J:
-                R[r:r + rows] = nearest_rotations(M[r:r + rows])
+                nearest_rotations(M[r:r + rows], out=R[r:r + rows])  # rows of R: contiguous
             elif moving.size:  # take: a contiguous copy, unlike M[:, moving]
                 R[r:r + rows, moving] = nearest_rotations(np.take(M[r:r + rows], moving, axis=1))
         return R
