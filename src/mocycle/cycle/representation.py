@@ -143,9 +143,10 @@ class CycleSpace:
         width = int(max(1, min(round(period), psi.size)))
         return line + moving_average(psi - line, width)
 
-    def straighten(self, L: np.ndarray, period: float) -> np.ndarray:
+    def straighten(self, L: np.ndarray, period: float, trend: np.ndarray | None = None) -> np.ndarray:
         """``L (T, 4)`` with its path straightened: step ``t`` turned back by the heading trend's change
-        since the first frame (:meth:`heading_trend`, ``period`` in frames).
+        since the first frame (:meth:`heading_trend`, ``period`` in frames; ``trend``: ``heading_trend(L[:, 3],
+        period)`` when the caller has it).
 
         The vertical component and the heading are kept; the first frame stays where it is.  A walk along
         a circle becomes a straight walk (periodic plus a line), which the cycle models can fit; a walk
@@ -154,7 +155,7 @@ class CycleSpace:
         L = np.asarray(L, dtype=np.float64)
         if L.shape[0] < 2:
             return L.copy()
-        trend = self.heading_trend(L[:, 3], period)
+        trend = self.heading_trend(L[:, 3], period) if trend is None else trend
         mid = 0.5 * (trend[1:] + trend[:-1])
         steps = self._turned(np.diff(L[:, :3], axis=0), trend[0] - mid)
         out = L.copy()
