@@ -120,6 +120,21 @@ def test_nearest_rotations_match_the_svd_without_it():
     assert nearest_rotations(np.zeros((0, 3, 3))).shape == (0, 3, 3)
 
 
+
+def test_nearest_rotations_into_the_callers_rows():
+    from mocycle.rotations import nearest_rotations
+
+    rng = np.random.default_rng(8)
+    M = Rotation.random(300, random_state=9).as_matrix().reshape(100, 3, 3, 3)
+    M = M + 0.02 * rng.normal(size=M.shape)
+    M[5, 1] *= -1.0  # det -1: the SVD writes this one
+    R = np.full((120, 3, 3, 3), np.nan)
+    assert nearest_rotations(M, out=R[10:110]) is not None
+    np.testing.assert_array_equal(R[10:110], nearest_rotations(M))
+    assert np.isnan(R[:10]).all() and np.isnan(R[110:]).all()
+    with pytest.raises(ValueError, match="C-contiguous"):
+        nearest_rotations(M, out=R[:100, :, :, :].swapaxes(0, 1))
+
 def test_matrix_quats_and_mean_rotations_match_scipy():
     from mocycle.rotations import matrix_quats, mean_rotations
 

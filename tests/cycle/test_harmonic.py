@@ -66,6 +66,26 @@ def test_batched_fgls_equals_one_weighted_least_squares_per_dof():
         assert np.allclose(fit.coef_[:, j], np.linalg.lstsq(B, t, rcond=None)[0], atol=1e-7)
 
 
+
+@pytest.mark.parametrize("rows", [8192, 64])  # one block (its factors shared), several (the first block's shared)
+def test_fits_sharing_their_designs_factors_are_the_fits_alone(rows):
+    from mocycle.cycle.harmonic import _array_blocks
+
+    x, _, Yn, xd, dY, ddY, _ = _curves(noise=0.02, seed=5)
+    _, _, Zn, _, dZ, ddZ, _ = _curves(noise=0.03, seed=6)
+    alone = [HarmonicRegression(7, "M1", linear=linear).fit_blocks(_array_blocks(x, Y, rows=rows),
+                                                                    _array_blocks(xd, d, dd, rows=rows))
+             for linear, Y, d, dd in ((False, Yn, dY, ddY), (False, Zn, dZ, ddZ), (True, Zn, dZ, ddZ))]
+    shared: dict = {}
+    together = [HarmonicRegression(7, "M1", linear=linear).fit_blocks(_array_blocks(x, Y, rows=rows),
+                                                                       _array_blocks(xd, d, dd, rows=rows),
+                                                                       shared=shared)
+                for linear, Y, d, dd in ((False, Yn, dY, ddY), (False, Zn, dZ, ddZ), (True, Zn, dZ, ddZ))]
+    assert len(shared) == 6  # the first blocks' three designs, each with and without the linear term
+    for a, b in zip(alone, together, strict=True):
+        for name in ("coef_", "alpha_", "gamma_", "sigma2_", "rmse_"):
+            np.testing.assert_array_equal(getattr(b, name), getattr(a, name))
+
 def test_derivative_bases_are_the_derivatives():
     x = np.linspace(0, 2, 101)
     h = 1e-6

@@ -70,6 +70,27 @@ def test_metric_rows_are_the_metric_features(walk):
                                    rtol=1e-9, atol=1e-13)
 
 
+
+def _one_lag(q: np.ndarray, lag: int) -> np.ndarray:
+    """The squared distances of rows ``lag`` apart as made one lag at a time (before issue 38's runs of lags)."""
+    cos = np.einsum("tjk,tjk->tj", q[:q.shape[0] - lag], q[lag:])
+    return 4.0 * (q.shape[1] - np.einsum("tj,tj->t", cos, cos))
+
+
+@pytest.mark.parametrize("joints", ["every", "some"])
+def test_lags_made_together_are_each_lag_made_alone(walk, joints):
+    rows = MetricRows(walk).moving()
+    q = walk.rotations
+    if joints == "some":  # columns of joints 1, 2 and 5 only: the others' quaternions are left out
+        rows = rows.select(np.isin(rows.columns // 9, [1, 2, 5]))
+        q = np.take(q, rows.joints[[1, 2, 5]], axis=1)
+    lags = [1, 2, 3, 50, 51, 52, 53, 64, 65, 300, 419, 420, 500]  # runs, a lone lag, lags at and past the end
+    together = rows.lag_differences_of(lags)
+    assert sorted(together) == lags
+    for lag in lags:
+        np.testing.assert_array_equal(together[lag], _one_lag(q, lag) if lag < q.shape[0] else np.empty(0))
+        np.testing.assert_array_equal(rows.lag_differences(lag), together[lag])
+
 def test_the_autocorrelation_of_column_blocks_is_that_of_the_array(walk):
     Y = moving_columns(metric_features(walk))
     rows = MetricRows(walk).moving()

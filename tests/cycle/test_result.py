@@ -31,8 +31,20 @@ def test_repeat_is_decoded_once_per_count_and_root(cycle):
     assert cycle.cache(("repeat", 2, "motion")) is twice and cycle.cache("nothing kept") is None
 
 
+@pytest.mark.parametrize("root", ["motion", "inplace"])
+@pytest.mark.parametrize("count", [1, 2, 3])
+def test_a_repeat_is_the_decoded_repeated_arrays(walk, count, root):
+    """Only the travel joint's quaternions are made per repeat: the same Motion as decoding the repeated arrays."""
+    cycle = extract_cycle(walk)  # its own caches
+    P = np.tile(cycle.P, (count, 1))
+    whole = cycle.space.decode(P, cycle._repeat_L(count, root), cycle.rotation_matrices(count))
+    repeated = cycle.repeat(count, root=root)
+    np.testing.assert_array_equal(repeated.rotations, whole.rotations)
+    np.testing.assert_array_equal(repeated.translations, whole.translations)
+
+
 def test_kept_arrays_are_read_only(cycle):
-    for array in (cycle.rotation_matrices(), cycle.inplace_L()):
+    for array in (cycle.rotation_matrices(), cycle.quaternions(), cycle.inplace_L()):
         assert not array.flags.writeable
     assert cycle.rotation_matrices(2).flags.writeable  # a new array
     with pytest.raises(ValueError):

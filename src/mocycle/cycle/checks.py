@@ -85,10 +85,13 @@ def _plain_cut_error(Y: np.ndarray | MetricRows, period: float, differences: dic
     lags = lags[lags < M - 1]
     h = max(1, int(round(0.1 * period)))
     best = (np.inf, 0, 0)
+    if isinstance(Y, MetricRows):  # the lags not searched yet, made together
+        differences.update(Y.lag_differences_of([lag for lag in lags.tolist() if lag not in differences]))
     for lag in lags:
         lag = int(lag)
         if lag not in differences:
-            differences[lag] = Y.lag_differences(lag) if isinstance(Y, MetricRows) else _lag_differences(Y, lag)
+            assert isinstance(Y, np.ndarray)  # a MetricRows' lags were all made above
+            differences[lag] = _lag_differences(Y, lag)
         d = differences[lag]
         if d.size < 2 * h + 1:
             continue

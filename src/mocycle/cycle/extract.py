@@ -112,7 +112,8 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", h
     else:
         P, L = space.encode(motion)
     # The path is fitted straightened (periodic plus a line) and turned back along the cycle's heading.
-    Q = space.straighten(L, axis.period_frames)
+    trend = space.heading_trend(L[:, 3], axis.period_frames)  # the heading without its sway: made once
+    Q = space.straighten(L, axis.period_frames, trend)
     # The cut's wrap is its seam; the others have none, so they start at the calmest point.
     if method == "harmonic":
         cycle = harmonic_cycle(space, P, Q, axis, periodic, model, harmonics, calmest=True)
@@ -126,7 +127,7 @@ def extract_cycle(motion: Motion, method: str = "harmonic", model: str = "M1", h
     else:
         assert isinstance(P, np.ndarray)
         cycle = cut_cycle(space, P, Q, axis, periodic, metric_features(motion))
-    path, drift = space.bend(cycle.L, cycle.drift, space.heading_trend(L[:, 3], axis.period_frames)[0])
+    path, drift = space.bend(cycle.L, cycle.drift, trend[0])
     cycle = cycle.on_path(path, drift)  # the same P: the same rotation matrices
     cycle.seconds = time.perf_counter() - t0
     return cycle

@@ -184,17 +184,34 @@ ROWS = 8192
 class _DesignSums:
     """What M1 needs of one design ``B`` and its targets ``Y``, added up block by block of rows: ``BᵀB``
     ``(p, p)``, ``BᵀY`` ``(p, D)``, the ``R`` of ``B``'s QR factorisation (``B = QR``: ``B``'s singular values
-    and right singular vectors are ``R``'s), which columns of ``B`` are not all zero, and the row count."""
+    and right singular vectors are ``R``'s), which columns of ``B`` are not all zero, and the row count.
 
-    def __init__(self):
-        self.BtB = self.BtY = self.R = self.nonzero = None
+    ``shared``: a dict that fits on the same designs share (the two curves of a cycle, when the path has no
+    linear term): the factors of a design read in one block (``BᵀB``, ``R``, the columns used and ``R``'s
+    SVD), which depend on the design alone, are made by the first fit and read by the next, the same numbers.
+    It holds the designs it was given (the fits' own, while they run)."""
+
+    def __init__(self, shared: dict | None = None):
+        self.BtB: Any = None
+        self.BtY: Any = None
+        self.R: Any = None
+        self.nonzero: Any = None
         self.rows = 0
+        self.shared = shared
+        self.first: list | None = None  # the design's shared factors, while the fit is one block
 
     def add(self, B: np.ndarray, Y: np.ndarray) -> None:
-        BtB, BtY = B.T @ B, B.T @ Y
-        stacked = B if self.R is None else np.vstack([self.R, B])
-        self.R = np.linalg.qr(stacked, mode="r")
-        nonzero = np.abs(B).max(axis=0) > 0 if B.shape[0] else np.zeros(B.shape[1], dtype=bool)
+        BtY = B.T @ Y
+        if self.R is None and self.shared is not None:  # one design's own factors: made once per design
+            kept = self.shared.get(id(B))
+            if kept is None or kept[0] is not B:
+                kept = self.shared[id(B)] = [B, *self._factors(B, None), None]
+            _, BtB, self.R, nonzero, _ = kept
+            BtB, nonzero = BtB.copy(), nonzero.copy()  # added to in place by the blocks that follow
+            self.first = kept
+        else:
+            BtB, self.R, nonzero = self._factors(B, self.R)
+            self.first = None
         if self.BtB is None:
             self.BtB, self.BtY, self.nonzero = BtB, BtY, nonzero
         else:
@@ -203,16 +220,30 @@ class _DesignSums:
             self.nonzero |= nonzero
         self.rows += B.shape[0]
 
+    @staticmethod
+    def _factors(B: np.ndarray, R: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``BᵀB``, the ``R`` of ``B`` below the ``R`` of the blocks before (``None``: the first block) and the
+        columns of ``B`` that are not all zero."""
+        factor: Any = np.linalg.qr(B if R is None else np.vstack([R, B]), mode="r")
+        nonzero = np.abs(B).max(axis=0) > 0 if B.shape[0] else np.zeros(B.shape[1], dtype=bool)
+        return B.T @ B, factor, nonzero
+
     def least_squares(self) -> tuple[np.ndarray, np.ndarray]:
         """The columns used and :func:`least_squares` ``(B[:, cols], Y)`` from the sums: ``cols`` are ``B``'s
         columns that are not all zero (derivative designs lose the constant column); ``R[:, cols]``'s SVD
         is ``B[:, cols]``'s (``U`` aside), with the same cut of small singular values, and
         ``Uᵀ Y = S⁻¹ Vᵀ (BᵀY)``."""
-        cols = np.flatnonzero(self.nonzero)
-        _, S, Vt = np.linalg.svd(self.R[:, cols], full_matrices=False)
-        kept = S > np.finfo(np.float64).eps * max(self.rows, cols.size) * (S[0] if S.size else 0.0)
-        inv = np.where(kept, 1.0 / np.where(kept, S, 1.0), 0.0)
-        return cols, Vt.T @ ((inv ** 2)[:, None] * (Vt @ self.BtY[cols]))
+        solved = self.first[4] if self.first is not None else None
+        if solved is None:
+            cols = np.flatnonzero(self.nonzero)
+            _, S, Vt = np.linalg.svd(self.R[:, cols], full_matrices=False)
+            kept = S > np.finfo(np.float64).eps * max(self.rows, cols.size) * (S[0] if S.size else 0.0)
+            inv = np.where(kept, 1.0 / np.where(kept, S, 1.0), 0.0)
+            solved = (cols, Vt, inv ** 2)
+            if self.first is not None:  # one block: the design's alone, for the next fit on it
+                self.first[4] = solved
+        cols, Vt, inv2 = solved
+        return cols, Vt.T @ (inv2[:, None] * (Vt @ self.BtY[cols]))
 
 
 def _array_blocks(*arrays: np.ndarray, rows: int = ROWS):
@@ -295,7 +326,7 @@ class HarmonicRegression:
         self.rmse_ = self._rmse(P, Y, xd, dY, ddY)
         return self
 
-    def fit_blocks(self, positions, derivatives=None) -> HarmonicRegression:
+    def fit_blocks(self, positions, derivatives=None, *, shared: dict | None = None) -> HarmonicRegression:
         """:meth:`fit` on rows handed over block by block, so that no array of every row need be held (a long
         take's velocities and accelerations are made a block at a time from its positions).
 
@@ -303,7 +334,8 @@ class HarmonicRegression:
         ``derivatives()`` (M1, M3): likewise of ``(xd, dY, ddY)`` blocks.  M1 reads them in three passes:
         the designs' cross products and QR factors; the residuals of the separate ordinary fits (the group
         variances, eq. 3.11-3.13); the residuals of the weighted fit (``rmse_``).  M2 and M3 join the blocks
-        and fit them as :meth:`fit` does."""
+        and fit them as :meth:`fit` does.  ``shared``: a dict (empty at first) that M1 fits on the same time
+        axis pass along: the factors of a design that both read in one block are made once (the same numbers)."""
         _validate.choice("model", self.model, MODELS)
         if self.model != "M1":
             x, Y = (np.concatenate(part) for part in zip(*positions(), strict=True))
@@ -314,7 +346,7 @@ class HarmonicRegression:
         if derivatives is None:
             raise MocycleError(f"model {self.model} needs velocities and accelerations (xd, dY, ddY)")
         lin, p = self.linear, 2 * K + 1 + int(self.linear)
-        pos, vel, acc = _DesignSums(), _DesignSums(), _DesignSums()
+        pos, vel, acc = _DesignSums(shared), _DesignSums(shared), _DesignSums(shared)
         first, moving = None, None
         for x, Y in positions():  # pass 1: cross products, QR factors, the columns that move
             x, Y = np.asarray(x, dtype=np.float64).reshape(-1), np.asarray(Y, dtype=np.float64)

@@ -131,9 +131,12 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray | EncodedRows, L: np.ndarray
         L = L - np.outer(np.nan_to_num(axis.x), drift)
     linear = drift is None
     if model == "M1":  # the rows block by block: P's frames, velocities and accelerations are never held whole
-        fit_p = HarmonicRegression(K, model).fit_blocks(_position_blocks(P, axis), _derivative_blocks(P, axis))
+        shared: dict = {}  # without the linear term the path's designs are the poses': factored once
+        fit_p = HarmonicRegression(K, model).fit_blocks(_position_blocks(P, axis), _derivative_blocks(P, axis),
+                                                        shared=shared)
         fit_l = HarmonicRegression(K, model, linear=linear).fit_blocks(_position_blocks(L, axis),
-                                                                       _derivative_blocks(L, axis))
+                                                                       _derivative_blocks(L, axis), shared=shared)
+        del shared
     else:
         assert isinstance(P, np.ndarray)  # rows made as read are for M1 only (cycle.extract)
         xd, dP, ddP = _derivative_rows(P, axis) if model != "M2" else (None, None, None)

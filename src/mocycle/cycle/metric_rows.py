@@ -182,18 +182,28 @@ class MetricRows:
 
     def lag_differences(self, lag: int) -> np.ndarray:
         """``(n - lag,)`` squared distances between rows ``lag`` apart (see the class docstring)."""
-        M = self.shape[0]
-        d = np.empty(max(0, M - lag))
+        return self.lag_differences_of([lag])[int(lag)]
+
+    def lag_differences_of(self, lags) -> dict[int, np.ndarray]:
+        """:meth:`lag_differences` of each of ``lags`` (ints >= 1), ``{lag: (n - lag,)}``, the same numbers: a run
+        of consecutive lags is made together, rows ``r .. r + lag`` of every lag of the run in one product
+        (a plain cut searches some 30 lags near a period; one product per lag cost more in calls than in
+        arithmetic).  A block of rows at a time: the ``(lags, rows, joints)`` temporaries stay small."""
         joints = self.joints[np.unique(self.columns // 9)]  # those with a column here: the others add nothing
-        every = np.array_equal(joints, np.arange(self.quats.shape[1]))
-        for r in range(0, M - lag, self.BLOCK):
-            r1 = min(r + self.BLOCK, M - lag)
-            a, b = self.quats[r:r1], self.quats[r + lag:r1 + lag]
-            if not every:
-                a, b = np.take(a, joints, axis=1), np.take(b, joints, axis=1)
-            cos = np.einsum("tjk,tjk->tj", a, b)  # cos(θ/2) per joint, up to sign
-            d[r:r1] = 4.0 * (joints.size - np.einsum("tj,tj->t", cos, cos))
-        return d
+        q = self.quats
+        if not np.array_equal(joints, np.arange(q.shape[1])):
+            q = np.take(q, joints, axis=1)
+        M, out = q.shape[0], {}
+        for run in _runs(sorted({int(lag) for lag in lags})):
+            first, last = run[0], run[-1]
+            n = max(0, M - first)
+            d = np.empty((len(run), n))
+            rows = max(1, self.BLOCK // len(run))
+            for r0 in range(0, n, rows):
+                r1 = min(r0 + rows, n)
+                d[:, r0:r1] = 4.0 * (joints.size - _lag_sums(q[r0:r1], _later_rows(q, r0 + first, r1 + last)))
+            out.update({lag: d[k, :max(0, M - lag)] for k, lag in enumerate(run)})
+        return out
 
     def spread(self) -> float:
         """RMS distance of the rows from their mean row."""
@@ -201,6 +211,36 @@ class MetricRows:
         mean = sum(self[r:r + self.BLOCK].sum(axis=0) for r in range(0, M, self.BLOCK)) / M
         return float(np.sqrt(sum(float(((self[r:r + self.BLOCK] - mean) ** 2).sum())
                                  for r in range(0, M, self.BLOCK)) / M))
+
+
+def _runs(values: list[int]) -> list[list[int]]:
+    """Sorted ints cut into runs of consecutive ones."""
+    runs: list[list[int]] = []
+    for v in values:
+        if runs and v == runs[-1][-1] + 1:
+            runs[-1].append(v)
+        else:
+            runs.append([v])
+    return runs
+
+
+def _later_rows(q: np.ndarray, start: int, stop: int) -> np.ndarray:
+    """Rows ``start:stop`` of the quaternions ``q (M, J, 4)``, rows past ``M`` zeros (their distances are not kept)."""
+    later = q[start:stop]
+    if later.shape[0] < stop - start:
+        later = np.concatenate([later, np.zeros((stop - start - later.shape[0],) + q.shape[1:])])
+    return later
+
+
+def _lag_sums(a: np.ndarray, later: np.ndarray) -> np.ndarray:
+    """``(lags, rows)`` sums over the joints of ``cos²(θ/2)`` between rows ``a (rows, J, 4)`` and the rows ``lag``
+    on, for the consecutive lags of ``later`` (rows ``r0 + first .. r1 + last`` of the same quaternions): for
+    lag ``first + k`` the rows ``later[k:k + rows]``, a strided view (no copy per lag)."""
+    n_lags = later.shape[0] - a.shape[0] + 1
+    shifted = np.lib.stride_tricks.as_strided(later, shape=(n_lags,) + a.shape,
+                                              strides=(later.strides[0],) + later.strides, writeable=False)
+    cos = np.einsum("tjk,ltjk->ltj", a, shifted)  # cos(θ/2) per joint, up to sign
+    return np.einsum("ltj,ltj->lt", cos, cos)
 
 
 def loop_blocks(cycle: Cycle) -> tuple[np.ndarray, np.ndarray]:

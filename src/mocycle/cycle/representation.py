@@ -143,9 +143,10 @@ class CycleSpace:
         width = int(max(1, min(round(period), psi.size)))
         return line + moving_average(psi - line, width)
 
-    def straighten(self, L: np.ndarray, period: float) -> np.ndarray:
+    def straighten(self, L: np.ndarray, period: float, trend: np.ndarray | None = None) -> np.ndarray:
         """``L (T, 4)`` with its path straightened: step ``t`` turned back by the heading trend's change
-        since the first frame (:meth:`heading_trend`, ``period`` in frames).
+        since the first frame (:meth:`heading_trend`, ``period`` in frames; ``trend``: ``heading_trend(L[:, 3],
+        period)`` when the caller has it).
 
         The vertical component and the heading are kept; the first frame stays where it is.  A walk along
         a circle becomes a straight walk (periodic plus a line), which the cycle models can fit; a walk
@@ -154,7 +155,7 @@ class CycleSpace:
         L = np.asarray(L, dtype=np.float64)
         if L.shape[0] < 2:
             return L.copy()
-        trend = self.heading_trend(L[:, 3], period)
+        trend = self.heading_trend(L[:, 3], period) if trend is None else trend
         mid = 0.5 * (trend[1:] + trend[:-1])
         steps = self._turned(np.diff(L[:, :3], axis=0), trend[0] - mid)
         out = L.copy()
@@ -196,7 +197,7 @@ class CycleSpace:
         M = P[:, : 9 * J].reshape(N, J, 3, 3)
         still = np.all(P[:, : 9 * J] == P[:1, : 9 * J], axis=0).reshape(J, 9).all(axis=1) if N > 1 \
             else np.zeros(J, dtype=bool)
-        R = np.empty_like(M)
+        R = np.empty(M.shape)
         if still.any():
             R[:, still] = nearest_rotations(M[0, still])
         moving = np.flatnonzero(~still)
@@ -205,7 +206,7 @@ class CycleSpace:
         rows = max(1, PROJECT_MATRICES // max(1, moving.size))
         for r in range(0, N, rows):
             if moving.size == J:
-                R[r:r + rows] = nearest_rotations(M[r:r + rows])
+                nearest_rotations(M[r:r + rows], out=R[r:r + rows])  # rows of R: contiguous
             elif moving.size:  # take: a contiguous copy, unlike M[:, moving]
                 R[r:r + rows, moving] = nearest_rotations(np.take(M[r:r + rows], moving, axis=1))
         return R
@@ -270,6 +271,25 @@ class CycleSpace:
         quats = continuous_quats(matrix_quats(self.rotations(P, L, projected)))
         return Motion(self.skeleton, quats, self.static_translations, self.frame_time, tracks=self.tracks(P, L),
                       copy=False)
+
+    def decode_repeated(self, P: np.ndarray, L: np.ndarray, projected: np.ndarray, quats: np.ndarray,
+                        count: int) -> Motion:
+        """:meth:`decode` of ``P (N, n_periodic)`` repeated ``count`` times on the path ``L (count * N, 4)``, the
+        same Motion, from ``projected`` (:meth:`project` of ``P``, ``(N, J, 3, 3)``) and its quaternions ``quats``
+        ``(N, J, 4)`` (:func:`~mocycle.rotations.matrix_quats` of it): every joint but the travel joint has the
+        same rotations in every repeat, so only the travel joint's, turned to each frame's heading, are
+        converted (each matrix's quaternion depends on that matrix alone)."""
+        N, J, travel = P.shape[0], self.n_joints, self.travel
+        if L.shape != (count * N, self.n_drifting) or projected.shape != (N, J, 3, 3) or quats.shape != (N, J, 4):
+            raise MocycleError(f"expected L ({count * N}, 4), projected ({N}, {J}, 3, 3) and quats ({N}, {J}, 4); "
+                               f"got {L.shape}, {projected.shape}, {quats.shape}")
+        # the travel joint's matrices laid out as decode's (a view of the repeated (count N, J, 3, 3) array)
+        tiled = projected if count == 1 else np.tile(projected, (count, 1, 1, 1))
+        q = np.tile(quats, (count, 1, 1))
+        q[:, travel] = matrix_quats(self.heading_rotations(L) @ tiled[:, travel])
+        P = P if count == 1 else np.tile(P, (count, 1))
+        return Motion(self.skeleton, continuous_quats(q, inplace=True), self.static_translations, self.frame_time,
+                      tracks=self.tracks(P, L), copy=False)
 
 
 class EncodedRows:

@@ -88,8 +88,9 @@ class Cycle:
 
         Arrays are kept read-only and Motions are shared: copy where the caller changes them, and never hand
         a kept Motion over (:meth:`Motion.hand_over`).  The keys in use: ``"rotations"``
-        (:meth:`rotation_matrices`), ``"inplace L"`` (:meth:`inplace_L`), ``("repeat", count, root)``
-        (:meth:`repeat`), ``"loop blocks"`` (:func:`~mocycle.cycle.metric_rows.loop_blocks`).
+        (:meth:`rotation_matrices`), ``"quaternions"`` (:meth:`quaternions`), ``"inplace L"`` (:meth:`inplace_L`),
+        ``("repeat", count, root)`` (:meth:`repeat`), ``"loop blocks"``
+        (:func:`~mocycle.cycle.metric_rows.loop_blocks`).
 
         Examples
         --------
@@ -125,6 +126,12 @@ class Cycle:
         only the travel joint's heading differs (here it has none)."""
         R = self.cache("rotations", lambda cycle: _read_only(cycle.space.project(cycle.P)))
         return R if count == 1 else np.tile(R, (count, 1, 1, 1))
+
+    def quaternions(self) -> np.ndarray:
+        """:func:`~mocycle.rotations.matrix_quats` of :meth:`rotation_matrices` ``(N, J, 4)`` (read-only, made once):
+        the quaternions of every joint of every motion of the cycle, but the travel joint's (turned to the
+        heading in each)."""
+        return self.cache("quaternions", lambda cycle: _read_only(matrix_quats(cycle.rotation_matrices())))
 
     @property
     def period_frames(self) -> float:
@@ -198,8 +205,8 @@ class Cycle:
     def _decode(self, count: int, root: str) -> Motion:
         check_frames(count * self.n_frames, self.space.skeleton.n_joints,
                      f"{count} cycles of {self.n_frames} frames")
-        P = self.P if count == 1 else np.tile(self.P, (count, 1))
-        return self.space.decode(P, self._repeat_L(count, root), self.rotation_matrices(count))
+        return self.space.decode_repeated(self.P, self._repeat_L(count, root), self.rotation_matrices(),
+                                          self.quaternions(), count)
 
     def _repeat_L(self, count: int, root: str) -> np.ndarray:
         """``L (count * N, 4)`` of :meth:`repeat` (a new array)."""
