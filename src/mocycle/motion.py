@@ -247,21 +247,22 @@ def _forward_kinematics(quats: np.ndarray, translations: np.ndarray, parents) ->
 
 def chain_forward_kinematics(motion: Motion, chain: list[int], rows: slice, Rw: np.ndarray, W: np.ndarray) -> None:
     """Forward kinematics of ``chain`` (joints with all their ancestors, parents first) over the frames
-    ``rows``, into ``Rw`` ``(n, len(chain), 3, 3)`` and ``W`` ``(n, len(chain), 3)`` (columns in chain order); each
-    joint's local rotation matrices are made when it is reached, not all at once.  The same numbers as
-    :func:`_forward_kinematics`."""
+    ``rows``, into ``Rw`` ``(n, len(chain), 3, 3)`` and ``W`` ``(n, len(chain), 3)`` (columns in chain order).  The
+    chain's local rotation matrices are made at once (one more array of ``Rw``'s size, while it is filled: one
+    scipy ``Rotation`` instead of one per joint).  The same numbers as :func:`_forward_kinematics`."""
     parents = motion.skeleton.parents
     column = {int(j): i for i, j in enumerate(chain)}
+    n = Rw.shape[0]
+    local = Rotation.from_quat(motion.rotations[rows][:, chain].reshape(-1, 4)).as_matrix().reshape(n, len(chain), 3, 3)
     for i, j in enumerate(chain):
         p = int(parents[j])
-        local = Rotation.from_quat(motion.rotations[rows, j]).as_matrix()
         t = motion.joint_translations(j)[rows]
         if p < 0:
-            Rw[:, i] = local
+            Rw[:, i] = local[:, i]
             W[:, i] = t
         else:
             Rp = Rw[:, column[p]]
-            np.matmul(Rp, local, out=Rw[:, i])
+            np.matmul(Rp, local[:, i], out=Rw[:, i])
             W[:, i] = W[:, column[p]] + (Rp @ np.ascontiguousarray(t)[..., None])[..., 0]
 
 
