@@ -45,6 +45,7 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion
+from ..rotations import vector_norms
 from .legs import ChainArray, Foot, body_height, chain_joints, chain_positions, find_feet, up_axis
 from .smooth import gaussian, minimum
 
@@ -178,7 +179,7 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
     vu = v @ up
     for k in range(3):  # the horizontal velocity in place: v - vu up, axis by axis
         v[..., k] -= vu * up[k]
-    return h, np.linalg.norm(v, axis=-1), np.abs(vu)
+    return h, vector_norms(v), np.abs(vu)
 
 
 def local_floor(h: np.ndarray, fps: float) -> np.ndarray:
@@ -194,7 +195,7 @@ def _travel_speed(motion: Motion, W: np.ndarray | ChainArray, up: np.ndarray) ->
         return np.zeros(motion.n_frames)
     p = W[:, motion.travel_joint]
     v = np.gradient(p, motion.frame_time, axis=0)
-    v = np.linalg.norm(v - np.outer(v @ up, up), axis=1)
+    v = vector_norms(v - np.outer(v @ up, up))
     return gaussian(v, TRAVEL_SECONDS / motion.frame_time)
 
 

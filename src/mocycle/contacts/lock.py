@@ -58,7 +58,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
-from ..rotations import axis_rotations
+from ..rotations import axis_rotations, vector_norms
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
 from .legs import ChainArray, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
@@ -118,22 +118,32 @@ def _hold_weights(mask: np.ndarray, n_blend: int) -> np.ndarray:
 
 
 def _normalize(v: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    n = vector_norms(v, keepdims=True)
     return v / np.maximum(n, 1e-300)
+
+
+def _squares(v: np.ndarray) -> np.ndarray:
+    """``np.sum(v * v, axis=-1)`` of 3-vectors ``(..., 3)``, bit for bit (summed in its order), without numpy's
+    reduction over a short last axis (:func:`~mocycle.rotations.vector_norms` squared)."""
+    x, y, z = v[..., 0], v[..., 1], v[..., 2]
+    return x * x + y * y + z * z
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Row-wise cross products of ``(T, 3)`` arrays (``np.cross`` without its axis handling: it is called
     on short arrays many times)."""
-    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+    out = np.empty(a.shape)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
 
 
 def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The smallest rotations ``(T, 3, 3)`` turning the directions of ``a`` into those of ``b`` ``(T, 3)``."""
     a, b = _normalize(a), _normalize(b)
     axis = _cross(a, b)
-    s = np.linalg.norm(axis, axis=-1)
+    s = vector_norms(axis)
     angle = np.arctan2(s, np.sum(a * b, axis=-1))
     rotvec = _normalize(axis) * angle[:, None]
     return Rotation.from_rotvec(rotvec).as_matrix()
@@ -142,13 +152,13 @@ def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def _leg_length(W: ChainArray, foot) -> np.ndarray:
     """Hip-knee plus knee-ankle ``(T,)``."""
     H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
-    return np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
+    return vector_norms(K - H) + vector_norms(A - K)
 
 
 def _reach(W: ChainArray, foot, reach: float) -> np.ndarray:
     """How far ``(T,)`` a held ankle may be from its hip: ``reach`` of the leg's length (a held knee never
     goes fully straight, where a millimetre of length takes a large knee angle)."""
-    return np.maximum(reach * _leg_length(W, foot), np.linalg.norm(W[:, foot.ankle] - W[:, foot.hip], axis=1))
+    return np.maximum(reach * _leg_length(W, foot), vector_norms(W[:, foot.ankle] - W[:, foot.hip]))
 
 
 def _need(goals: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -156,7 +166,7 @@ def _need(goals: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray) ->
     (as close as it gets when the goal is too far sideways); broadcasts over leading axes."""
     d = goals - hips
     du = d @ up
-    disc = du ** 2 - np.sum(d * d, axis=-1) + R ** 2
+    disc = du * du - _squares(d) + R * R
     return np.maximum(np.where(disc >= 0, -du - np.sqrt(np.maximum(disc, 0.0)), -du), 0.0)
 
 
@@ -168,11 +178,11 @@ def _best_hold(path: np.ndarray, offsets: np.ndarray, hips: np.ndarray, R: np.nd
     the mean (``DISTANCE_WEIGHT`` × the distance to the mean weighs like the same lowering)."""
     floor = (path @ up).min()
     mean = path.mean(axis=0)
-    cands = np.vstack([mean, path])                                   # (n, 3)
-    cands = cands + np.outer(floor - cands @ up, up)                  # planted at the contact's lowest point
+    cands = np.concatenate([mean[None], path])                        # (n, 3)
+    cands = cands + (floor - cands @ up)[:, None] * up                # planted at the contact's lowest point
     mean = cands[0]
     need = _need(cands[:, None, :] + offsets[None], hips[None], R[None], up).max(axis=1)
-    cost = need + DISTANCE_WEIGHT * np.linalg.norm(cands - mean, axis=1)
+    cost = need + DISTANCE_WEIGHT * vector_norms(cands - mean)
     k = int(np.argmin(cost))
     return cands[0] if need[0] <= need[k] + 1e-6 * body else cands[k]
 
@@ -207,7 +217,7 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
             continue
         c = goal[k] - path[f]
         cu = c @ up
-        ok = (height[f] < goal[k] @ up + low) & (np.linalg.norm(c - cu[:, None] * up, axis=1) <= near)
+        ok = (height[f] < goal[k] @ up + low) & (vector_norms(c - cu[:, None] * up) <= near)
         misses = np.cumsum(~ok)                                     # up to the first miss of each window
         keep = misses == np.concatenate([[0], misses])[np.cumsum(count) - count][k]
         f, k, c, cu = f[keep], k[keep], c[keep], cu[keep]
@@ -273,8 +283,8 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
     kept) where that is enough, else pulled toward the hip.  ``corr`` is unchanged where the goal is nearer
     than that."""
     v = base + corr - hips
-    d = np.linalg.norm(v, axis=1)
-    raw = np.linalg.norm(base - hips, axis=1)
+    d = vector_norms(v)
+    raw = vector_norms(base - hips)
     start = np.minimum(np.maximum(R - zone, raw), R)
     room = R - start
     out = corr.copy()
@@ -359,7 +369,7 @@ def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, bod
     h = path @ up
     h = h - h.min()
     v = np.gradient(path, frame_time, axis=0)
-    v = np.linalg.norm(v - np.outer(v @ up, up), axis=1) / body
+    v = vector_norms(v - np.outer(v @ up, up)) / body
     ramp = np.clip((v - SLOW_SPEED) / (SWING_SPEED - SLOW_SPEED), 0.0, 1.0)
     holds = np.flatnonzero(level)
     if holds.size == 0:   # a foot without contacts (or a missed stance) stays
@@ -438,7 +448,7 @@ def _toe_holds(ankle: _Contact, toe: _Contact, partner: dict, h: _Holding) -> No
     # the ankle is back within reach, rather than the root going down
     on_toe = level_a == FOLLOW
     if on_toe.any():
-        length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
+        length = vector_norms(t[on_toe] - a[on_toe])
         goal_t = t[on_toe] + corr_t[on_toe]
         lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
         corr_a[on_toe] = lifted - a[on_toe]
@@ -446,7 +456,7 @@ def _toe_holds(ankle: _Contact, toe: _Contact, partner: dict, h: _Holding) -> No
     _ease_carried(corr_t, level_t, h.n_ease)
     if on_toe.any():  # still one foot length from the held toe (the toe is aimed at, so it stays put)
         goal_t = t[on_toe] + corr_t[on_toe]
-        length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
+        length = vector_norms(t[on_toe] - a[on_toe])
         corr_a[on_toe] = goal_t + length[:, None] * _normalize(a[on_toe] + corr_a[on_toe] - goal_t) - a[on_toe]
 
 
@@ -469,9 +479,9 @@ def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray,
     """``p`` on the sphere ``(c1, r1)`` moved along it to the nearest point within ``r2`` of ``c2`` (where
     it is out of reach and the spheres meet; unchanged elsewhere).  All ``(T, 3)`` / ``(T,)``."""
     out = p.copy()
-    far = np.linalg.norm(p - c2, axis=1) > r2
+    far = vector_norms(p - c2) > r2
     axis = c2 - c1
-    d = np.linalg.norm(axis, axis=1)
+    d = vector_norms(axis)
     a = (d ** 2 + r1 ** 2 - r2 ** 2) / (2 * np.maximum(d, 1e-300))
     meet = far & (d > 1e-12) & (np.abs(a) <= r1)
     if meet.any():
@@ -523,8 +533,8 @@ def _thigh_shin(W, foot, t: np.ndarray) -> tuple[np.ndarray, ...]:
     """Hip, knee and ankle positions ``(n, 3)`` at the frames ``t``, the thigh and shin lengths ``(n,)`` and
     unit directions ``(n, 3)``: ``H, K, A, l1, l2, u1, u2``."""
     H, K, A = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle]
-    l1 = np.linalg.norm(K - H, axis=1)
-    l2 = np.linalg.norm(A - K, axis=1)
+    l1 = vector_norms(K - H)
+    l2 = vector_norms(A - K)
     return H, K, A, l1, l2, (K - H) / l1[:, None], (A - K) / l2[:, None]
 
 
@@ -601,25 +611,28 @@ def _leg_ik(motion: Motion, foot, W, Rb: np.ndarray, column: dict, t: np.ndarray
     H, K, A, l1, l2, u1, u2 = _thigh_shin(W, foot, t)
     G = g[t]
     n = _bend_normals(Rb[rb, column[foot.hip]], u1, u2, axis)
-    d = np.clip(np.linalg.norm(G - H, axis=1), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
+    d = np.clip(vector_norms(G - H), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
     cos1 = -np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0)  # thigh . shin wanted
     R1 = Rotation.from_rotvec(n * _knee_turn(u1, u2, n, cos1)[:, None]).as_matrix()  # knee bend, world
     A1 = K + np.einsum("tij,tj->ti", R1, A - K)
-    R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
+    n = t.size
+    if gt is None:
+        R2 = _swing(A1 - H, G - H)                                         # thigh swing about the hip
+        aim = np.broadcast_to(np.eye(3), (n, 3, 3))
+    else:  # the thigh's swing and the foot's aim at its toe goal, from one scipy Rotation
+        swings = _swing(np.concatenate([A1 - H, W[t, foot.toe] - A]), np.concatenate([G - H, gt[t] - G]))
+        R2, aim = swings[:n], swings[n:]
     hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
-    Rp_hip = Rb[rb, column[hp]] if hp >= 0 else np.broadcast_to(np.eye(3), (t.size, 3, 3))
-    aim = np.broadcast_to(np.eye(3), (t.size, 3, 3))
-    if gt is not None:
-        aim = _swing(W[t, foot.toe] - A, gt[t] - G)
+    Rp_hip = Rb[rb, column[hp]] if hp >= 0 else np.broadcast_to(np.eye(3), (n, 3, 3))
     new_parent = R2 @ R1 @ Rb[rb, column[ap]]
-    out = []
-    for j, local in ((foot.hip, np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rb[rb, column[foot.hip]]),
-                     (foot.knee, np.swapaxes(Rb[rb, column[kp]], 1, 2) @ R1 @ Rb[rb, column[foot.knee]]),
-                     (foot.ankle, np.swapaxes(new_parent, 1, 2) @ aim @ Rb[rb, column[foot.ankle]])):
-        quats = Rotation.from_matrix(local).as_quat()
-        quats *= np.where(np.sum(quats * motion.rotations[t, j], axis=-1, keepdims=True) < 0, -1.0, 1.0)
-        out.append((t, j, quats))
-    return out
+    joints = (foot.hip, foot.knee, foot.ankle)
+    local = np.concatenate([np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rb[rb, column[foot.hip]],
+                            np.swapaxes(Rb[rb, column[kp]], 1, 2) @ R1 @ Rb[rb, column[foot.knee]],
+                            np.swapaxes(new_parent, 1, 2) @ aim @ Rb[rb, column[foot.ankle]]])
+    quats = Rotation.from_matrix(local).as_quat().reshape(3, n, 4)   # the three joints' from one Rotation
+    old = np.swapaxes(motion.rotations[t][:, list(joints)], 0, 1)     # (3, n, 4)
+    quats *= np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    return [(t, j, q) for j, q in zip(joints, quats, strict=True)]
 
 
 def _bend_axes(feet, W, blocks, column: dict, solved: list[np.ndarray]) -> list[np.ndarray | None]:

@@ -16,6 +16,7 @@ from typing import Literal, overload
 import numpy as np
 
 from ..motion import Motion
+from ..rotations import vector_norms
 from .legs import ChainArray, Foot, body_height, find_feet, leg_joints, up_axis
 
 SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual absolute H
@@ -66,7 +67,7 @@ def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: f
     vu = step @ up
     for k in range(3):  # the horizontal step in place: step - (step . up) up, axis by axis
         step[..., k] -= vu * up[k]
-    speed = np.linalg.norm(step, axis=-1) / motion.frame_time    # (T-1, C)
+    speed = vector_norms(step) / motion.frame_time    # (T-1, C)
     hm = 0.5 * (h[1:] + h[:-1])
     # the exponent clipped at 1 (where the weight is 0 anyway): a foot far above a tiny body height (a still
     # take, a rig whose body height comes out near 0) overflowed 2**(h/H) and printed a numpy warning
