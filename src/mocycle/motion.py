@@ -570,7 +570,7 @@ class Motion:
         """World rotations ``(T, J, 3, 3)`` and world joint positions ``(T, J, 3)``."""
         return _forward_kinematics(self.rotations, self.translations, self.skeleton.parents)
 
-    def world_positions(self, end_sites: bool = False) -> np.ndarray:
+    def world_positions(self, end_sites: bool = False, step: int = 1) -> np.ndarray:
         """Forward kinematics: world joint positions ``(T, J, 3)`` in file units.
 
         Computed in blocks of frames, so that the ``(T, J, 3, 3)`` rotation matrices are never held whole.
@@ -578,10 +578,12 @@ class Motion:
         Parameters
         ----------
         end_sites : append the End Site points: ``(T, J + E, 3)``.
+        step : every ``step``-th frame only: the same numbers as ``motion[::step].world_positions()``, without
+            making that motion (a sample of a take's frames, as :func:`mocycle.contacts.body_height` takes).
 
         Returns
         -------
-        ``(T, J, 3)`` (or ``(T, J + E, 3)``) float array, joints in skeleton order.
+        ``(T, J, 3)`` (or ``(T, J + E, 3)``) float array, joints in skeleton order (``T``: the frames taken).
 
         Examples
         --------
@@ -591,12 +593,19 @@ class Motion:
         ((300, 22, 3), (300, 27, 3))
         """
         ends = self.skeleton.end_sites if end_sites else []
-        T, J = self.n_frames, self.n_joints
+        step = int(step)
+        if step < 1:
+            raise ValueError(f"step must be a positive whole number; got {step}")
+        quats = self.rotations[::step]
+        T, J = quats.shape[0], self.n_joints
         out = np.empty((T, J + len(ends), 3))
         for f0 in range(0, T, _FK_BLOCK):
             block = slice(f0, f0 + _FK_BLOCK)
-            world_r, world_p = _forward_kinematics(self.rotations[block], self.translations_at(block),
-                                                   self.skeleton.parents)
+            q = quats[block]
+            if step > 1:  # normalised again, as Motion() does those of motion[::step]
+                q = q / vector_norms(q, keepdims=True)
+            frames = slice(f0 * step, (f0 + _FK_BLOCK) * step, step)
+            world_r, world_p = _forward_kinematics(q, self.translations_at(frames), self.skeleton.parents)
             out[block, :J] = world_p
             for k, s in enumerate(ends):
                 out[block, J + k] = world_p[:, s.parent] + world_r[:, s.parent] @ np.asarray(s.offset)

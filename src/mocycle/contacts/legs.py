@@ -230,7 +230,7 @@ def body_height(motion: Motion, up: np.ndarray | None = None, positions: np.ndar
     keep = [j for j in range(skel.n_joints) if j not in above] + [
         skel.n_joints + i for i, site in enumerate(skel.end_sites) if site.parent not in above]
     step = max(1, motion.n_frames // 50)
-    W = motion[::step].world_positions(end_sites=True) if positions is None else positions[::step]
+    W = motion.world_positions(end_sites=True, step=step) if positions is None else positions[::step]
     pose = (W[:, keep] - W[:, travel:travel + 1]).mean(axis=0)
     return float(np.ptp(pose @ up)) or 1.0
 
