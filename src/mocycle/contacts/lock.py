@@ -58,7 +58,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
-from ..rotations import axis_rotations, vector_norms
+from ..rotations import axis_rotations
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
 from .legs import ChainArray, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
@@ -118,15 +118,21 @@ def _hold_weights(mask: np.ndarray, n_blend: int) -> np.ndarray:
 
 
 def _normalize(v: np.ndarray) -> np.ndarray:
-    n = vector_norms(v, keepdims=True)
+    n = _norms(v)[..., None]
     return v / np.maximum(n, 1e-300)
 
 
 def _squares(v: np.ndarray) -> np.ndarray:
     """``np.sum(v * v, axis=-1)`` of 3-vectors ``(..., 3)``, bit for bit (summed in its order), without numpy's
-    reduction over a short last axis (:func:`~mocycle.rotations.vector_norms` squared)."""
+    reduction over a short last axis."""
     x, y, z = v[..., 0], v[..., 1], v[..., 2]
     return x * x + y * y + z * z
+
+
+def _norms(v: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(v, axis=-1)`` of 3-vectors ``(..., 3)``, bit for bit (as
+    :func:`~mocycle.rotations.vector_norms`, with fewer numpy calls: these arrays are short)."""
+    return np.sqrt(_squares(v))
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -143,7 +149,7 @@ def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The smallest rotations ``(T, 3, 3)`` turning the directions of ``a`` into those of ``b`` ``(T, 3)``."""
     a, b = _normalize(a), _normalize(b)
     axis = _cross(a, b)
-    s = vector_norms(axis)
+    s = _norms(axis)
     angle = np.arctan2(s, np.sum(a * b, axis=-1))
     rotvec = _normalize(axis) * angle[:, None]
     return Rotation.from_rotvec(rotvec).as_matrix()
@@ -152,13 +158,13 @@ def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def _leg_length(W: ChainArray, foot) -> np.ndarray:
     """Hip-knee plus knee-ankle ``(T,)``."""
     H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
-    return vector_norms(K - H) + vector_norms(A - K)
+    return _norms(K - H) + _norms(A - K)
 
 
 def _reach(W: ChainArray, foot, reach: float) -> np.ndarray:
     """How far ``(T,)`` a held ankle may be from its hip: ``reach`` of the leg's length (a held knee never
     goes fully straight, where a millimetre of length takes a large knee angle)."""
-    return np.maximum(reach * _leg_length(W, foot), vector_norms(W[:, foot.ankle] - W[:, foot.hip]))
+    return np.maximum(reach * _leg_length(W, foot), _norms(W[:, foot.ankle] - W[:, foot.hip]))
 
 
 def _need(goals: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -182,7 +188,7 @@ def _best_hold(path: np.ndarray, offsets: np.ndarray, hips: np.ndarray, R: np.nd
     cands = cands + (floor - cands @ up)[:, None] * up                # planted at the contact's lowest point
     mean = cands[0]
     need = _need(cands[:, None, :] + offsets[None], hips[None], R[None], up).max(axis=1)
-    cost = need + DISTANCE_WEIGHT * vector_norms(cands - mean)
+    cost = need + DISTANCE_WEIGHT * _norms(cands - mean)
     k = int(np.argmin(cost))
     return cands[0] if need[0] <= need[k] + 1e-6 * body else cands[k]
 
@@ -217,7 +223,7 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
             continue
         c = goal[k] - path[f]
         cu = c @ up
-        ok = (height[f] < goal[k] @ up + low) & (vector_norms(c - cu[:, None] * up) <= near)
+        ok = (height[f] < goal[k] @ up + low) & (_norms(c - cu[:, None] * up) <= near)
         misses = np.cumsum(~ok)                                     # up to the first miss of each window
         keep = misses == np.concatenate([[0], misses])[np.cumsum(count) - count][k]
         f, k, c, cu = f[keep], k[keep], c[keep], cu[keep]
@@ -283,8 +289,8 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
     kept) where that is enough, else pulled toward the hip.  ``corr`` is unchanged where the goal is nearer
     than that."""
     v = base + corr - hips
-    d = vector_norms(v)
-    raw = vector_norms(base - hips)
+    d = _norms(v)
+    raw = _norms(base - hips)
     start = np.minimum(np.maximum(R - zone, raw), R)
     room = R - start
     out = corr.copy()
@@ -303,14 +309,15 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
 
 
 def _foot_goals(W: ChainArray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
-                reach: float, clearance: np.ndarray):
+                R: np.ndarray, clearance: np.ndarray):
     """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, ``(T,)`` True where the foot is held (the ankle
-    holds or follows its hold) and ``(T,)`` True where either goal differs from the capture."""
+    holds or follows its hold) and ``(T,)`` True where either goal differs from the capture.  ``R``: the
+    leg's :func:`_reach` ``(T,)``."""
     foot = contacts.feet[f]
     up, body = contacts.up, contacts.body
     low, near = EXTEND_HEIGHT * body, EXTEND_DISTANCE * body
     cols = {contacts.joints[c]: c for c, g in enumerate(contacts.foot_of) if g == f}
-    a, hips, R = W[:, foot.ankle], W[:, foot.hip], _reach(W, foot, reach)
+    a, hips = W[:, foot.ankle], W[:, foot.hip]
     ma = contacts.mask[:, cols[foot.ankle]]
     ra = ranges(ma)
     mt = contacts.mask[:, cols[foot.toe]] if foot.toe is not None else np.zeros_like(ma)
@@ -369,7 +376,7 @@ def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, bod
     h = path @ up
     h = h - h.min()
     v = np.gradient(path, frame_time, axis=0)
-    v = vector_norms(v - np.outer(v @ up, up)) / body
+    v = _norms(v - np.outer(v @ up, up)) / body
     ramp = np.clip((v - SLOW_SPEED) / (SWING_SPEED - SLOW_SPEED), 0.0, 1.0)
     holds = np.flatnonzero(level)
     if holds.size == 0:   # a foot without contacts (or a missed stance) stays
@@ -448,7 +455,7 @@ def _toe_holds(ankle: _Contact, toe: _Contact, partner: dict, h: _Holding) -> No
     # the ankle is back within reach, rather than the root going down
     on_toe = level_a == FOLLOW
     if on_toe.any():
-        length = vector_norms(t[on_toe] - a[on_toe])
+        length = _norms(t[on_toe] - a[on_toe])
         goal_t = t[on_toe] + corr_t[on_toe]
         lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
         corr_a[on_toe] = lifted - a[on_toe]
@@ -456,7 +463,7 @@ def _toe_holds(ankle: _Contact, toe: _Contact, partner: dict, h: _Holding) -> No
     _ease_carried(corr_t, level_t, h.n_ease)
     if on_toe.any():  # still one foot length from the held toe (the toe is aimed at, so it stays put)
         goal_t = t[on_toe] + corr_t[on_toe]
-        length = vector_norms(t[on_toe] - a[on_toe])
+        length = _norms(t[on_toe] - a[on_toe])
         corr_a[on_toe] = goal_t + length[:, None] * _normalize(a[on_toe] + corr_a[on_toe] - goal_t) - a[on_toe]
 
 
@@ -479,9 +486,9 @@ def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray,
     """``p`` on the sphere ``(c1, r1)`` moved along it to the nearest point within ``r2`` of ``c2`` (where
     it is out of reach and the spheres meet; unchanged elsewhere).  All ``(T, 3)`` / ``(T,)``."""
     out = p.copy()
-    far = vector_norms(p - c2) > r2
+    far = _norms(p - c2) > r2
     axis = c2 - c1
-    d = vector_norms(axis)
+    d = _norms(axis)
     a = (d ** 2 + r1 ** 2 - r2 ** 2) / (2 * np.maximum(d, 1e-300))
     meet = far & (d > 1e-12) & (np.abs(a) <= r1)
     if meet.any():
@@ -494,13 +501,13 @@ def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray,
     return out
 
 
-def _lowering(W: ChainArray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray], reach: float,
-              n_blend: int) -> np.ndarray:
-    """How far ``(T,)`` the root must go down so every held ankle goal (weight > 0) is within reach, smoothed
-    so it is never less."""
+def _lowering(W: ChainArray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray],
+              reaches: list[np.ndarray], n_blend: int) -> np.ndarray:
+    """How far ``(T,)`` the root must go down so every held ankle goal (weight > 0) is within reach (``reaches``:
+    each leg's :func:`_reach` ``(T,)``), smoothed so it is never less."""
     need = np.zeros(W.shape[0])
-    for foot, g, w in zip(contacts.feet, goals, weights, strict=True):
-        need = np.maximum(need, np.where(w > 0, _need(g, W[:, foot.hip], _reach(W, foot, reach), contacts.up), 0.0))
+    for foot, g, w, R in zip(contacts.feet, goals, weights, reaches, strict=True):
+        need = np.maximum(need, np.where(w > 0, _need(g, W[:, foot.hip], R, contacts.up), 0.0))
     if not need.any():
         return need
     width = 2 * max(1, n_blend) + 1
@@ -533,8 +540,8 @@ def _thigh_shin(W, foot, t: np.ndarray) -> tuple[np.ndarray, ...]:
     """Hip, knee and ankle positions ``(n, 3)`` at the frames ``t``, the thigh and shin lengths ``(n,)`` and
     unit directions ``(n, 3)``: ``H, K, A, l1, l2, u1, u2``."""
     H, K, A = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle]
-    l1 = vector_norms(K - H)
-    l2 = vector_norms(A - K)
+    l1 = _norms(K - H)
+    l2 = _norms(A - K)
     return H, K, A, l1, l2, (K - H) / l1[:, None], (A - K) / l2[:, None]
 
 
@@ -611,7 +618,7 @@ def _leg_ik(motion: Motion, foot, W, Rb: np.ndarray, column: dict, t: np.ndarray
     H, K, A, l1, l2, u1, u2 = _thigh_shin(W, foot, t)
     G = g[t]
     n = _bend_normals(Rb[rb, column[foot.hip]], u1, u2, axis)
-    d = np.clip(vector_norms(G - H), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
+    d = np.clip(_norms(G - H), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
     cos1 = -np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0)  # thigh . shin wanted
     R1 = Rotation.from_rotvec(n * _knee_turn(u1, u2, n, cos1)[:, None]).as_matrix()  # knee bend, world
     A1 = K + np.einsum("tij,tj->ti", R1, A - K)
@@ -710,13 +717,14 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     n_extend = int(round(EXTEND_SECONDS / motion.frame_time))
     n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
     goals, toe_goals, held, changed = [], [], [], []
+    reaches = [_reach(W, foot, reach) for foot in contacts.feet]   # of the legs followed, before any lowering
     for f in range(len(contacts.feet)):
-        g, gt, h, ch = _foot_goals(W, contacts, f, n_extend, n_bridge, n_blend, reach, clearance)
+        g, gt, h, ch = _foot_goals(W, contacts, f, n_extend, n_bridge, n_blend, reaches[f], clearance)
         goals.append(g)
         toe_goals.append(gt)
         held.append(h)
         changed.append(ch)
-    delta = _lowering(W, contacts, goals, held, reach, n_blend)
+    delta = _lowering(W, contacts, goals, held, reaches, n_blend)
     lowered = delta > 0
     if lowered.any():  # every foot keeps its goal in the world: a swing foot does not dip with the root
         down = -np.outer(delta, contacts.up)
