@@ -626,22 +626,22 @@ def _leg_ik(motion: Motion, foot, W, Rb: np.ndarray, column: dict, t: np.ndarray
     cos1 = -np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0)  # thigh . shin wanted
     R1 = Rotation.from_rotvec(n * _knee_turn(u1, u2, n, cos1)[:, None]).as_matrix()  # knee bend, world
     A1 = K + np.einsum("tij,tj->ti", R1, A - K)
-    n = t.size
+    size = t.size
     if gt is None:
         R2 = _swing(A1 - H, G - H)                                         # thigh swing about the hip
-        aim = np.broadcast_to(np.eye(3), (n, 3, 3))
+        aim = np.broadcast_to(np.eye(3), (size, 3, 3))
     else:  # the thigh's swing and the foot's aim at its toe goal, from one scipy Rotation
         swings = _swing(np.concatenate([A1 - H, W[t, foot.toe] - A]), np.concatenate([G - H, gt[t] - G]))
-        R2, aim = swings[:n], swings[n:]
+        R2, aim = swings[:size], swings[size:]
     hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
-    Rp_hip = Rb[rb, column[hp]] if hp >= 0 else np.broadcast_to(np.eye(3), (n, 3, 3))
+    Rp_hip = Rb[rb, column[hp]] if hp >= 0 else np.broadcast_to(np.eye(3), (size, 3, 3))
     new_parent = R2 @ R1 @ Rb[rb, column[ap]]
     joints = (foot.hip, foot.knee, foot.ankle)
     local = np.concatenate([np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rb[rb, column[foot.hip]],
                             np.swapaxes(Rb[rb, column[kp]], 1, 2) @ R1 @ Rb[rb, column[foot.knee]],
                             np.swapaxes(new_parent, 1, 2) @ aim @ Rb[rb, column[foot.ankle]]])
-    quats = Rotation.from_matrix(local).as_quat().reshape(3, n, 4)   # the three joints' from one Rotation
-    old = np.swapaxes(motion.rotations[t][:, list(joints)], 0, 1)     # (3, n, 4)
+    quats = Rotation.from_matrix(local).as_quat().reshape(3, size, 4)   # the three joints' from one Rotation
+    old = np.swapaxes(motion.rotations[t][:, list(joints)], 0, 1)     # (3, size, 4)
     quats *= np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)
     return [(t, j, q) for j, q in zip(joints, quats, strict=True)]
 
