@@ -217,25 +217,21 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
     third = (a[1:] - b[:-1]) // 3
     n_before = np.minimum(np.minimum(n_extend, np.concatenate([[n_extend], third])), a)
     n_after = np.minimum(np.minimum(n_extend, np.concatenate([third, [n_extend]])), T - b)
-    # the windows before each contact (frames going back from it), then those after it, in one pass
-    first, edge = np.concatenate([a - 1, b]), np.concatenate([a, b - 1])
-    count = np.concatenate([n_before, n_after])
-    w = np.repeat(np.arange(first.size), count)                       # the window of each frame
-    start = np.cumsum(count) - count
-    f = first[w] + np.where(w < a.size, -1, 1) * (np.arange(w.size) - start[w])
-    if f.size:
-        k = w % a.size                                                # its contact
+    for first, count, edge, step in ((a - 1, n_before, a, -1), (b, n_after, b - 1, 1)):
+        f, k = _windows(first, count, step)
+        if f.size == 0:
+            continue
         c = goal[k] - path[f]
         cu = c @ up
         ok = (height[f] < goal[k] @ up + low) & (_norms(c - cu[:, None] * up) <= near)
         misses = np.cumsum(~ok)                                     # up to the first miss of each window
-        keep = misses == np.concatenate([[0], misses])[start][w]
-        f, k, w, c, cu = f[keep], k[keep], w[keep], c[keep], cu[keep]
-        edge_u = (goal[k] - path[edge[w]]) @ up
+        keep = misses == np.concatenate([[0], misses])[np.cumsum(count) - count][k]
+        f, k, c, cu = f[keep], k[keep], c[keep], cu[keep]
+        edge_u = (goal[k] - path[edge[k]]) @ up
         # a joint held lower than it came in (or left) moves down with the hold only near the contact: the
         # shift eases out over the low frames, so a heel coming in at speed is not pulled down to skim
         # the floor from far away
-        ease = 1.0 - _smoothstep((np.abs(f - first[w]) + 1) / (n_extend + 1))
+        ease = 1.0 - _smoothstep((np.abs(f - first[k]) + 1) / (n_extend + 1))
         edge_u = np.where(edge_u < 0, edge_u * ease, edge_u)
         corr[f] = c + (edge_u - cu)[:, None] * up
         level[f] = LOW
