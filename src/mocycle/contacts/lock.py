@@ -61,7 +61,7 @@ from ..motion import Motion
 from ..rotations import axis_rotations
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
-from .legs import ChainArray, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
+from .legs import ChainArray, along, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
 from .smooth import maximum, uniform
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
@@ -171,7 +171,7 @@ def _need(goals: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray) ->
     """Smallest lowering ``delta >= 0`` of the hips along ``-up`` putting each goal within ``R`` of its hip
     (as close as it gets when the goal is too far sideways); broadcasts over leading axes."""
     d = goals - hips
-    du = d @ up
+    du = along(d, up)
     disc = du * du - _squares(d) + R * R
     return np.maximum(np.where(disc >= 0, -du - np.sqrt(np.maximum(disc, 0.0)), -du), 0.0)
 
@@ -578,7 +578,7 @@ def _root_shift(W: ChainArray, contacts: Contacts, n_blend: int, period: int | N
     up = contacts.up
     w = _weights(contacts, n_blend)
     v = np.diff(W[:, list(contacts.joints)], axis=0)                  # (T-1, C, 3)
-    v = v - (v @ up)[..., None] * up
+    v = v - along(v, up)[..., None] * up
     ws = 0.5 * (w[1:] + w[:-1])
     u = -np.einsum("tc,tci->ti", ws, v) / np.maximum(ws.sum(axis=1), 1.0)[:, None]
     if not (period and T >= 3 * period):

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..motion import Motion
 from ..rotations import vector_norms
-from .legs import ChainArray, Foot, body_height, find_feet, leg_joints, up_axis
+from .legs import ChainArray, Foot, along, body_height, find_feet, leg_joints, up_axis
 
 SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual absolute H
 
@@ -60,11 +60,11 @@ def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: f
     if motion.n_frames < 2:
         return {motion.skeleton.names[j]: 0.0 for j in joints} if per_joint else 0.0
     P = (motion.world_positions() if positions is None else positions)[:, joints]  # (T, C, 3)
-    h = P @ up
+    h = along(P, up)
     h = h - h.min(axis=0)
     step = np.diff(P, axis=0)
     del P  # (T, C, 3) arrays held one or two at a time (memory)
-    vu = step @ up
+    vu = along(step, up)
     for k in range(3):  # the horizontal step in place: step - (step . up) up, axis by axis
         step[..., k] -= vu * up[k]
     speed = vector_norms(step) / motion.frame_time    # (T-1, C)
