@@ -208,6 +208,18 @@ def test_one_joints_path_is_its_column_of_the_world_positions(monkeypatch):
         np.testing.assert_array_equal(walk.joint_path(j), W[:, j])
 
 
+def test_every_steps_frame_of_the_world_positions_is_that_of_the_motion_sliced(monkeypatch):
+    import mocycle.motion as motion_module
+
+    walk = synthetic_walk(n_frames=151, noise_deg=2.0).motion
+    monkeypatch.setattr(motion_module, "_FK_BLOCK", 16)  # blocks of the frames taken, the last one short
+    for step in (1, 2, 3, 7, 50):
+        np.testing.assert_array_equal(walk.world_positions(end_sites=True, step=step),
+                                      walk[::step].world_positions(end_sites=True))
+    with pytest.raises(ValueError):
+        walk.world_positions(step=0)
+
+
 def test_the_body_root_is_where_the_skeleton_branches():
     """A take where no joint moves (one frame, a still pose) takes the body's root as its travel joint, not a
     static joint above it (Bandai's joint_Root at the room's origin)."""

@@ -229,10 +229,20 @@ JOINT_GROUPS: dict[str, list[str]] = {
 _FK_BLOCK = 4096
 
 
-def _forward_kinematics(quats: np.ndarray, translations: np.ndarray, parents) -> tuple[np.ndarray, np.ndarray]:
+def _turned(R: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """``R @ offset`` ``(n, 3)``: rotations ``R`` ``(n, 3, 3)`` applied to one vector ``offset`` ``(3,)``, as one
+    matrix-vector product over the ``3n`` rows (one BLAS call instead of one per frame; the same dot products
+    of three, the same numbers)."""
+    return (np.ascontiguousarray(R).reshape(-1, 3) @ offset).reshape(-1, 3)
+
+
+def _forward_kinematics(quats: np.ndarray, translations: np.ndarray, parents,
+                        tracked: Iterable[int] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """World rotations ``(T, J, 3, 3)`` and positions ``(T, J, 3)`` of local ``quats`` (T, J, 4) and
-    ``translations`` (T, J, 3) (parents before children)."""
+    ``translations`` (T, J, 3) (parents before children).  ``tracked``: the joints whose translation may
+    change from frame to frame (default all); every other joint's is ``translations[0, j]`` throughout."""
     T, J = quats.shape[:2]
+    moving = set(range(J)) if tracked is None else set(tracked)
     local = Rotation.from_quat(quats.reshape(-1, 4)).as_matrix().reshape(T, J, 3, 3)
     world_r = np.empty_like(local)
     world_p = np.empty((T, J, 3))
@@ -241,28 +251,36 @@ def _forward_kinematics(quats: np.ndarray, translations: np.ndarray, parents) ->
     for j in range(1, J):
         p = parents[j]
         world_r[:, j] = world_r[:, p] @ local[:, j]
-        world_p[:, j] = world_p[:, p] + (world_r[:, p] @ translations[:, j, :, None])[..., 0]
+        if j in moving:
+            world_p[:, j] = world_p[:, p] + (world_r[:, p] @ translations[:, j, :, None])[..., 0]
+        else:
+            world_p[:, j] = world_p[:, p] + _turned(world_r[:, p], translations[0, j])
     return world_r, world_p
 
 
 def chain_forward_kinematics(motion: Motion, chain: list[int], rows: slice, Rw: np.ndarray, W: np.ndarray) -> None:
     """Forward kinematics of ``chain`` (joints with all their ancestors, parents first) over the frames
-    ``rows``, into ``Rw`` ``(n, len(chain), 3, 3)`` and ``W`` ``(n, len(chain), 3)`` (columns in chain order); each
-    joint's local rotation matrices are made when it is reached, not all at once.  The same numbers as
-    :func:`_forward_kinematics`."""
+    ``rows``, into ``Rw`` ``(n, len(chain), 3, 3)`` and ``W`` ``(n, len(chain), 3)`` (columns in chain order).  The
+    chain's local rotation matrices are made at once (one more array of ``Rw``'s size, while it is filled: one
+    scipy ``Rotation`` instead of one per joint).  The same numbers as :func:`_forward_kinematics`."""
     parents = motion.skeleton.parents
     column = {int(j): i for i, j in enumerate(chain)}
+    n = Rw.shape[0]
+    local = Rotation.from_quat(motion.rotations[rows][:, chain].reshape(-1, 4)).as_matrix().reshape(n, len(chain), 3, 3)
+    tracked = motion.tracked_joints
     for i, j in enumerate(chain):
         p = int(parents[j])
-        local = Rotation.from_quat(motion.rotations[rows, j]).as_matrix()
-        t = motion.joint_translations(j)[rows]
         if p < 0:
-            Rw[:, i] = local
-            W[:, i] = t
+            Rw[:, i] = local[:, i]
+            W[:, i] = motion.joint_translations(j)[rows]
         else:
             Rp = Rw[:, column[p]]
-            np.matmul(Rp, local, out=Rw[:, i])
-            W[:, i] = W[:, column[p]] + (Rp @ np.ascontiguousarray(t)[..., None])[..., 0]
+            np.matmul(Rp, local[:, i], out=Rw[:, i])
+            if j in tracked:
+                t = np.ascontiguousarray(motion.joint_translations(j)[rows])
+                W[:, i] = W[:, column[p]] + (Rp @ t[..., None])[..., 0]
+            else:  # the same offset on every frame
+                W[:, i] = W[:, column[p]] + _turned(Rp, motion._static[j])
 
 
 def chain_kinematics_blocks(motion: Motion, chain: list[int], block: int):
@@ -567,9 +585,9 @@ class Motion:
     # -- forward kinematics ---------------------------------------------
     def world_transforms(self) -> tuple[np.ndarray, np.ndarray]:
         """World rotations ``(T, J, 3, 3)`` and world joint positions ``(T, J, 3)``."""
-        return _forward_kinematics(self.rotations, self.translations, self.skeleton.parents)
+        return _forward_kinematics(self.rotations, self.translations, self.skeleton.parents, self._tracks)
 
-    def world_positions(self, end_sites: bool = False) -> np.ndarray:
+    def world_positions(self, end_sites: bool = False, step: int = 1) -> np.ndarray:
         """Forward kinematics: world joint positions ``(T, J, 3)`` in file units.
 
         Computed in blocks of frames, so that the ``(T, J, 3, 3)`` rotation matrices are never held whole.
@@ -577,10 +595,12 @@ class Motion:
         Parameters
         ----------
         end_sites : append the End Site points: ``(T, J + E, 3)``.
+        step : every ``step``-th frame only: the same numbers as ``motion[::step].world_positions()``, without
+            making that motion (a sample of a take's frames, as :func:`mocycle.contacts.body_height` takes).
 
         Returns
         -------
-        ``(T, J, 3)`` (or ``(T, J + E, 3)``) float array, joints in skeleton order.
+        ``(T, J, 3)`` (or ``(T, J + E, 3)``) float array, joints in skeleton order (``T``: the frames taken).
 
         Examples
         --------
@@ -590,15 +610,23 @@ class Motion:
         ((300, 22, 3), (300, 27, 3))
         """
         ends = self.skeleton.end_sites if end_sites else []
-        T, J = self.n_frames, self.n_joints
+        step = int(step)
+        if step < 1:
+            raise ValueError(f"step must be a positive whole number; got {step}")
+        quats = self.rotations[::step]
+        T, J = quats.shape[0], self.n_joints
         out = np.empty((T, J + len(ends), 3))
         for f0 in range(0, T, _FK_BLOCK):
             block = slice(f0, f0 + _FK_BLOCK)
-            world_r, world_p = _forward_kinematics(self.rotations[block], self.translations_at(block),
-                                                   self.skeleton.parents)
+            q = quats[block]
+            if step > 1:  # normalised again, as Motion() does those of motion[::step]
+                q = q / vector_norms(q, keepdims=True)
+            frames = slice(f0 * step, (f0 + _FK_BLOCK) * step, step)
+            world_r, world_p = _forward_kinematics(q, self.translations_at(frames), self.skeleton.parents,
+                                                   self._tracks)
             out[block, :J] = world_p
             for k, s in enumerate(ends):
-                out[block, J + k] = world_p[:, s.parent] + world_r[:, s.parent] @ np.asarray(s.offset)
+                out[block, J + k] = world_p[:, s.parent] + _turned(world_r[:, s.parent], np.asarray(s.offset))
         return out
 
     def joint_path(self, joint: int) -> np.ndarray:

@@ -45,7 +45,8 @@ import numpy as np
 
 from ..errors import MocycleError
 from ..motion import Motion
-from .legs import ChainArray, Foot, body_height, chain_joints, chain_positions, find_feet, up_axis
+from ..rotations import vector_norms
+from .legs import ChainArray, Foot, along, body_height, chain_joints, chain_positions, find_feet, up_axis
 from .smooth import gaussian, minimum
 
 CONTACT_HEIGHT = 0.025  # of the body height, above the joint's lowest level
@@ -166,7 +167,7 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
     """
     W = motion.world_positions() if positions is None else positions
     P = W[:, list(joints)]
-    h = P @ up
+    h = along(P, up)
     h = h - h.min(axis=0)
     sigma = smooth / motion.frame_time
     if motion.n_frames < 2:
@@ -175,10 +176,10 @@ def heights_and_speeds(motion: Motion, joints: Sequence[int], up: np.ndarray, sm
         P = gaussian(P, sigma)
     v = np.gradient(P, motion.frame_time, axis=0)
     del P  # (T, C, 3) arrays held one or two at a time (memory)
-    vu = v @ up
+    vu = along(v, up)
     for k in range(3):  # the horizontal velocity in place: v - vu up, axis by axis
         v[..., k] -= vu * up[k]
-    return h, np.linalg.norm(v, axis=-1), np.abs(vu)
+    return h, vector_norms(v), np.abs(vu)
 
 
 def local_floor(h: np.ndarray, fps: float) -> np.ndarray:
@@ -194,7 +195,7 @@ def _travel_speed(motion: Motion, W: np.ndarray | ChainArray, up: np.ndarray) ->
         return np.zeros(motion.n_frames)
     p = W[:, motion.travel_joint]
     v = np.gradient(p, motion.frame_time, axis=0)
-    v = np.linalg.norm(v - np.outer(v @ up, up), axis=1)
+    v = vector_norms(v - np.outer(v @ up, up))
     return gaussian(v, TRAVEL_SECONDS / motion.frame_time)
 
 
@@ -250,7 +251,7 @@ def detect_contacts(motion: Motion, feet: Sequence[Foot] | str | None = None, *,
 
     mask = find(h, v, vu, rise)
     if relax:
-        lows = (W[:, list(joints)] @ up).min(axis=0) / body            # each joint's lowest level
+        lows = along(W[:, list(joints)], up).min(axis=0) / body            # each joint's lowest level
         kind = [0 if j == feet[f].ankle else 1 for j, f in zip(joints, foot_of, strict=True)]
         ground = {k: min(lo for lo, kk in zip(lows, kind, strict=True) if kk == k) for k in set(kind)}
         for f in range(len(feet)):

@@ -212,6 +212,17 @@ def _by_name(skeleton: Skeleton) -> list[Foot]:
     return [feet["left"], feet["right"]]
 
 
+def along(vectors: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """``vectors @ up``: the components ``(...)`` of ``vectors`` ``(..., k, 3)`` along ``up`` ``(3,)``.  Stacked,
+    numpy makes one BLAS matrix-vector product per ``(k, 3)`` matrix (a frame's joints); for a C-ordered array
+    with ``k >= 2`` the rows are taken as one ``(n k, 3)`` matrix instead, one BLAS call with the same dot
+    products, the same numbers (a single row, ``k == 1``, is numpy's own dot, and a strided array may be numpy's
+    own loop: both left as they are)."""
+    if vectors.ndim > 2 and vectors.shape[-2] >= 2 and vectors.flags.c_contiguous:
+        return (vectors.reshape(-1, 3) @ up).reshape(vectors.shape[:-1])
+    return vectors @ up
+
+
 def up_axis(motion: Motion, up=None) -> np.ndarray:
     """The world up direction ``(3,)`` of ``motion`` (:func:`mocycle.axes.vertical_axis`; ``up`` overrides)."""
     return vertical_axis(motion, up)
@@ -230,7 +241,7 @@ def body_height(motion: Motion, up: np.ndarray | None = None, positions: np.ndar
     keep = [j for j in range(skel.n_joints) if j not in above] + [
         skel.n_joints + i for i, site in enumerate(skel.end_sites) if site.parent not in above]
     step = max(1, motion.n_frames // 50)
-    W = motion[::step].world_positions(end_sites=True) if positions is None else positions[::step]
+    W = motion.world_positions(end_sites=True, step=step) if positions is None else positions[::step]
     pose = (W[:, keep] - W[:, travel:travel + 1]).mean(axis=0)
     return float(np.ptp(pose @ up)) or 1.0
 

@@ -61,7 +61,7 @@ from ..motion import Motion
 from ..rotations import axis_rotations
 from .clearance import SWING_SPEED, swing_clearance
 from .detect import Contacts, ranges
-from .legs import ChainArray, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
+from .legs import ChainArray, along, chain_joints, chain_positions, chain_rotation_blocks, leg_joints
 from .smooth import maximum, uniform
 
 BLEND_SECONDS = 0.1  # cross-fade in and out of each contact
@@ -118,22 +118,38 @@ def _hold_weights(mask: np.ndarray, n_blend: int) -> np.ndarray:
 
 
 def _normalize(v: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    n = _norms(v)[..., None]
     return v / np.maximum(n, 1e-300)
+
+
+def _squares(v: np.ndarray) -> np.ndarray:
+    """``np.sum(v * v, axis=-1)`` of 3-vectors ``(..., 3)``, bit for bit (summed in its order), without numpy's
+    reduction over a short last axis."""
+    x, y, z = v[..., 0], v[..., 1], v[..., 2]
+    return x * x + y * y + z * z
+
+
+def _norms(v: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(v, axis=-1)`` of 3-vectors ``(..., 3)``, bit for bit (as
+    :func:`~mocycle.rotations.vector_norms`, with fewer numpy calls: these arrays are short)."""
+    return np.sqrt(_squares(v))
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Row-wise cross products of ``(T, 3)`` arrays (``np.cross`` without its axis handling: it is called
     on short arrays many times)."""
-    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+    out = np.empty(a.shape)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
 
 
 def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The smallest rotations ``(T, 3, 3)`` turning the directions of ``a`` into those of ``b`` ``(T, 3)``."""
     a, b = _normalize(a), _normalize(b)
     axis = _cross(a, b)
-    s = np.linalg.norm(axis, axis=-1)
+    s = _norms(axis)
     angle = np.arctan2(s, np.sum(a * b, axis=-1))
     rotvec = _normalize(axis) * angle[:, None]
     return Rotation.from_rotvec(rotvec).as_matrix()
@@ -142,21 +158,21 @@ def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def _leg_length(W: ChainArray, foot) -> np.ndarray:
     """Hip-knee plus knee-ankle ``(T,)``."""
     H, K, A = W[:, foot.hip], W[:, foot.knee], W[:, foot.ankle]
-    return np.linalg.norm(K - H, axis=1) + np.linalg.norm(A - K, axis=1)
+    return _norms(K - H) + _norms(A - K)
 
 
 def _reach(W: ChainArray, foot, reach: float) -> np.ndarray:
     """How far ``(T,)`` a held ankle may be from its hip: ``reach`` of the leg's length (a held knee never
     goes fully straight, where a millimetre of length takes a large knee angle)."""
-    return np.maximum(reach * _leg_length(W, foot), np.linalg.norm(W[:, foot.ankle] - W[:, foot.hip], axis=1))
+    return np.maximum(reach * _leg_length(W, foot), _norms(W[:, foot.ankle] - W[:, foot.hip]))
 
 
 def _need(goals: np.ndarray, hips: np.ndarray, R: np.ndarray, up: np.ndarray) -> np.ndarray:
     """Smallest lowering ``delta >= 0`` of the hips along ``-up`` putting each goal within ``R`` of its hip
     (as close as it gets when the goal is too far sideways); broadcasts over leading axes."""
     d = goals - hips
-    du = d @ up
-    disc = du ** 2 - np.sum(d * d, axis=-1) + R ** 2
+    du = along(d, up)
+    disc = du * du - _squares(d) + R * R
     return np.maximum(np.where(disc >= 0, -du - np.sqrt(np.maximum(disc, 0.0)), -du), 0.0)
 
 
@@ -168,11 +184,11 @@ def _best_hold(path: np.ndarray, offsets: np.ndarray, hips: np.ndarray, R: np.nd
     the mean (``DISTANCE_WEIGHT`` × the distance to the mean weighs like the same lowering)."""
     floor = (path @ up).min()
     mean = path.mean(axis=0)
-    cands = np.vstack([mean, path])                                   # (n, 3)
-    cands = cands + np.outer(floor - cands @ up, up)                  # planted at the contact's lowest point
+    cands = np.concatenate([mean[None], path])                        # (n, 3)
+    cands = cands + (floor - cands @ up)[:, None] * up                # planted at the contact's lowest point
     mean = cands[0]
     need = _need(cands[:, None, :] + offsets[None], hips[None], R[None], up).max(axis=1)
-    cost = need + DISTANCE_WEIGHT * np.linalg.norm(cands - mean, axis=1)
+    cost = need + DISTANCE_WEIGHT * _norms(cands - mean)
     k = int(np.argmin(cost))
     return cands[0] if need[0] <= need[k] + 1e-6 * body else cands[k]
 
@@ -207,7 +223,7 @@ def _own_holds(path: np.ndarray, mask: np.ndarray, targets: list[np.ndarray], up
             continue
         c = goal[k] - path[f]
         cu = c @ up
-        ok = (height[f] < goal[k] @ up + low) & (np.linalg.norm(c - cu[:, None] * up, axis=1) <= near)
+        ok = (height[f] < goal[k] @ up + low) & (_norms(c - cu[:, None] * up) <= near)
         misses = np.cumsum(~ok)                                     # up to the first miss of each window
         keep = misses == np.concatenate([[0], misses])[np.cumsum(count) - count][k]
         f, k, c, cu = f[keep], k[keep], c[keep], cu[keep]
@@ -273,8 +289,8 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
     kept) where that is enough, else pulled toward the hip.  ``corr`` is unchanged where the goal is nearer
     than that."""
     v = base + corr - hips
-    d = np.linalg.norm(v, axis=1)
-    raw = np.linalg.norm(base - hips, axis=1)
+    d = _norms(v)
+    raw = _norms(base - hips)
     start = np.minimum(np.maximum(R - zone, raw), R)
     room = R - start
     out = corr.copy()
@@ -293,14 +309,15 @@ def _soft_reach(base: np.ndarray, corr: np.ndarray, hips: np.ndarray, R: np.ndar
 
 
 def _foot_goals(W: ChainArray, contacts: Contacts, f: int, n_extend: int, n_bridge: int, n_fade: int,
-                reach: float, clearance: np.ndarray):
+                R: np.ndarray, clearance: np.ndarray):
     """Ankle goal ``(T, 3)``, toe goal ``(T, 3)`` or None, ``(T,)`` True where the foot is held (the ankle
-    holds or follows its hold) and ``(T,)`` True where either goal differs from the capture."""
+    holds or follows its hold) and ``(T,)`` True where either goal differs from the capture.  ``R``: the
+    leg's :func:`_reach` ``(T,)``."""
     foot = contacts.feet[f]
     up, body = contacts.up, contacts.body
     low, near = EXTEND_HEIGHT * body, EXTEND_DISTANCE * body
     cols = {contacts.joints[c]: c for c, g in enumerate(contacts.foot_of) if g == f}
-    a, hips, R = W[:, foot.ankle], W[:, foot.hip], _reach(W, foot, reach)
+    a, hips = W[:, foot.ankle], W[:, foot.hip]
     ma = contacts.mask[:, cols[foot.ankle]]
     ra = ranges(ma)
     mt = contacts.mask[:, cols[foot.toe]] if foot.toe is not None else np.zeros_like(ma)
@@ -359,7 +376,7 @@ def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, bod
     h = path @ up
     h = h - h.min()
     v = np.gradient(path, frame_time, axis=0)
-    v = np.linalg.norm(v - np.outer(v @ up, up), axis=1) / body
+    v = _norms(v - np.outer(v @ up, up)) / body
     ramp = np.clip((v - SLOW_SPEED) / (SWING_SPEED - SLOW_SPEED), 0.0, 1.0)
     holds = np.flatnonzero(level)
     if holds.size == 0:   # a foot without contacts (or a missed stance) stays
@@ -438,7 +455,7 @@ def _toe_holds(ankle: _Contact, toe: _Contact, partner: dict, h: _Holding) -> No
     # the ankle is back within reach, rather than the root going down
     on_toe = level_a == FOLLOW
     if on_toe.any():
-        length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
+        length = _norms(t[on_toe] - a[on_toe])
         goal_t = t[on_toe] + corr_t[on_toe]
         lifted = _within_reach(a[on_toe] + corr_a[on_toe], goal_t, length, hips[on_toe], R[on_toe])
         corr_a[on_toe] = lifted - a[on_toe]
@@ -446,7 +463,7 @@ def _toe_holds(ankle: _Contact, toe: _Contact, partner: dict, h: _Holding) -> No
     _ease_carried(corr_t, level_t, h.n_ease)
     if on_toe.any():  # still one foot length from the held toe (the toe is aimed at, so it stays put)
         goal_t = t[on_toe] + corr_t[on_toe]
-        length = np.linalg.norm(t[on_toe] - a[on_toe], axis=1)
+        length = _norms(t[on_toe] - a[on_toe])
         corr_a[on_toe] = goal_t + length[:, None] * _normalize(a[on_toe] + corr_a[on_toe] - goal_t) - a[on_toe]
 
 
@@ -469,9 +486,9 @@ def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray,
     """``p`` on the sphere ``(c1, r1)`` moved along it to the nearest point within ``r2`` of ``c2`` (where
     it is out of reach and the spheres meet; unchanged elsewhere).  All ``(T, 3)`` / ``(T,)``."""
     out = p.copy()
-    far = np.linalg.norm(p - c2, axis=1) > r2
+    far = _norms(p - c2) > r2
     axis = c2 - c1
-    d = np.linalg.norm(axis, axis=1)
+    d = _norms(axis)
     a = (d ** 2 + r1 ** 2 - r2 ** 2) / (2 * np.maximum(d, 1e-300))
     meet = far & (d > 1e-12) & (np.abs(a) <= r1)
     if meet.any():
@@ -484,13 +501,13 @@ def _within_reach(p: np.ndarray, c1: np.ndarray, r1: np.ndarray, c2: np.ndarray,
     return out
 
 
-def _lowering(W: ChainArray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray], reach: float,
-              n_blend: int) -> np.ndarray:
-    """How far ``(T,)`` the root must go down so every held ankle goal (weight > 0) is within reach, smoothed
-    so it is never less."""
+def _lowering(W: ChainArray, contacts: Contacts, goals: list[np.ndarray], weights: list[np.ndarray],
+              reaches: list[np.ndarray], n_blend: int) -> np.ndarray:
+    """How far ``(T,)`` the root must go down so every held ankle goal (weight > 0) is within reach (``reaches``:
+    each leg's :func:`_reach` ``(T,)``), smoothed so it is never less."""
     need = np.zeros(W.shape[0])
-    for foot, g, w in zip(contacts.feet, goals, weights, strict=True):
-        need = np.maximum(need, np.where(w > 0, _need(g, W[:, foot.hip], _reach(W, foot, reach), contacts.up), 0.0))
+    for foot, g, w, R in zip(contacts.feet, goals, weights, reaches, strict=True):
+        need = np.maximum(need, np.where(w > 0, _need(g, W[:, foot.hip], R, contacts.up), 0.0))
     if not need.any():
         return need
     width = 2 * max(1, n_blend) + 1
@@ -523,8 +540,8 @@ def _thigh_shin(W, foot, t: np.ndarray) -> tuple[np.ndarray, ...]:
     """Hip, knee and ankle positions ``(n, 3)`` at the frames ``t``, the thigh and shin lengths ``(n,)`` and
     unit directions ``(n, 3)``: ``H, K, A, l1, l2, u1, u2``."""
     H, K, A = W[t, foot.hip], W[t, foot.knee], W[t, foot.ankle]
-    l1 = np.linalg.norm(K - H, axis=1)
-    l2 = np.linalg.norm(A - K, axis=1)
+    l1 = _norms(K - H)
+    l2 = _norms(A - K)
     return H, K, A, l1, l2, (K - H) / l1[:, None], (A - K) / l2[:, None]
 
 
@@ -561,7 +578,7 @@ def _root_shift(W: ChainArray, contacts: Contacts, n_blend: int, period: int | N
     up = contacts.up
     w = _weights(contacts, n_blend)
     v = np.diff(W[:, list(contacts.joints)], axis=0)                  # (T-1, C, 3)
-    v = v - (v @ up)[..., None] * up
+    v = v - along(v, up)[..., None] * up
     ws = 0.5 * (w[1:] + w[:-1])
     u = -np.einsum("tc,tci->ti", ws, v) / np.maximum(ws.sum(axis=1), 1.0)[:, None]
     if not (period and T >= 3 * period):
@@ -601,25 +618,28 @@ def _leg_ik(motion: Motion, foot, W, Rb: np.ndarray, column: dict, t: np.ndarray
     H, K, A, l1, l2, u1, u2 = _thigh_shin(W, foot, t)
     G = g[t]
     n = _bend_normals(Rb[rb, column[foot.hip]], u1, u2, axis)
-    d = np.clip(np.linalg.norm(G - H, axis=1), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
+    d = np.clip(_norms(G - H), np.abs(l1 - l2) + 1e-9 * (l1 + l2), (1 - 1e-12) * (l1 + l2))
     cos1 = -np.clip((l1 ** 2 + l2 ** 2 - d ** 2) / (2 * l1 * l2), -1.0, 1.0)  # thigh . shin wanted
     R1 = Rotation.from_rotvec(n * _knee_turn(u1, u2, n, cos1)[:, None]).as_matrix()  # knee bend, world
     A1 = K + np.einsum("tij,tj->ti", R1, A - K)
-    R2 = _swing(A1 - H, G - H)                                             # thigh swing about the hip
+    size = t.size
+    if gt is None:
+        R2 = _swing(A1 - H, G - H)                                         # thigh swing about the hip
+        aim = np.broadcast_to(np.eye(3), (size, 3, 3))
+    else:  # the thigh's swing and the foot's aim at its toe goal, from one scipy Rotation
+        swings = _swing(np.concatenate([A1 - H, W[t, foot.toe] - A]), np.concatenate([G - H, gt[t] - G]))
+        R2, aim = swings[:size], swings[size:]
     hp, kp, ap = (int(skel.parents[j]) for j in (foot.hip, foot.knee, foot.ankle))
-    Rp_hip = Rb[rb, column[hp]] if hp >= 0 else np.broadcast_to(np.eye(3), (t.size, 3, 3))
-    aim = np.broadcast_to(np.eye(3), (t.size, 3, 3))
-    if gt is not None:
-        aim = _swing(W[t, foot.toe] - A, gt[t] - G)
+    Rp_hip = Rb[rb, column[hp]] if hp >= 0 else np.broadcast_to(np.eye(3), (size, 3, 3))
     new_parent = R2 @ R1 @ Rb[rb, column[ap]]
-    out = []
-    for j, local in ((foot.hip, np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rb[rb, column[foot.hip]]),
-                     (foot.knee, np.swapaxes(Rb[rb, column[kp]], 1, 2) @ R1 @ Rb[rb, column[foot.knee]]),
-                     (foot.ankle, np.swapaxes(new_parent, 1, 2) @ aim @ Rb[rb, column[foot.ankle]])):
-        quats = Rotation.from_matrix(local).as_quat()
-        quats *= np.where(np.sum(quats * motion.rotations[t, j], axis=-1, keepdims=True) < 0, -1.0, 1.0)
-        out.append((t, j, quats))
-    return out
+    joints = (foot.hip, foot.knee, foot.ankle)
+    local = np.concatenate([np.swapaxes(Rp_hip, 1, 2) @ R2 @ Rb[rb, column[foot.hip]],
+                            np.swapaxes(Rb[rb, column[kp]], 1, 2) @ R1 @ Rb[rb, column[foot.knee]],
+                            np.swapaxes(new_parent, 1, 2) @ aim @ Rb[rb, column[foot.ankle]]])
+    quats = Rotation.from_matrix(local).as_quat().reshape(3, size, 4)   # the three joints' from one Rotation
+    old = np.swapaxes(motion.rotations[t][:, list(joints)], 0, 1)     # (3, size, 4)
+    quats *= np.where(np.sum(quats * old, axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    return [(t, j, q) for j, q in zip(joints, quats, strict=True)]
 
 
 def _bend_axes(feet, W, blocks, column: dict, solved: list[np.ndarray]) -> list[np.ndarray | None]:
@@ -697,13 +717,14 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
     n_extend = int(round(EXTEND_SECONDS / motion.frame_time))
     n_bridge = int(round(BRIDGE_SECONDS / motion.frame_time))
     goals, toe_goals, held, changed = [], [], [], []
+    reaches = [_reach(W, foot, reach) for foot in contacts.feet]   # of the legs followed, before any lowering
     for f in range(len(contacts.feet)):
-        g, gt, h, ch = _foot_goals(W, contacts, f, n_extend, n_bridge, n_blend, reach, clearance)
+        g, gt, h, ch = _foot_goals(W, contacts, f, n_extend, n_bridge, n_blend, reaches[f], clearance)
         goals.append(g)
         toe_goals.append(gt)
         held.append(h)
         changed.append(ch)
-    delta = _lowering(W, contacts, goals, held, reach, n_blend)
+    delta = _lowering(W, contacts, goals, held, reaches, n_blend)
     lowered = delta > 0
     if lowered.any():  # every foot keeps its goal in the world: a swing foot does not dip with the root
         down = -np.outer(delta, contacts.up)

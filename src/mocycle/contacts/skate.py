@@ -16,7 +16,8 @@ from typing import Literal, overload
 import numpy as np
 
 from ..motion import Motion
-from .legs import ChainArray, Foot, body_height, find_feet, leg_joints, up_axis
+from ..rotations import vector_norms
+from .legs import ChainArray, Foot, along, body_height, find_feet, leg_joints, up_axis
 
 SKATE_HEIGHT = 0.015  # H, of the body height: 2.5 cm on a 1.7 m body, the usual absolute H
 
@@ -59,14 +60,14 @@ def skate(motion: Motion, feet: Sequence[Foot] | str | None = None, *, height: f
     if motion.n_frames < 2:
         return {motion.skeleton.names[j]: 0.0 for j in joints} if per_joint else 0.0
     P = (motion.world_positions() if positions is None else positions)[:, joints]  # (T, C, 3)
-    h = P @ up
+    h = along(P, up)
     h = h - h.min(axis=0)
     step = np.diff(P, axis=0)
     del P  # (T, C, 3) arrays held one or two at a time (memory)
-    vu = step @ up
+    vu = along(step, up)
     for k in range(3):  # the horizontal step in place: step - (step . up) up, axis by axis
         step[..., k] -= vu * up[k]
-    speed = np.linalg.norm(step, axis=-1) / motion.frame_time    # (T-1, C)
+    speed = vector_norms(step) / motion.frame_time    # (T-1, C)
     hm = 0.5 * (h[1:] + h[:-1])
     # the exponent clipped at 1 (where the weight is 0 anyway): a foot far above a tiny body height (a still
     # take, a rig whose body height comes out near 0) overflowed 2**(h/H) and printed a numpy warning
@@ -83,5 +84,7 @@ def largest_leg_step(motion: Motion, feet: Sequence[Foot] | None = None) -> floa
     q = motion.rotations[:, leg_joints(feet)]
     if q.shape[0] < 2:
         return 0.0
-    dots = np.clip(np.abs(np.sum(q[1:] * q[:-1], axis=-1)), 0.0, 1.0)
+    a, b = q[1:], q[:-1]   # the dot products summed component by component: np.sum's order, without its overhead
+    dots = np.clip(np.abs(a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+                          + a[..., 3] * b[..., 3]), 0.0, 1.0)
     return float(2.0 * np.arccos(dots).max())

@@ -16,6 +16,12 @@ from ..phase.period import moving_average
 TRUNCATE = 4.0  # the Gaussian kernel reaches this many standard deviations, as scipy's
 
 
+def _edge_padded(x: np.ndarray, before: int, after: int) -> np.ndarray:
+    """``x`` ``(T, ...)`` with its first sample repeated ``before`` times ahead of it and its last ``after`` times
+    behind it along axis 0: ``np.pad(x, ..., mode="edge")`` (a new C-ordered array), without its overhead."""
+    return np.concatenate([np.repeat(x[:1], before, axis=0), x, np.repeat(x[-1:], after, axis=0)])
+
+
 def gaussian(x: np.ndarray, sigma: float) -> np.ndarray:
     """``x`` ``(T, ...)`` smoothed along axis 0 by a Gaussian of ``sigma`` samples (``gaussian_filter1d``)."""
     x = np.asarray(x, dtype=np.float64)
@@ -25,8 +31,7 @@ def gaussian(x: np.ndarray, sigma: float) -> np.ndarray:
     k = np.arange(-radius, radius + 1, dtype=np.float64)
     w = np.exp(-0.5 / (float(sigma) ** 2) * k ** 2)
     w /= w.sum()
-    padded = np.pad(x, [(radius, radius)] + [(0, 0)] * (x.ndim - 1), mode="edge")
-    return sliding_window_view(padded, 2 * radius + 1, axis=0) @ w
+    return sliding_window_view(_edge_padded(x, radius, radius), 2 * radius + 1, axis=0) @ w
 
 
 def maximum(x: np.ndarray, size: int) -> np.ndarray:
@@ -35,8 +40,7 @@ def maximum(x: np.ndarray, size: int) -> np.ndarray:
     size = int(size)
     if size <= 1 or x.size == 0:
         return x.copy()
-    padded = np.pad(x, (size // 2, size - 1 - size // 2), mode="edge")
-    return sliding_window_view(padded, size).max(axis=-1)
+    return sliding_window_view(_edge_padded(x, size // 2, size - 1 - size // 2), size).max(axis=-1)
 
 
 def minimum(x: np.ndarray, size: int) -> np.ndarray:
@@ -49,10 +53,11 @@ def minimum(x: np.ndarray, size: int) -> np.ndarray:
     if size <= 1 or T == 0:
         return x.copy()
     size = min(size, 2 * T - 1)  # a wider window holds every sample already
-    padded = np.pad(x, [(size // 2, size - 1 - size // 2)] + [(0, 0)] * (x.ndim - 1), mode="edge")
-    n = padded.shape[0]
+    n = T + size - 1
     blocks = -(-n // size)
-    padded = np.pad(padded, [(0, blocks * size - n)] + [(0, 0)] * (x.ndim - 1), constant_values=np.inf)
+    # the edges repeated, then +inf up to whole blocks
+    padded = np.concatenate([np.repeat(x[:1], size // 2, axis=0), x, np.repeat(x[-1:], size - 1 - size // 2, axis=0),
+                             np.full((blocks * size - n,) + x.shape[1:], np.inf)])
     b = padded.reshape((blocks, size) + x.shape[1:])
     forward = np.minimum.accumulate(b, axis=1).reshape(padded.shape)
     backward = np.minimum.accumulate(b[:, ::-1], axis=1)[:, ::-1].reshape(padded.shape)

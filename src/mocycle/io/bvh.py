@@ -484,6 +484,16 @@ def _fmt(x: float) -> str:
     return f"{x:.9g}"
 
 
+def _rows_text(block: np.ndarray) -> str:
+    """The lines of the channel values ``block`` ``(n, C)``, ``%.9g`` each, space-separated (the text of
+    ``np.savetxt(fmt="%.9g", delimiter=" ")``), with one ``%`` over the whole block; a column that holds one
+    value throughout (a joint's constant position channels) is formatted once, into the line's format."""
+    same = (block == block[0]).all(axis=0)
+    line = " ".join(_fmt(v) if constant else "%.9g"
+                    for v, constant in zip(block[0].tolist(), same.tolist(), strict=True))
+    return ((line + "\n") * block.shape[0]) % tuple(block[:, ~same].ravel().tolist())
+
+
 def format_bvh(motion: Motion) -> str:
     """The BVH text of ``motion`` (written without recursion: any depth of hierarchy)."""
     return "".join(bvh_chunks(motion))
@@ -606,12 +616,7 @@ def bvh_chunks(motion: Motion, names: tuple[list[str], list[str | None]] | None 
         return
     for _, block in channel_blocks(motion, _ROWS_PER_CHUNK):  # a block of rows at a time, none held whole
         # Write tiny values as 0 so files stay readable; keep 9 significant digits.
-        block = np.where(np.abs(block) < 1e-9, 0.0, block)
-        out = io.StringIO()
-        np.savetxt(out, block, fmt="%.9g", delimiter=" ")
-        text = out.getvalue()
-        out.close()  # savetxt's writer holds the buffer in a reference cycle: freed now, not at the next gc
-        yield text
+        yield _rows_text(np.where(np.abs(block) < 1e-9, 0.0, block))
 
 
 def write_bvh(motion: Motion, path: str | os.PathLike) -> Path:
