@@ -398,18 +398,25 @@ def _gait_changes(strides: np.ndarray, poses: np.ndarray | None = None) -> set[i
     """The landings (indices into a chain's landings; a part boundary there starts a new part at that step)
     where a straight gait changes (:data:`STRIDE_STEPS`, :data:`GAIT_CHANGE`, :data:`STEADY_SIDES`): the
     medians of up to three strides ending at the landing and three starting there differ (``poses``: the
-    strides' mean poses, :func:`_stride_poses`, a change of posture counting as one more figure); of
-    candidates two strides apart or less, the landing where they differ most, moved to the neighbouring
-    landing whose parts would be steadier (:func:`_steadiest_cut`).  Turning strides are left out: a turn
-    slows a walk, and the turn's own borders are cut by :func:`_turn_runs`."""
-    n = strides.shape[0]
-    score = np.zeros(n + 6)
-    score[3:n - 1] = _change_scores(strides, poses)  # landings 3 .. n-2: two strides or more on either side
-    # of candidates two strides or less apart (four landings), the one where the gait differs most: a stride
-    # unlike the others (the one that blends two takes) enters the comparisons of the landings that far on
-    found = {b for b in range(2, n) if score[b] > 0 and score[max(0, b - 4):b].max(initial=0.0) <= score[b]
-             and score[b] > score[b + 1:b + 5].max()}
-    return {_steadiest_cut(b, strides, poses) for b in found}
+    strides' mean poses, :func:`_stride_poses`, a change of posture counting as one more figure).  The landing
+    where they differ most is moved to the neighbouring landing whose parts would be steadier
+    (:func:`_steadiest_cut`), and the strides on either side of the step it drops are looked at again, each side
+    on its own: the stride that blends two takes, which sways the comparisons of the landings up to two strides
+    on, is then in neither, and a take of a few strides between two others still shows both its changes.
+    Turning strides are left out: a turn slows a walk, and the turn's own borders are cut by
+    :func:`_turn_runs`."""
+    return _changes_in(strides, poses, 0, strides.shape[0])
+
+
+def _changes_in(strides: np.ndarray, poses: np.ndarray | None, lo: int, hi: int) -> set[int]:
+    """:func:`_gait_changes` over strides ``lo .. hi-1`` of a chain only (landing indices of the chain)."""
+    score = _change_scores(strides[lo:hi], None if poses is None else poses[lo:hi])
+    if not score.size or not score.max() > 0:
+        return set()
+    b = 3 + int(np.argmax(score))  # the landing (of strides lo ..) where they differ most
+    c = _steadiest_cut(b, strides[lo:hi], None if poses is None else poses[lo:hi])
+    # strides ending by landing c, and those starting after the step it drops (landing c + 1)
+    return {lo + c} | _changes_in(strides, poses, lo, lo + c - 1) | _changes_in(strides, poses, lo + c + 1, hi)
 
 
 def _windows(values: np.ndarray) -> np.ndarray:
