@@ -391,7 +391,8 @@ def task_command(name: str, into: typer.Typer | None = None) -> Callable:
             return func(**{k: v for k, v in given.items() if k in own})
 
         # typer reads a command's parameters from its signature only (docs/architecture.md says why not click's)
-        command.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]
+        # a function's __signature__ is what inspect (and so typer) reads
+        command.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]  # not on Callable
         command.__annotations__ = {p.name: p.annotation for p in params}
         del command.__wrapped__  # typer reads the signature made here, not the function's
         return (into or app).command(name)(friendly(command))

@@ -701,7 +701,8 @@ def read_gltf(path: str | os.PathLike, *, take: str | int | None = None, fps: fl
             rate = _file_rate([[c[2] for c in _channels(f, k, N, values=False, inputs=inputs)]
                                for k in range(len(names))]) or DEFAULT_FPS
             if not _on_grid(keys, rate):
-                warnings.warn(f"{p}: the keys of take {names[index]!r} lie on no regular grid of the file's "  # type: ignore[index]
+                assert index is not None  # keys come from a take's channels
+                warnings.warn(f"{p}: the keys of take {names[index]!r} lie on no regular grid of the file's "
                               f"{rate:g} fps frames; sampled at {rate:g} fps", MocycleWarning, stacklevel=2)
         times = frame_times(min(float(k[0]) for k in keys), max(float(k[-1]) for k in keys), rate, len(members), p)
     else:
