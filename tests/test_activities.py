@@ -338,3 +338,22 @@ def test_return_distance_stays_a_number_where_a_period_is_over_half_the_frames()
     assert np.all(np.isfinite(d))
     assert np.all(d[:15] < ALIKE) and np.all(d[45:] < ALIKE)  # a period apart: the same pose
     assert np.all(d[25:35] > ALIKE)  # nothing a period away
+
+
+def test_a_short_gait_part_is_judged_on_its_own_frames_not_on_the_takes_beside_it():
+    """A walk of 1.7 strides between two waves: its own frames compare more than a step and are alike, so it is a
+    gait part; the frames beside it (another take in a session) are not looked at (they were: unlike, the walk
+    was dropped)."""
+    from mocycle.activities import Activity, _legs_repeat_in
+    from mocycle.datasets import join_takes
+
+    fps = 60.0
+    takes = [synthetic_wave(n_frames=180, fps=fps, seed=1).motion,
+             synthetic_walk(n_frames=120, fps=fps, period_s=1.0, noise_deg=0.5, seed=2).motion,
+             synthetic_wave(n_frames=180, fps=fps, seed=3).motion]
+    s = join_takes(takes, ["wave", "walk", "wave"])
+    _, a, b = s.stretches[1]
+    walk = Activity(start=a + 3, stop=b - 3, kind="walk straight", period_frames=60.0)
+    assert _legs_repeat_in(s.motion, walk)
+    waves = Activity(start=0, stop=a - 3, kind="walk straight", period_frames=60.0)
+    assert not _legs_repeat_in(s.motion, waves)  # legs that stand still while the arms wave make no gait
