@@ -372,6 +372,9 @@ def _step_gaits(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
 #: where one take meets the next, not the ramp of a walk that starts from standing), the gait changes there.
 STRIDE_STEPS = {"period": 0.08, "speed": 0.15, "flight": 0.12, "double support": 0.15, "pose": 0.5}
 GAIT_CHANGE, STEADY_SIDES = 1.25, 3.0
+#: the scales of a stride's figures (period, speed, flight, double support: :func:`_stride_figures`' columns 0, 2,
+#: 3, 4), in that order
+_FIGURE_SCALE = np.array([STRIDE_STEPS[k] for k in ("period", "speed", "flight", "double support")])
 
 
 def _stride_poses(motion: Motion, frames: np.ndarray) -> np.ndarray | None:
@@ -441,15 +444,13 @@ def _change_scores(strides: np.ndarray, poses: np.ndarray | None) -> np.ndarray:
     n = strides.shape[0]
     if n < 5:
         return np.zeros(max(0, n - 4))
-    scale = np.array([STRIDE_STEPS["period"], STRIDE_STEPS["speed"], STRIDE_STEPS["flight"],
-                      STRIDE_STEPS["double support"]])
     landing = np.arange(3, n - 1)  # strides landing-4 .. landing-2 end by it, landing .. landing+2 start there
     before, after = landing - 3, landing + 1  # their windows (:func:`_windows`)
     figures = _windows(strides[:, [0, 2, 3, 4]])
     turns = np.nan_to_num(_windows(np.abs(strides[:, 1])))
     m0 = _median3(figures[before])
     m1 = _median3(figures[after])
-    unit = np.column_stack([m0[:, 0], m0[:, 1], np.ones_like(m0[:, :2])]) * scale  # period, speed relative
+    unit = np.column_stack([m0[:, 0], m0[:, 1], np.ones_like(m0[:, :2])]) * _FIGURE_SCALE  # period, speed relative
     with np.errstate(invalid="ignore", divide="ignore"):
         # spread: the median deviation, blind to the one stride a blend may spoil
         squares = [np.sum(((m1 - m0) / unit) ** 2, axis=1),
@@ -477,8 +478,6 @@ def _steadiest_cut(b: int, strides: np.ndarray, poses: np.ndarray | None) -> int
     deviate least from their medians (in the scales of :data:`STRIDE_STEPS`) is the one that drops it."""
     n = strides.shape[0]
     figures = strides[:, [0, 2, 3, 4]]
-    scale = np.array([STRIDE_STEPS["period"], STRIDE_STEPS["speed"], STRIDE_STEPS["flight"],
-                      STRIDE_STEPS["double support"]])
     cost = {}
     for c in (b - 1, b, b + 1):
         before, after = slice(max(0, c - 4), c - 1), slice(c + 1, min(n, c + 4))
@@ -487,7 +486,7 @@ def _steadiest_cut(b: int, strides: np.ndarray, poses: np.ndarray | None) -> int
         deviation = 0.0
         for side in (before, after):
             m = np.median(figures[side], axis=0)
-            unit = np.array([abs(m[0]), abs(m[1]), 1.0, 1.0]) * scale + 1e-12
+            unit = np.array([abs(m[0]), abs(m[1]), 1.0, 1.0]) * _FIGURE_SCALE + 1e-12
             deviation += float(np.sum(np.abs(figures[side] - m) / unit))
             if poses is not None:
                 deviation += float(np.sum(np.linalg.norm(poses[side] - np.median(poses[side], axis=0), axis=1))) \
@@ -1288,11 +1287,8 @@ def _spread_of(q: np.ndarray) -> np.ndarray:
 
 def _legs_stand(motion: Motion, start: int, stop: int) -> bool:
     """:func:`_legs_still` over frames ``start .. stop-1``, the spread measured on the leg joints only."""
-    try:
-        legs = motion.skeleton.select("legs")
-    except MocycleError:
-        return True
-    return not legs or float(_spread_of(motion.rotations[start:stop, legs]).max()) < 2 * STILL_DEG
+    legs = _leg_joint_indices(motion.skeleton)
+    return _still_legs(_spread_of(motion.rotations[start:stop, legs]) if legs else np.zeros(0))
 
 
 def _moving_arm_joints(skeleton, spread: np.ndarray) -> list[str]:
@@ -1308,12 +1304,22 @@ def _moving_arm_joints(skeleton, spread: np.ndarray) -> list[str]:
 
 
 def _legs_still(skeleton, spread: np.ndarray) -> bool:
-    """Whether the legs stand: no leg joint's rotation spreads more than twice :data:`STILL_DEG`."""
+    """Whether the legs stand: no leg joint's rotation spreads (``spread``, every joint's) more than twice
+    :data:`STILL_DEG`."""
+    return _still_legs(spread[_leg_joint_indices(skeleton)])
+
+
+def _leg_joint_indices(skeleton) -> list[int]:
+    """The rig's leg joints (none when it names none)."""
     try:
-        legs = skeleton.select("legs")
+        return skeleton.select("legs")
     except MocycleError:
-        return True
-    return not legs or float(spread[legs].max()) < 2 * STILL_DEG
+        return []
+
+
+def _still_legs(leg_spread: np.ndarray) -> bool:
+    """:func:`_legs_still` of the leg joints' spread ``(L,)`` (degrees): no legs stand too."""
+    return leg_spread.size == 0 or float(leg_spread.max()) < 2 * STILL_DEG
 
 
 def _repeating_region(piece: Motion, joints, least: float) -> tuple[int, int, float] | None:

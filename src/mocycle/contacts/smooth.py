@@ -56,7 +56,7 @@ def minimum(x: np.ndarray, size: int) -> np.ndarray:
     n = T + size - 1
     blocks = -(-n // size)
     # the edges repeated, then +inf up to whole blocks
-    padded = np.concatenate([np.repeat(x[:1], size // 2, axis=0), x, np.repeat(x[-1:], size - 1 - size // 2, axis=0),
+    padded = np.concatenate([_edge_padded(x, size // 2, size - 1 - size // 2),
                              np.full((blocks * size - n,) + x.shape[1:], np.inf)])
     b = padded.reshape((blocks, size) + x.shape[1:])
     forward = np.minimum.accumulate(b, axis=1).reshape(padded.shape)

@@ -147,9 +147,7 @@ def run(take, options: Options | None = None, *, deliver=None) -> Report:
             stack.enter_context(client)
         with rec.part("parts"):
             acts = segment_activities(motion, min_periods=o.min_periods, joints=o.joints, classes=o.classes,
-                                      pca=o.pca, delay=o.delay, step=o.step,
-                                      map=partial(pool.map, chunksize=1) if pool is not None else
-                                      map if client is None else partial(_cluster_map, client))
+                                      pca=o.pca, delay=o.delay, step=o.step, map=_mapper(pool, client))
         parts = acts.parts
         loops, not_looped, motions, cycles, extras, refusals = [], [], {}, [], {}, []
         tried = parts_to_try(acts, o.which)
@@ -312,6 +310,13 @@ def _client(o: Options):
     from distributed import Client
 
     return Client(o.scheduler, timeout="30s")
+
+
+def _mapper(pool, client):
+    """How the cut maps its stretches: on the local ``pool``, on the dask cluster of ``client``, or here."""
+    if pool is not None:
+        return partial(pool.map, chunksize=1)
+    return map if client is None else partial(_cluster_map, client)
 
 
 def _cluster_map(client, fn, items) -> list:
