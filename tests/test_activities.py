@@ -357,3 +357,74 @@ def test_a_short_gait_part_is_judged_on_its_own_frames_not_on_the_takes_beside_i
     assert _legs_repeat_in(s.motion, walk)
     waves = Activity(start=0, stop=a - 3, kind="walk straight", period_frames=60.0)
     assert not _legs_repeat_in(s.motion, waves)  # legs that stand still while the arms wave make no gait
+
+
+def _figures(n: int, period: float = 60.0, speed: float = 1.0, double: float = 0.3) -> np.ndarray:
+    """Stride figures (:func:`mocycle.activities._stride_figures`' columns) of ``n`` steady straight strides."""
+    return np.tile([period, 0.0, speed, 0.0, double], (n, 1)).astype(np.float64)
+
+
+def test_a_blended_stride_at_a_chains_end_is_left_out_and_its_own_part_keeps_three():
+    """Where one take meets the next the landings may run on into it for a step or two: the stride over the join
+    (slower, with less double support) is left out, a step at a time; one that turns (a turn slows a walk) is
+    kept, and so are the strides of a short part beyond a gait change (compared within its own part only)."""
+    from mocycle.activities import _steady_ends
+
+    strides = _figures(8)
+    assert _steady_ends(strides, None) == (0, 8)
+    strides[-1, 2:] = [0.6, 0.0, 0.1]  # the last stride runs into a slower take
+    assert _steady_ends(strides, None) == (0, 7)
+    strides[0, 0] = 80.0  # and the first one into the take before
+    assert _steady_ends(strides, None) == (1, 7)
+    turning = strides.copy()
+    turning[-1, 1] = 40.0
+    assert _steady_ends(turning, None) == (1, 8)
+    # a gait change at landing 5: the last part holds strides 6 and 7 only, too few to judge one of them by
+    assert _steady_ends(strides, None, cuts={5}) == (1, 8)
+    poses = np.zeros((8, 3))
+    poses[-1] = [0.0, 1.0, 0.0]  # the same figures, another posture: a blend as well
+    assert _steady_ends(_figures(8), poses) == (0, 7)
+
+
+def test_the_second_look_stays_on_one_side_of_a_gait_change():
+    """Frames where steps were seen but nothing loops are looked at again without gait; where the gait was seen
+    to change between two such parts, each side is looked at on its own (one look across both found a
+    "periodic" motion holding the end of one take and the start of the next)."""
+    from mocycle.activities import Activity, _second_look, find_landings
+
+    walk = synthetic_walk(n_frames=360, fps=60.0, period_s=1.0, noise_deg=0.5, seed=3).motion
+    landings = find_landings(walk)
+
+    def looked(changes):
+        seen = []
+
+        def record(fn, gaps):
+            seen.extend((g.offset, g.offset + g.motion.n_frames) for g in gaps)
+            return [[] for _ in gaps]
+
+        parts = [Activity(start=0, stop=150, kind="transition", landings={"left": [30]}),
+                 Activity(start=150, stop=360, kind="transition", landings={"left": [200]})]
+        _second_look(walk, parts, landings, 1.2, {"joints": None, "step": 1}, record, changes)
+        return seen
+
+    assert looked(()) == [(0, 360)]
+    assert looked({150}) == [(0, 150), (150, 360)]
+
+
+def test_a_run_whose_landings_run_on_into_the_walk_after_it_is_not_looped_across_the_join():
+    """Joined end to end, a run's chain of landings runs on a step into the walk after it (the blend of the two
+    keeps the tempo for a step): the steps about the join are a transition, the run's loop stays in the run
+    (it held 39 frames of the walk, most of a run's stride) and the walk still loops."""
+    from mocycle.datasets import join_takes
+
+    fps = 60.0
+    s = join_takes([synthetic_run(n_frames=254, fps=fps, period_s=0.7, noise_deg=0.5, seed=2).motion,
+                    synthetic_walk(n_frames=240, fps=fps, period_s=1.1, noise_deg=0.5, seed=12).motion],
+                   ["run", "walk"])
+    border = s.stretches[0][2]
+    parts = segment_activities(s.motion).parts
+    loops = [p for p in parts if p.loop]
+    assert [p.kind for p in loops] == ["run straight", "walk straight"], [(p.kind, p.start, p.stop) for p in parts]
+    run, walk = loops
+    assert run.stop - border <= 0.5 * run.period_frames and border - walk.start <= 0.5 * walk.period_frames
+    assert any(p.kind == "transition" and p.start < border < p.stop for p in parts)

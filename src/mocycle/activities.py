@@ -495,6 +495,49 @@ def _steadiest_cut(b: int, strides: np.ndarray, poses: np.ndarray | None) -> int
     return min(cost, key=lambda c: (cost[c], abs(c - b))) if cost else b
 
 
+#: At most this many steps are dropped at either end of a chain of landings as a blend (:func:`_steady_ends`).
+EDGE_STEPS = 2
+
+
+def _edge_change(strides: np.ndarray, poses: np.ndarray | None, k: int, ref: slice) -> float:
+    """How far stride ``k`` of a chain lies from the median of its strides ``ref`` (their figures,
+    :func:`_stride_figures`, and mean poses, :func:`_stride_poses`), in the scales of :data:`STRIDE_STEPS`."""
+    figures = strides[:, [0, 2, 3, 4]]
+    m = np.median(figures[ref], axis=0)
+    unit = np.array([abs(m[0]), abs(m[1]), 1.0, 1.0]) * _FIGURE_SCALE + 1e-12
+    square = float(np.sum(((figures[k] - m) / unit) ** 2))
+    if poses is not None:
+        square += float(np.sum((poses[k] - np.median(poses[ref], axis=0)) ** 2)) / STRIDE_STEPS["pose"] ** 2
+    return float(np.sqrt(square))
+
+
+def _steady_ends(strides: np.ndarray, poses: np.ndarray | None, cuts: Collection[int] = ()) -> tuple[int, int]:
+    """The strides ``lo .. hi-1`` of a chain that its gait parts may hold (the chain's landings ``lo .. hi+1``):
+    at either end of the chain, up to :data:`EDGE_STEPS` strides that differ from the median of the three
+    strides inside them by more than :data:`GAIT_CHANGE` (:func:`_edge_change`) are left out, one step at a
+    time.  Where one take meets the next the steps about the join blend the two (a stride longer or shorter
+    than either's, a speed between them, another posture) and the landings may run on a step or two into the
+    next take before its tempo breaks the chain.  The strides compared lie in the end's own part (``cuts``: the
+    landings where the chain's gait changes, :func:`_gait_changes`, or its steps change from walk to run) and
+    that part keeps three; a stride that
+    turns (:data:`TURN_DEG`) is never left out (a turn changes a gait's tempo on its own)."""
+    n = strides.shape[0]
+    first = min(cuts, default=n + 1) - 1  # the strides of the first part: 0 .. first-1; of the last: last .. n-1
+    last = max(cuts, default=-1) + 1
+    lo, hi = 0, n
+
+    def blended(k: int, ref: slice) -> bool:
+        if np.any(np.abs(strides[[k, *range(n)[ref]], 1]) > TURN_DEG):
+            return False
+        return _edge_change(strides, poses, k, ref) > GAIT_CHANGE
+
+    while lo < EDGE_STEPS and first - lo > 3 and blended(lo, slice(lo + 1, lo + 4)):
+        lo += 1
+    while n - hi < EDGE_STEPS and hi - max(last, lo) > 3 and blended(hi - 1, slice(hi - 4, hi - 1)):
+        hi -= 1
+    return lo, hi
+
+
 def stride_rate(heading: np.ndarray, period: float, start: int, stop: int) -> np.ndarray:
     """The hips' turning rate ``(stop - start,)`` in degrees per stride: the heading's change over one stride
     (``period`` frames) about each frame, where the hips' sway within a stride cancels; near the take's ends the
@@ -623,6 +666,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     parts = []
     stepped = []  # the landings of the gait chains: a stride phase is a line through these only
     changes: set[int] = set()  # the landings where a gait changes: the parts beside them reach no further
+    blends: list[tuple[int, int]] = []  # the steps left out at a chain's ends (:func:`_steady_ends`)
     for chain in _gait_chains(landings, fps, least=2):
         stepped.append(chain)
         a, b = int(landings.frames[chain[0]]), int(landings.frames[chain[-1]])
@@ -634,8 +678,20 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
                 parts.append(short)
             continue
         strides = _stride_figures(chain, landings, heading, path, fps)
+        poses = _stride_poses(motion, landings.frames[chain])
+        cuts = _gait_changes(strides, poses)
         kinds = _step_gaits(strides, body)
-        cuts = _gait_changes(strides, _stride_poses(motion, landings.frames[chain]))
+        walk_run = {j for j in range(1, len(kinds)) if kinds[j][0] != kinds[j - 1][0]}
+        lo, hi = _steady_ends(strides, poses, cuts | walk_run)
+        ends = [(0, lo)] if lo > 0 else []
+        if hi < strides.shape[0]:
+            ends.append((hi + 1, chain.size - 1))
+        for e0, e1 in ends:  # blended steps at an end: a transition; the parts beside it reach no further
+            blends.append((int(landings.frames[chain[e0]]), int(landings.frames[chain[e1]])))
+            changes.update(blends[-1])
+        chain, strides = chain[lo:hi + 2], strides[lo:hi]
+        cuts = {c - lo for c in cuts}
+        kinds = _step_gaits(strides, body)
         f = landings.frames[chain]
         i = 0
         while i < len(kinds):
@@ -656,6 +712,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     parts.sort(key=lambda p: p.start)
     _reach(motion, parts, T, changes)
     parts = [q for p in parts for q in (_split_turns(p, heading, path, fps) if " " not in p.kind else [p])]
+    parts = _with_blends(parts, blends)
     parts = _fill(motion, parts, landings, min_periods, options, map)
     keep = np.sort(np.concatenate(stepped)) if stepped else np.zeros(0, dtype=np.intp)
     steps = Landings(landings.frames[keep], landings.foot[keep], landings.sides, landings.down)
@@ -668,7 +725,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
         for p in gait:
             _asked_phase(motion, p, min_periods, options)
     _decide(parts, min_periods)
-    parts = _second_look(motion, parts, landings, min_periods, options, map)
+    parts = _second_look(motion, parts, landings, min_periods, options, map, changes)
     parts = _or_one_cycle(motion, parts, landings)
     return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True, reason=_listing(parts),
                       landings=landings)
@@ -753,17 +810,35 @@ def _or_one_cycle(motion: Motion, parts: list[Activity], landings: Landings | No
     return [part]
 
 
+def _with_blends(parts: list[Activity], blends: list[tuple[int, int]]) -> list[Activity]:
+    """The parts with the frames of ``blends`` (the steps left out at a chain's ends, :func:`_steady_ends`) that
+    no part holds as transitions, in frame order: looked at for no other motion (they blend two takes)."""
+    out = list(parts)
+    for a, b in blends:
+        for p in parts:  # a neighbour that reached into the blend keeps what it holds
+            if p.start <= a < p.stop:
+                a = p.stop
+            if p.start < b <= p.stop:
+                b = p.start
+        if b > a:
+            out.append(Activity(start=a, stop=b, kind="transition", limbs="none",
+                                reason="steps where one take meets another: a blend of the two, no one motion"))
+    return sorted(out, key=lambda q: q.start)
+
+
 def _second_look(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float, options: dict,
-                 map=map) -> list[Activity]:
+                 map=map, changes: Collection[int] = ()) -> list[Activity]:
     """Frames where steps were seen but no gait part loops (landings missed on a rig whose feet slide, a
     stumble) looked at again as frames without gait (:func:`_other`, through ``map``): each run of neighbouring
     parts that do not loop, holding steps and lasting :data:`MIN_OTHER_S` or more, is replaced by what that
-    finds when it finds a motion that repeats there; otherwise the parts stay as they were."""
+    finds when it finds a motion that repeats there; otherwise the parts stay as they were.  A run ends where a
+    part starts at a landing of ``changes`` (where the gait was seen to change): what is looked at again lies on
+    one side of every change."""
     runs: list[list[Activity]] = []
     k = 0
     while k < len(parts):
         j = k
-        while j < len(parts) and not parts[j].loop:
+        while j < len(parts) and not parts[j].loop and (j == k or parts[j].start not in changes):
             j += 1
         runs.append(parts[k:j] if j > k else [parts[k]])
         k = max(j, k + 1)
