@@ -90,18 +90,22 @@ def test_loop_part_all_writes_one_file_per_part(tmp_path):
     out = tmp_path / "loop.bvh"
     result = runner.invoke(app, ["loop", str(src), "-o", str(out), "--part", "all", "--json"])
     assert result.exit_code == 0, result.output
-    loops = json.loads(result.stdout)["loops"]
-    assert [f["output"] for f in loops] == [str(tmp_path / "loop.part0-walk-straight.bvh"),
-                                            str(tmp_path / "loop.part1-run-straight.bvh")]
-    assert not out.exists()
+    facts = json.loads(result.stdout)
+    loops = facts["loops"]
+    assert [f["kind"] for f in loops] == ["walk straight", "run straight"]
     walk, run = loops
+    k = run["part"]  # the index into the JSON's parts (the steps where the walk becomes a run may be one)
+    assert facts["parts"][k]["kind"] == "run straight" and walk["part"] == 0
+    assert [f["output"] for f in loops] == [str(tmp_path / "loop.part0-walk-straight.bvh"),
+                                            str(tmp_path / f"loop.part{k}-run-straight.bvh")]
+    assert not out.exists()
     assert abs(walk["period_frames"] - 30) < 1 and abs(run["period_frames"] - 21) < 1
     assert walk["frames"][1] <= 150 + 0.5 * 21 and run["frames"][0] >= 150 - 0.5 * 30  # each from its own part
-    assert read(tmp_path / "loop.part1-run-straight.bvh").n_frames == run["cycle_frames"]
+    assert read(tmp_path / f"loop.part{k}-run-straight.bvh").n_frames == run["cycle_frames"]
     for f in loops:
         assert f["joints_used"] == "legs" and f["period_source"] in f["period_candidates"]
-    text = runner.invoke(app, ["loop", str(src), "-o", str(out), "--class", "1"])  # --class: the old name
-    assert text.exit_code == 0 and "part 1 (run straight" in text.output and out.exists()
+    text = runner.invoke(app, ["loop", str(src), "-o", str(out), "--class", str(k)])  # --class: the old name
+    assert text.exit_code == 0 and f"part {k} (run straight" in text.output and out.exists()
     assert "--class is deprecated" in text.stderr and "--part" in text.stderr
     for bad in ("two", "-1", "9"):
         refused = runner.invoke(app, ["loop", str(src), "-o", str(tmp_path / "x.bvh"), "--part", bad])
