@@ -519,8 +519,8 @@ def _steady_ends(strides: np.ndarray, poses: np.ndarray | None, cuts: Collection
     than either's, a speed between them, another posture) and the landings may run on a step or two into the
     next take before its tempo breaks the chain.  The strides compared lie in the end's own part (``cuts``: the
     landings where the chain's gait changes, :func:`_gait_changes`, or its steps change from walk to run) and
-    that part keeps three; a stride that
-    turns (:data:`TURN_DEG`) is never left out (a turn changes a gait's tempo on its own)."""
+    that part keeps three; a stride that turns (:data:`TURN_DEG`) is never left out (a turn changes a gait's
+    tempo on its own)."""
     n = strides.shape[0]
     first = min(cuts, default=n + 1) - 1  # the strides of the first part: 0 .. first-1; of the last: last .. n-1
     last = max(cuts, default=-1) + 1
@@ -689,9 +689,10 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
         for e0, e1 in ends:  # blended steps at an end: a transition; the parts beside it reach no further
             blends.append((int(landings.frames[chain[e0]]), int(landings.frames[chain[e1]])))
             changes.update(blends[-1])
-        chain, strides = chain[lo:hi + 2], strides[lo:hi]
-        cuts = {c - lo for c in cuts}
-        kinds = _step_gaits(strides, body)
+        if (lo, hi) != (0, strides.shape[0]):  # the steps at the new ends lie in fewer strides
+            chain, strides = chain[lo:hi + 2], strides[lo:hi]
+            cuts = {c - lo for c in cuts}
+            kinds = _step_gaits(strides, body)
         f = landings.frames[chain]
         i = 0
         while i < len(kinds):
