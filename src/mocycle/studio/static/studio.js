@@ -83,6 +83,11 @@ async function pollLibrary() {
 async function openTake(id) {
   const t0 = performance.now();
   S.take = id;
+  // a loop still running (this take's, opened again, or the last take's) is superseded by this opening: its
+  // answer, arriving while this take loads, is not shown
+  S.loopSeq = (S.loopSeq || 0) + 1;
+  if (S.loopRunning) json(`/api/jobs/${S.loopRunning}`, undefined, "DELETE").catch(() => {});
+  S.loopRunning = null;
   $("loop-options").elements.force.checked = false;  // force is asked for one take's loop, not kept for the next
   document.querySelectorAll(".take").forEach((r) => r.classList.toggle("current", r.dataset.id === id));
   status("loading the take…");
@@ -94,9 +99,6 @@ async function openTake(id) {
   } catch (e) {
     // a take that cannot be read: its name and why, nothing of the previous take left to play or author on
     if (S.take !== id) return;
-    S.loopSeq = (S.loopSeq || 0) + 1;  // the previous take's loop, if still running, is not this take's
-    if (S.loopRunning) json(`/api/jobs/${S.loopRunning}`, undefined, "DELETE").catch(() => {});
-    S.loopRunning = null;
     S.motion = null; S.pose = null; S.plane = null; S.keys = null; S.loopJob = null;
     S.player.clear();
     loopState("failed", `cannot read this take: ${e.message}`);
