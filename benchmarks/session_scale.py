@@ -24,6 +24,7 @@ import filecmp
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -61,7 +62,8 @@ def _tree_rss(pid: int) -> int:
 
 
 def run(session: Path, out: Path, workers: int) -> dict:
-    out.mkdir(parents=True, exist_ok=True)
+    shutil.rmtree(out, ignore_errors=True)  # a kept folder of an earlier run: its files would be compared too
+    out.mkdir(parents=True)
     cmd = mocycle_cmd() + ["loop", str(session), "-o", str(out / "s.bvh"), "--part", "all", "--root", "motion",
                            "--json"] + (["--workers", str(workers)] if workers else [])
     peak = [0]
