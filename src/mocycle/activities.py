@@ -375,6 +375,14 @@ GAIT_CHANGE, STEADY_SIDES = 1.25, 3.0
 #: the scales of a stride's figures (period, speed, flight, double support: :func:`_stride_figures`' columns 0, 2,
 #: 3, 4), in that order
 _FIGURE_SCALE = np.array([STRIDE_STEPS[k] for k in ("period", "speed", "flight", "double support")])
+#: ... and those columns
+_FIGURE_COLUMNS = [0, 2, 3, 4]
+
+
+def _figure_units(m: np.ndarray) -> np.ndarray:
+    """The scales ``(4,)`` of the changes of stride figures whose median is ``m`` (period and speed as shares of
+    it, flight and double support as shares of a stride), never zero."""
+    return np.array([abs(m[0]), abs(m[1]), 1.0, 1.0]) * _FIGURE_SCALE + 1e-12
 
 
 def _stride_poses(motion: Motion, frames: np.ndarray) -> np.ndarray | None:
@@ -446,7 +454,7 @@ def _change_scores(strides: np.ndarray, poses: np.ndarray | None) -> np.ndarray:
         return np.zeros(max(0, n - 4))
     landing = np.arange(3, n - 1)  # strides landing-4 .. landing-2 end by it, landing .. landing+2 start there
     before, after = landing - 3, landing + 1  # their windows (:func:`_windows`)
-    figures = _windows(strides[:, [0, 2, 3, 4]])
+    figures = _windows(strides[:, _FIGURE_COLUMNS])
     turns = np.nan_to_num(_windows(np.abs(strides[:, 1])))
     m0 = _median3(figures[before])
     m1 = _median3(figures[after])
@@ -477,7 +485,7 @@ def _steadiest_cut(b: int, strides: np.ndarray, poses: np.ndarray | None) -> int
     holds the change spoils both strides across it; the cut whose parts' strides (two or three on either side)
     deviate least from their medians (in the scales of :data:`STRIDE_STEPS`) is the one that drops it."""
     n = strides.shape[0]
-    figures = strides[:, [0, 2, 3, 4]]
+    figures = strides[:, _FIGURE_COLUMNS]
     cost = {}
     for c in (b - 1, b, b + 1):
         before, after = slice(max(0, c - 4), c - 1), slice(c + 1, min(n, c + 4))
@@ -486,8 +494,7 @@ def _steadiest_cut(b: int, strides: np.ndarray, poses: np.ndarray | None) -> int
         deviation = 0.0
         for side in (before, after):
             m = np.median(figures[side], axis=0)
-            unit = np.array([abs(m[0]), abs(m[1]), 1.0, 1.0]) * _FIGURE_SCALE + 1e-12
-            deviation += float(np.sum(np.abs(figures[side] - m) / unit))
+            deviation += float(np.sum(np.abs(figures[side] - m) / _figure_units(m)))
             if poses is not None:
                 deviation += float(np.sum(np.linalg.norm(poses[side] - np.median(poses[side], axis=0), axis=1))) \
                     / STRIDE_STEPS["pose"]
@@ -502,10 +509,9 @@ EDGE_STEPS = 2
 def _edge_change(strides: np.ndarray, poses: np.ndarray | None, k: int, ref: slice) -> float:
     """How far stride ``k`` of a chain lies from the median of its strides ``ref`` (their figures,
     :func:`_stride_figures`, and mean poses, :func:`_stride_poses`), in the scales of :data:`STRIDE_STEPS`."""
-    figures = strides[:, [0, 2, 3, 4]]
+    figures = strides[:, _FIGURE_COLUMNS]
     m = np.median(figures[ref], axis=0)
-    unit = np.array([abs(m[0]), abs(m[1]), 1.0, 1.0]) * _FIGURE_SCALE + 1e-12
-    square = float(np.sum(((figures[k] - m) / unit) ** 2))
+    square = float(np.sum(((figures[k] - m) / _figure_units(m)) ** 2))
     if poses is not None:
         square += float(np.sum((poses[k] - np.median(poses[ref], axis=0)) ** 2)) / STRIDE_STEPS["pose"] ** 2
     return float(np.sqrt(square))
