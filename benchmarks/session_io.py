@@ -114,7 +114,8 @@ PARSERS = {  # name: (environment, what it is)
     "polars": ({"POLARS_MAX_THREADS": ""}, "polars.read_csv, its default threads"),
     "np.fromstring": ({}, "np.fromstring(text, sep=' ')"),
     "split + float": ({}, "np.array(bytes.split(), dtype=float)"),
-    "read_bvh": ({"POLARS_MAX_THREADS": "1"}, "this tree's read_bvh, polars on one thread"),
+    "read_bvh": ({"POLARS_MAX_THREADS": "1"}, "this tree's read_bvh as the command line runs it: one polars "
+                                              "thread in each of its helper threads"),
     "read_bvh any threads": ({"POLARS_MAX_THREADS": ""}, "this tree's read_bvh, polars' default threads"),
     "read_bvh no polars": ({}, "this tree's read_bvh without polars (np.loadtxt)"),
     "read_bvh baseline": ({}, "the baseline's read_bvh"),
@@ -284,7 +285,10 @@ def parsers(args, files: dict[str, Path]) -> None:
                   f"{statistics.median(cpu):.3f} | {'yes' if same else 'NO'} |")
         medians = {name: statistics.median(w for w, _ in runs[name]) for name in names if runs[name]}
         small = label.startswith("300")
+        # the goal: read_bvh (which parses and converts on every core it may use) within 1.3x the fastest
+        # parser with any threads; the fastest one-thread parser for reference
         for reader, pool, what in (("read_bvh", ONE_THREAD, "one-thread parser"),
+                                   ("read_bvh", [n for n in medians if n not in READERS], "parser, any threads"),
                                    ("read_bvh any threads", [n for n in medians if n not in READERS],
                                     "parser, any threads")):
             present = [n for n in pool if n in medians]
@@ -292,8 +296,8 @@ def parsers(args, files: dict[str, Path]) -> None:
                 continue
             fastest = min(present, key=medians.get)
             ratio = medians[reader] / medians[fastest]
-            print(f"{reader} / fastest {what} ({fastest}): {ratio:.2f}x (median wall; goal <= 1.3x: "
-                  f"{'met' if ratio <= 1.3 else 'NOT met'})")
+            goal = f"; goal <= 1.3x: {'met' if ratio <= 1.3 else 'NOT met'}" if "any" in what else ""
+            print(f"{reader} / fastest {what} ({fastest}): {ratio:.2f}x (median wall{goal})")
         if "read_bvh baseline" in medians and "read_bvh" in medians:
             base = medians["read_bvh baseline"]
             ratio = medians["read_bvh"] / base

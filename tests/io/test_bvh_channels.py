@@ -29,6 +29,8 @@ def _spun_channels(n=300):
     rot = [k for k, c in enumerate(c for chans in m.skeleton.channels for c in chans) if "rotation" in c]
     for frame in rng.choice(n, 40, replace=False):  # a whole turn more: the quaternion's sign flips
         values[frame, rng.choice(rot)] += 360.0
+    for frame in rng.choice(n, 8, replace=False):  # and stays flipped from there on
+        values[frame:, rng.choice(rot)] += 360.0
     return m.skeleton, values
 
 
@@ -39,6 +41,32 @@ def test_chunks_of_any_size_and_order_make_the_same_arrays(seed):
     cuts = sorted(np.random.default_rng(seed).choice(np.arange(1, len(values)), 6, replace=False).tolist())
     _assert_same(_arrays(skel, values, cuts), whole)
     _assert_same(_arrays(skel, np.asfortranarray(values), cuts), whole)  # a column-major parser's chunks
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_chunks_converted_at_once_in_threads_then_committed_in_order_make_the_same_arrays(seed):
+    from concurrent.futures import ThreadPoolExecutor
+
+    skel, values = _spun_channels()
+    whole = _arrays(skel, values, [])
+    rng = np.random.default_rng(seed)
+    cuts = sorted(rng.choice(np.arange(1, len(values)), 8, replace=False).tolist())
+    spans = list(zip([0, *cuts], [*cuts, len(values)], strict=True))
+    conv = ChannelConverter(skel, len(values))
+    order = rng.permutation(len(spans))  # converted in any order, several at once
+    with ThreadPoolExecutor(3) as pool:
+        futures = {k: pool.submit(conv.convert, spans[k][0], values[slice(*spans[k])]) for k in order}
+        converted = [futures[k].result() for k in range(len(spans))]
+    assert not conv.commit(spans[1][0], values[slice(*spans[1])], converted[1])  # not the next rows
+    for (a, b), done in zip(spans, converted, strict=True):
+        assert conv.commit(a, values[a:b], done)
+    _assert_same(conv.arrays(), whole)
+
+
+def test_rows_past_the_frame_count_are_not_converted():
+    skel, values = _spun_channels()
+    conv = ChannelConverter(skel, 200)
+    assert conv.convert(150, values[:100]) is None and conv.convert(100, values[:100]) is not None
 
 
 @pytest.mark.parametrize("block", [1, 7, None])

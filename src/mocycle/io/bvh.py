@@ -13,9 +13,10 @@ frame time and Euler angles that are continuous in time, and replaces the
 target file in one step (never a half-written file).
 
 :func:`read_bvh` reads the hierarchy line by line, then the frame rows: a long file's by polars' CSV reader
-a chunk at a time in a helper thread when the extra ``mocycle[fast]`` is installed (:mod:`.bvh_rows`), others
-by numpy's C ``loadtxt``; the rows become quaternions as they come (:mod:`.bvh_channels`), so a read takes
-about the parse alone with polars and 1.1-1.2 times ``loadtxt`` without (``docs/performance.md``).  When
+a chunk at a time when the extra ``mocycle[fast]`` is installed (:mod:`.bvh_rows`: the chunks parsed and
+converted to quaternions in helper threads at once, one per core), others by numpy's C ``loadtxt``; the rows
+become quaternions as they come (:mod:`.bvh_channels`), so a long read takes about polars' parse with its
+threads, and 1.1-1.2 times ``loadtxt`` without polars (``docs/performance.md``).  When
 anything is off (a warning, an error, a line the parser cannot take), the whole file is parsed again the
 careful way (:func:`parse_bvh`), which says what is wrong where.
 """
@@ -124,9 +125,10 @@ def _read_chunks(p: Path, offset: int, skel: Skeleton, frames: int) -> ChannelCo
         return None
     converter = ChannelConverter(skel, frames)
     try:
-        with contextlib.closing(bvh_rows.row_chunks(p, offset, skel.n_channels)) as chunks:
-            for values in chunks:
-                if not converter.add(values):
+        # pieces parsed and their rotations converted in threads at once, taken here in order
+        with contextlib.closing(bvh_rows.row_chunks(p, offset, skel.n_channels, then=converter.convert)) as chunks:
+            for r0, values, converted in chunks:
+                if converted is None or not converter.commit(r0, values, converted):
                     return None
     except bvh_rows.Unreadable:
         return None

@@ -13,6 +13,8 @@ depend on how the rows were cut: bit for bit what :class:`~mocycle.motion.Motion
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from ..limits import MAX_MAGNITUDE
@@ -95,23 +97,54 @@ class ChannelConverter:
         finite or beyond ``MAX_MAGNITUDE``, when the rows would pass ``n_frames``, or when a position
         channel's earlier rows cannot be rebuilt bit for bit (zeros of both signs before its first change:
         re-read the take in one chunk)."""
+        converted = self.convert(self.rows, values)
+        return converted is not None and self.commit(self.rows, values, converted)
+
+    def convert(self, r0: int, values: np.ndarray) -> "_Converted | None":
+        """The rotations of rows ``(n, C)`` that are rows ``r0:r0 + n`` of the take, written into them as if
+        they began the take (sign-continuous from their own first frame); ``None`` (nothing written) when a
+        value is not finite or beyond ``MAX_MAGNITUDE`` or the rows would pass ``n_frames``.  Chunks of
+        disjoint rows may be converted at once, in threads (numpy releases the GIL); :meth:`commit` then
+        takes them in order."""
         n = values.shape[0]
         if n == 0:
-            return True
-        if self.rows + n > self.n_frames or values.shape[1] != self.skel.n_channels:
-            return False
+            return _Converted(None, None, [])
+        if r0 < 0 or r0 + n > self.n_frames or values.shape[1] != self.skel.n_channels:
+            return None
         lo, hi = values.min(axis=0), values.max(axis=0)  # NaN propagates
         top = max(float(hi.max()), -float(lo.min())) if lo.size else 0.0
         if not (np.isfinite(lo).all() and np.isfinite(hi).all() and top <= MAX_MAGNITUDE):
+            return None
+        return _Converted(lo, hi, self._rotations(values, r0))
+
+    def commit(self, r0: int, values: np.ndarray, converted: "_Converted") -> bool:
+        """Take converted rows ``r0:r0 + n`` after the rows before them: their signs made continuous with
+        the frame before (a joint whose first frame flips against it is negated throughout the chunk, which
+        is bit for bit the flip a whole-take conversion makes) and the position tracks written.  ``False``
+        when ``r0`` is not the next row or a position channel's earlier rows cannot be rebuilt bit for bit."""
+        n = values.shape[0]
+        if r0 != self.rows:
             return False
-        r0 = self.rows
+        if n == 0:
+            return True
         if self.first is None:
             self.first = values[0].copy()
             for j, pos_cols, pos_axes in self.positions:  # the channel values replace the offset
                 self.static[j, pos_axes] = self.first[pos_cols]
-        if not self._positions(values, lo, hi, r0):
+        if not self._positions(values, converted.lo, converted.hi, r0):
             return False
-        self._rotations(values, r0)
+        for g, (order, joints, cols, k) in enumerate(self.groups):
+            first, (last, parity) = converted.seams[g]
+            before = self.carry[g]
+            if before is not None:
+                prev, prev_parity = before
+                dot = first[0] * prev[0] + first[1] * prev[1] + first[2] * prev[2] + first[3] * prev[3]
+                shift = (dot < 0) ^ prev_parity  # the chunk's own flips, all shifted by one more
+                if shift.any():
+                    idx = np.arange(self.skel.n_joints)[joints][shift]
+                    self.quats[r0:r0 + n, idx] = -self.quats[r0:r0 + n, idx]
+                parity = parity ^ shift
+            self.carry[g] = (last, parity)
         self.rows = r0 + n
         return True
 
@@ -139,10 +172,14 @@ class ChannelConverter:
             track[r0:r0 + n, pos_axes] = values[:, pos_cols]
         return True
 
-    def _rotations(self, values: np.ndarray, r0: int) -> None:
+    def _rotations(self, values: np.ndarray, r0: int) -> list:
+        """Rows ``values`` converted into quaternion rows ``r0:`` as a take of their own; per group: the first
+        frame's components (unflipped) and the carry (last frame's components, unflipped, and its flip
+        parity)."""
         n_rows = values.shape[0]
-        for g, (order, joints, cols, n) in enumerate(self.groups):
-            carry = self.carry[g]
+        seams = []
+        for order, joints, cols, n in self.groups:
+            carry = first = None
             block = block_frames(n)
             for f0 in range(0, n_rows, block):
                 f1 = min(n_rows, f0 + block)
@@ -150,6 +187,8 @@ class ChannelConverter:
                 angles = values[f0:f1, cols].reshape(f1 - f0, n, len(order)).transpose(2, 0, 1)
                 comp = euler_quat_components(np.multiply(angles, np.pi / 360.0, order="C"), order)
                 parts = [np.zeros((f1 - f0, n)) if c is None else c for c in comp]
+                if first is None:
+                    first = [c[0].copy() for c in parts]
                 norm = _norms(parts)
                 sign, carry = _flip_signs(parts, carry)
                 if sign is not None:
@@ -160,7 +199,8 @@ class ChannelConverter:
                     np.divide(parts[m], norm, out=out[..., m])
                 if not isinstance(joints, slice):  # joints of this order interleaved with others'
                     self.quats[a:b, joints] = out
-            self.carry[g] = carry
+            seams.append((first, carry))
+        return seams
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, dict[int, np.ndarray]]:
         """Quaternions ``(T, J, 4)``, constant translations ``(J, 3)`` and the tracks ``{joint: (T, 3)}``
@@ -171,6 +211,15 @@ class ChannelConverter:
             quats = quats[:T].copy()
             tracks = {j: t[:T].copy() for j, t in tracks.items()}
         return quats, self.static, tracks
+
+
+class _Converted(NamedTuple):
+    """What :meth:`ChannelConverter.convert` found of a chunk: per-column minima and maxima, and per group of
+    joints the first frame's quaternion components and the carry of :func:`_flip_signs`."""
+
+    lo: np.ndarray | None
+    hi: np.ndarray | None
+    seams: list
 
 
 def _norms(comp: list[np.ndarray]) -> np.ndarray:

@@ -3,8 +3,10 @@
 Text numbers are most of a BVH read.  ``np.loadtxt`` parses about 45 MB/s; polars' CSV reader (the optional
 extra ``mocycle[fast]``) about 200 MB/s on one thread, to the same float64 values bit for bit (both round
 correctly; ``docs/performance.md`` has the figures and the other parsers measured).  :func:`row_chunks` cuts
-the motion block at line ends into pieces of :data:`CHUNK_BYTES`, and parses the next piece in a helper thread
-(polars releases the GIL) while the caller converts the one before, so reading takes about the parse alone.
+the motion block at line ends into pieces of :data:`CHUNK_BYTES`, counts their lines (so each piece knows the
+row it starts at), and parses them and runs the caller's conversion on them in :func:`helpers` threads at once
+(polars and numpy release the GIL); the caller takes them in order.  Parse and conversion so share the cores:
+a long read takes about as long as polars' parse on its own threads.
 
 Only plain rows are taken: numbers separated by single spaces (a space at the end of every line allowed),
 ``\\n`` or ``\\r\\n`` line ends.  Anything else — tabs, runs of spaces, blank lines, a value missing or extra,
@@ -17,7 +19,8 @@ from __future__ import annotations
 import importlib.util
 import os
 import sys
-from collections.abc import Generator
+from collections.abc import Callable, Generator
+from typing import TypeVar
 
 import numpy as np
 
@@ -27,6 +30,8 @@ CHUNK_BYTES = 16 << 20
 MIN_BYTES = 8 << 20
 #: the same once polars is imported (a batch of takes, a second read)
 MIN_BYTES_IMPORTED = 256 << 10
+
+T = TypeVar("T")
 
 _BOM = b"\xef\xbb\xbf"
 
@@ -49,11 +54,24 @@ def _installed() -> bool:
         return False
 
 
-def row_chunks(path: str | os.PathLike, offset: int, n_channels: int) -> Generator[np.ndarray, None, None]:
-    """The rows from byte ``offset`` of ``path`` on as ``(n, n_channels)`` float64 arrays, in file order.
+def helpers() -> int:
+    """Threads that parse and convert pieces at once: the cores this process may use, 2 to 4."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    return min(4, max(2, cores))
 
-    Raises :class:`Unreadable` (possibly after some chunks) when the rows are not plain; a null (an empty
-    field) comes out as NaN, which the caller's finite check refuses.
+
+def row_chunks(path: str | os.PathLike, offset: int, n_channels: int,
+               then: Callable[[int, np.ndarray], T] | None = None) -> Generator[tuple[int, np.ndarray, T | None]]:
+    """The rows from byte ``offset`` of ``path`` on, in file order: ``(r0, values, then(r0, values))`` per
+    piece, ``values`` its rows ``(n, n_channels)`` (float64) and ``r0`` the row of the take it starts at.
+
+    Pieces are parsed, and ``then`` run on them, in :func:`helpers` threads at once (polars and numpy release
+    the GIL); ``then`` must only touch the rows it is given.  Raises :class:`Unreadable` (possibly after
+    some pieces) when the rows are not plain; a null (an empty field) comes out as NaN, which the caller's
+    finite check refuses.
     """
     from concurrent.futures import ThreadPoolExecutor
 
@@ -69,63 +87,79 @@ def row_chunks(path: str | os.PathLike, offset: int, n_channels: int) -> Generat
         names = [f"c{i}" for i in range(n_channels + trailing)]
         schema = {name: pl.Float64 for name in names}
         rest = [b""]
+        r0 = 0
 
-        def next_piece() -> bytes:
-            """The next whole lines, about CHUNK_BYTES of them (``b""`` at the end)."""
+        def next_piece() -> tuple[bytes, int] | None:
+            """The next whole lines, about CHUNK_BYTES of them, as polars takes them, and their count
+            (``None`` at the end)."""
             data = rest[0]
             while True:
                 block = fh.read(CHUNK_BYTES)
-                if not block:
+                if block:
+                    data += block
+                    cut = data.rfind(b"\n") + 1
+                    if not cut:
+                        continue
+                    rest[0], data = data[cut:], data[:cut]
+                else:
                     rest[0] = b""
-                    return data
-                data += block
-                cut = data.rfind(b"\n") + 1
-                if cut:
-                    rest[0] = data[cut:]
-                    return data[:cut]
+                # blank lines closing a piece go (np.loadtxt skips blank lines; polars would make a row of
+                # nulls); a row that lost its closing space gets it back (polars counts the fields of the
+                # first line)
+                piece = data.rstrip(b" \t\r\n")
+                if piece:
+                    if piece.startswith(_BOM):  # polars would skip it; the usual parse refuses it with its line
+                        raise Unreadable("a byte-order mark")
+                    return piece + b" " if trailing else piece, piece.count(b"\n") + 1
+                if not block:
+                    return None
+                data = rest[0]
 
-        def parse(piece: bytes) -> np.ndarray | None:
-            # blank lines closing a piece go (np.loadtxt skips blank lines; polars would make a row of nulls);
-            # a row that lost its closing space gets it back (polars counts the fields of the first line)
-            piece = piece.rstrip(b" \t\r\n")
-            if not piece:
-                return None
-            if trailing:
-                piece += b" "
-            if piece.startswith(_BOM):  # polars would skip it; the usual parse refuses it with its line
-                raise Unreadable("a byte-order mark")
+        def parse(piece: bytes, rows: int, r0: int):
             try:
                 frame = pl.read_csv(piece, has_header=False, separator=" ", schema=schema, quote_char=None)
                 if trailing:
                     if frame[names[-1]].null_count() != frame.height:
                         raise Unreadable("a value after the last channel")
                     frame = frame.drop(names[-1])
-                return frame.to_numpy()
+                values = frame.to_numpy()
             except Unreadable:
                 raise
             except Exception as exc:  # a polars error, or an API this polars lacks: the usual parse decides
                 raise Unreadable(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
-
-        def read_parse() -> np.ndarray | None:
-            while True:
-                piece = next_piece()
-                if not piece:
-                    return None
-                values = parse(piece)
-                if values is not None:
-                    return values
+            if values.shape[0] != rows:  # a blank line within, a line polars read as two
+                raise Unreadable(f"{values.shape[0]} rows parsed of {rows} lines")
+            return r0, values, None if then is None else then(r0, values)
 
         def submit(pool):
+            nonlocal r0
+            got = next_piece()
+            if got is None:
+                return None
+            piece, rows = got
             try:
-                return pool.submit(read_parse)
+                future = pool.submit(parse, piece, rows, r0)
             except RuntimeError as exc:  # the interpreter is shutting down (Ctrl-C, SIGTERM): no helper thread
                 raise Unreadable(str(exc)) from None
+            r0 += rows
+            return future
 
-        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="mocycle-bvh-rows") as pool:
-            pending = submit(pool)
-            while True:
-                values = pending.result()
-                if values is None:
-                    return
-                pending = submit(pool)  # the next piece is parsed while the caller converts this one
-                yield values
+        n_threads = helpers()
+        with ThreadPoolExecutor(max_workers=n_threads, thread_name_prefix="mocycle-bvh-rows") as pool:
+            pending = []
+            try:
+                # one piece more than threads: a thread is never idle while the caller takes a piece
+                for _ in range(n_threads + 1):
+                    future = submit(pool)
+                    if future is None:
+                        break
+                    pending.append(future)
+                while pending:
+                    done = pending.pop(0).result()
+                    future = submit(pool)
+                    if future is not None:
+                        pending.append(future)
+                    yield done
+            finally:
+                for future in pending:
+                    future.cancel()
