@@ -100,7 +100,7 @@ class ChannelConverter:
         converted = self.convert(self.rows, values)
         return converted is not None and self.commit(self.rows, values, converted)
 
-    def convert(self, r0: int, values: np.ndarray) -> "_Converted | None":
+    def convert(self, r0: int, values: np.ndarray) -> _Converted | None:
         """The rotations of rows ``(n, C)`` that are rows ``r0:r0 + n`` of the take, written into them as if
         they began the take (sign-continuous from their own first frame); ``None`` (nothing written) when a
         value is not finite or beyond ``MAX_MAGNITUDE`` or the rows would pass ``n_frames``.  Chunks of
@@ -117,7 +117,7 @@ class ChannelConverter:
             return None
         return _Converted(lo, hi, self._rotations(values, r0))
 
-    def commit(self, r0: int, values: np.ndarray, converted: "_Converted") -> bool:
+    def commit(self, r0: int, values: np.ndarray, converted: _Converted) -> bool:
         """Take converted rows ``r0:r0 + n`` after the rows before them: their signs made continuous with
         the frame before (a joint whose first frame flips against it is negated throughout the chunk, which
         is bit for bit the flip a whole-take conversion makes) and the position tracks written.  ``False``
@@ -131,9 +131,10 @@ class ChannelConverter:
             self.first = values[0].copy()
             for j, pos_cols, pos_axes in self.positions:  # the channel values replace the offset
                 self.static[j, pos_axes] = self.first[pos_cols]
+        assert converted.lo is not None and converted.hi is not None  # rows were converted
         if not self._positions(values, converted.lo, converted.hi, r0):
             return False
-        for g, (order, joints, cols, k) in enumerate(self.groups):
+        for g, (_, joints, _, _) in enumerate(self.groups):
             first, (last, parity) = converted.seams[g]
             before = self.carry[g]
             if before is not None:
