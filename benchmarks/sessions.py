@@ -10,7 +10,11 @@ ended, 10-frame cross-fade; the take's label is the truth of its stretch):
 * from ``../shared/data`` (when present): the Bandai "youthful" session of the sessions issue (walk, turn
   right, run, wave, raise a hand, turn left, raise both hands, walk) at 30 fps and at 120 fps, and sessions of
   ``--minutes`` minutes drawn (seeded) from every Bandai take of that rig (walks, runs, dashes, walk-turn-walks,
-  waves, raised hands), resampled to ``--fps``.
+  waves, raised hands), resampled to ``--fps``;
+* from ``../shared/data/cmu-iclone`` (when present): CMU takes retargeted to the iClone rig at 60 fps (other
+  performers, another skeleton, floors that drift within a take), one session per rig the takes come on
+  (``CC_Base_Hip``: walks of three subjects, two dance phrases, a run of punches, a jump; ``RL_BoneRoot``: three
+  walks and a short jog): takes of different rigs are never joined.
 
 Then runs ``mocycle loop SESSION -o OUT/s.bvh --part all --root motion --json`` as a user would, and prints per
 session: stretches, parts found, loops written, the stretches that should get a loop of their own (every gait
@@ -138,6 +142,33 @@ def real_sessions(folder: Path, data: Path, minutes: list[float], fps: float, qu
             total += motion.n_frames - CROSSFADE
         out.append(_write(folder, f"bandai_{m:g}min_{fps:g}fps", chosen, fps))
     return out
+
+
+#: CMU takes on the iClone rig in session order, with their truth: the walks and the jog are gaits; a dance
+#: phrase (05_09, 05_13: arabesques, jetes, a pirouette; the hands' autocorrelation finds no repeat or a weak one)
+#: is neither a repeat to loop nor a one-off, so it is not judged; 02_05 is a run of punches at a steady 1.5 s
+#: (the hands' autocorrelation 0.65 at 89 frames, 0.74 at 262), not a one-off, and is not judged either;
+#: 02_04 (one jump, then balancing) is a one-off gesture.
+ICLONE_SESSION = [("walk", "07_12"), ("walk", "07_04"), ("dance", "05_13"), ("walk", "05_01"), ("punch", "02_05"),
+                  ("walk", "07_05"), ("gesture", "02_04"), ("walk", "07_02"), ("dance", "05_09"),
+                  ("walk", "07_06"), ("walk", "07_03"),
+                  ("walk", "07_01"), ("walk", "02_01"), ("run", "02_03"), ("walk", "02_02")]
+
+
+def _rig(motion) -> tuple:
+    return tuple(motion.skeleton.names), tuple(int(p) for p in motion.skeleton.parents)
+
+
+def iclone_sessions(folder: Path, data: Path) -> list[Session]:
+    """One session per rig of :data:`ICLONE_SESSION` (takes in list order; a rig's name is its root joint)."""
+    rigs: dict[tuple, list] = {}
+    for label, name in ICLONE_SESSION:
+        path = data / "cmu-iclone" / f"{name}.bvh"
+        if path.is_file():
+            motion = mocycle.read(path)
+            rigs.setdefault(_rig(motion), []).append((label, motion))
+    return [_write(folder, f"iclone_{rig[0][0].lower()}_{takes[0][1].fps:.0f}fps", takes, None)
+            for rig, takes in rigs.items() if len(takes) >= 2]
 
 
 def _onto(motion, first):
@@ -285,6 +316,7 @@ def main(argv=None) -> int:
         if not args.synthetic_only:
             if data.is_dir():
                 sessions += real_sessions(root / "sessions", data, minutes, args.fps, args.quick)
+                sessions += iclone_sessions(root / "sessions", data)
             else:
                 print(f"({data} not found: the real sessions are skipped)")
         results = []
