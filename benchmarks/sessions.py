@@ -299,7 +299,7 @@ def measure(r: Result) -> None:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="the 30 fps sessions only, no timed sizes")
+    ap.add_argument("--quick", action="store_true", help="the 30 fps and iClone sessions, no timed sizes")
     ap.add_argument("--synthetic-only", action="store_true")
     ap.add_argument("--minutes", default="1,4", help="sizes of the drawn sessions, comma-separated (e.g. 1,4,15,60)")
     ap.add_argument("--fps", type=float, default=120.0, help="frame rate of the drawn sessions")
