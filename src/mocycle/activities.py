@@ -253,15 +253,15 @@ def find_landings(motion: Motion) -> Landings | None:
         n = len(ft.contact_joints)
         low = h[:, col:col + n].min(axis=1)
         col += n
-        down += low < LAND_HEIGHT
-        lifted = False
-        for t, v in enumerate(low.tolist()):
-            if v > LIFT_HEIGHT:
-                lifted = True
-            elif lifted and v < LAND_HEIGHT:
-                frames.append(t)
-                foot.append(f)
-                lifted = False
+        landed = low < LAND_HEIGHT
+        down += landed
+        # a frame under LAND_HEIGHT is a landing when the foot was lifted (above LIFT_HEIGHT) since the last such
+        # frame: the count of lifted frames grew since then
+        low_frames = np.flatnonzero(landed)
+        lifts = np.cumsum(low > LIFT_HEIGHT)[low_frames]
+        new = np.diff(lifts, prepend=0) > 0
+        frames.extend(low_frames[new].tolist())
+        foot.extend([f] * int(new.sum()))
     order = np.argsort(frames, kind="stable")
     return Landings(np.asarray(frames, dtype=np.intp)[order], np.asarray(foot, dtype=np.intp)[order],
                     tuple(f.side for f in feet), down)
