@@ -190,6 +190,23 @@ def test_stride_phase_keeps_the_run_of_alternating_feet_inside_the_part():
     assert period2 == pytest.approx(period)
 
 
+def test_stride_phase_leaves_out_a_step_unlike_the_others():
+    """A step across a join (the other foot's landing of the take before, alternating by chance, almost two steps
+    before the part's first landing) starts a new run: the line goes through the part's own steps."""
+    from mocycle.activities import Activity, stride_phase
+
+    part = Activity(start=100, stop=300, kind="run straight", limbs="legs", period_frames=42.0)
+    own = 120 + 21 * np.arange(9)  # a run: a step every 21 frames
+    frames = np.r_[own[0] - 40, own]  # 80: the last landing before the join, 40 frames (1.9 steps) back
+    foot = np.arange(frames.size) % 2
+    _, period = stride_phase(part, frames, foot, 100, 400)
+    assert period == pytest.approx(42.0)
+    # a step of 1.4 steps counted as one would have bent the line (the period over 4 % long)
+    B = np.column_stack([np.ones(frames.size), np.arange(frames.size) / 2.0, foot != foot[0]])
+    bent = np.linalg.lstsq(B, frames.astype(float), rcond=None)[0][1]
+    assert bent > 1.04 * 42.0
+
+
 def _steps(motion):
     from mocycle.activities import find_landings
 

@@ -1556,7 +1556,8 @@ def line_periodic(x: np.ndarray, period: float, frame_time: float, source: str, 
 def stride_phase(part: Activity, landings_frames: np.ndarray, landings_foot: np.ndarray, start: int,
                  stop: int) -> tuple[np.ndarray, float]:
     """Time in cycles ``(stop - start,)`` through the landings (take frames) that fall within a step of
-    ``[start, stop)`` and alternate feet (their longest such run in the part): a least-squares line
+    ``[start, stop)``, alternate feet and step within :data:`STEP_RATIO` of their median step (their longest
+    such run in the part): a least-squares line
     ``t = t0 + P (k/2) + c [foot is the second one]`` over the
     landings' step counts ``k``, so each foot's landings are a whole cycle ``P`` apart.  Returns the time
     (cycles, frame ``start`` first) and ``P`` (frames)."""
@@ -1564,8 +1565,11 @@ def stride_phase(part: Activity, landings_frames: np.ndarray, landings_foot: np.
     near = (landings_frames >= start - step) & (landings_frames <= stop + step)
     f = landings_frames[near].astype(np.float64)
     foot = landings_foot[near]
-    if f.size >= 2:  # the run of landings that alternate feet holding most of the part (another gait's
-        cuts = np.flatnonzero(foot[1:] == foot[:-1]) + 1  # landings nearby do not bend the line)
+    if f.size >= 2:  # the run of landings that alternate feet with steps of a like length holding most of the
+        # part (another gait's landings nearby, or a step across a join or a missed landing, do not bend the line)
+        steps = np.diff(f)
+        ratio = steps / np.median(steps)
+        cuts = np.flatnonzero((foot[1:] == foot[:-1]) | (ratio > STEP_RATIO) | (ratio < 1.0 / STEP_RATIO)) + 1
         runs = np.split(np.arange(f.size), cuts)
         best = max(runs, key=lambda r: (np.count_nonzero((f[r] >= start) & (f[r] < stop)), r.size))
         f, foot = f[best], foot[best]
