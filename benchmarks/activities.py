@@ -438,7 +438,7 @@ def mocycle_cmd() -> list[str]:
 def has_parts_option() -> bool:
     r = subprocess.run(mocycle_cmd() + ["loop", "--help"], capture_output=True, text=True, check=False,
                        env={**os.environ, "COLUMNS": "200"})
-    return "--parts" in r.stdout
+    return re.search(r"--parts?\b", r.stdout) is not None
 
 
 def read_loops(doc, new_shape: bool) -> tuple[list[dict], list[dict], str, str]:
@@ -477,7 +477,7 @@ class Row:
 
 def run_take(take: Take, outdir: Path, new_shape: bool) -> Row:
     out = outdir / f"{take.name.replace('/', '__')}.bvh"
-    opt = ["--parts", "all"] if new_shape else ["--class", "all"]
+    opt = ["--part", "all"] if new_shape else ["--class", "all"]
     cmd = mocycle_cmd() + ["loop", str(take.path), "-o", str(out), *opt, "--root", "motion", "--cycles", "2",
                            "--json"]
     t0 = time.perf_counter()
@@ -680,7 +680,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     new_shape = has_parts_option()
     print(f"mocycle: {mocycle.__file__}; command: {' '.join(mocycle_cmd())}")
-    print("JSON shape read: " + ("the parts contract (--parts all)" if new_shape
+    print("JSON shape read: " + ("the parts contract (--part all)" if new_shape
                                  else "--parts absent: fell back to --class all (loops with class, excitation)"))
     with tempfile.TemporaryDirectory(prefix="mocycle-activities-") as tmp:
         root = args.keep or Path(tmp)
