@@ -233,6 +233,29 @@ def test_a_walk_too_short_to_be_seen_repeating_loops_when_its_feet_land_a_period
     assert "the feet landing a period apart" in looped[0].reason
 
 
+@pytest.mark.parametrize("period_share, loops", [(0.4, False), (1.0, True)])
+def test_a_repeat_found_where_the_feet_step_but_make_no_stride_is_checked_by_the_legs(monkeypatch, period_share,
+                                                                                     loops):
+    """Frames of a walk without a stride of landings (a step or two only, at the end of a walk-turn-walk take in a
+    session): a repeat the cohomology finds there at 0.4 of the stride (the legs swap sides by then) is no loop
+    of the walk, one at the stride is."""
+    import mocycle.activities as A
+
+    fps, period = 60.0, 1.0
+    walk = synthetic_walk(n_frames=int(1.6 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
+    steps = _steps(walk)
+    first = int(np.flatnonzero(steps.foot != steps.foot[0])[0])
+    two = A.Landings(steps.frames[first - 1:first + 1], steps.foot[first - 1:first + 1], steps.sides, steps.down)
+    assert A._foot_periods(two, 0, walk.n_frames, fps).size == 0  # two steps: no stride to be in step with
+    P = period_share * period * fps
+    found = A.line_periodic(np.arange(walk.n_frames) / P, P, walk.frame_time, "cohomology", "all", "found")
+    monkeypatch.setattr(A, "_periodic_in", lambda *args, **kwargs: ("all", "periodic", found, (0, walk.n_frames)))
+    parts = A._other(walk, 0, walk.n_frames, 1.2, True, {"joints": None, "step": 1}, steps=two)
+    assert [p.loop for p in parts] == [loops], [(p.kind, p.reason) for p in parts]
+    if not loops:
+        assert parts[0].kind == "transition" and "unlike themselves" in parts[0].reason
+
+
 def test_a_walk_running_off_without_a_chain_of_landings_is_not_looped_across_the_change():
     """Frames without a gait part where a short walk turns into a run: looked at blind, the whole body "repeats"
     across both (one loop holding a walk and a run); with the landings, the part that loops lies in one gait."""

@@ -1313,7 +1313,9 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
     if s > 0:
         out.extend(_other(motion, start, start + s, min_periods, gait_near, options, "before", steps))
     P = pm.period_frames
-    steps_in = kind == "periodic" and _foot_periods(steps, start + s, start + e, motion.fps).size > 0
+    # feet that land in it (a stride or only a step or two) say whether the legs come back a period later
+    steps_in = kind == "periodic" and steps is not None and \
+        bool(np.any((steps.frames >= start + s) & (steps.frames < start + e)))
     legs = legs_repeat(motion, start + s, start + e, P) if steps_in else float("nan")
     why = f"{kind}: {(e - s) / P:.1f} periods of {P:.1f} frames"
     if np.isfinite(legs) and legs >= UNLIKE:
