@@ -1570,7 +1570,8 @@ def stride_phase(part: Activity, landings_frames: np.ndarray, landings_foot: np.
     if f.size >= 2:  # the run of landings that alternate feet with steps of a like length holding most of the
         # part (another gait's landings nearby, or a step across a join or a missed landing, do not bend the line)
         steps = np.diff(f)
-        ratio = steps / np.median(steps)
+        typical = float(np.median(steps))
+        ratio = steps / typical if typical > 0 else np.ones_like(steps)  # (landings on one frame: no step to tell)
         cuts = np.flatnonzero((foot[1:] == foot[:-1]) | (ratio > STEP_RATIO) | (ratio < 1.0 / STEP_RATIO)) + 1
         runs = np.split(np.arange(f.size), cuts)
         best = max(runs, key=lambda r: (np.count_nonzero((f[r] >= start) & (f[r] < stop)), r.size))
@@ -1581,7 +1582,7 @@ def stride_phase(part: Activity, landings_frames: np.ndarray, landings_foot: np.
     second = (foot != foot[0]).astype(np.float64)
     B = np.column_stack([np.ones_like(k), k / 2.0, second])
     (t0, P, _), *_ = np.linalg.lstsq(B, f, rcond=None)
-    if not P > 0:
+    if not P >= 2.0:  # (landings on one frame or going back: no stride)
         raise MocycleError(f"the landings of frames {start}-{stop} give no stride period")
     t = np.arange(start, stop, dtype=np.float64)
     return (t - t0) / P, float(P)
