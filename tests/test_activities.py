@@ -468,3 +468,28 @@ def test_a_run_whose_landings_run_on_into_the_walk_after_it_is_not_looped_across
     run, walk = loops
     assert run.stop - border <= 0.5 * run.period_frames and border - walk.start <= 0.5 * walk.period_frames
     assert any(p.kind == "transition" and p.start < border < p.stop for p in parts)
+
+
+def test_a_run_joined_at_a_higher_floor_is_a_run_of_its_own():
+    """A session's take whose floor stands 3 % of the body height above its neighbours' (takes captured or
+    scaled apart): from the floor of the frames about them its stances never land, and the run was looped as a
+    `periodic` motion; measured from their own level where no gait is found, they land, make a run part at its
+    stride, and its chain stops where the walk's landings, on the other floor, begin (no loop over the border)."""
+    from mocycle.axes import vertical_axis
+    from mocycle.contacts import body_height, up_axis
+    from mocycle.datasets import join_takes
+
+    fps = 60.0
+    walk = synthetic_walk(n_frames=240, fps=fps, period_s=1.0, seed=1).motion
+    run = synthetic_run(n_frames=130, fps=fps, period_s=0.7, seed=2).motion
+    up, j = vertical_axis(run), run.travel_joint
+    lift = up * 0.03 * body_height(run, up_axis(run))
+    run = run.replace(tracks={j: run.joint_translations(j) + lift})
+    s = join_takes([walk, run, walk], ["walk", "run", "walk"])
+    (_, a, b) = s.stretches[1]
+    loops = segment_activities(s.motion).loopable()
+    runs = [p for p in loops if p.kind.startswith("run")]
+    assert len(runs) == 1, [(p.kind, p.start, p.stop) for p in loops]
+    assert runs[0].period_frames == pytest.approx(0.7 * fps, rel=0.08)
+    assert runs[0].start >= a - 5 and runs[0].stop <= b + 5  # within its take (the cross-fade is 10 frames)
+    assert [p.kind for p in loops] == ["walk straight", "run straight", "walk straight"]

@@ -44,6 +44,7 @@ from .axes import vertical_axis
 from .contacts import body_height, find_feet, up_axis
 from .contacts.detect import heights_and_speeds, local_floor
 from .contacts.legs import chain_joints, chain_positions
+from .contacts.smooth import minimum
 from .defaults import MIN_PERIODS
 from .errors import MocycleError, NoPeriodicMotion
 from .features import HeadingFrame, pose_matrix
@@ -220,10 +221,16 @@ class Landings:
     foot: np.ndarray
     sides: tuple[str, ...]
     down: np.ndarray
+    #: ``(n,)`` whether each landing was measured from its stance's own level (:func:`find_landings`), or None
+    own: np.ndarray | None = None
 
 
 #: A foot is lifted above this height over its floor (body heights), and has landed below LAND_HEIGHT.
 LIFT_HEIGHT, LAND_HEIGHT = 0.04, 0.02
+#: Where the landings make no gait, a stance's own level: a contact joint's lowest over STANCE_FLOOR_S seconds
+#: about a frame (a stance beside every swing of a stride), when under STANCE_CAP (body heights) above its
+#: floor (higher, the foot is held up); frames within STANCE_MARGIN_S of a chain of landings keep theirs.
+STANCE_FLOOR_S, STANCE_CAP, STANCE_MARGIN_S = 0.6, 0.06, 0.5
 
 
 def find_landings(motion: Motion) -> Landings | None:
@@ -233,8 +240,11 @@ def find_landings(motion: Motion) -> Landings | None:
     :data:`LIFT_HEIGHT` of the body height above its floor) comes down (under :data:`LAND_HEIGHT`).  Heights
     only, no speeds: a foot that glides on the floor (a retargeted or synthetic take, a fitted loop) still
     lands where it comes down, and feet that stay down while the legs sway make no landing.  The floor of
-    each joint is its lowest level nearby (:func:`~mocycle.contacts.detect.local_floor`)."""
-
+    each joint is its lowest level nearby (:func:`~mocycle.contacts.detect.local_floor`).  Where those
+    landings make no gait (frames more than :data:`STANCE_MARGIN_S` from every chain of three), the stances
+    are measured from their own level instead (:func:`_stance_floor`): a take joined to others at another
+    floor height, or a floor that rises, puts them a few percent above the floor of the frames about them;
+    such landings are marked (``own``) and no chain passes between them and the others."""
     try:
         feet = find_feet(motion.skeleton)
     except MocycleError:
@@ -246,11 +256,35 @@ def find_landings(motion: Motion) -> Landings | None:
     h, _, _ = heights_and_speeds(motion, joints, up, positions=W)
     h = h / body
     h = h - local_floor(h, motion.fps)
+    sides = tuple(f.side for f in feet)
+    sizes = [len(f.contact_joints) for f in feet]
+    found = _landings_of(h, sizes, sides)
+    gait = np.zeros(motion.n_frames, dtype=bool)
+    for chain in _gait_chains(found, motion.fps, least=3):
+        gait[found.frames[chain[0]]:found.frames[chain[-1]] + 1] = True
+    margin = int(round(STANCE_MARGIN_S * motion.fps))
+    # frames more than the margin from every chain's frames
+    free = minimum((~gait).astype(np.float64)[:, None], 2 * margin + 1)[:, 0] > 0
+    if not free.any():
+        return found
+    own = _landings_of(h - _stance_floor(h, motion.fps), sizes, sides)
+    keep_old = ~free[found.frames]
+    keep_new = free[own.frames]
+    frames = np.concatenate([found.frames[keep_old], own.frames[keep_new]])
+    foot = np.concatenate([found.foot[keep_old], own.foot[keep_new]])
+    mark = np.concatenate([np.zeros(int(keep_old.sum()), bool), np.ones(int(keep_new.sum()), bool)])
+    order = np.argsort(frames, kind="stable")
+    down = np.where(free, own.down, found.down).astype(np.int8)
+    return Landings(frames[order], foot[order], sides, down, mark[order])
+
+
+def _landings_of(h: np.ndarray, sizes: list[int], sides: tuple[str, ...]) -> Landings:
+    """The landings of feet whose contact joints (``sizes`` per foot, in order) stand ``h`` ``(T, C)`` above
+    their floor (body heights)."""
     frames, foot = [], []
-    down = np.zeros(motion.n_frames, dtype=np.int8)
+    down = np.zeros(h.shape[0], dtype=np.int8)
     col = 0
-    for f, ft in enumerate(feet):
-        n = len(ft.contact_joints)
+    for f, n in enumerate(sizes):
         low = h[:, col:col + n].min(axis=1)
         col += n
         landed = low < LAND_HEIGHT
@@ -263,8 +297,18 @@ def find_landings(motion: Motion) -> Landings | None:
         frames.extend(low_frames[new].tolist())
         foot.extend([f] * int(new.sum()))
     order = np.argsort(frames, kind="stable")
-    return Landings(np.asarray(frames, dtype=np.intp)[order], np.asarray(foot, dtype=np.intp)[order],
-                    tuple(f.side for f in feet), down)
+    return Landings(np.asarray(frames, dtype=np.intp)[order], np.asarray(foot, dtype=np.intp)[order], sides, down)
+
+
+def _stance_floor(h: np.ndarray, fps: float) -> np.ndarray:
+    """``(T, C)``: each contact joint's own level about a frame (its lowest over :data:`STANCE_FLOOR_S`) where
+    that is under :data:`STANCE_CAP` above the floor of heights ``h`` ``(T, C)``, else 0 (a foot held up); the
+    floor itself within half that time of the first and last frames (a window the take cuts short may hold no
+    stance)."""
+    size = max(1, int(round(STANCE_FLOOR_S * fps)))
+    pad = np.zeros((size,) + h.shape[1:])
+    near = minimum(np.concatenate([pad, h, pad]), size)[size:size + h.shape[0]]
+    return np.where(near < STANCE_CAP, near, 0.0)
 
 
 def _gait_chains(landings: Landings, fps: float, least: int = 3) -> list[np.ndarray]:
@@ -275,7 +319,8 @@ def _gait_chains(landings: Landings, fps: float, least: int = 3) -> list[np.ndar
     for i in range(1, landings.frames.size):
         step = landings.frames[i] - landings.frames[i - 1]
         before = landings.frames[i - 1] - landings.frames[run[-2]] if len(run) >= 2 else step
-        if landings.foot[i] != landings.foot[i - 1] and lo <= step <= hi and \
+        same_floor = landings.own is None or landings.own[i] == landings.own[i - 1]  # (another take's floor)
+        if landings.foot[i] != landings.foot[i - 1] and lo <= step <= hi and same_floor and \
                 1 / STEP_RATIO <= step / before <= STEP_RATIO:
             run.append(i)
         else:
