@@ -259,12 +259,10 @@ def find_landings(motion: Motion) -> Landings | None:
     sides = tuple(f.side for f in feet)
     sizes = [len(f.contact_joints) for f in feet]
     found = _landings_of(h, sizes, sides)
-    gait = np.zeros(motion.n_frames, dtype=bool)
-    for chain in _gait_chains(found, motion.fps, least=3):
-        gait[found.frames[chain[0]]:found.frames[chain[-1]] + 1] = True
     margin = int(round(STANCE_MARGIN_S * motion.fps))
-    # frames more than the margin from every chain's frames
-    free = minimum((~gait).astype(np.float64)[:, None], 2 * margin + 1)[:, 0] > 0
+    free = np.ones(motion.n_frames, dtype=bool)  # frames more than the margin from every chain's frames
+    for chain in _gait_chains(found, motion.fps, least=3):
+        free[max(0, found.frames[chain[0]] - margin):found.frames[chain[-1]] + margin + 1] = False
     if not free.any():
         return found
     own = _landings_of(h - _stance_floor(h, motion.fps), sizes, sides)
@@ -274,7 +272,7 @@ def find_landings(motion: Motion) -> Landings | None:
     foot = np.concatenate([found.foot[keep_old], own.foot[keep_new]])
     mark = np.concatenate([np.zeros(int(keep_old.sum()), bool), np.ones(int(keep_new.sum()), bool)])
     order = np.argsort(frames, kind="stable")
-    down = np.where(free, own.down, found.down).astype(np.int8)
+    down = np.where(free, own.down, found.down)
     return Landings(frames[order], foot[order], sides, down, mark[order])
 
 
