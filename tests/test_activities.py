@@ -399,6 +399,26 @@ def test_a_short_gait_part_is_judged_on_its_own_frames_not_on_the_takes_beside_i
     assert not _legs_repeat_in(s.motion, waves)  # legs that stand still while the arms wave make no gait
 
 
+@pytest.mark.parametrize("n_walk,first", [(150, 32), (140, 27)])
+def test_a_short_gait_part_inside_its_take_is_judged_a_step_beyond_it_before_a_stride(n_walk, first):
+    """A walk take between two waves whose landings give a part of 1.4 strides starting half a stride into the
+    take (its first landing lost at the join): a step on either side of the part is still the walk, and its legs
+    are alike a stride later there; a stride on either side takes in the waves (legs that stand), and the walk
+    was dropped as no gait."""
+    from mocycle.activities import Activity, _legs_repeat_in
+    from mocycle.datasets import join_takes
+
+    fps = 60.0
+    for seed in (1, 2, 3):
+        takes = [synthetic_wave(n_frames=180, fps=fps, seed=seed).motion,
+                 synthetic_walk(n_frames=n_walk, fps=fps, period_s=1.0, noise_deg=0.5, seed=seed + 1).motion,
+                 synthetic_wave(n_frames=180, fps=fps, seed=seed + 2).motion]
+        s = join_takes(takes, ["wave", "walk", "wave"])
+        _, a, b = s.stretches[1]
+        walk = Activity(start=a + first, stop=a + first + 86, kind="walk straight", period_frames=60.0)
+        assert _legs_repeat_in(s.motion, walk), seed
+
+
 def _figures(n: int, period: float = 60.0, speed: float = 1.0, double: float = 0.3) -> np.ndarray:
     """Stride figures (:func:`mocycle.activities._stride_figures`' columns) of ``n`` steady straight strides."""
     return np.tile([period, 0.0, speed, 0.0, double], (n, 1)).astype(np.float64)

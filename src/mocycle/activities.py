@@ -1082,11 +1082,14 @@ def legs_repeat(motion: Motion, start: int, stop: int, period: float) -> float:
 
 def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
     """Whether the legs of a gait part are like themselves one stride later, over the part (and, for a part of
-    under two strides, up to a stride on either side, so that a stride can be compared with the next):
-    unlikeness under :data:`UNLIKE` where a stride or more of frames can be compared, under
-    :data:`UNLIKE_ONE_STEP` where less can.  A part of two strides or more is judged on its own frames only:
-    in a session the frames beside it are another activity; so is a shorter one whose own frames compare a step
-    or more and are alike (the frames beside it are looked at only where its own cannot tell)."""
+    under two strides, up to a step on either side, then, where that does not show it, up to a stride, so
+    that a stride can be compared with the next): unlikeness under :data:`UNLIKE` where a stride or more of
+    frames can be compared, under :data:`UNLIKE_ONE_STEP` where less can.  A part of two strides or more is
+    judged on its own frames only: in a session the frames beside it are another activity; so is a shorter one
+    whose own frames compare a step or more and are alike (the frames beside it are looked at only where its
+    own cannot tell).  A step on either side first: a part's landings may start a step or more into its take
+    (a landing lost where the take is joined to the one before), and a stride's reach then takes in the next
+    activity, which is unlike the part's legs however alike its own strides are."""
     P = part.period_frames
     if not (np.isfinite(P) and P >= 2):
         return False
@@ -1095,15 +1098,16 @@ def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
         X = _leg_features(motion, part.start, part.stop)
         if X is not None and _unlike(X, lag) < UNLIKE_ONE_STEP:
             return True
-    reach = P if part.n_frames < 2 * P else 0
-    lo, hi = max(0, int(part.start - reach)), min(motion.n_frames, int(np.ceil(part.stop + reach)))
-    X = _leg_features(motion, lo, hi)
-    if X is None:
-        return True  # no legs to tell by: the landings decide
-    overlap = X.shape[0] - lag
-    if overlap < _least_overlap(lag):
-        return False
-    return _unlike(X, lag) < (UNLIKE if overlap >= lag else UNLIKE_ONE_STEP)
+    reaches = [0.0] if part.n_frames >= 2 * P else [0.5 * P, P]
+    for reach in reaches:
+        lo, hi = max(0, int(part.start - reach)), min(motion.n_frames, int(np.ceil(part.stop + reach)))
+        X = _leg_features(motion, lo, hi)
+        if X is None:
+            return True  # no legs to tell by: the landings decide
+        overlap = X.shape[0] - lag
+        if overlap >= _least_overlap(lag) and _unlike(X, lag) < (UNLIKE if overlap >= lag else UNLIKE_ONE_STEP):
+            return True
+    return False
 
 
 #: The legs' self-similar period overrules the landings' when it is this far off and the legs are at least
