@@ -137,7 +137,11 @@ def test_the_page_shows_a_refused_loop_as_refused(refused_library, tmp_path):
         row.locator("li.refused summary").click()
         assert "fit: the cycle fits the take" in row.inner_text() and "plain cut" in row.inner_text()
         assert page.locator('[data-testid="take"]', has_text="walk.bvh").get_attribute("data-state") == "ok"
-        before = page.evaluate("window.__studio.loopJob ? window.__studio.loopJob.id : null")
+        # the page opened the first take itself and loops it: let that loop settle first, or its answer, arriving
+        # while the click below still fetches the take, passes for the click's own
+        page.wait_for_function("window.__studio.loopJob && "
+                               "document.getElementById('loop-status').dataset.state !== 'running'", timeout=120_000)
+        before = page.evaluate("window.__studio.loopJob.id")
         row.click()  # (the page opened it first too: wait for the loop job of this click)
         status = page.locator('[data-testid="loop-status"]')
         page.wait_for_function(f"window.__studio.loopJob && window.__studio.loopJob.id !== {json.dumps(before)} && "
