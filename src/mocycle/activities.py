@@ -1288,19 +1288,19 @@ def _repeating_reach(motion: Motion, part: Activity, want: int, edge: int) -> in
     X = _leg_features(motion, lo, hi)
     if X is None or X.shape[0] <= lag:
         return want
-    ref = X[edge - lo - lag: edge - lo] if forward else X[edge - lo: edge - lo + lag]
-    var = float(ref.var(axis=0).sum())
+    ref = X[max(0, edge - lo - lag): edge - lo] if forward else X[edge - lo: edge - lo + lag]
+    var = float(ref.var(axis=0).sum()) if ref.shape[0] >= 2 else 0.0  # (a stride before a take's first frames)
     if not var > 0:
         return want
     d = ((X[lag:] - X[:-lag]) ** 2).sum(axis=1) / (2.0 * var)   # frame t + lag against frame t (relative to lo)
     d = moving_average(d, 3)
-    if forward:  # frames edge .. want-1 against a stride before
-        run = d[edge - lo - lag:]
-        bad = np.flatnonzero(run >= UNLIKE)
-        return edge + int(bad[0]) if bad.size else want
-    run = d[: edge - lo][::-1]  # frames edge-1 .. want against a stride after, going back
-    bad = np.flatnonzero(run >= UNLIKE)
-    return edge - int(bad[0]) if bad.size else want
+    if forward:  # frames edge .. want-1 against a stride before (those a stride into the take, near its start)
+        first = max(0, edge - lo - lag)
+        bad = np.flatnonzero(d[first:] >= UNLIKE)
+        return lo + lag + first + int(bad[0]) if bad.size else want
+    top = min(edge - lo, d.size)  # frames edge-1 .. want against a stride after, going back (from a stride
+    bad = np.flatnonzero(d[:top][::-1] >= UNLIKE)  # before the take's end, near it)
+    return lo + top - int(bad[0]) if bad.size else want
 
 
 def _gaps(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float, options: dict) -> list:
