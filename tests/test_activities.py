@@ -561,3 +561,56 @@ def test_a_chains_parts_from_its_own_frames_and_margin_are_those_read_against_th
         assert mine[1:] == whole[1:]
         seen += len(mine[0])
     assert seen >= 4
+
+
+def _stepping_heights(levels_l, levels_r, step: int = 30, swing: int = 18, peak: float = 0.15) -> np.ndarray:
+    """Heights ``(T, 2)`` (body heights over the floor) of a left and a right foot that step in turn, ``step``
+    frames apart, each stance flat at its own level (``levels_*``: one per stance), each swing an arc of
+    ``swing`` frames ``peak`` high: one contact joint per foot."""
+    n = len(levels_l) + len(levels_r)
+    T = (n + 1) * step
+    h = np.zeros((T, 2))
+    for foot, levels in ((0, levels_l), (1, levels_r)):
+        starts = np.arange(foot * step, T, 2 * step)[: len(levels) + 1]
+        for k, level in enumerate(levels):
+            a = int(starts[k])
+            b = min(T, a + 2 * step)
+            h[a:b, foot] = level
+            s = max(0, a - swing)  # the swing that lands at frame a, from the last stance's level
+            before = levels[k - 1] if k > 0 else level
+            arc = np.sin(np.linspace(0, np.pi, a - s, endpoint=False)) * peak
+            h[s:a, foot] = np.linspace(before, level, a - s) + arc
+    return h
+
+
+@pytest.mark.parametrize("high_l,high_r,n", [((2,), (3,), 6), ((4,), (), 8), ((2, 5), (4,), 8)])
+def test_stances_that_drift_from_step_to_step_still_make_one_chain_of_landings(high_l, high_r, n):
+    """A walk whose stances stand at levels that drift from step to step by more than a landing's height (a
+    retargeted rig's ankles, a floor that is not flat; ``high_*``: the stances 2.5 landing heights up): over the
+    floor (the lowest level about), the higher stances land too high and the landings break into chains of a few
+    steps; over each stance's own level they make one chain, longer than every piece of the floor's, which is
+    kept (the iClone walks 07_02 and 07_06 in a session: no loop before)."""
+    from mocycle.activities import LAND_HEIGHT, _gait_chains, _landings_from, _landings_of
+
+    fps = 60.0
+    levels_l = [2.5 * LAND_HEIGHT if k in high_l else 0.0 for k in range(n)]
+    levels_r = [2.5 * LAND_HEIGHT if k in high_r else 0.0 for k in range(n)]
+    h = _stepping_heights(levels_l, levels_r)
+    sides = ("left", "right")
+    pieces = [c.size for c in _gait_chains(_landings_of(h, [1, 1], sides), fps, least=3)]
+    assert len(pieces) >= 2 and max(pieces) < 2 * n - 1  # broken over the floor
+    found = _landings_from(h, [1, 1], sides, fps)
+    chains = _gait_chains(found, fps, least=3)
+    assert len(chains) == 1 and chains[0].size == 2 * n - 1
+    assert np.all(np.abs(np.diff(found.frames[chains[0]]) - 30) <= 2)
+
+
+def test_a_steady_chain_over_the_floor_is_kept_where_the_stances_own_levels_break_it():
+    """Flat stances: the landings over the floor make one long chain and are kept as they are (none measured from
+    the stances' own levels)."""
+    from mocycle.activities import _gait_chains, _landings_from
+
+    h = _stepping_heights([0.0] * 6, [0.0] * 6)
+    found = _landings_from(h, [1, 1], ("left", "right"), 60.0)
+    assert not found.own.any() if found.own is not None else True
+    assert max(c.size for c in _gait_chains(found, 60.0, least=3)) >= 11

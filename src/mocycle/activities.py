@@ -231,6 +231,10 @@ LIFT_HEIGHT, LAND_HEIGHT = 0.04, 0.02
 #: about a frame (a stance beside every swing of a stride), when under STANCE_CAP (body heights) above its
 #: floor (higher, the foot is held up); frames within STANCE_MARGIN_S of a chain of landings keep theirs.
 STANCE_FLOOR_S, STANCE_CAP, STANCE_MARGIN_S = 0.6, 0.06, 0.5
+#: Where the stances' own levels make a chain of landings this many longer (a stride) than every chain of the
+#: floor's it meets, the landings there are measured from the stances' own levels (one more is often only a
+#: foot that comes down at another floor where one take meets the next).
+OWN_CHAIN_MORE = 2
 
 
 def find_landings(motion: Motion) -> Landings | None:
@@ -241,10 +245,13 @@ def find_landings(motion: Motion) -> Landings | None:
     only, no speeds: a foot that glides on the floor (a retargeted or synthetic take, a fitted loop) still
     lands where it comes down, and feet that stay down while the legs sway make no landing.  The floor of
     each joint is its lowest level nearby (:func:`~mocycle.contacts.detect.local_floor`).  Where those
-    landings make no gait (frames more than :data:`STANCE_MARGIN_S` from every chain of three), the stances
-    are measured from their own level instead (:func:`_stance_floor`): a take joined to others at another
-    floor height, or a floor that rises, puts them a few percent above the floor of the frames about them;
-    such landings are marked (``own``) and no chain passes between them and the others."""
+    landings make no gait (frames more than :data:`STANCE_MARGIN_S` from every chain of three), and where the
+    stances measured from their own level (:func:`_stance_floor`) make a chain a stride longer than every chain
+    of the floor's they meet, the stances are measured from their own level instead: a take joined to others at
+    another floor height, a floor that rises, or one that drifts from stance to stance (a retargeted rig's
+    ankles) puts them a few percent above the floor of the frames about them and breaks the floor's chain;
+    such landings are marked (``own``) and no chain passes between them and the others
+    (:func:`_landings_from`)."""
     try:
         feet = find_feet(motion.skeleton)
     except MocycleError:
@@ -256,16 +263,32 @@ def find_landings(motion: Motion) -> Landings | None:
     h, _, _ = heights_and_speeds(motion, joints, up, positions=W)
     h = h / body
     h = h - local_floor(h, motion.fps)
-    sides = tuple(f.side for f in feet)
-    sizes = [len(f.contact_joints) for f in feet]
+    return _landings_from(h, [len(f.contact_joints) for f in feet], tuple(f.side for f in feet), motion.fps)
+
+
+def _landings_from(h: np.ndarray, sizes: list[int], sides: tuple[str, ...], fps: float) -> Landings:
+    """:func:`find_landings` from the heights ``h`` ``(T, C)`` of the feet's contact joints above their floor (body
+    heights; ``sizes``: contact joints per foot, in order): the landings over the floor, and, where they make
+    no chain (frames more than :data:`STANCE_MARGIN_S` from every chain of three) or where the stances' own
+    levels make a chain :data:`OWN_CHAIN_MORE` landings longer than every chain of the floor's it meets (a floor
+    that drifts from stance to stance breaks the floor's chain in pieces), those over the stances' own levels
+    (:func:`_stance_floor`)."""
     found = _landings_of(h, sizes, sides)
-    margin = int(round(STANCE_MARGIN_S * motion.fps))
-    free = np.ones(motion.n_frames, dtype=bool)  # frames more than the margin from every chain's frames
-    for chain in _gait_chains(found, motion.fps, least=3):
+    T = h.shape[0]
+    margin = int(round(STANCE_MARGIN_S * fps))
+    free = np.ones(T, dtype=bool)  # frames more than the margin from every chain's frames
+    chains = _gait_chains(found, fps, least=3)
+    for chain in chains:
         free[max(0, found.frames[chain[0]] - margin):found.frames[chain[-1]] + margin + 1] = False
+    spans = np.array([(found.frames[c[0]], found.frames[c[-1]], c.size) for c in chains]).reshape(-1, 3)
+    own = _landings_of(h - _stance_floor(h, fps), sizes, sides)
+    for chain in _gait_chains(own, fps, least=3):  # the stances' own levels make a chain a stride longer
+        a, b = int(own.frames[chain[0]]), int(own.frames[chain[-1]])  # than every chain of the floor's it meets
+        meets = (spans[:, 0] <= b) & (spans[:, 1] >= a)
+        if chain.size >= spans[meets, 2].max(initial=0) + OWN_CHAIN_MORE:
+            free[a:b + 1] = True
     if not free.any():
         return found
-    own = _landings_of(h - _stance_floor(h, motion.fps), sizes, sides)
     keep_old = ~free[found.frames]
     keep_new = free[own.frames]
     frames = np.concatenate([found.frames[keep_old], own.frames[keep_new]])
