@@ -515,54 +515,6 @@ def test_a_run_joined_at_a_higher_floor_is_a_run_of_its_own():
     assert [p.kind for p in loops] == ["walk straight", "run straight", "walk straight"]
 
 
-def test_a_chains_parts_from_its_own_frames_and_margin_are_those_read_against_the_whole_take(monkeypatch):
-    """Each chain of landings is cut on its own (side by side in a session), sent only its frames and a margin
-    (:func:`_chain_margin`): the parts, blended ends and changes it gives are those of the same chain read against
-    the whole take, and every frame the chain's reading looks at beside it (a one-step part's legs two steps
-    either side, a short part's legs' repeat beyond its ends) lies in the margin."""
-    from dataclasses import asdict
-
-    import mocycle.activities as acts
-    from mocycle.datasets import join_takes
-
-    fps = 60.0
-    takes = [synthetic_walk(n_frames=300, fps=fps, period_s=1.0, noise_deg=0.5, seed=1).motion,
-             synthetic_wave(n_frames=150, fps=fps, seed=2).motion,
-             synthetic_walk(n_frames=80, fps=fps, period_s=0.9, noise_deg=0.5, seed=3).motion,
-             synthetic_run(n_frames=200, fps=fps, seed=4).motion,
-             synthetic_walk(n_frames=130, fps=fps, period_s=1.0, noise_deg=0.5, seed=5).motion,
-             synthetic_wave(n_frames=150, fps=fps, seed=6).motion,
-             synthetic_walk_turn_walk(fps=fps, seed=7).motion]
-    motion = join_takes(takes, ["walk", "wave", "walk", "run", "walk", "wave", "walk"]).motion
-    T = motion.n_frames
-    landings = acts.find_landings(motion)
-    heading, path, body = acts.heading_degrees(motion), acts._horizontal_path(motion), acts._body_height(motion)
-    chains = acts._gait_chains(landings, fps, least=2)
-    assert sum(c.size == 2 for c in chains) >= 1 and sum(c.size > 2 for c in chains) >= 4
-
-    read = []
-    legs = acts._leg_features
-    monkeypatch.setattr(acts, "_leg_features", lambda m, a, b: read.append((a, b)) or legs(m, a, b))
-
-    def fields(parts):
-        return [{k: v for k, v in asdict(p).items() if k != "periodic"} for p in parts]
-
-    seen = 0
-    for chain in chains:
-        job = acts._chain_job(motion, landings, chain, heading, path, body)
-        lo, hi = job.offset, job.offset + job.motion.n_frames
-        assert hi - lo < T  # only its own frames and the margin
-        mine = acts._chain_parts(job)
-        read.clear()
-        whole = acts._chain_parts(acts._ChainJob(motion, 0, acts.Landings(
-            landings.frames[chain], landings.foot[chain], landings.sides, landings.down), heading, path, body))
-        assert read and all((a >= lo or a == 0) and (b <= hi or b == T) for a, b in read), (lo, hi, read)
-        assert fields(mine[0]) == fields(whole[0])
-        assert mine[1:] == whole[1:]
-        seen += len(mine[0])
-    assert seen >= 4
-
-
 def _stepping_heights(levels_l, levels_r, step: int = 30, swing: int = 18, peak: float = 0.15) -> np.ndarray:
     """Heights ``(T, 2)`` (body heights over the floor) of a left and a right foot that step in turn, ``step``
     frames apart, each stance flat at its own level (``levels_*``: one per stance), each swing an arc of

@@ -736,141 +736,72 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     path = _horizontal_path(motion)
     body = _body_height(motion)
     parts = []
+    stepped = []  # the landings of the gait chains: a stride phase is a line through these only
     changes: set[int] = set()  # the landings where a gait changes: the parts beside them reach no further
     blends: list[tuple[int, int]] = []  # the steps left out at a chain's ends (:func:`_steady_ends`)
-    chains = _gait_chains(landings, fps, least=2)
-    stepped = list(chains)  # the landings of the gait chains: a stride phase is a line through these only
-    jobs = [_chain_job(motion, landings, chain, heading, path, body) for chain in chains]
-    for found, ends, at in map(_chain_parts, jobs):  # each chain on its own, side by side
-        parts.extend(found)
-        blends.extend(ends)
-        changes.update(at)
+    for chain in _gait_chains(landings, fps, least=2):
+        stepped.append(chain)
+        a, b = int(landings.frames[chain[0]]), int(landings.frames[chain[-1]])
+        if _legs_stand(motion, a, b + 1):
+            continue  # contacts that flicker while the legs stand are no steps
+        if chain.size == 2:  # one step: a take (or a part) of little more than a stride
+            short = _one_step_part(motion, chain, landings, heading, path, body)
+            if short is not None:
+                parts.append(short)
+            continue
+        strides = _stride_figures(chain, landings, heading, path, fps)
+        poses = _stride_poses(motion, landings.frames[chain])
+        cuts = _gait_changes(strides, poses)
+        kinds = _step_gaits(strides, body)
+        walk_run = {j for j in range(1, len(kinds)) if kinds[j][0] != kinds[j - 1][0]}
+        lo, hi = _steady_ends(strides, poses, cuts | walk_run)
+        ends = [(0, lo)] if lo > 0 else []
+        if hi < strides.shape[0]:
+            ends.append((hi + 1, chain.size - 1))
+        for e0, e1 in ends:  # blended steps at an end: a transition; the parts beside it reach no further
+            blends.append((int(landings.frames[chain[e0]]), int(landings.frames[chain[e1]])))
+            changes.update(blends[-1])
+        if (lo, hi) != (0, strides.shape[0]):  # the steps at the new ends lie in fewer strides
+            chain, strides = chain[lo:hi + 2], strides[lo:hi]
+            cuts = {c - lo for c in cuts}
+            kinds = _step_gaits(strides, body)
+        f = landings.frames[chain]
+        i = 0
+        while i < len(kinds):
+            j = i + 1
+            while j < len(kinds) and kinds[j][0] == kinds[i][0] and j not in cuts and \
+                    abs(kinds[j][1] / float(np.median([k[1] for k in kinds[i:j]])) - 1) <= TEMPO_CHANGE:
+                j += 1
+            # steps i .. j-1: landings f[i] .. f[j]
+            parts.append(_gait_part(kinds[i][0], f, chain, i, j, landings, strides, heading, path, fps))
+            # where the gait changes, the step across the change belongs to neither part (a blend of the two)
+            if j in cuts and j + 2 < len(kinds):
+                changes.update((int(f[j]), int(f[j + 1])))
+                i = j + 1
+            else:
+                i = j
+    # steps that land in turn but whose legs do not repeat a stride later (a wander, a stumble) are no gait
+    parts = [p for p in parts if _legs_repeat_in(motion, p)]
     parts.sort(key=lambda p: p.start)
     _reach(motion, parts, T, changes)
     parts = [q for p in parts for q in (_split_turns(p, heading, path, fps) if " " not in p.kind else [p])]
     parts = _with_blends(parts, blends)
+    parts = _fill(motion, parts, landings, min_periods, options, map)
     keep = np.sort(np.concatenate(stepped)) if stepped else np.zeros(0, dtype=np.intp)
     steps = Landings(landings.frames[keep], landings.foot[keep], landings.sides, landings.down)
-    # the frames between the gait parts, each looked at on its own, and each gait part's phase from its own
-    # frames and the landings near them: side by side, in one map
-    gait = [p for p in parts if p.gait and p.n_periods >= min_periods] if joints is None else []
-    gaps = _gaps(motion, parts, landings, min_periods, options)
-    found = list(map(_cut_job, [*gaps, *(_GaitJob(motion[p.start:p.stop], _rebased_part(p), _steps_near(steps, p))
-                                         for p in gait)]))
-    for p, (periodic, period) in zip(gait, found[len(gaps):], strict=True):
-        p.periodic, p.period_frames = periodic, period
-    parts = sorted([*parts, *(q for qs in found[:len(gaps)] for q in qs)], key=lambda q: q.start)
-    phased = {id(p) for p in gait}
-    more = [p for p in parts if p.gait and p.n_periods >= min_periods and id(p) not in phased]
-    if joints is None:  # a gait whose chain of landings broke, found between the chains': its phase the same way
-        jobs = [_GaitJob(motion[p.start:p.stop], _rebased_part(p), _steps_near(steps, p)) for p in more]
-        for p, (periodic, period) in zip(more, map(_gait_job, jobs), strict=True):
+    gait = [p for p in parts if p.gait and p.n_periods >= min_periods]
+    if joints is None:  # each part's phase from its own frames and the landings near them: side by side
+        jobs = [_GaitJob(motion[p.start:p.stop], _rebased_part(p), _steps_near(steps, p)) for p in gait]
+        for p, (periodic, period) in zip(gait, map(_gait_job, jobs), strict=True):
             p.periodic, p.period_frames = periodic, period
     else:
-        for p in more:
+        for p in gait:
             _asked_phase(motion, p, min_periods, options)
     _decide(parts, min_periods)
     parts = _second_look(motion, parts, landings, min_periods, options, map, changes)
     parts = _or_one_cycle(motion, parts, landings)
     return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True, reason=_listing(parts),
                       landings=landings)
-
-
-@dataclass(frozen=True)
-class _ChainJob:
-    """One chain of landings with what its parts need (sent as it is to another process): the take's frames
-    ``offset ..`` over the chain and :func:`_chain_margin` beyond it, the chain's landings (its frames), the
-    hips' heading and path over those frames and the body height."""
-
-    motion: Motion
-    offset: int
-    landings: Landings
-    heading: np.ndarray
-    path: np.ndarray
-    body: float
-
-
-def _chain_margin(frames: np.ndarray) -> int:
-    """Frames beyond a chain (landings at ``frames``) that its parts read: a one-step part's legs two steps
-    either side (:func:`_one_step_part`), a part's legs' repeat up to its period (at most 4/3 of two steps,
-    :func:`short_period`) beyond its ends (:func:`_legs_repeat_in`); three of its longest steps and two
-    frames cover both."""
-    return 3 * int(np.max(np.diff(frames))) + 2
-
-
-def _chain_job(motion: Motion, landings: Landings, chain: np.ndarray, heading: np.ndarray, path: np.ndarray,
-               body: float) -> _ChainJob:
-    f = landings.frames[chain]
-    margin = _chain_margin(f)
-    lo, hi = max(0, int(f[0]) - margin), min(motion.n_frames, int(f[-1]) + margin + 1)
-    own = Landings(f - lo, landings.foot[chain], landings.sides, landings.down[lo:hi])
-    return _ChainJob(motion[lo:hi], lo, own, heading[lo:hi], path[lo:hi], body)
-
-
-def _chain_parts(job: _ChainJob) -> tuple[list[Activity], list[tuple[int, int]], set[int]]:
-    """The gait parts of one chain of landings (:class:`_ChainJob`), those whose legs repeat a stride later
-    (:func:`_legs_repeat_in`), with the steps blended at its ends (``(first, last)`` landing frames) and the
-    landings where its gait changes, all in the take's frames: the chain cut where its strides' gait, tempo or
-    posture change (:func:`_gait_changes`, :func:`_step_gaits`, :data:`TEMPO_CHANGE`), its blended ends left
-    out (:func:`_steady_ends`); a chain of one step is one part when its legs repeat (:func:`_one_step_part`)."""
-    motion, landings, heading, path, body = job.motion, job.landings, job.heading, job.path, job.body
-    blends: list[tuple[int, int]] = []
-    changes: set[int] = set()
-    parts = _chain_steps(motion, np.arange(landings.frames.size), landings, heading, path, body, motion.fps, blends,
-                         changes)
-    # steps that land in turn but whose legs do not repeat a stride later (a wander, a stumble) are no gait
-    parts = [p for p in parts if _legs_repeat_in(motion, p)]
-    d = job.offset
-    for p in parts:
-        p.start, p.stop = p.start + d, p.stop + d
-        p.landings = {k: [f + d for f in v] for k, v in p.landings.items()}
-    return parts, [(a + d, b + d) for a, b in blends], {c + d for c in changes}
-
-
-def _chain_steps(motion, chain, landings, heading, path, body, fps, blends, changes) -> list[Activity]:
-    """:func:`_chain_parts` before the legs' repeat is looked at, in the job's frames (``blends`` and
-    ``changes`` filled in)."""
-    parts: list[Activity] = []
-    a, b = int(landings.frames[chain[0]]), int(landings.frames[chain[-1]])
-    if _legs_stand(motion, a, b + 1):
-        return parts  # contacts that flicker while the legs stand are no steps
-    if chain.size == 2:  # one step: a take (or a part) of little more than a stride
-        short = _one_step_part(motion, chain, landings, heading, path, body)
-        if short is not None:
-            parts.append(short)
-        return parts
-    strides = _stride_figures(chain, landings, heading, path, fps)
-    poses = _stride_poses(motion, landings.frames[chain])
-    cuts = _gait_changes(strides, poses)
-    kinds = _step_gaits(strides, body)
-    walk_run = {j for j in range(1, len(kinds)) if kinds[j][0] != kinds[j - 1][0]}
-    lo, hi = _steady_ends(strides, poses, cuts | walk_run)
-    ends = [(0, lo)] if lo > 0 else []
-    if hi < strides.shape[0]:
-        ends.append((hi + 1, chain.size - 1))
-    for e0, e1 in ends:  # blended steps at an end: a transition; the parts beside it reach no further
-        blends.append((int(landings.frames[chain[e0]]), int(landings.frames[chain[e1]])))
-        changes.update(blends[-1])
-    if (lo, hi) != (0, strides.shape[0]):  # the steps at the new ends lie in fewer strides
-        chain, strides = chain[lo:hi + 2], strides[lo:hi]
-        cuts = {c - lo for c in cuts}
-        kinds = _step_gaits(strides, body)
-    f = landings.frames[chain]
-    i = 0
-    while i < len(kinds):
-        j = i + 1
-        while j < len(kinds) and kinds[j][0] == kinds[i][0] and j not in cuts and \
-                abs(kinds[j][1] / float(np.median([k[1] for k in kinds[i:j]])) - 1) <= TEMPO_CHANGE:
-            j += 1
-        # steps i .. j-1: landings f[i] .. f[j]
-        parts.append(_gait_part(kinds[i][0], f, chain, i, j, landings, strides, heading, path, fps))
-        # where the gait changes, the step across the change belongs to neither part (a blend of the two)
-        if j in cuts and j + 2 < len(kinds):
-            changes.update((int(f[j]), int(f[j + 1])))
-            i = j + 1
-        else:
-            i = j
-    return parts
 
 
 #: A take is one cycle when its wrap (last frame to first, or, when the last frame repeats the first, the one
@@ -1326,9 +1257,10 @@ def _repeating_reach(motion: Motion, part: Activity, want: int, edge: int) -> in
     return lo + top - int(bad[0]) if bad.size else want
 
 
-def _gaps(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float, options: dict) -> list:
-    """The frames between the parts (and before the first, after the last), each a :class:`_Gap` with the
-    landings in it, to be looked at on its own (:func:`_gap_parts`)."""
+def _fill(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float, options: dict,
+          map=map) -> list[Activity]:
+    """The parts with the frames between them (and before the first, after the last) as parts of their own,
+    each stretch looked at on its own (:func:`_other`, through ``map``) with the landings in it."""
     T = motion.n_frames
     gaps, at = [], 0
     for p in [*parts, None]:
@@ -1337,13 +1269,10 @@ def _gaps(motion: Motion, parts: list[Activity], landings: Landings, min_periods
             gaps.append((at, stop))
         if p is not None:
             at = p.stop
-    return [_Gap(motion[a:b], a, min_periods, bool(parts), options, _steps_in(landings, a, b)) for a, b in gaps]
-
-
-def _cut_job(job):
-    """One job of the cut's map: the parts of a :class:`_Gap` (:func:`_gap_parts`) or the phase of a
-    :class:`_GaitJob` (:func:`_gait_job`)."""
-    return _gap_parts(job) if isinstance(job, _Gap) else _gait_job(job)
+    found = map(_gap_parts, [_Gap(motion[a:b], a, min_periods, bool(parts), options, _steps_in(landings, a, b))
+                             for a, b in gaps])
+    out = [*parts, *(q for qs in found for q in qs)]
+    return sorted(out, key=lambda q: q.start)
 
 
 @dataclass(frozen=True)
