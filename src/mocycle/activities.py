@@ -229,7 +229,8 @@ class Landings:
 LIFT_HEIGHT, LAND_HEIGHT = 0.04, 0.02
 #: Where the landings make no gait, a stance's own level: a contact joint's lowest over STANCE_FLOOR_S seconds
 #: about a frame (a stance beside every swing of a stride), when under STANCE_CAP (body heights) above its
-#: floor (higher, the foot is held up); frames within STANCE_MARGIN_S of a chain of landings keep theirs.
+#: floor (higher, the foot is held up); frames within STANCE_MARGIN_S of a chain of landings keep theirs, unless
+#: the own levels make a chain OWN_CHAIN_MORE landings longer there.
 STANCE_FLOOR_S, STANCE_CAP, STANCE_MARGIN_S = 0.6, 0.06, 0.5
 #: Where the stances' own levels make a chain of landings this many longer (a stride) than every chain of the
 #: floor's it meets, the landings there are measured from the stances' own levels (one more is often only a
