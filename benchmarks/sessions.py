@@ -205,6 +205,8 @@ def _write(folder: Path, name: str, takes, fps: float | None) -> Session:
         stretches[-1] = (stretches[-1][0], stretches[-1][1], motion.n_frames)
     path = folder / f"{name}.bvh"
     mocycle.write(motion, path)
+    # the truth beside the session, for a look at its loops later (``--keep``)
+    (folder / f"{name}.truth.json").write_text(json.dumps({"fps": motion.fps, "stretches": stretches}))
     return Session(name, path, stretches, motion.fps, motion.n_frames)
 
 
@@ -229,6 +231,7 @@ def run(session: Session, outdir: Path) -> Result:
         doc = json.loads(text) if text.strip() else None
     except json.JSONDecodeError:
         doc = None
+    (out / "s.json").write_text(text)  # the report beside the loops (kept with ``--keep``)
     return Result(session, p.returncode, usage.ru_utime + usage.ru_stime, wall, usage.ru_maxrss / 1024, doc, err)
 
 
