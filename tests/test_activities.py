@@ -446,6 +446,27 @@ def test_a_blended_stride_at_a_chains_end_is_left_out_and_its_own_part_keeps_thr
     assert _steady_ends(_figures(8), poses) == (0, 7)
 
 
+def test_a_small_change_that_leaves_a_side_too_short_to_loop_is_no_cut():
+    """A run of five strides that speeds up by a quarter after its third (a short take's wobble: its strides
+    at 30 fps vary that much) was cut in two, a stride and a half and a stride, and neither piece looped: the
+    take got no loop.  A change that small is cut only where both sides keep a stride and a half; a clear one
+    (period and speed both jump, as where one take meets the next) is cut however short its sides."""
+    from mocycle.activities import CLEAR_CHANGE, _change_scores, _gait_changes
+
+    def strides(*runs):
+        return np.vstack([_figures(n, period=period, speed=speed) for n, period, speed in runs])
+
+    small = strides((3, 60.0, 1.0), (2, 60.0, 1.25))
+    assert 0 < _change_scores(small, None).max() < CLEAR_CHANGE
+    assert _gait_changes(small) == set()
+    assert _gait_changes(strides((2, 60.0, 1.0), (3, 60.0, 1.25))) == set()
+    assert _gait_changes(strides((3, 60.0, 1.0), (3, 60.0, 1.25))) == {3}  # four landings a side: cut
+    assert _gait_changes(strides((8, 60.0, 1.0), (8, 60.0, 1.25))) == {7}
+    clear = strides((3, 60.0, 1.0), (2, 75.0, 1.5))
+    assert _change_scores(clear, None).max() >= CLEAR_CHANGE
+    assert _gait_changes(clear) == {3}
+
+
 def test_the_second_look_stays_on_one_side_of_a_gait_change():
     """Frames where steps were seen but nothing loops are looked at again without gait; where the gait was seen
     to change between two such parts, each side is looked at on its own (one look across both found a

@@ -439,6 +439,11 @@ def _step_gaits(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
 #: where one take meets the next, not the ramp of a walk that starts from standing), the gait changes there.
 STRIDE_STEPS = {"period": 0.08, "speed": 0.15, "flight": 0.12, "double support": 0.15, "pose": 0.5}
 GAIT_CHANGE, STEADY_SIDES = 1.25, 3.0
+#: A change under CLEAR_CHANGE is cut only where either side keeps at least SIDE_LANDINGS landings (a stride and a
+#: half): a short take's strides wobble (a run of three strides speeding up by a fifth), and cutting there leaves
+#: pieces too short to loop; a change of CLEAR_CHANGE or more (where one take meets the next) is cut however
+#: short its sides.
+CLEAR_CHANGE, SIDE_LANDINGS = 2 * GAIT_CHANGE, 4
 #: the scales of a stride's figures (period, speed, flight, double support: :func:`_stride_figures`' columns 0, 2,
 #: 3, 4), in that order
 _FIGURE_SCALE = np.array([STRIDE_STEPS[k] for k in ("period", "speed", "flight", "double support")])
@@ -493,6 +498,8 @@ def _changes_in(strides: np.ndarray, poses: np.ndarray | None, lo: int, hi: int)
         return set()
     b = 3 + int(np.argmax(score))  # the landing (of strides lo ..) where they differ most
     c = _steadiest_cut(b, strides[lo:hi], None if poses is None else poses[lo:hi])
+    if float(score.max()) < CLEAR_CHANGE and min(c + 1, hi - lo + 1 - c) < SIDE_LANDINGS:
+        return set()  # a small change that leaves a side too short to loop: the steps' own wobble, no new gait
     # strides ending by landing c, and those starting after the step it drops (landing c + 1)
     return {lo + c} | _changes_in(strides, poses, lo, lo + c - 1) | _changes_in(strides, poses, lo + c + 1, hi)
 
