@@ -207,6 +207,27 @@ def test_stride_phase_leaves_out_a_step_unlike_the_others():
     assert bent > 1.04 * 42.0
 
 
+def test_stride_phase_takes_a_landing_outside_the_part_only_at_its_tempo():
+    """A 30 fps run whose feet land every 10.5 frames, and the next take's first landing 16 frames after its last
+    (a blend: under STEP_RATIO of the median step, so the run of landings holds it): the line through it made
+    the run's period 22.3 frames where its feet land every 21, and the loop was refused as 6 % off its strides.
+    A landing outside the part carries the phase to the part's edge only when it steps at the part's tempo."""
+    from mocycle.activities import Activity, stride_phase
+
+    part = Activity(start=0, stop=64, kind="run straight", limbs="legs", period_frames=21.0)
+    own = np.round(3 + 10.5 * np.arange(6))  # 3, 14 (13.5), 24, 34, 45, 56
+    foot = np.arange(own.size + 1) % 2
+    blend = np.r_[own, own[-1] + 16]
+    _, period = stride_phase(part, blend, foot, 0, 64)
+    assert period == pytest.approx(21.0, rel=0.01)
+    B = np.column_stack([np.ones(blend.size), np.arange(blend.size) / 2.0, foot != foot[0]])
+    assert np.linalg.lstsq(B, blend.astype(float), rcond=None)[0][1] > 1.04 * 21.0  # the line through it bends
+    # a landing just outside at the part's tempo still carries the phase (the same period as without it)
+    steady = np.r_[own, own[-1] + 10]
+    _, p2 = stride_phase(part, steady, foot, 0, 64)
+    assert p2 == pytest.approx(21.0, rel=0.02)
+
+
 def _steps(motion):
     from mocycle.activities import find_landings
 

@@ -1654,6 +1654,17 @@ def stride_phase(part: Activity, landings_frames: np.ndarray, landings_foot: np.
         runs = np.split(np.arange(f.size), cuts)
         best = max(runs, key=lambda r: (np.count_nonzero((f[r] >= start) & (f[r] < stop)), r.size))
         f, foot = f[best], foot[best]
+        # a landing outside the part only carries its phase to the part's edge when it steps at the part's tempo
+        # (within TEMPO_CHANGE of its median step): the first step into the next take is often a blend, long
+        # enough to pass STEP_RATIO and bend the line (a 30 fps run at 22.3 frames where its feet land every 21)
+        if f.size >= 4:
+            typical = float(np.median(np.diff(f)))
+            lo, hi = 0, f.size
+            if f[0] < start and abs((f[1] - f[0]) / typical - 1.0) > TEMPO_CHANGE:
+                lo = 1
+            if f[-1] >= stop and abs((f[-1] - f[-2]) / typical - 1.0) > TEMPO_CHANGE and hi - lo > 3:
+                hi -= 1
+            f, foot = f[lo:hi], foot[lo:hi]
     if f.size < 3:
         raise MocycleError(f"a stride phase needs three landings; frames {start}-{stop} have {f.size}")
     k = np.arange(f.size, dtype=np.float64)
