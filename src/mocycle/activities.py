@@ -439,10 +439,11 @@ def _step_gaits(strides: np.ndarray, body: float) -> list[tuple[str, float]]:
 #: where one take meets the next, not the ramp of a walk that starts from standing), the gait changes there.
 STRIDE_STEPS = {"period": 0.08, "speed": 0.15, "flight": 0.12, "double support": 0.15, "pose": 0.5}
 GAIT_CHANGE, STEADY_SIDES = 1.25, 3.0
-#: A change under CLEAR_CHANGE is cut only where either side keeps at least SIDE_LANDINGS landings (a stride and a
+#: A change under CLEAR_CHANGE is cut only where both sides keep at least SIDE_LANDINGS landings (a stride and a
 #: half): a short take's strides wobble (a run of three strides speeding up by a fifth), and cutting there leaves
 #: pieces too short to loop; a change of CLEAR_CHANGE or more (where one take meets the next) is cut however
-#: short its sides.
+#: short its sides.  Where the largest change of a stretch is such a small one, the stretch is not cut at all
+#: (looking for the next largest instead cut the hours' sessions into more pieces: 10 loops fewer at 120 fps).
 CLEAR_CHANGE, SIDE_LANDINGS = 2 * GAIT_CHANGE, 4
 #: the scales of a stride's figures (period, speed, flight, double support: :func:`_stride_figures`' columns 0, 2,
 #: 3, 4), in that order
