@@ -1659,11 +1659,11 @@ def stride_phase(part: Activity, landings_frames: np.ndarray, landings_foot: np.
         # (within TEMPO_CHANGE of its median step): the first step into the next take is often a blend, long
         # enough to pass STEP_RATIO and bend the line (a 30 fps run at 22.3 frames where its feet land every 21)
         if f.size >= 4:
-            typical = float(np.median(np.diff(f)))
+            run_step = float(np.median(np.diff(f)))  # the run's median step (``typical`` was all the landings')
             lo, hi = 0, f.size
-            if f[0] < start and abs((f[1] - f[0]) / typical - 1.0) > TEMPO_CHANGE:
+            if f[0] < start and abs((f[1] - f[0]) / run_step - 1.0) > TEMPO_CHANGE:
                 lo = 1
-            if f[-1] >= stop and abs((f[-1] - f[-2]) / typical - 1.0) > TEMPO_CHANGE and hi - lo > 3:
+            if f[-1] >= stop and abs((f[-1] - f[-2]) / run_step - 1.0) > TEMPO_CHANGE and hi - lo > 3:
                 hi -= 1
             f, foot = f[lo:hi], foot[lo:hi]
     if f.size < 3:
