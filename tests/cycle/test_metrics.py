@@ -4,7 +4,7 @@ from scipy.spatial.transform import Rotation
 from mocycle.cycle import extract_cycle
 from mocycle.cycle.metric_rows import metric_features
 from mocycle.cycle.metrics import foot_points, foot_sliding, jerk_ratio, loop_metrics, template_error
-from mocycle.cycle.seam import calmest_start, seam_ratios
+from mocycle.cycle.seam import _changes, calmest_sample, calmest_start, seam_ratios
 from mocycle.datasets import synthetic_still, synthetic_walk
 
 
@@ -52,6 +52,46 @@ def test_calmest_start_picks_the_slowest_step():
     r = seam_ratios(rolled)
     assert r["pose"] <= 1.0 and r["velocity"] <= 1.0
     assert r["pose"] <= min(seam_ratios(np.roll(C, -j, axis=0))["pose"] for j in range(48)) + 0.6
+
+
+def _scores(C, stride):
+    """calmest_start's score of every start (its definition, written out)."""
+    step, acc = _changes(C, stride)
+    return np.maximum(step / np.median(step), np.maximum(acc, np.roll(acc, stride)) / np.median(acc))
+
+
+def test_calmest_sample_finds_the_start_between_frames_from_a_few_samples():
+    N, stride = 48, 10
+    t = np.arange(N * stride) / (N * stride)
+    rng = np.random.default_rng(3)
+    for trial in range(20):
+        a, b = rng.normal(size=2)
+        C = np.c_[np.sin(2 * np.pi * t) + a * np.sin(4 * np.pi * t + b), np.cos(2 * np.pi * t + a)]
+        read = []
+
+        def at(rows, C=C, read=read):
+            read.append(rows)
+            return (C[rows],)
+
+        k = calmest_sample(at, N * stride, stride)
+        assert all(np.all(np.diff(r) > 0) for r in read)               # sorted, no sample twice
+        assert sum(r.size for r in read) < 0.5 * N * stride               # not every sample made
+        exact = _scores(C, stride)
+        # as calm as calmest_start's start within 5 %: the ratios are to the medians of the frames (as the seam
+        # check measures a loop), not of every sample, which moves the best start by a sample or so
+        assert exact[k] <= exact.min() * 1.05
+    walk = np.c_[np.sin(2 * np.pi * np.arange(N) / N)]                    # stride 1: calmest_start itself
+    assert calmest_sample(lambda rows: (walk[rows],), N, 1) == calmest_start(walk)
+
+
+def test_loop_blocks_at_rows_are_the_rows_of_loop_blocks():
+    from mocycle.cycle.metric_rows import loop_blocks, loop_blocks_at
+
+    cycle = extract_cycle(synthetic_walk(n_frames=300).motion)
+    rows = np.array([0, 3, 4, 17, cycle.n_frames - 1])
+    C, path = loop_blocks(cycle)
+    C_at, path_at = loop_blocks_at(cycle, rows)
+    assert np.allclose(C_at, C[rows], atol=1e-12) and np.allclose(path_at, path[rows], atol=1e-9)
 
 
 def test_jerk_ratio_is_one_for_the_input_itself_and_small_for_a_denoised_cycle():

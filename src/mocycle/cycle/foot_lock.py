@@ -63,4 +63,8 @@ def lock_cycle(cycle: Cycle, feet: Sequence[Foot] | str | None = None, *, blend:
     L[:, :3] = (L[:, :3] - p0 - move) @ R + p0    # undo repeat's move to the second cycle
     L[:, 3] -= turn
     L[:, 3] += 2 * np.pi * np.round((cycle.L[0, 3] - L[0, 3]) / (2 * np.pi))
-    return replace(cycle, P=P, L=L, regression=None), contacts.window(N, 2 * N)
+    # P's rotation blocks are the locked motion's rotations (the travel joint's less its heading): already
+    # rotations, so kept as the projection rather than projected again
+    J = cycle.space.n_joints
+    projected = P[:, :9 * J].reshape(N, J, 3, 3).copy()
+    return replace(cycle, P=P, L=L, regression=None, projected=projected), contacts.window(N, 2 * N)

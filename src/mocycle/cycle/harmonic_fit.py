@@ -12,10 +12,10 @@ from ..errors import MocycleError
 from ..phase.analysis import PeriodicMotion
 from .differences import HALF, central_acceleration, central_velocity
 from .harmonic import MODELS, ROWS, HarmonicRegression, max_harmonics
-from .metric_rows import loop_blocks
+from .metric_rows import loop_blocks_at
 from .representation import CycleSpace, EncodedRows
 from .result import Cycle, _check_choice
-from .seam import calmest_start
+from .seam import calmest_sample
 from .timeaxis import TimeAxis
 
 DEFAULT_HARMONICS = defaults.HARMONICS  # the thesis' K
@@ -156,12 +156,14 @@ def harmonic_cycle(space: CycleSpace, P: np.ndarray | EncodedRows, L: np.ndarray
         trial = Cycle(space=space, P=fit_p.predict(fine), L=path(fine), drift=drift,
                       method="harmonic", model=model, harmonics=K, axis=axis, positions=np.zeros(0),
                       periodic=periodic)
-        start = calmest_start(*loop_blocks(trial), stride=SUBFRAMES)
+        # the trial's rotations projected only where the start is looked for (the projection is most of it)
+        start = calmest_sample(lambda rows: loop_blocks_at(trial, rows), SUBFRAMES * N, SUBFRAMES)
         x0 += start / (SUBFRAMES * N)
         # the cycle's frames are trial samples start, start + 10, ... (one period on, where they pass its end:
-        # the periodic block and its projection are the same there): taken, not fitted and projected again
+        # the periodic block is the same there): taken, not fitted again
         rows = (start + SUBFRAMES * np.arange(N)) % (SUBFRAMES * N)
-        P, projected = trial.P[rows], trial.rotation_matrices()[rows]
+        P = trial.P[rows]
+        projected = space.project(P)
     else:
         P, projected = fit_p.predict(x0 + np.arange(N) / N), None
     xs = x0 + np.arange(N) / N

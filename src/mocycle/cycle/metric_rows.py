@@ -255,19 +255,33 @@ def loop_blocks(cycle: Cycle) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _loop_blocks(cycle: Cycle) -> tuple[np.ndarray, np.ndarray]:
+    C, path = _blocks(cycle, cycle.rotation_matrices(), cycle.inplace_L(), cycle.P)
+    C.setflags(write=False)
+    path.setflags(write=False)
+    return C, path
+
+
+def loop_blocks_at(cycle: Cycle, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`loop_blocks` at the cycle's ``rows`` only (indices ``(n,)``): the same numbers, with only those
+    rows projected onto rotations (each row's blocks depend on that row alone, once the in-place path, which
+    depends on them all, is made).  Not kept."""
+    P = cycle.P[rows]
+    return _blocks(cycle, cycle.space.project(P), cycle.inplace_L()[rows], P)
+
+
+def _blocks(cycle: Cycle, R: np.ndarray, L: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The blocks of :func:`loop_blocks` from rows of the cycle's projected rotations ``R (n, J, 3, 3)``,
+    in-place path ``L (n, 4)`` and periodic curves ``P (n, n_periodic)``."""
     space = cycle.space
     joints = _rotation_joints(space.skeleton)
     if not joints:
         raise MocycleError("no features: the selected joints have no rotation channels and the root is dropped")
-    L = cycle.inplace_L()
-    R = cycle.rotation_matrices()  # local rotations; the travel joint's without its heading, put in below
+    # local rotations: the travel joint's without its heading, put in below
     travel = space.heading_rotations(L) @ R[:, space.travel]
     every = len(joints) == space.n_joints
     C = (R if every else np.take(R, joints, axis=1)).reshape(R.shape[0], -1) / np.sqrt(2.0)
     if space.travel in joints:
         at = space.travel if every else joints.index(space.travel)
         C[:, 9 * at:9 * at + 9] = travel.reshape(-1, 9) / np.sqrt(2.0)
-    path = space.travel_path(R, space.translations(cycle.P, L), travel)
-    C.setflags(write=False)
-    path.setflags(write=False)
+    path = space.travel_path(R, space.translations(P, L), travel)
     return C, path

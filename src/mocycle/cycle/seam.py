@@ -11,6 +11,8 @@ where the wrap is placed).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
 
 LOCAL = 4  # frames on each side of the wrap for the local ratio
@@ -81,13 +83,61 @@ def calmest_start(*blocks: np.ndarray, stride: int = 1) -> int:
     block (``(n, D_b)`` arrays of one cycle sampled ``stride`` times per frame, e.g. rotations and the
     in-place root path); the start with the smallest largest ratio wins.  Where a loop is smooth this puts
     the wrap at a calm pose, which is where animators cut loops too.  ``stride > 1`` chooses the start
-    between frames (for cycles that can be sampled anywhere, such as a harmonic fit).
+    between frames (for cycles that can be sampled anywhere, such as a harmonic fit; :func:`calmest_sample`
+    does so from a few samples).
     """
     score = np.zeros(blocks[0].shape[0])
     for C in blocks:
         step, acc = _changes(C, stride)
         ms, ma = np.median(step), np.median(acc)
-        pose = step / ms if ms > 0 else np.zeros_like(step)
-        vel = np.maximum(acc, np.roll(acc, stride)) / ma if ma > 0 else np.zeros_like(acc)
-        score = np.maximum(score, np.maximum(pose, vel))
+        score = np.maximum(score, _score(step, np.roll(acc, stride), acc, ms, ma))
     return int(np.argmin(score))
+
+
+def _score(step: np.ndarray, acc_before: np.ndarray, acc: np.ndarray, ms: float, ma: float) -> np.ndarray:
+    """The wrap's larger ratio at each start: its step over the median step ``ms``, the larger velocity change
+    on either side of it over the median change ``ma`` (0 where a median is 0)."""
+    pose = step / ms if ms > 0 else np.zeros_like(step)
+    vel = np.maximum(acc, acc_before) / ma if ma > 0 else np.zeros_like(acc)
+    return np.maximum(pose, vel)
+
+
+#: the calmest frames between which :func:`calmest_sample` looks at every sample
+CANDIDATES = 3
+
+
+def calmest_sample(blocks_at: Callable[[np.ndarray], Sequence[np.ndarray]], samples: int, stride: int,
+                   candidates: int = CANDIDATES) -> int:
+    """:func:`calmest_start` (``stride`` samples per frame) of a cycle of ``samples`` samples that is sampled
+    only where it is looked at: ``blocks_at(rows)`` gives its blocks at those sample indices (sorted).
+
+    The ratios are first made at every frame (every ``stride``-th sample, one frame apart; their medians are
+    the ones every start is measured against), then at every sample within a frame of the ``candidates``
+    calmest frames, from the samples up to three frames before and two after them: about ``candidates * 5``
+    frames' samples made, not all ``samples``."""
+    frames = np.arange(0, samples, stride)
+    medians, score = [], np.zeros(frames.size)
+    for C in blocks_at(frames):
+        step, acc = _changes(C, 1)
+        ms, ma = float(np.median(step)), float(np.median(acc))
+        medians.append((ms, ma))
+        score = np.maximum(score, _score(step, np.roll(acc, 1), acc, ms, ma))
+    best = frames[np.argsort(score, kind="stable")[:candidates]]
+    if stride == 1:
+        return int(best[0])
+    starts = np.unique((best[:, None] + np.arange(-stride, stride + 1)).ravel() % samples)
+    need = np.unique((best[:, None] + np.arange(-3 * stride, 2 * stride + 1)).ravel() % samples)
+
+    def at(k: np.ndarray) -> np.ndarray:  # rows of the blocks made at ``need`` for samples ``k``
+        return np.searchsorted(need, k % samples)
+
+    score = np.zeros(starts.size)
+    for C, (ms, ma) in zip(blocks_at(need), medians, strict=True):
+        C = np.asarray(C, dtype=np.float64).reshape(C.shape[0], -1)
+        a, b, c, d = (C[at(starts + o * stride)] for o in (-2, -1, 0, 1))
+        into, before, after = c - b, b - a, d - c
+        step = np.sqrt(np.add.reduce(into * into, axis=1))
+        acc = _row_norms(after - into)
+        acc_before = _row_norms(into - before)
+        score = np.maximum(score, _score(step, acc_before, acc, ms, ma))
+    return int(starts[np.argmin(score)])
