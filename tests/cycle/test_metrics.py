@@ -64,7 +64,7 @@ def test_calmest_sample_finds_the_start_between_frames_from_a_few_samples():
     N, stride = 48, 10
     t = np.arange(N * stride) / (N * stride)
     rng = np.random.default_rng(3)
-    for trial in range(20):
+    for _ in range(20):
         a, b = rng.normal(size=2)
         C = np.c_[np.sin(2 * np.pi * t) + a * np.sin(4 * np.pi * t + b), np.cos(2 * np.pi * t + a)]
         read = []
