@@ -262,9 +262,10 @@ def _loop_blocks(cycle: Cycle) -> tuple[np.ndarray, np.ndarray]:
 
 
 def loop_blocks_at(cycle: Cycle, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`loop_blocks` at the cycle's ``rows`` only (indices ``(n,)``): the same numbers, with only those
-    rows projected onto rotations (each row's blocks depend on that row alone, once the in-place path, which
-    depends on them all, is made).  Not kept."""
+    """:func:`loop_blocks` at the cycle's ``rows`` only (indices ``(n,)``): the same numbers within rounding
+    (the projection's last step is shared by the rows projected together), with only those rows projected onto
+    rotations (each row's blocks depend on that row alone, once the in-place path, which depends on them all,
+    is made).  Not kept."""
     P = cycle.P[rows]
     return _blocks(cycle, cycle.space.project(P), cycle.inplace_L()[rows], P)
 
