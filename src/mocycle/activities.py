@@ -1659,7 +1659,7 @@ def stride_phase(part: Activity, landings_frames: np.ndarray, landings_foot: np.
         # (within TEMPO_CHANGE of its median step): the first step into the next take is often a blend, long
         # enough to pass STEP_RATIO and bend the line (a 30 fps run at 22.3 frames where its feet land every 21)
         if f.size >= 4:
-            run_step = float(np.median(np.diff(f)))  # the run's median step (``typical`` was all the landings')
+            run_step = float(np.median(np.diff(f)))  # this run's median step, not all the landings'
             lo, hi = 0, f.size
             if f[0] < start and abs((f[1] - f[0]) / run_step - 1.0) > TEMPO_CHANGE:
                 lo = 1

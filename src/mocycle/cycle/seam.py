@@ -135,9 +135,9 @@ def calmest_sample(blocks_at: Callable[[np.ndarray], Sequence[np.ndarray]], samp
     for C, (ms, ma) in zip(blocks_at(need), medians, strict=True):
         C = np.asarray(C, dtype=np.float64).reshape(C.shape[0], -1)
         a, b, c, d = (C[at(starts + o * stride)] for o in (-2, -1, 0, 1))
-        into, before, after = c - b, b - a, d - c
-        step = np.sqrt(np.add.reduce(into * into, axis=1))
-        acc = _row_norms(after - into)
-        acc_before = _row_norms(into - before)
+        into = c - b
+        acc = _row_norms((d - c) - into)
+        acc_before = _row_norms(into - (b - a))
+        step = _row_norms(into)  # last: squares ``into`` in place
         score = np.maximum(score, _score(step, acc_before, acc, ms, ma))
     return int(starts[np.argmin(score)])
