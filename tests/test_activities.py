@@ -488,6 +488,37 @@ def test_a_small_change_that_leaves_a_side_too_short_to_loop_is_no_cut():
     assert _gait_changes(clear) == {3}
 
 
+def test_a_gait_change_is_cut_once_at_the_step_that_blends_the_two_takes():
+    """Where one take meets the next, the step across the join spoils the two strides that hold it (41 and 39
+    frames between walks of 36 and 31).  The change scores (medians of three strides a side) stay high over
+    four landings and peak two landings past that step; the cut searched only one landing about the peak
+    dropped a step of either take instead, and the strides left between the two cuts (the blend) were looked at
+    again as one motion: a walk loop across the join.  The steadiest cut within two landings drops the blended
+    step itself, once."""
+    from mocycle.activities import _change_scores, _gait_changes
+
+    strides = np.vstack([_figures(8, period=36.0), _figures(1, period=41.0), _figures(1, period=39.0),
+                         _figures(8, period=31.0, speed=1.2)])
+    score = _change_scores(strides, None)
+    assert 3 + int(np.argmax(score)) == 11  # the peak: two landings after the blended step (landings 9 to 10)
+    assert _gait_changes(strides) == {9}
+
+
+def test_parts_found_between_gait_parts_keep_their_landings_in_the_takes_frames():
+    """A stretch between gait parts is looked at on its own frames; a walk found there by its feet (a chain of
+    landings that broke) listed its landings counted from the stretch's first frame, not the take's."""
+    from mocycle.activities import _Gap, _gap_parts, _steps_in, find_landings
+
+    walk = synthetic_walk(n_frames=600, fps=60.0, period_s=1.0, noise_deg=0.5, seed=3).motion
+    a, b = 200, 450
+    gap = _Gap(walk[a:b], a, 1.2, True, {"joints": None, "step": 1}, _steps_in(find_landings(walk), a, b))
+    stepping = [q for q in _gap_parts(gap) if q.landings]
+    assert stepping and stepping[0].in_step
+    for q in stepping:
+        frames = [f for v in q.landings.values() for f in v]
+        assert min(frames) >= q.start >= a and max(frames) < q.stop, (q.start, q.stop, q.landings)
+
+
 def test_the_second_look_stays_on_one_side_of_a_gait_change():
     """Frames where steps were seen but nothing loops are looked at again without gait; where the gait was seen
     to change between two such parts, each side is looked at on its own (one look across both found a

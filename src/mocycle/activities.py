@@ -483,7 +483,7 @@ def _gait_changes(strides: np.ndarray, poses: np.ndarray | None = None) -> set[i
     where a straight gait changes (:data:`STRIDE_STEPS`, :data:`GAIT_CHANGE`, :data:`STEADY_SIDES`): the
     medians of up to three strides ending at the landing and three starting there differ (``poses``: the
     strides' mean poses, :func:`_stride_poses`, a change of posture counting as one more figure).  The landing
-    where they differ most is moved to the neighbouring landing whose parts would be steadier
+    where they differ most is moved to the landing near it (up to :data:`CUT_REACH` away) whose parts would be steadier
     (:func:`_steadiest_cut`), and the strides on either side of the step it drops are looked at again, each side
     on its own: the stride that blends two takes, which sways the comparisons of the landings up to two strides
     on, is then in neither, and a take of a few strides between two others still shows both its changes.
@@ -553,16 +553,23 @@ def _change_scores(strides: np.ndarray, poses: np.ndarray | None) -> np.ndarray:
     return np.where(ok, change, 0.0)
 
 
+#: How many landings from where the change scores peak a gait change's cut may be moved (:func:`_steadiest_cut`).
+CUT_REACH = 2
+
+
 def _steadiest_cut(b: int, strides: np.ndarray, poses: np.ndarray | None) -> int:
-    """Of landings ``b - 1 .. b + 1`` of a chain (its strides' figures ``strides``, :func:`_stride_figures`, and
-    mean poses ``poses``), where to cut a gait that changes about landing ``b``: a cut at landing ``c`` drops
-    the step from landing ``c`` to ``c + 1`` (the parts end at ``c`` and start at ``c + 1``), and the step that
-    holds the change spoils both strides across it; the cut whose parts' strides (two or three on either side)
-    deviate least from their medians (in the scales of :data:`STRIDE_STEPS`) is the one that drops it."""
+    """Of landings ``b - CUT_REACH .. b + CUT_REACH`` of a chain (its strides' figures ``strides``,
+    :func:`_stride_figures`, and mean poses ``poses``), where to cut a gait that changes about landing ``b``: a
+    cut at landing ``c`` drops the step from landing ``c`` to ``c + 1`` (the parts end at ``c`` and start at
+    ``c + 1``), and the step that holds the change spoils both strides across it; the cut whose parts' strides
+    (two or three on either side) deviate least from their medians (in the scales of :data:`STRIDE_STEPS`) is
+    the one that drops it.  The change scores compare medians of three strides, so they stay high for a landing
+    or two on either side of the change (the blended step's two strides sway one side's median): the landing
+    where they peak may lie two landings from the step that blends."""
     n = strides.shape[0]
     figures = strides[:, _FIGURE_COLUMNS]
     cost = {}
-    for c in (b - 1, b, b + 1):
+    for c in range(b - CUT_REACH, b + CUT_REACH + 1):
         before, after = slice(max(0, c - 4), c - 1), slice(c + 1, min(n, c + 4))
         if min(before.stop - before.start, after.stop - after.start) < 2:  # one stride is always steady
             continue
@@ -1214,7 +1221,11 @@ def _reach(motion: Motion, parts: list[Activity], T: int, changes: Collection[in
     """Let each gait part reach up to one step before its first and after its last landing (the take starts or
     ends mid-stride; up to a stride at the take's ends), short of its neighbours and only as far as its legs
     still repeat the stride (:func:`_repeating_reach`: where the gait stops or blends into another motion, the
-    part stops); a gap smaller than a step between two parts is split.  A part that starts or ends at a landing
+    part stops); into a gap smaller than a step left after the part before it, a part reaches back as far as its
+    legs repeat, and the part before reaches on into what is left as far as its own legs repeat (frames neither
+    part's legs repeat through, where one motion blends into the next, are left between them: split in halves,
+    they held a third of a stride of another take).  A part that
+    starts or ends at a landing
     of ``changes`` (where the gait changes, :func:`_gait_changes`) stays there: the step across the change is
     a blend of the two gaits, neither part's, even where the legs repeat alike on both sides of it."""
     for k, p in enumerate(parts):
@@ -1222,9 +1233,10 @@ def _reach(motion: Motion, parts: list[Activity], T: int, changes: Collection[in
         lo = parts[k - 1].stop if k > 0 else 0
         if p.start in changes:
             pass
-        elif k > 0 and p.start - lo < step and parts[k - 1].stop not in changes:   # a gap under a step: halve it
-            mid = (lo + p.start) // 2
-            parts[k - 1].stop, p.start = mid, mid
+        elif k > 0 and p.start - lo < step and parts[k - 1].stop not in changes:  # a gap under a step: reach
+            p.start = _repeating_reach(motion, p, lo, p.start)  # into it as far as the legs repeat
+            if p.start > lo:  # and the part before, as far as its own legs repeat
+                parts[k - 1].stop = _repeating_reach(motion, parts[k - 1], p.start, lo)
         else:  # at the take's start a foot may be mid-swing: up to a stride
             want = max(lo, int(np.floor(p.start - (2 * step if k == 0 else step))))
             p.start = _repeating_reach(motion, p, want, p.start)
@@ -1330,10 +1342,11 @@ def _in_step(periods: np.ndarray, period: float) -> bool | None:
 
 
 def _gap_parts(gap: _Gap) -> list[Activity]:
-    """:func:`_other` of a stretch between gait parts, in the take's frames."""
+    """:func:`_other` of a stretch between gait parts, in the take's frames (its frames and its landings)."""
     out = _other(gap.motion, 0, gap.motion.n_frames, gap.min_periods, gap.gait_near, gap.options, steps=gap.steps)
     for q in out:
         q.start, q.stop = q.start + gap.offset, q.stop + gap.offset
+        q.landings = {side: [f + gap.offset for f in frames] for side, frames in q.landings.items()}
     return out
 
 
