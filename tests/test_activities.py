@@ -639,3 +639,15 @@ def test_a_steady_chain_over_the_floor_is_kept_where_the_stances_own_levels_brea
     found = _landings_from(h, [1, 1], ("left", "right"), 60.0)
     assert not found.own.any() if found.own is not None else True
     assert max(c.size for c in _gait_chains(found, 60.0, least=3)) >= 11
+
+
+def test_a_one_frame_gap_between_parts_says_one_frame():
+    """The reason of a gap too short to look at counts its frames in plain words ("only 1 frame", not "1
+    frames")."""
+    from mocycle.activities import _other
+
+    walk = synthetic_walk(n_frames=120, fps=60.0, period_s=1.0, noise_deg=0.5, seed=3).motion
+    one, = _other(walk, 10, 11, 1.2, True, {"joints": None, "step": 1})
+    assert one.kind == "transition" and one.reason.startswith("only 1 frame (0.0 s) between activities")
+    two, = _other(walk, 10, 12, 1.2, True, {"joints": None, "step": 1})
+    assert two.reason.startswith("only 2 frames (")

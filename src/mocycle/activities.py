@@ -1370,8 +1370,9 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
                              reason=f"the movement {when} the repeating part: it happens once")]
         kind = "transition" if gait_near else "gesture"
         why = "between activities" if gait_near else "in the whole take"
+        frames = f"{n} frame" if n == 1 else f"{n} frames"
         return [Activity(start=start, stop=stop, kind=kind, limbs="none",
-                         reason=f"only {n} frames ({n * motion.frame_time:.1f} s) {why}: too short to repeat")]
+                         reason=f"only {frames} ({n * motion.frame_time:.1f} s) {why}: too short to repeat")]
     piece = motion[start:stop]
     spread = _rotation_spread(piece)
     if float(np.sort(spread)[-min(3, spread.size)]) < STILL_DEG:  # fewer than three joints move
