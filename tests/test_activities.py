@@ -651,3 +651,32 @@ def test_a_one_frame_gap_between_parts_says_one_frame():
     assert one.kind == "transition" and one.reason.startswith("only 1 frame (0.0 s) between activities")
     two, = _other(walk, 10, 12, 1.2, True, {"joints": None, "step": 1})
     assert two.reason.startswith("only 2 frames (")
+
+
+def test_a_sliver_between_parts_is_merged_into_a_neighbour_that_does_not_loop():
+    """A frame or two left between two cuts (a transition of one frame beside another transition) is merged
+    into the part before it, or else the part after it, when that one does not loop; beside parts that loop
+    on both sides it stays (a loop's frames are never grown by it)."""
+    from mocycle.activities import Activity, _without_slivers
+
+    def parts():
+        return [Activity(start=0, stop=100, kind="walk straight", loop=True),
+                Activity(start=100, stop=130, kind="transition", reason="steps where one take meets another",
+                         landings={"left": [110]}),
+                Activity(start=130, stop=132, kind="transition", reason="only 2 frames", landings={"right": [131]}),
+                Activity(start=132, stop=133, kind="transition", reason="only 1 frame"),
+                Activity(start=133, stop=200, kind="run straight", loop=True),
+                Activity(start=200, stop=201, kind="gesture", reason="only 1 frame"),
+                Activity(start=201, stop=300, kind="walk straight", loop=True)]
+
+    out = _without_slivers(parts(), fps=30.0)
+    assert [(p.kind, p.start, p.stop) for p in out] == [
+        ("walk straight", 0, 100), ("transition", 100, 133), ("run straight", 133, 200), ("gesture", 200, 201),
+        ("walk straight", 201, 300)]
+    assert out[1].reason == "steps where one take meets another" and out[1].landings == {"left": [110], "right": [131]}
+    first = [Activity(start=0, stop=2, kind="transition", reason="only 2 frames"),  # a sliver first: merged
+             Activity(start=2, stop=40, kind="gesture", reason="once"),               # into the part after it
+             Activity(start=40, stop=90, kind="run straight", loop=True)]
+    out = _without_slivers(first, fps=30.0)
+    assert [(p.kind, p.start, p.stop, p.reason) for p in out] == [("gesture", 0, 40, "once"),
+                                                                   ("run straight", 40, 90, "")]

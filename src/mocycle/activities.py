@@ -815,6 +815,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
             _asked_phase(motion, p, min_periods, options)
     _decide(parts, min_periods)
     parts = _second_look(motion, parts, landings, min_periods, options, map, changes)
+    parts = _without_slivers(parts, fps)
     parts = _or_one_cycle(motion, parts, landings)
     return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True, reason=_listing(parts),
                       landings=landings)
@@ -913,6 +914,33 @@ def _with_blends(parts: list[Activity], blends: list[tuple[int, int]]) -> list[A
             out.append(Activity(start=a, stop=b, kind="transition", limbs="none",
                                 reason="steps where one take meets another: a blend of the two, no one motion"))
     return sorted(out, key=lambda q: q.start)
+
+
+#: A part that does not loop and lasts under this many seconds is merged into a neighbour that does not loop
+#: either (:func:`_without_slivers`).
+SLIVER_S = 0.1
+
+
+def _without_slivers(parts: list[Activity], fps: float) -> list[Activity]:
+    """``parts`` with each sliver (a part that does not loop, under :data:`SLIVER_S`: the frame or two left
+    between two cuts) merged into the part before it, or else the part after it, when that part does not loop
+    and has no phase of its own either; the merged part keeps its kind and reason.  A sliver between two parts
+    that loop stays as it is (their borders are where their own frames end)."""
+    def takes(q: Activity) -> bool:
+        return not q.loop and q.periodic is None
+
+    out: list[Activity] = []
+    for k, p in enumerate(parts):
+        if takes(p) and p.n_frames < SLIVER_S * fps:
+            into = out[-1] if out and takes(out[-1]) else \
+                parts[k + 1] if k + 1 < len(parts) and takes(parts[k + 1]) else None
+            if into is not None:
+                into.start, into.stop = min(into.start, p.start), max(into.stop, p.stop)
+                into.landings = {side: sorted(set(into.landings.get(side, [])) | set(p.landings.get(side, [])))
+                                 for side in {**into.landings, **p.landings}}
+                continue
+        out.append(p)
+    return out
 
 
 def _second_look(motion: Motion, parts: list[Activity], landings: Landings, min_periods: float, options: dict,
