@@ -483,10 +483,11 @@ def _gait_changes(strides: np.ndarray, poses: np.ndarray | None = None) -> set[i
     where a straight gait changes (:data:`STRIDE_STEPS`, :data:`GAIT_CHANGE`, :data:`STEADY_SIDES`): the
     medians of up to three strides ending at the landing and three starting there differ (``poses``: the
     strides' mean poses, :func:`_stride_poses`, a change of posture counting as one more figure).  The landing
-    where they differ most is moved to the landing near it (up to :data:`CUT_REACH` away) whose parts would be steadier
-    (:func:`_steadiest_cut`), and the strides on either side of the step it drops are looked at again, each side
-    on its own: the stride that blends two takes, which sways the comparisons of the landings up to two strides
-    on, is then in neither, and a take of a few strides between two others still shows both its changes.
+    where they differ most is moved to the landing near it (up to :data:`CUT_REACH` away) whose parts would be
+    steadier (:func:`_steadiest_cut`), and the strides on either side of the step it drops are looked at again,
+    each side on its own: the stride that blends two takes, which sways the comparisons of the landings up to
+    two strides on, is then in neither, and a take of a few strides between two others still shows both its
+    changes.
     Turning strides are left out: a turn slows a walk, and the turn's own borders are cut by
     :func:`_turn_runs`."""
     return _changes_in(strides, poses, 0, strides.shape[0])
@@ -1252,10 +1253,9 @@ def _reach(motion: Motion, parts: list[Activity], T: int, changes: Collection[in
     part stops); into a gap smaller than a step left after the part before it, a part reaches back as far as its
     legs repeat, and the part before reaches on into what is left as far as its own legs repeat (frames neither
     part's legs repeat through, where one motion blends into the next, are left between them: split in halves,
-    they held a third of a stride of another take).  A part that
-    starts or ends at a landing
-    of ``changes`` (where the gait changes, :func:`_gait_changes`) stays there: the step across the change is
-    a blend of the two gaits, neither part's, even where the legs repeat alike on both sides of it."""
+    they held a third of a stride of another take).  A part that starts or ends at a landing of ``changes``
+    (where the gait changes, :func:`_gait_changes`) stays there: the step across the change is a blend of the
+    two gaits, neither part's, even where the legs repeat alike on both sides of it."""
     for k, p in enumerate(parts):
         step = p.period_frames / 2.0
         lo = parts[k - 1].stop if k > 0 else 0
