@@ -493,8 +493,8 @@ def test_a_gait_change_is_cut_once_at_the_step_that_blends_the_two_takes():
     frames between walks of 36 and 31).  The change scores (medians of three strides a side) stay high over
     four landings and peak two landings past that step; the cut searched only one landing about the peak
     dropped a step of either take instead, and the strides left between the two cuts (the blend) were looked at
-    again as one motion: a walk loop across the join.  The steadiest cut within two landings drops the blended
-    step itself, once."""
+    again as one motion: a walk loop across the join.  The steadiest cut from three landings before the peak to two
+    after it drops the blended step itself, once."""
     from mocycle.activities import _change_scores, _gait_changes
 
     strides = np.vstack([_figures(8, period=36.0), _figures(1, period=41.0), _figures(1, period=39.0),

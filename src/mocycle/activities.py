@@ -483,7 +483,7 @@ def _gait_changes(strides: np.ndarray, poses: np.ndarray | None = None) -> set[i
     where a straight gait changes (:data:`STRIDE_STEPS`, :data:`GAIT_CHANGE`, :data:`STEADY_SIDES`): the
     medians of up to three strides ending at the landing and three starting there differ (``poses``: the
     strides' mean poses, :func:`_stride_poses`, a change of posture counting as one more figure).  The landing
-    where they differ most is moved to the landing near it (up to :data:`CUT_REACH` away) whose parts would be
+    where they differ most is moved to the landing near it (up to three before, two after) whose parts would be
     steadier (:func:`_steadiest_cut`), and the strides on either side of the step it drops are looked at again,
     each side on its own: the stride that blends two takes, which sways the comparisons of the landings up to
     two strides on, is then in neither, and a take of a few strides between two others still shows both its
@@ -554,23 +554,21 @@ def _change_scores(strides: np.ndarray, poses: np.ndarray | None) -> np.ndarray:
     return np.where(ok, change, 0.0)
 
 
-#: How many landings from where the change scores peak a gait change's cut may be moved (:func:`_steadiest_cut`).
-CUT_REACH = 2
-
-
 def _steadiest_cut(b: int, strides: np.ndarray, poses: np.ndarray | None) -> int:
-    """Of landings ``b - CUT_REACH .. b + CUT_REACH`` of a chain (its strides' figures ``strides``,
-    :func:`_stride_figures`, and mean poses ``poses``), where to cut a gait that changes about landing ``b``: a
-    cut at landing ``c`` drops the step from landing ``c`` to ``c + 1`` (the parts end at ``c`` and start at
-    ``c + 1``), and the step that holds the change spoils both strides across it; the cut whose parts' strides
-    (two or three on either side) deviate least from their medians (in the scales of :data:`STRIDE_STEPS`) is
-    the one that drops it.  The change scores compare medians of three strides, so they stay high for a landing
-    or two on either side of the change (the blended step's two strides sway one side's median): the landing
-    where they peak may lie two landings from the step that blends."""
+    """Of landings ``b - 3 .. b + 2`` of a chain (its strides' figures ``strides``, :func:`_stride_figures`, and
+    mean poses ``poses``), where to cut a gait that changes about landing ``b``: a cut at landing ``c`` drops the
+    step from landing ``c`` to ``c + 1`` (the parts end at ``c`` and start at ``c + 1``), and the step that holds
+    the change spoils both strides across it (strides ``c - 1`` and ``c``, stride ``k`` running from landing
+    ``k`` to ``k + 2``); the cut whose parts' strides (two or three on either side) deviate least from their
+    medians (in the scales of :data:`STRIDE_STEPS`) is the one that drops it.  Where the change scores
+    (:func:`_change_scores`) peak says only roughly where that step is: they compare the medians of three
+    strides ending at a landing and three starting there, and the two spoiled strides, two of a window's three,
+    make its median theirs at landings ``c - 2 .. c - 1`` (the window after) and ``c + 2 .. c + 3`` (the window
+    before), so the peak may lie anywhere from two landings before the step to three after it."""
     n = strides.shape[0]
     figures = strides[:, _FIGURE_COLUMNS]
     cost = {}
-    for c in range(b - CUT_REACH, b + CUT_REACH + 1):
+    for c in range(b - 3, b + 3):
         before, after = slice(max(0, c - 4), c - 1), slice(c + 1, min(n, c + 4))
         if min(before.stop - before.start, after.stop - after.start) < 2:  # one stride is always steady
             continue
