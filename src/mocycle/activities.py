@@ -931,8 +931,11 @@ def _without_slivers(parts: list[Activity], fps: float) -> list[Activity]:
     out: list[Activity] = []
     for k, p in enumerate(parts):
         if takes(p) and p.n_frames < SLIVER_S * fps:
-            into = out[-1] if out and takes(out[-1]) else \
-                parts[k + 1] if k + 1 < len(parts) and takes(parts[k + 1]) else None
+            into = None
+            if out and takes(out[-1]):
+                into = out[-1]
+            elif k + 1 < len(parts) and takes(parts[k + 1]):
+                into = parts[k + 1]
             if into is not None:
                 into.start, into.stop = min(into.start, p.start), max(into.stop, p.stop)
                 into.landings = {side: sorted(set(into.landings.get(side, [])) | set(p.landings.get(side, [])))
