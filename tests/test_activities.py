@@ -109,6 +109,32 @@ def test_a_walk_followed_by_a_wave_gives_two_parts(tmp_path):
     assert result.exit_code == 0 and [loop["kind"] for loop in facts["loops"]] == ["walk straight", "arms"]
 
 
+@pytest.mark.parametrize("fps, step", [(30.0, 1), (60.0, 2), (120.0, 4)])
+def test_frames_without_gait_are_looked_at_about_30_times_a_second_unless_told(monkeypatch, tmp_path, fps, step):
+    """The cohomology of a wave sees the same points on its circle at 120 fps as at 30 (``PHASE_RATE``): every
+    fourth frame; ``--step 1`` still looks at every frame.  The arms are looped at their period either way."""
+    from mocycle import activities
+
+    assert activities.phase_step(fps) == step
+    steps = []
+    real = activities.find_phase_every
+
+    def spy(motion, step=1, **options):
+        steps.append(step)
+        return real(motion, step, **options)
+
+    monkeypatch.setattr(activities, "find_phase_every", spy)
+    take = synthetic_wave(fps=fps, n_frames=int(6 * fps), seed=2)
+    result, facts = _loops(take, tmp_path)
+    assert result.exit_code == 0, result.output
+    [loop] = facts["loops"]
+    assert loop["kind"] == "arms" and abs(loop["period_frames"] / np.nanmedian(take.period_frames) - 1) < 0.08
+    assert steps and set(steps) == {step}
+    steps.clear()
+    result, facts = _loops(take, tmp_path, "--step", "1")
+    assert result.exit_code == 0 and steps and set(steps) == {1}
+
+
 def test_a_take_of_one_and_a_third_periods_is_found_and_looped(tmp_path):
     take = synthetic_walk(n_frames=80, fps=60.0, period_s=1.0, noise_deg=1.0, seed=7)
     result, facts = _loops(take, tmp_path)

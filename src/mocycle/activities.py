@@ -116,6 +116,11 @@ ALIKE = 0.5
 PERIOD_REFINES = 2
 #: ... and move: at least this share of the largest local speed of those frames (not a gesture's stillness).
 BUSY_SHARE = 0.2
+#: Frames a second the cohomology looks at in frames without gait unless told otherwise (``step``): a take of
+#: more is looked at on every ``round(fps / PHASE_RATE)``-th frame (4 at 120 fps), so its points on the circle lie as
+#: far apart and its delay spans as long as in a 30 fps take.  A body's cycle holds no motion a 30 fps capture
+#: misses; 120 points a second only cost the Rips filtration (about the cube of the landmarks it takes).
+PHASE_RATE = 30.0
 
 
 def _least_overlap(lag):
@@ -712,7 +717,7 @@ def _split_turns(part: Activity, heading: np.ndarray, path: np.ndarray, fps: flo
     return out
 
 
-def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, joints=None, step: int = 1,
+def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, joints=None, step: int | None = None,
                        map=map, **phase_options) -> Activities:
     """Cut ``motion`` into steady parts (module notes); ``min_periods``: cycles a part needs to be looped.
 
@@ -720,7 +725,8 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     :func:`~mocycle.phase.find_phase`'s, used inside the parts without gait (``joints``: the joints those parts'
     periodic motion is found on, instead of the moving arm joints or the whole body; ``step``: the phase found
     on every ``step``-th frame).  Gait parts take their phase from the landings, or, when ``joints`` are given,
-    from the cohomology of those joints inside the part.  ``map``: how the stretches between gait parts, which
+    from the cohomology of those joints inside the part.  ``step`` ``None``: :func:`phase_step` of the take's
+    frame rate.  ``map``: how the stretches between gait parts, which
     are looked at each on its own, are mapped (a process pool's ``map`` looks at them side by side; the parts
     are the same).  Without feet found by name, the whole take is looked
     at as frames without gait (arms, then the whole body, region by region).  Every part that loops (``loop``)
@@ -738,6 +744,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     min_periods = _validate.real("min_periods", min_periods, 1.0)
     if joints is not None:
         motion.skeleton.select(joints)  # a joint the rig lacks is the caller's mistake: said once, here
+    step = phase_step(fps) if step is None else _validate.integer("step", step, 1)
     options = {"joints": joints, "step": step, **phase_options}
     landings = find_landings(motion)
     if landings is None:
@@ -818,6 +825,12 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     parts = _or_one_cycle(motion, parts, landings)
     return Activities(parts=parts, n_frames=T, frame_time=motion.frame_time, feet=True, reason=_listing(parts),
                       landings=landings)
+
+
+def phase_step(fps: float) -> int:
+    """The frames from one the cohomology looks at to the next in a take of ``fps`` frames a second when not told
+    (:data:`PHASE_RATE`): 1 up to 45 fps, 2 at 60, 4 at 120."""
+    return max(1, int(round(float(fps) / PHASE_RATE)))
 
 
 #: A take is one cycle when its wrap (last frame to first, or, when the last frame repeats the first, the one
