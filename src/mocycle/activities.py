@@ -119,7 +119,7 @@ BUSY_SHARE = 0.2
 #: Frames a second the cohomology looks at in frames without gait unless told otherwise (``step``): a take of
 #: more is looked at on every ``round(fps / PHASE_RATE)``-th frame (4 at 120 fps), so its points on the circle lie as
 #: far apart and its delay spans as long as in a 30 fps take.  A body's cycle holds no motion a 30 fps capture
-#: misses; 120 points a second only cost the Rips filtration (about the cube of the landmarks it takes).
+#: misses; 120 points a second only cost the cohomology (the Rips filtration grows with the cube of its landmarks).
 PHASE_RATE = 30.0
 
 
