@@ -96,8 +96,7 @@ def test_different_skeletons_exit_1_naming_the_joints(walks, tmp_path):
 def test_blend_and_transition_take_the_phase_options(walks, tmp_path):
     out = tmp_path / "blend.bvh"
     result = runner.invoke(app, ["blend", str(walks[0]), str(walks[1]), "-o", str(out), "--json", "--joints", "legs",
-                                 "--pca", "6", "--delay", "1", "--classes", "1", "--part", "0",
-                                 "--min-periods", "1.5"])
+                                 "--pca", "6", "--delay", "1", "--classes", "1", "--min-periods", "1.5"])
     assert result.exit_code == 0, result.output
     assert abs(json.loads(result.stdout)["period_frames"] - 54) < 1.5
     refused = runner.invoke(app, ["transition", str(walks[0]), str(walks[1]), "-o", str(tmp_path / "t.bvh"),

@@ -549,10 +549,21 @@ def find_phase_every(motion: Motion, step: int = 1, **options) -> PhaseResult:
     n_frames = motion.n_frames
     frames = np.arange(n_frames)
     classes = []
+    note = f" (found on every {_ordinal(step)} frame: the frames in this reason are those)"
     for c in result.classes:
         unwrapped = np.interp(frames, np.arange(c.unwrapped.size) * step, c.unwrapped)
         excitation = [(s * step, min(n_frames, (e - 1) * step + 1)) for s, e in c.excitation]
         classes.append(replace(c, coords=np.mod(unwrapped, 1.0), unwrapped=unwrapped, excitation=excitation,
-                               period_frames=c.period_frames * step, frame_time=c.frame_time / step))
+                               period_frames=c.period_frames * step, frame_time=c.frame_time / step,
+                               period_candidates={k: v * step for k, v in c.period_candidates.items()},
+                               legs_period_frames=c.legs_period_frames * step,
+                               period_reason=c.period_reason + note if c.period_reason else c.period_reason))
     return replace(result, classes=classes, n_frames=n_frames, frame_time=result.frame_time / step,
-                   autocorrelation_period_frames=result.autocorrelation_period_frames * step)
+                   autocorrelation_period_frames=result.autocorrelation_period_frames * step,
+                   legs_period_frames=result.legs_period_frames * step)
+
+
+def _ordinal(n: int) -> str:
+    """``2nd``, ``3rd``, ``4th``, ``21st``."""
+    tail = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
+    return f"{n}{tail}"
