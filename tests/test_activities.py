@@ -135,6 +135,16 @@ def test_frames_without_gait_are_looked_at_about_30_times_a_second_unless_told(m
     assert result.exit_code == 0 and steps and set(steps) == {1}
 
 
+def test_frames_where_the_feet_land_are_looked_at_on_every_frame_unless_told():
+    """A short gait found between gait parts must match its strides' period within a few percent over as few as
+    1.2 cycles: every frame, not every fourth; a step asked for is taken everywhere."""
+    from mocycle.activities import _phase_step_in
+
+    assert _phase_step_in(None, 120.0) == 4 and _phase_step_in(None, 120.0, stepping=True) == 1
+    assert _phase_step_in(3, 120.0) == 3 and _phase_step_in(3, 120.0, stepping=True) == 3
+    assert _phase_step_in(None, 30.0) == 1
+
+
 def test_a_take_of_one_and_a_third_periods_is_found_and_looped(tmp_path):
     take = synthetic_walk(n_frames=80, fps=60.0, period_s=1.0, noise_deg=1.0, seed=7)
     result, facts = _loops(take, tmp_path)

@@ -136,7 +136,8 @@ def test_extract_cycle_options_reach_the_task(walk):
             pb.select = flag
         else:
             pb.bone.select = flag
-    assert bpy.ops.mocycle.extract_cycle(method="harmonic", model="M2", harmonics="6", step=2,
+    # step: a text field (empty: about 30 frames a second, the task's default)
+    assert bpy.ops.mocycle.extract_cycle(method="harmonic", model="M2", harmonics="6", step="2",
                                          use_frame_range=True, frame_start=31, frame_end=210, feet="lock",
                                          root="motion") == {"FINISHED"}
     bpy.ops.object.mode_set(mode="OBJECT")

@@ -120,6 +120,9 @@ BUSY_SHARE = 0.2
 #: more is looked at on every ``round(fps / PHASE_RATE)``-th frame (4 at 120 fps), so its points on the circle lie as
 #: far apart and its delay spans as long as in a 30 fps take.  A body's cycle holds no motion a 30 fps capture
 #: misses; 120 points a second only cost the cohomology (the Rips filtration grows with the cube of its landmarks).
+#: Frames where the feet land are looked at on every frame all the same: such a stretch is a short gait looked at
+#: for as few as ``min_periods`` cycles, whose period must match its strides within a few percent, and a cycle and
+#: a fifth at 30 points a second hold too few points for that (a two-stride run came out 7 % short at 120 fps).
 PHASE_RATE = 30.0
 
 
@@ -726,10 +729,10 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     periodic motion is found on, instead of the moving arm joints or the whole body; ``step``: the phase found
     on every ``step``-th frame).  Gait parts take their phase from the landings, or, when ``joints`` are given,
     from the cohomology of those joints inside the part.  ``step`` ``None``: :func:`phase_step` of the take's
-    frame rate.  ``map``: how the stretches between gait parts, which
-    are looked at each on its own, are mapped (a process pool's ``map`` looks at them side by side; the parts
-    are the same).  Without feet found by name, the whole take is looked
-    at as frames without gait (arms, then the whole body, region by region).  Every part that loops (``loop``)
+    frame rate (every frame where the feet land, :data:`PHASE_RATE`).  ``map``: how the stretches between gait
+    parts, which are looked at each on its own, are mapped (a process pool's ``map`` looks at them side by side;
+    the parts are the same).  Without feet found by name, the whole take is looked at as frames without gait
+    (arms, then the whole body, region by region).  Every part that loops (``loop``)
     holds at least ``min_periods`` cycles of its own ``periodic`` phase, and a part without gait at least
     :data:`MIN_REPEATS`.
 
@@ -744,7 +747,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
     min_periods = _validate.real("min_periods", min_periods, 1.0)
     if joints is not None:
         motion.skeleton.select(joints)  # a joint the rig lacks is the caller's mistake: said once, here
-    step = phase_step(fps) if step is None else _validate.integer("step", step, 1)
+    step = None if step is None else _validate.integer("step", step, 1)  # None: :func:`_phase_step_in`'s
     options = {"joints": joints, "step": step, **phase_options}
     landings = find_landings(motion)
     if landings is None:
@@ -831,6 +834,14 @@ def phase_step(fps: float) -> int:
     """The frames from one the cohomology looks at to the next in a take of ``fps`` frames a second when not told
     (:data:`PHASE_RATE`): 1 up to 45 fps, 2 at 60, 4 at 120."""
     return max(1, int(round(float(fps) / PHASE_RATE)))
+
+
+def _phase_step_in(step: int | None, fps: float, stepping: bool = False) -> int:
+    """The step the cohomology takes in a stretch: ``step`` when one was asked for, else every frame where the
+    feet land (``stepping``) and :func:`phase_step` elsewhere (:data:`PHASE_RATE`)."""
+    if step is not None:
+        return int(step)
+    return 1 if stepping else phase_step(fps)
 
 
 #: A take is one cycle when its wrap (last frame to first, or, when the last frame repeats the first, the one
@@ -1051,7 +1062,7 @@ def _asked_phase(motion: Motion, p: Activity, min_periods: float, options: dict)
     joints (:func:`~mocycle.phase.find_phase`), the periodic motion covering most of them; the loop checks then
     hold it against the strides."""
     options = dict(options)
-    step = int(options.pop("step", 1) or 1)
+    step = _phase_step_in(options.pop("step", None), motion.fps)
     try:
         found = find_phase_every(motion[p.start:p.stop], step, min_periods=min_periods, **options).classes
     except MocycleError as exc:
@@ -1632,7 +1643,7 @@ def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float, options:
     ``options``: :func:`~mocycle.phase.find_phase`'s, and ``step``.  ``stepping``: the feet land in the piece,
     so a region of ``min_periods`` is looked at (the landings then say whether it repeats, :func:`_other`)."""
     options = dict(options)
-    step = int(options.pop("step", 1) or 1)
+    step = _phase_step_in(options.pop("step", None), piece.fps, stepping)
     chosen = options.pop("joints", None)
     if chosen is not None:
         tries = [(chosen, "periodic")]
