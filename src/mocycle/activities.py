@@ -120,9 +120,10 @@ BUSY_SHARE = 0.2
 #: more is looked at on every ``round(fps / PHASE_RATE)``-th frame (4 at 120 fps), so its points on the circle lie as
 #: far apart and its delay spans as long as in a 30 fps take.  A body's cycle holds no motion a 30 fps capture
 #: misses; 120 points a second only cost the cohomology (the Rips filtration grows with the cube of its landmarks).
-#: Frames where the feet land are looked at on every frame all the same: such a stretch is a short gait looked at
-#: for as few as ``min_periods`` cycles, whose period must match its strides within a few percent, and a cycle and
-#: a fifth at 30 points a second hold too few points for that (a two-stride run came out 7 % short at 120 fps).
+#: Frames where the feet land are looked at on every frame all the same (a stretch between gait parts, a gait
+#: part whose phase is asked of ``joints``): such a stretch is a gait looked at for as few as ``min_periods``
+#: cycles, whose period must match its strides within a few percent, and a cycle and a fifth at 30 points a second
+#: hold too few points for that (a two-stride run came out 7 % short at 120 fps).
 PHASE_RATE = 30.0
 
 
@@ -1062,7 +1063,7 @@ def _asked_phase(motion: Motion, p: Activity, min_periods: float, options: dict)
     joints (:func:`~mocycle.phase.find_phase`), the periodic motion covering most of them; the loop checks then
     hold it against the strides."""
     options = dict(options)
-    step = _phase_step_in(options.pop("step", None), motion.fps)
+    step = _phase_step_in(options.pop("step", None), motion.fps, stepping=True)  # a gait: its feet land
     try:
         found = find_phase_every(motion[p.start:p.stop], step, min_periods=min_periods, **options).classes
     except MocycleError as exc:

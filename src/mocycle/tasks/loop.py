@@ -90,7 +90,8 @@ class Options(fields.CycleOptions):
     root: str = fields.root("inplace", "inplace (walks on the spot, facing kept) or motion (moves on).")
     frame_range: str | None = option(None, "Use frames START:STOP of the take.", FrameRange(), flag="--range")
     step: int | None = option(None, "Find the phase of frames without gait on every STEP-th frame (default: about 30 "
-                                    "frames a second, 4 at 120 fps; 1: every frame).", Integer(1, optional=True))
+                                    "frames a second, every 4th at 120 fps, and every frame where the feet land).",
+                              Integer(1, optional=True))
     cycles: int = fields.cycles(1, "Repeat the cycle this many times in the output.")
     time_axis: str = option("smooth", "Phase to time: smooth (default), rank (thesis eq. 3.20), gmm (eq. 3.21) "
                                       "or line.", Choice(TIME_AXES), flag="--time")
