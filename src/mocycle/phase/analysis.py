@@ -549,7 +549,7 @@ def find_phase_every(motion: Motion, step: int = 1, **options) -> PhaseResult:
     n_frames = motion.n_frames
     frames = np.arange(n_frames)
     classes = []
-    note = f" (found on every {_ordinal(step)} frame: the frames in this reason are those)"
+    note = f" (found on one frame in {step}: the frames in this reason are those)"
     for c in result.classes:
         unwrapped = np.interp(frames, np.arange(c.unwrapped.size) * step, c.unwrapped)
         excitation = [(s * step, min(n_frames, (e - 1) * step + 1)) for s, e in c.excitation]
@@ -562,8 +562,3 @@ def find_phase_every(motion: Motion, step: int = 1, **options) -> PhaseResult:
                    autocorrelation_period_frames=result.autocorrelation_period_frames * step,
                    legs_period_frames=result.legs_period_frames * step)
 
-
-def _ordinal(n: int) -> str:
-    """``2nd``, ``3rd``, ``4th``, ``21st``."""
-    tail = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
-    return f"{n}{tail}"
