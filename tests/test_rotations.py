@@ -7,6 +7,7 @@ from mocycle.rotations import (
     continuous_euler_blocks,
     continuous_quats,
     euler_to_quats,
+    half_angle_sincos,
     quat_exp,
     quat_log,
     quat_multiply,
@@ -177,3 +178,56 @@ def test_continuous_euler_a_block_at_a_time_is_the_same(order):
         parts = list(continuous_euler_blocks(q, order, [2, 0, 1], block))
         assert [rows.start for rows, _ in parts] == list(range(0, 400, block))
         np.testing.assert_array_equal(np.concatenate([a for _, a in parts]), whole)
+
+
+def _reference_half_sincos(degrees: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """sin and cos of half of ``degrees`` within about 1 ulp: the half angle folded exactly into [-45, 45]
+    degrees around the nearest multiple of 90 (exact in floating point for these magnitudes), converted to
+    radians there (one rounding of a small number), then np.sin/np.cos and the quadrant's swap."""
+    half = degrees * 0.5
+    quarter = np.rint(half / 90.0)
+    rest = np.radians(half - quarter * 90.0)
+    s, c = np.sin(rest), np.cos(rest)
+    turn = quarter.astype(int) % 4
+    sin = np.select([turn == 0, turn == 1, turn == 2], [s, c, -s], -c)
+    cos = np.select([turn == 0, turn == 1, turn == 2], [c, -s, -c], s)
+    return sin, cos
+
+
+def test_half_angle_sincos_of_degrees_is_within_a_few_ulp_where_radians_first_is_not():
+    rng = np.random.default_rng(7)
+    a = np.concatenate([rng.uniform(-180, 180, 200_000), rng.uniform(-3000, 3000, 20_000),
+                        rng.normal(0, 1e-3, 2_000), 360.0 * np.arange(-8, 9) + rng.normal(0, 1e-9, 17),
+                        np.arange(-720, 720.5, 0.25)])
+    sin, cos = half_angle_sincos(a, degrees=True)
+    want_sin, want_cos = _reference_half_sincos(a)
+    for got, want in ((sin, want_sin), (cos, want_cos)):
+        ulp = np.abs(got - want) / np.spacing(np.maximum(np.abs(want), 1e-300))
+        assert ulp.max() <= 3, ulp.max()
+    # converting to radians first loses the small results near multiples of 360 degrees (why degrees differ)
+    near = np.abs(want_sin) < 1e-8
+    ulp_np = np.abs(np.sin(a[near] * np.pi / 360) - want_sin[near]) / np.spacing(np.abs(want_sin[near]))
+    assert ulp_np.max() > 100
+
+
+def test_half_angle_sincos_is_exact_at_right_angles_odd_and_periodic():
+    a = np.array([0.0, 90.0, 180.0, 270.0, 360.0, -180.0, 540.0, 720.0])
+    sin, cos = half_angle_sincos(a, degrees=True)
+    np.testing.assert_array_equal(sin, [0.0, np.sqrt(0.5), 1.0, np.sqrt(0.5), 0.0, -1.0, -1.0, 0.0])
+    np.testing.assert_array_equal(cos, [1.0, np.sqrt(0.5), 0.0, -np.sqrt(0.5), -1.0, 0.0, 0.0, 1.0])
+    x = np.round(np.random.default_rng(3).uniform(-360, 360, 10_000) * 2.0**30) / 2.0**30  # x + 2160: exact
+    s1, c1 = half_angle_sincos(x, degrees=True)
+    s2, c2 = half_angle_sincos(-x, degrees=True)
+    s3, c3 = half_angle_sincos(x + 720.0 * 3, degrees=True)
+    np.testing.assert_array_equal(s2, -s1)
+    np.testing.assert_array_equal(c2, c1)
+    np.testing.assert_array_equal(s3, s1)
+    np.testing.assert_array_equal(c3, c1)
+    assert np.isnan(half_angle_sincos(np.array([np.nan, 1.0, np.nan]), degrees=True)[0][::2]).all()  # quietly
+
+
+def test_half_angle_sincos_of_radians_is_numpys():
+    x = np.random.default_rng(4).uniform(-10, 10, 1000)
+    sin, cos = half_angle_sincos(x)
+    np.testing.assert_array_equal(sin, np.sin(x * 0.5))
+    np.testing.assert_array_equal(cos, np.cos(x * 0.5))

@@ -9,7 +9,8 @@ Quaternions are ``(x, y, z, w)`` arrays (scipy's order), matrices ``(..., 3, 3)`
   previous frame, so curves written to BVH or fed to regressions are smooth.
 * **Vectorised quaternion algebra** on ``(..., 4)`` arrays: :func:`quat_multiply`
   (about 10× faster than ``Rotation.__mul__`` on 100 000 products), :func:`quat_conj`,
-  :func:`quat_log` / :func:`quat_exp`, :func:`euler_to_quats` (:func:`euler_quat_components`), :func:`axis_angle_quats`,
+  :func:`quat_log` / :func:`quat_exp`, :func:`euler_to_quats` (:func:`euler_quat_components`,
+  :func:`half_angle_sincos`), :func:`axis_angle_quats`,
   :func:`twist_angles`, :func:`quat_angles` (geodesic), :func:`slerp`; single rotations:
   :func:`rotvec_quat`, :func:`quat_rotvec`.
 * **Matrices**: :func:`axis_rotations` (about one axis), :func:`nearest_rotations` (Newton polar
@@ -266,23 +267,23 @@ def euler_to_quats(angles: np.ndarray, order: str, degrees: bool = False) -> np.
         q = np.zeros(shape + (4,))
         q[..., 3] = 1.0
         return q
-    # (k, n) half angles, each axis contiguous in memory
-    half = np.multiply(angles.reshape(-1, k).T, np.pi / 360.0 if degrees else 0.5, order="C")
-    comp = euler_quat_components(half, order)
-    out = np.empty((half.shape[1], 4))
+    # (k, n) angles, each axis contiguous in memory
+    flat = np.ascontiguousarray(angles.reshape(-1, k).T)
+    comp = euler_quat_components(flat, order, degrees)
+    out = np.empty((flat.shape[1], 4))
     for m in range(4):
         out[:, m] = 0.0 if comp[m] is None else comp[m]
     return out.reshape(shape + (4,))
 
 
-def euler_quat_components(half: np.ndarray, order: str) -> list[np.ndarray | None]:
-    """The x, y, z, w arrays of :func:`euler_to_quats` from half angles ``(k, ...)`` in radians, axis by axis
-    along the first dimension; ``None`` for a component that is exactly zero (one-axis orders)."""
-    s, c = np.sin(half), np.cos(half)
+def euler_quat_components(angles: np.ndarray, order: str, degrees: bool = False) -> list[np.ndarray | None]:
+    """The x, y, z, w arrays of :func:`euler_to_quats` from Euler angles ``(k, ...)`` (degrees or radians), axis
+    by axis along the first dimension; ``None`` for a component that is exactly zero (one-axis orders)."""
+    s, c = half_angle_sincos(angles, degrees)
     order = order.upper()
     comp: list[np.ndarray | None] = [None, None, None, c[0]]  # x, y, z, w; None: exactly zero
     comp["XYZ".index(order[0])] = s[0]
-    for i, axis in enumerate(order[1:half.shape[0]], start=1):
+    for i, axis in enumerate(order[1:angles.shape[0]], start=1):
         # q ⊗ (sin·e_axis + cos) = cos·q + sin·(q ⊗ e_axis); q ⊗ e_axis permutes q's entries (zeros skipped).
         perm, sign = _AXIS_PRODUCT[axis]
         new = []
@@ -298,6 +299,77 @@ def euler_quat_components(half: np.ndarray, order: str) -> list[np.ndarray | Non
                 new.append(np.add(cos_a, sin_b, out=cos_a) if sign[m] > 0 else np.subtract(cos_a, sin_b, out=cos_a))
         comp = new
     return comp
+
+
+#: table steps of :func:`half_angle_sincos` per turn of the half angle: 360/4096 = 0.087890625 degrees, a binary
+#: fraction, so an angle's remainder after the nearest step is exact
+SINCOS_STEPS = 4096
+_STEP_DEGREES = 360.0 / SINCOS_STEPS
+
+
+def _sincos_table(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """sin and cos of ``i * 360 / n`` degrees, ``i < n``: ``np.sin``/``np.cos`` of the angle folded into the
+    first octant (an argument of at most pi/4, rounded once), the other octants by symmetry, so that
+    multiples of 45 degrees are exact to the bit and the table is symmetric (``sin(-a) = -sin(a)`` bit for bit)."""
+    q = n // 8
+    i = np.arange(n)
+    within, quadrant = i % (2 * q), i // (2 * q)
+    folded = np.minimum(within, 2 * q - within) * (2.0 * np.pi / n)
+    sf, cf = np.sin(folded), np.cos(folded)
+    sf[within == q] = cf[within == q] = np.sqrt(0.5)  # 45 degrees: both correctly rounded, and equal
+    low = within <= q
+    s, c = np.where(low, sf, cf), np.where(low, cf, sf)
+    # turn by quadrant × 90°: (sin, cos) -> (cos, -sin)
+    sin = np.select([quadrant == 0, quadrant == 1, quadrant == 2], [s, c, -s], -c)
+    cos = np.select([quadrant == 0, quadrant == 1, quadrant == 2], [c, -s, -c], s)
+    return sin, cos
+
+
+_SIN_TABLE, _COS_TABLE = _sincos_table(SINCOS_STEPS)
+
+
+def half_angle_sincos(angles: np.ndarray, degrees: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """``sin(a / 2)`` and ``cos(a / 2)`` of angles ``a`` (any shape).
+
+    Radians: ``np.sin``/``np.cos`` of the halves.  Degrees (what BVH and FBX files hold) take a faster and more
+    exact way, 2.5x faster than ``np.sin`` + ``np.cos`` on this project's machines and within 2 ulp of the
+    exact values where converting to radians first is off by up to thousands of ulp near multiples of 360
+    degrees (``tests/test_rotations.py``; ``scipy.special.sindg``/``cosdg`` are 3x slower than numpy):
+    the half angle in degrees is split exactly into the nearest step ``k`` of :data:`SINCOS_STEPS` per turn
+    and a remainder ``r`` of at most 0.044 degrees; then ``sin(k + r) = S_k cos r + C_k sin r`` and
+    ``cos(k + r) = C_k cos r - S_k sin r`` from a table of ``S_k``, ``C_k`` and short Taylor series of ``sin r``
+    and ``cos r - 1`` (their first omitted terms are below 1e-21).
+    """
+    a = np.asarray(angles, dtype=np.float64)
+    if not degrees:
+        half = a * 0.5
+        return np.sin(half), np.cos(half)
+    steps = np.rint(a * (0.5 / _STEP_DEGREES))
+    r = a * 0.5
+    r -= steps * _STEP_DEGREES  # exact: both are multiples of the half angle's last bit, and |r| < 0.05
+    r *= np.pi / 180.0
+    with np.errstate(invalid="ignore"):  # NaN or inf: any index, the result is NaN all the same
+        k = steps.astype(np.intp)
+    k &= SINCOS_STEPS - 1
+    sin_k, cos_k = _SIN_TABLE.take(k), _COS_TABLE.take(k)
+    r2 = r * r
+    sin_r = r2 * (1.0 / 120.0)  # sin r = r - r^3/6 + r^5/120
+    sin_r -= 1.0 / 6.0
+    sin_r *= r2
+    sin_r *= r
+    sin_r += r
+    cos_r1 = r2 * (1.0 / 24.0)  # cos r - 1 = -r^2/2 + r^4/24
+    cos_r1 -= 0.5
+    cos_r1 *= r2
+    sin = sin_k * cos_r1
+    r2 = np.multiply(cos_k, sin_r, out=r2)
+    sin += r2
+    sin += sin_k
+    cos = np.multiply(cos_k, cos_r1, out=cos_r1)
+    np.multiply(sin_k, sin_r, out=r2)
+    cos -= r2
+    cos += cos_k
+    return sin, cos
 
 
 # q ⊗ e for the pure unit quaternions e = x, y, z: entry permutation and signs.

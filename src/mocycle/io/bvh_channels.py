@@ -184,9 +184,10 @@ class ChannelConverter:
             block = block_frames(n)
             for f0 in range(0, n_rows, block):
                 f1 = min(n_rows, f0 + block)
-                # half angles (k, B, n) in one pass over the block's channels (a view of them when cols is a slice)
+                # angles (k, B, n), each axis contiguous, in one pass over the block's channels (a view of them
+                # when cols is a slice)
                 angles = values[f0:f1, cols].reshape(f1 - f0, n, len(order)).transpose(2, 0, 1)
-                comp = euler_quat_components(np.multiply(angles, np.pi / 360.0, order="C"), order)
+                comp = euler_quat_components(np.ascontiguousarray(angles), order, degrees=True)
                 parts = [np.zeros((f1 - f0, n)) if c is None else c for c in comp]
                 if first is None:
                     first = [c[0].copy() for c in parts]
