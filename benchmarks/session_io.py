@@ -14,7 +14,8 @@ Sections:
   pandas' C engine, polars (one thread and its default), ``np.fromstring(sep=" ")`` and ``bytes.split`` +
   ``float``, and the whole ``read_bvh`` of this tree (with polars, and without: ``np.loadtxt``) and of
   ``--baseline`` (default ``main``).  Every measurement runs in a fresh process (thread counts are set before
-  the libraries load), the parsers interleaved, ``--repeat`` rounds; the first round checks that every array
+  the libraries load; numpy's huge-page advice off, as the command line runs, unless ``NUMPY_MADVISE_HUGEPAGE``
+  is set), the parsers interleaved, ``--repeat`` rounds; the first round checks that every array
   is bit for bit ``np.loadtxt``'s and every ``read_bvh`` motion bit for bit the baseline's.  Prints wall and
   CPU seconds (min and median) and ``read_bvh`` over the fastest parser, one-thread and any-thread.
 * ``outputs``: 558 and 5,000 small files written with ``io.atomic.atomic_write`` into one folder: the
@@ -238,6 +239,9 @@ def _baseline_tree(rev: str, work: Path) -> Path:
 
 def _run_child(name: str, path: Path, baseline_src: Path, digest: bool) -> dict:
     env = {k: v for k, v in os.environ.items() if k != "POLARS_MAX_THREADS"}
+    # every child without numpy's huge-page advice, as the command line runs (mocycle.threads): on a machine
+    # that cannot give huge pages it triples the first touch of every large array, the parsers' included
+    env.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
     extra, _ = PARSERS[name]
     env.update({k: v for k, v in extra.items() if v})
     src = baseline_src if name == "read_bvh baseline" else ROOT / "src"
@@ -253,7 +257,8 @@ def parsers(args, files: dict[str, Path]) -> None:
     baseline_src = _baseline_tree(args.baseline, args.workdir)
     names = [n for n in PARSERS if not args.parsers or n in args.parsers]
     print(f"\n## BVH frame rows: every parser in a fresh process, interleaved, {args.repeat} rounds "
-          f"(load {os.getloadavg()[0]:.1f}; baseline {args.baseline})", flush=True)
+          f"(load {os.getloadavg()[0]:.1f}; baseline {args.baseline}; NUMPY_MADVISE_HUGEPAGE="
+          f"{os.environ.get('NUMPY_MADVISE_HUGEPAGE', '0')})", flush=True)
     for label, path in files.items():
         if label == "hour 30 fps":
             continue

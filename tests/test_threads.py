@@ -24,14 +24,19 @@ except SystemExit:
     pass
 from threadpoolctl import threadpool_info
 tasks = len(os.listdir("/proc/self/task")) if os.path.isdir("/proc/self/task") else None
-print("\n@@" + json.dumps({"pools": threadpool_info(), "os_threads": tasks,
+try:
+    from numpy._core.multiarray import _get_madvise_hugepage
+except ImportError:  # numpy 1.x
+    from numpy.core.multiarray import _get_madvise_hugepage
+print("\n@@" + json.dumps({"pools": threadpool_info(), "os_threads": tasks, "hugepage": _get_madvise_hugepage(),
                            "env": {k: os.environ.get(k) for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")}}))
 """
 
 
 def cli_pools(args, **env):
     """Run a command through the console script's ``main``, then report the BLAS/OpenMP pools of that process."""
-    environ = {k: v for k, v in os.environ.items() if k not in threads.LIBRARY_VARIABLES + (threads.ENV,)}
+    environ = {k: v for k, v in os.environ.items()
+               if k not in threads.LIBRARY_VARIABLES + (threads.ENV, threads.HUGEPAGE_VARIABLE)}
     environ.update(PYTHONPATH=os.pathsep.join(p for p in sys.path if p), **env)
     out = subprocess.run([sys.executable, "-c", _CLI_THEN_INFO, json.dumps([str(a) for a in args])],
                          capture_output=True, text=True, env=environ, check=True).stdout
@@ -66,6 +71,12 @@ def test_a_variable_set_by_the_user_is_left_alone(walk_file):
     pytest.importorskip("typer")
     report = cli_pools(["info", walk_file], OPENBLAS_NUM_THREADS="2")
     assert report["env"] == {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "2"}
+
+
+def test_the_command_line_turns_numpys_huge_page_advice_off_unless_told(walk_file):
+    pytest.importorskip("typer")
+    assert cli_pools(["info", walk_file])["hugepage"] is False
+    assert cli_pools(["info", walk_file], NUMPY_MADVISE_HUGEPAGE="1")["hugepage"] is True
 
 
 def test_a_bad_value_is_a_usage_error(walk_file):

@@ -13,6 +13,13 @@ hand-overs than it saves, and on a busy machine its spinning worker stalls calls
 
 ``MOCYCLE_THREADS=N`` allows N threads; ``MOCYCLE_THREADS=0`` (or ``auto``) leaves the libraries' own default
 (one per core).
+
+The command line also turns off numpy's huge-page advice (``NUMPY_MADVISE_HUGEPAGE=0``, numpy's own switch, read
+when numpy loads; set it to 1 yourself to keep numpy's default).  numpy asks the kernel for transparent huge pages
+on every array of 4 MB or more; where the kernel cannot find them (every machine this project runs on so far:
+``AnonHugePages: 0 kB`` in ``/proc/meminfo``) each such array's first touch costs 3-6 times the system time of
+plain pages: 0.75-1.2 s against 0.2 s for a 428 MB array, and 38-44 s against 33-36 s of wall for the loops of
+an hour of capture (``docs/performance.md``).
 """
 
 from __future__ import annotations
@@ -25,7 +32,7 @@ import threading
 
 from .errors import MocycleError
 
-__all__ = ["ENV", "LIBRARY_VARIABLES", "limit_threads", "limited", "pin_environment", "threads"]
+__all__ = ["ENV", "HUGEPAGE_VARIABLE", "LIBRARY_VARIABLES", "limit_threads", "limited", "pin_environment", "threads"]
 
 ENV = "MOCYCLE_THREADS"
 #: the variables BLAS and OpenMP builds read when they load (and polars, which parses long BVH files)
@@ -53,10 +60,16 @@ def threads() -> int | None:
     return n
 
 
+#: numpy's switch for its huge-page advice, read when numpy loads (see the module notes)
+HUGEPAGE_VARIABLE = "NUMPY_MADVISE_HUGEPAGE"
+
+
 def pin_environment() -> None:
-    """Set the BLAS/OpenMP thread variables to :func:`threads` where they are unset, for the libraries that read
-    them when they load: call before numpy is imported (``mocycle.__main__`` does, first thing)."""
+    """Set the BLAS/OpenMP thread variables to :func:`threads` and numpy's huge-page advice off where they are
+    unset, for the libraries that read them when they load: call before numpy is imported (``mocycle.__main__``
+    does, first thing)."""
     n = threads()
+    os.environ.setdefault(HUGEPAGE_VARIABLE, "0")
     if n is None:
         return
     for name in LIBRARY_VARIABLES:
