@@ -338,12 +338,29 @@ def half_angle_sincos(angles: np.ndarray, degrees: bool = False) -> tuple[np.nda
     the half angle in degrees is split exactly into the nearest step ``k`` of :data:`SINCOS_STEPS` per turn
     and a remainder ``r`` of at most 0.044 degrees; then ``sin(k + r) = S_k cos r + C_k sin r`` and
     ``cos(k + r) = C_k cos r - S_k sin r`` from a table of ``S_k``, ``C_k`` and short Taylor series of ``sin r``
-    and ``cos r - 1`` (their first omitted terms are below 1e-21).
+    and ``cos r - 1`` (their first omitted terms are below 1e-21).  Pieces of :data:`SINCOS_PIECE` angles at a
+    time: the dozen temporaries stay in the cache and under malloc's 128 kB threshold for ``mmap`` (above it,
+    every temporary of a 300-frame take was a fresh mapping to fault in, and the conversion was slower than
+    ``np.sin``).
     """
     a = np.asarray(angles, dtype=np.float64)
     if not degrees:
         half = a * 0.5
         return np.sin(half), np.cos(half)
+    flat = a.reshape(-1)
+    sin, cos = np.empty(flat.shape), np.empty(flat.shape)
+    for i in range(0, flat.size, SINCOS_PIECE):
+        j = i + SINCOS_PIECE
+        _half_sincos_degrees(flat[i:j], sin[i:j], cos[i:j])
+    return sin.reshape(a.shape), cos.reshape(a.shape)
+
+
+#: angles converted at a time by :func:`half_angle_sincos` (64 kB per temporary)
+SINCOS_PIECE = 8192
+
+
+def _half_sincos_degrees(a: np.ndarray, sin: np.ndarray, cos: np.ndarray) -> None:
+    """:func:`half_angle_sincos` of degrees ``a`` (1-D) into ``sin`` and ``cos``."""
     steps = np.rint(a * (0.5 / _STEP_DEGREES))
     r = a * 0.5
     r -= steps * _STEP_DEGREES  # exact: both are multiples of the half angle's last bit, and |r| < 0.05
@@ -358,18 +375,17 @@ def half_angle_sincos(angles: np.ndarray, degrees: bool = False) -> tuple[np.nda
     sin_r *= r2
     sin_r *= r
     sin_r += r
-    cos_r1 = r2 * (1.0 / 24.0)  # cos r - 1 = -r^2/2 + r^4/24
+    cos_r1 = np.multiply(r2, 1.0 / 24.0, out=steps)  # cos r - 1 = -r^2/2 + r^4/24
     cos_r1 -= 0.5
     cos_r1 *= r2
-    sin = sin_k * cos_r1
-    r2 = np.multiply(cos_k, sin_r, out=r2)
+    np.multiply(sin_k, cos_r1, out=sin)
+    np.multiply(cos_k, sin_r, out=r2)
     sin += r2
     sin += sin_k
-    cos = np.multiply(cos_k, cos_r1, out=cos_r1)
+    np.multiply(cos_k, cos_r1, out=cos)
     np.multiply(sin_k, sin_r, out=r2)
     cos -= r2
     cos += cos_k
-    return sin, cos
 
 
 # q ⊗ e for the pure unit quaternions e = x, y, z: entry permutation and signs.

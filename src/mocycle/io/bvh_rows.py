@@ -4,14 +4,16 @@ Text numbers are most of a BVH read.  ``np.loadtxt`` parses about 45 MB/s; polar
 extra ``mocycle[fast]``) about 200 MB/s on one thread, to the same float64 values bit for bit (both round
 correctly; ``docs/performance.md`` has the figures and the other parsers measured).  :func:`row_chunks` cuts
 the motion block at line ends into pieces of :data:`CHUNK_BYTES`, counts their lines (so each piece knows the
-row it starts at), and parses them and runs the caller's conversion on them in :func:`helpers` threads at once
+row it starts at; a piece is the bytes as read, with no copy: polars is told how many lines to take and the
+file is sought back to the start of the line the piece cut), and parses them and runs the caller's conversion on them in :func:`helpers` threads at once
 (polars and numpy release the GIL); the caller takes them in order.  Parse and conversion so share the cores:
 a long read takes about as long as polars' parse on its own threads.
 
 Only plain rows are taken: numbers separated by single spaces (a space at the end of every line allowed),
-``\\n`` or ``\\r\\n`` line ends.  Anything else — tabs, runs of spaces, blank lines, a value missing or extra,
-text polars refuses, a byte-order mark — raises :class:`Unreadable`, and the reader parses the whole file
-the usual way, which accepts every layout and names the line of any error.
+``\\n`` or ``\\r\\n`` line ends.  Anything else — tabs, runs of spaces, a value missing or extra, text polars
+refuses, a byte-order mark — raises :class:`Unreadable` (a blank line within the rows becomes a row of NaN,
+which the caller's finite check refuses), and the reader parses the whole file the usual way, which accepts
+every layout and names the line of any error.
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ MIN_BYTES_IMPORTED = 1 << 20
 T = TypeVar("T")
 
 _BOM = b"\xef\xbb\xbf"
+_SPACE = frozenset(b" \t\r\n")
 
 
 class Unreadable(Exception):
@@ -87,38 +90,35 @@ def row_chunks(path: str | os.PathLike, offset: int, n_channels: int,
         trailing = first.rstrip(b"\r\n").endswith(b" ")  # iClone, Bandai: a space closes every row
         names = [f"c{i}" for i in range(n_channels + trailing)]
         schema = {name: pl.Float64 for name in names}
-        rest = [b""]
         r0 = 0
 
         def next_piece() -> tuple[bytes, int] | None:
-            """The next whole lines, about CHUNK_BYTES of them, as polars takes them, and their count
-            (``None`` at the end)."""
-            data = rest[0]
-            while True:
-                block = fh.read(CHUNK_BYTES)
-                if block:
-                    data += block
-                    cut = data.rfind(b"\n") + 1
-                    if not cut:
-                        continue
-                    rest[0], data = data[cut:], data[:cut]
-                else:
-                    rest[0] = b""
-                # blank lines closing a piece go (np.loadtxt skips blank lines; polars would make a row of
-                # nulls); a row that lost its closing space gets it back (polars counts the fields of the
-                # first line)
-                piece = data.rstrip(b" \t\r\n")
-                if piece:
-                    if piece.startswith(_BOM):  # polars would skip it; the usual parse refuses it with its line
-                        raise Unreadable("a byte-order mark")
-                    return piece + b" " if trailing else piece, piece.count(b"\n") + 1
-                if not block:
-                    return None
-                data = rest[0]
+            """The next piece as read (no copy: polars reads its first ``rows`` lines and no further) and its
+            count of whole lines, about CHUNK_BYTES of them (``None`` at the end).  The file is left at the
+            start of the next line."""
+            block = fh.read(CHUNK_BYTES)
+            if block.startswith(_BOM):  # polars would skip it; the usual parse refuses it with its line
+                raise Unreadable("a byte-order mark")
+            if len(block) == CHUNK_BYTES:
+                cut = block.rfind(b"\n") + 1
+                if not cut:  # a line of 16 MB is no frame row (nor a CR-only file's rows)
+                    raise Unreadable("no line end within a piece")
+                if cut < len(block):
+                    fh.seek(cut - len(block), os.SEEK_CUR)
+                return block, block.count(b"\n", 0, cut)  # a blank line within: a row of nulls (NaN)
+            # the last piece: its blank lines at the end go (np.loadtxt skips them; polars would make rows of
+            # nulls); its last row may lack a line end
+            end = len(block)
+            while end and block[end - 1] in _SPACE:
+                end -= 1
+            if not end:
+                return None
+            return block, block.count(b"\n", 0, end) + 1
 
         def parse(piece: bytes, rows: int, r0: int):
             try:
-                frame = pl.read_csv(piece, has_header=False, separator=" ", schema=schema, quote_char=None)
+                frame = pl.read_csv(piece, has_header=False, separator=" ", schema=schema, quote_char=None,
+                                    n_rows=rows)
                 if trailing:
                     if frame[names[-1]].null_count() != frame.height:
                         raise Unreadable("a value after the last channel")
@@ -128,7 +128,7 @@ def row_chunks(path: str | os.PathLike, offset: int, n_channels: int,
                 raise
             except Exception as exc:  # a polars error, or an API this polars lacks: the usual parse decides
                 raise Unreadable(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
-            if values.shape[0] != rows:  # a blank line within, a line polars read as two
+            if values.shape[0] != rows:  # a line polars read as two
                 raise Unreadable(f"{values.shape[0]} rows parsed of {rows} lines")
             return r0, values, None if then is None else then(r0, values)
 
