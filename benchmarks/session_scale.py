@@ -8,13 +8,14 @@ shared data, the project's synthetic takes), then runs, each in a fresh process,
 
     mocycle loop SESSION.bvh -o OUT/s.bvh --part all --root motion --json --workers N
 
-for every N of ``--workers`` (0: the cores this process may use), side by side on the same file, and prints per
-size and N: frames, loops written, CPU seconds (every process of the run), wall seconds, peak memory (the sum
-of the proportional set sizes of the command and its worker processes, sampled every 50 ms: pages they share
-counted once), and the largest resident set of any one of them, the stage times the
-command reports (reading and cutting into parts, then per-part fitting, metrics, feet, writing, summed over
-the parts), whether the files written are byte-identical to the one-worker run, and the growth exponents of
-CPU time and peak memory between the last two sizes (1 = linear).
+for every N of ``--workers`` (0: the cores this process may use), side by side on the same file, and prints per size
+and N: frames, the parts the JSON calls loopable, loops written, the loopable parts listed in ``not_looped`` with
+their reason and those neither looped nor listed ("lost": 0 is the goal), CPU seconds (every process of the run),
+wall seconds, peak memory (the sum of the proportional set sizes of the command and its worker processes, sampled
+every 50 ms: pages they share counted once), and the largest resident set of any one of them, the stage times the
+command reports (reading and cutting into parts, then per-part fitting, metrics, feet, writing, summed over the
+parts), whether the files written are byte-identical to the one-worker run, and the growth exponents of CPU time and
+peak memory between the last two sizes (1 = linear).
 """
 
 from __future__ import annotations
@@ -88,7 +89,13 @@ def run(session: Path, out: Path, workers: int) -> dict:
         text, err = so.read().decode(), se.read().decode(errors="replace")
     code = os.waitstatus_to_exitcode(status)
     doc = json.loads(text) if text.strip().startswith("{") else {}
-    return {"code": code, "wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "peak_mb": peak[0] / 2**20,
+    # every part the JSON calls loopable is looped or listed in not_looped with its reason
+    parts = doc.get("parts") or (doc.get("activities") or {}).get("parts") or []
+    loopable = {k for k, part in enumerate(parts) if part.get("loop")}
+    looped = {f.get("part") for f in doc.get("loops") or []}
+    listed = {d.get("part") for d in doc.get("not_looped") or []}
+    return {"loopable": len(loopable), "listed": len(loopable & listed), "lost": len(loopable - looped - listed),
+            "code": code, "wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "peak_mb": peak[0] / 2**20,
             "max_rss_mb": usage.ru_maxrss / 1024,
             "loops": len(doc.get("loops") or []), "timings": doc.get("timings_s") or {},
             "error": "" if code in (0, 3) else err.strip().splitlines()[-1:]}
@@ -134,11 +141,12 @@ def main(argv=None) -> int:
                 print(f"  {s.name} workers {w or 'all'}: exit {r['code']}, {r['loops']} loops, {r['cpu']:.1f} CPU s, "
                       f"{r['wall']:.1f} s, {r['peak_mb']:.0f} MB {r['error'] or ''}", file=sys.stderr, flush=True)
     print()
-    print(f"{'session':24} {'frames':>8} {'workers':>7} {'exit':>4} {'loops':>5} {'CPU s':>7} {'wall s':>7} "
-          f"{'peak MB':>8} {'max RSS':>8} {'same bytes':>10}  stages (s)")
+    print(f"{'session':24} {'frames':>8} {'workers':>7} {'exit':>4} {'loopable':>8} {'loops':>5} {'listed':>6} "
+          f"{'lost':>4} {'CPU s':>7} {'wall s':>7} {'peak MB':>8} {'max RSS':>8} {'same bytes':>10}  stages (s)")
     for s, w, r, same in rows:
         stages = ", ".join(f"{k} {v:.1f}" for k, v in r["timings"].items() if k != "total")
-        print(f"{s.name:24} {s.frames:8d} {w or 'all':>7} {r['code']:4d} {r['loops']:5d} {r['cpu']:7.1f} "
+        print(f"{s.name:24} {s.frames:8d} {w or 'all':>7} {r['code']:4d} {r['loopable']:8d} {r['loops']:5d} "
+              f"{r['listed']:6d} {r['lost']:4d} {r['cpu']:7.1f} "
               f"{r['wall']:7.1f} {r['peak_mb']:8.0f} {r['max_rss_mb']:8.0f} {same:>10}  {stages}")
     for w in counts:
         sized = [(s, r) for s, ww, r, _ in rows if ww == w]
