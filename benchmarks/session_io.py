@@ -290,13 +290,11 @@ def parsers(args, files: dict[str, Path]) -> None:
                 print(f"| {name} | {missing[name][:60]} | | | | |")
                 continue
             wall, cpu = [w for w, _ in runs[name]], [c for _, c in runs[name]]
-            if name == "read_bvh baseline":
-                same = digests.get(name) == want["motion"] or "its own"
-            else:
-                same = digests.get(name) == want["motion" if name in READERS else "array"]
+            same = digests.get(name) == want["motion" if name in READERS else "array"]
+            mark = "yes" if same else "its own" if name == "read_bvh baseline" else "NO"
             d = 4 if small else 3
             print(f"| {name} | {min(wall):.{d}f} | {statistics.median(wall):.{d}f} | {min(cpu):.{d}f} | "
-                  f"{statistics.median(cpu):.{d}f} | {same if isinstance(same, str) else 'yes' if same else 'NO'} |")
+                  f"{statistics.median(cpu):.{d}f} | {mark} |")
         medians = {name: statistics.median(w for w, _ in runs[name]) for name in names if runs[name]}
         # the goal: read_bvh (which parses and converts on every core it may use) within 1.3x the fastest
         # parser with any threads; the fastest one-thread parser for reference

@@ -90,7 +90,7 @@ def run(session: Path, out: Path, workers: int) -> dict:
     code = os.waitstatus_to_exitcode(status)
     doc = json.loads(text) if text.strip().startswith("{") else {}
     # every part the JSON calls loopable is looped or listed in not_looped with its reason
-    parts = doc.get("parts") or (doc.get("activities") or {}).get("parts") or []
+    parts = doc.get("parts") or []
     loopable = {k for k, part in enumerate(parts) if part.get("loop")}
     looped = {f.get("part") for f in doc.get("loops") or []}
     listed = {d.get("part") for d in doc.get("not_looped") or []}
