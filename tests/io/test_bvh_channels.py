@@ -112,6 +112,21 @@ def test_zeros_of_both_signs_before_a_late_change_need_the_take_whole():
     _assert_same(_arrays(skel, values, [100, 200]), _arrays(skel, values, []))
 
 
+def test_a_first_row_of_negative_zero_needs_every_later_zero_negative():
+    """The same with the signs the other way round: the first row holds -0.0, an early chunk also +0.0."""
+    skel, values = _spun_channels()
+    _standing_root(values, -0.0)
+    values[250:, 0] = np.linspace(1.0, 3.0, len(values) - 250)
+    # every zero before the change negative, as the first row's: chunks are fine
+    _assert_same(_arrays(skel, values, [100, 200]), _arrays(skel, values, []))
+    values[120:130, 0] = 0.0
+    conv = ChannelConverter(skel, len(values))
+    assert conv.add(values[:100]) and conv.add(values[100:200])
+    assert not conv.add(values[200:])
+    quats, static, tracks = _arrays(skel, values, [])
+    assert tracks[0][:, 0].tobytes() == values[:, 0].tobytes()
+
+
 def test_constant_zeros_of_both_signs_stay_one_constant_as_before():
     skel, values = _spun_channels()
     _standing_root(values)

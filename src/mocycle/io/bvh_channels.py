@@ -79,6 +79,7 @@ class ChannelConverter:
         # a joint whose position values have so far all equalled the first row's bit for bit (its track, made
         # when a value first changes, starts as that row); False once a zero of the other sign came
         self.exact = {j: True for j, _, _ in self.positions}
+        self.position_columns = np.array(sorted(c for _, cols, _ in self.positions for c in cols), dtype=np.intp)
         self.groups = []
         for order, items in by_order.items():
             joints = [j for j, _ in items]
@@ -108,14 +109,27 @@ class ChannelConverter:
         takes them in order."""
         n = values.shape[0]
         if n == 0:
-            return _Converted(None, None, [])
+            return _Converted(None, None, [], {})
         if r0 < 0 or r0 + n > self.n_frames or values.shape[1] != self.skel.n_channels:
             return None
         lo, hi = values.min(axis=0), values.max(axis=0)  # NaN propagates
         top = max(float(hi.max()), -float(lo.min())) if lo.size else 0.0
         if not (np.isfinite(lo).all() and np.isfinite(hi).all() and top <= MAX_MAGNITUDE):
             return None
-        return _Converted(lo, hi, self._rotations(values, r0))
+        return _Converted(lo, hi, self._rotations(values, r0), self._zero_signs(values, lo, hi))
+
+    def _zero_signs(self, values: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> dict[int, tuple[bool, bool]]:
+        """Per position column whose rows are all zeros (of either sign): whether any of them, and whether all,
+        are -0.0 (one gather of those columns, done in the converting thread)."""
+        cols = self.position_columns
+        if not cols.size:
+            return {}
+        zero = cols[(lo[cols] == 0.0) & (hi[cols] == 0.0)]
+        if not zero.size:
+            return {}
+        negative = np.signbit(values[:, zero])
+        flags = zip(negative.any(axis=0).tolist(), negative.all(axis=0).tolist(), strict=True)
+        return dict(zip(zero.tolist(), flags, strict=True))
 
     def commit(self, r0: int, values: np.ndarray, converted: _Converted) -> bool:
         """Take converted rows ``r0:r0 + n`` after the rows before them: their signs made continuous with
@@ -132,7 +146,7 @@ class ChannelConverter:
             for j, pos_cols, pos_axes in self.positions:  # the channel values replace the offset
                 self.static[j, pos_axes] = self.first[pos_cols]
         assert converted.lo is not None and converted.hi is not None  # rows were converted
-        if not self._positions(values, converted.lo, converted.hi, r0):
+        if not self._positions(values, converted, r0):
             return False
         for g, (_, joints, _, _) in enumerate(self.groups):
             first, (last, parity) = converted.seams[g]
@@ -149,21 +163,24 @@ class ChannelConverter:
         self.rows = r0 + n
         return True
 
-    def _positions(self, values: np.ndarray, lo: np.ndarray, hi: np.ndarray, r0: int) -> bool:
+    def _positions(self, values: np.ndarray, converted: _Converted, r0: int) -> bool:
         """The tracks of the joints whose position values change (a joint whose values never change, by
         ``==``, keeps its first row as its constant translation)."""
         first = self.first
-        assert first is not None  # add() set it
+        assert first is not None and converted.lo is not None and converted.hi is not None  # add() set them
         n = values.shape[0]
+        unchanged = ((converted.lo == first) & (converted.hi == first)).tolist()  # per column, as Python bools
+        first_values = first.tolist()
         for j, pos_cols, pos_axes in self.positions:
             track = self.tracks.get(j)
             if track is None:
-                same = (lo[pos_cols] == first[pos_cols]).all() and (hi[pos_cols] == first[pos_cols]).all()
-                if same:
+                if all(unchanged[c] for c in pos_cols):
                     if self.exact[j]:
-                        zeros = [c for c in pos_cols if first[c] == 0.0]
-                        if zeros and (np.signbit(values[:, zeros]) != np.signbit(first[zeros])).any():
-                            self.exact[j] = False
+                        for c in pos_cols:
+                            if first_values[c] == 0.0:  # +0.0 and -0.0 alike: exact when all have the first's sign
+                                any_negative, all_negative = converted.zero_signs[c]
+                                if (not all_negative) if np.signbit(first[c]) else any_negative:
+                                    self.exact[j] = False
                     continue
                 if not self.exact[j] and r0 > 0:
                     return False
@@ -217,11 +234,13 @@ class ChannelConverter:
 
 class _Converted(NamedTuple):
     """What :meth:`ChannelConverter.convert` found of a chunk: per-column minima and maxima, and per group of
-    joints the first frame's quaternion components and the carry of :func:`_flip_signs`."""
+    joints the first frame's quaternion components and the carry of :func:`_flip_signs`, and per position
+    column of only zeros whether any and whether all of them are -0.0."""
 
     lo: np.ndarray | None
     hi: np.ndarray | None
     seams: list
+    zero_signs: dict[int, tuple[bool, bool]]
 
 
 def _norms(comp: list[np.ndarray]) -> np.ndarray:

