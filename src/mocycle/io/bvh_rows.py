@@ -6,8 +6,12 @@ Text numbers are most of a BVH read. ``np.loadtxt`` parses about 45 MB/s; polars
 line ends into pieces of :data:`CHUNK_BYTES`, counts their lines (so each piece knows the row it starts at; a piece
 is the bytes as read, with no copy: polars is told how many lines to take and the file is sought back to the start
 of the line the piece cut), and parses them and runs the caller's conversion on them in :func:`helpers` threads at
-once (polars and numpy release the GIL); the caller takes them in order. Parse and conversion so share the cores: a
-long read takes about 1.2 times polars' parse alone on its own threads (22 joints; 1.4 times for CMU's 31).
+once (polars and numpy release the GIL); the caller takes them in order. Polars parses on its own pool, which the
+command line sizes to one thread (``POLARS_MAX_THREADS=1``): the pieces' parses then run one after another on that
+thread and the conversions beside them on the other core, so a long read takes about as long as the parses alone
+(32 pieces of 44 ms for the 22-joint hour: 1.3 times polars' parse of the whole text on two threads; 1.7 times for
+CMU's 31 joints, whose conversion costs more than its parse). Polars' pool is global; letting it run two threads
+here measured no faster (its threads and the conversions then share the two cores).
 
 Only plain rows are taken: numbers separated by single spaces (a space at the end of every line allowed),
 ``\\n`` or ``\\r\\n`` line ends.  Anything else — tabs, runs of spaces, a value missing or extra, text polars
