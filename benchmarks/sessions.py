@@ -8,9 +8,10 @@ ended, 10-frame cross-fade; the take's label is the truth of its stretch):
 * from the project's generated motions: walks, walk-turn-walks, runs, waves, a dance step on the spot (legs
   moving without landings), one-off gestures and a raised hand, at 30 and 60 fps;
 * from ``../shared/data`` (when present): the Bandai "youthful" session of the sessions issue (walk, turn
-  right, run, wave, raise a hand, turn left, raise both hands, walk) at 30 fps and at 120 fps, and sessions of
-  ``--minutes`` minutes drawn (seeded) from every Bandai take of that rig (walks, runs, dashes, walk-turn-walks,
-  waves, raised hands), resampled to ``--fps``;
+  right, run, wave, raise a hand, turn left, raise both hands, walk) and the same takes in the issue's own order
+  (walk, turn, run, wave, gesture, turn, walk: a turn take that walks out into a walk) at 30 fps and at 120 fps,
+  and sessions of ``--minutes`` minutes drawn (seeded) from every Bandai take of that rig (walks, runs, dashes,
+  walk-turn-walks, waves, raised hands), resampled to ``--fps``;
 * from ``../shared/data/cmu-iclone`` (when present): CMU takes retargeted to the iClone rig at 60 fps (other
   performers, another skeleton, floors that drift within a take), one session per rig the takes come on
   (``CC_Base_Hip``: walks of three subjects, two dance phrases, a run of punches, a jump; ``RL_BoneRoot``: three
@@ -111,6 +112,9 @@ BANDAI_SESSION = [("walk", "dataset-2_walk_youthful_025"), ("turn", "dataset-2_w
                   ("raise", "dataset-2_raise-up-right-hand_youthful_023"),
                   ("turn", "dataset-2_walk-turn-left_youthful_001"),
                   ("raise", "dataset-2_raise-up-both-hands_youthful_001"), ("walk", "dataset-2_walk_youthful_025")]
+#: ... and in the issue's own order (walk, turn, run, wave, gesture, turn, walk): the last turn take walks out of its
+#: turn into a walk of the same tempo
+BANDAI_ISSUE_ORDER = [item for item in BANDAI_SESSION if item[1] != "dataset-2_raise-up-both-hands_youthful_001"]
 
 
 def _label(name: str) -> str:
@@ -125,10 +129,12 @@ def real_sessions(folder: Path, data: Path, minutes: list[float], fps: float, qu
     files = {p.stem: p for sub in ("bandai", "bandai2") for p in sorted((data / sub).glob("*.bvh"))}
     if not files:
         return []
-    takes = [(label, mocycle.read(files[name])) for label, name in BANDAI_SESSION if name in files]
-    out = [_write(folder, "bandai_youthful_30fps", takes, None)]
-    if not quick:
-        out.append(_write(folder, f"bandai_youthful_{fps:g}fps", takes, fps))
+    out = []
+    for stem, order in (("bandai_youthful", BANDAI_SESSION), ("bandai_issue_order", BANDAI_ISSUE_ORDER)):
+        takes = [(label, mocycle.read(files[name])) for label, name in order if name in files]
+        out.append(_write(folder, f"{stem}_30fps", takes, None))
+        if not quick:
+            out.append(_write(folder, f"{stem}_{fps:g}fps", takes, fps))
     pool = [(_label(n), p) for n, p in files.items() if mocycle.read(p).n_frames > 3 * CROSSFADE]
     cache: dict[Path, object] = {}
     rng = random.Random(35)

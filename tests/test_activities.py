@@ -716,3 +716,54 @@ def test_a_sliver_between_parts_is_merged_into_a_neighbour_that_does_not_loop():
     out = _without_slivers(first, fps=30.0)
     assert [(p.kind, p.start, p.stop, p.reason) for p in out] == [("gesture", 0, 40, "once"),
                                                                    ("run straight", 40, 90, "")]
+
+
+def _strides(periods, turns, speed=120.0):
+    """Stride figures (:func:`mocycle.activities._stride_figures`' columns) of a walk: ``periods`` and ``turns``
+    per stride, a steady speed, double support 0.4."""
+    return np.array([(p, t, speed, 0.0, 0.4) for p, t in zip(periods, turns, strict=True)], dtype=np.float64)
+
+
+def test_a_join_next_to_a_turn_is_cut_where_its_blended_strides_end():
+    """One take walks out of a turn and the next, a walk of the same tempo, starts a stride and a half later:
+    the change test needs two straight strides before the join and has one, so the strides next to the turn are
+    held against the steady ones beyond them; the part after starts where the last blended stride ends (the
+    youthful session in the issue's order: turn, then walk, looped as one walk across the join before)."""
+    from mocycle.activities import _joins_at_turns
+
+    turns = [0, 0, 20, 65, 70, 22, 1, 6, 5, 0, 0, 0, 0, 0]
+    periods = [32, 34, 34, 34, 31, 31, 31, 35, 35, 31, 31, 32, 32, 31]  # strides 7-8 blend the join
+    assert _joins_at_turns(_strides(periods, turns), None) == {9}  # landings 9 on: the walk take's
+    steady = [32, 34, 34, 34, 31, 31, 31, 31, 32, 31, 31, 32, 32, 31]
+    assert _joins_at_turns(_strides(steady, turns), None) == set()  # one take walking on: no cut
+    one = [32, 34, 34, 34, 31, 31, 31, 35, 32, 31, 31, 32, 32, 31]  # one stride off: the part after starts at its end
+    assert _joins_at_turns(_strides(one, turns), None) == {8}
+    # the mirror: a walk joined to a take that walks into a turn; the part before ends where the blend starts
+    back = list(reversed(periods))
+    assert _joins_at_turns(_strides(back, list(reversed(turns))), None) == {len(periods) - 9}
+    # a cut already made among the strides held against, or too few straight strides beyond: not looked at
+    assert _joins_at_turns(_strides(periods, turns), None, cuts={11}) == set()
+    assert _joins_at_turns(_strides(periods[:11], turns[:11]), None) == set()
+
+
+def test_the_issues_session_order_gives_no_loop_across_the_last_turns_join(shared_data):
+    """The sessions issue's order (walk, turn, run, wave, gesture, turn, walk) from one performer's Bandai takes at
+    30 fps: the last turn take walks out of its turn for a stride and a half and the walk after it keeps the tempo;
+    no looped part reaches more than half a stride across a join into another take."""
+    from mocycle.datasets import join_takes
+
+    names = ["walk_youthful_025", "walk-turn-right_youthful_027", "run_youthful_019", "wave-both-hands_youthful_026",
+             "raise-up-right-hand_youthful_023", "walk-turn-left_youthful_001", "walk_youthful_025"]
+    paths = [shared_data / "bandai2" / f"dataset-2_{n}.bvh" for n in names]
+    if not all(p.is_file() for p in paths):
+        pytest.skip("the Bandai youthful takes are absent from ../shared/data/bandai2")
+    labels = ["walk", "turn", "run", "wave", "gesture", "turn", "walk"]
+    session = join_takes([read(p) for p in paths], labels)
+    acts = segment_activities(session.motion)
+    loops = [p for p in acts.parts if p.loop]
+    assert len(loops) >= 7
+    for p in loops:
+        inside = [min(p.stop, b) - max(p.start, a) for _, a, b in session.stretches]
+        assert sorted(inside)[-2] <= p.period_frames / 2, (p.kind, p.start, p.stop, session.stretches)
+    last_walk = session.stretches[-1]
+    assert any(p.start >= last_walk[1] - 16 and p.kind == "walk straight" for p in loops)

@@ -634,6 +634,44 @@ def _steady_ends(strides: np.ndarray, poses: np.ndarray | None, cuts: Collection
     return lo, hi
 
 
+def _joins_at_turns(strides: np.ndarray, poses: np.ndarray | None, cuts: Collection[int] = ()) -> set[int]:
+    """Landings (chain indices, as :func:`_gait_changes`') where one take meets the next within
+    :data:`EDGE_STEPS` + 1 strides of a turn: a take that ends walking out of a turn, joined to a walk of the same
+    tempo and posture (one performer's session), or a walk joined to a take that walks into a turn.  The change
+    test needs two straight strides on either side of a join, and a turn's strides are none; so the strides
+    next to the turn are held against the three straight strides beyond them (:func:`_edge_change`), and where
+    one or two differ by more than :data:`GAIT_CHANGE` (the blend of the join: a stride longer or shorter than
+    either take's, another speed, another posture), the straight part beyond them starts where the last of them
+    ends (after a turn), or the one before them ends where the first begins (before a turn).  Strides that turn
+    (:data:`TURN_DEG`) and strides across a cut already made are never held against."""
+    n = strides.shape[0]
+    turning = np.abs(strides[:, 1]) > TURN_DEG
+    width = EDGE_STEPS + 1
+    out: set[int] = set()
+
+    def steady(strides_in: range) -> bool:  # straight strides that no cut crosses
+        a, b = strides_in.start, strides_in.stop
+        return a >= 0 and b <= n and not turning[a:b].any() and not any(a - 1 <= c < b for c in cuts)
+
+    def differs(k: int, ref: range) -> bool:
+        return _edge_change(strides, poses, k, slice(ref.start, ref.stop)) > GAIT_CHANGE
+
+    for s in range(1, n):
+        if turning[s - 1] and not turning[s]:  # straight strides s .. after a turn
+            window, ref = range(s, s + width), range(s + width, s + width + 3)
+            if steady(range(s, ref.stop)):
+                ends = [k for k in window if differs(k, ref)]
+                if ends:
+                    out.add(ends[-1] + 1)  # the part after starts at landing ends[-1] + 2
+        if not turning[s - 1] and turning[s]:  # straight strides .. s - 1 before a turn
+            window, ref = range(s - width, s), range(s - width - 3, s - width)
+            if steady(range(ref.start, s)):
+                starts = [k for k in window if differs(k, ref)]
+                if starts:
+                    out.add(starts[0])  # the part before ends at landing starts[0]
+    return out
+
+
 def stride_rate(heading: np.ndarray, period: float, start: int, stop: int) -> np.ndarray:
     """The hips' turning rate ``(stop - start,)`` in degrees per stride: the heading's change over one stride
     (``period`` frames) about each frame, where the hips' sway within a stride cancels; near the take's ends the
@@ -778,6 +816,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
         strides = _stride_figures(chain, landings, heading, path, fps)
         poses = _stride_poses(motion, landings.frames[chain])
         cuts = _gait_changes(strides, poses)
+        cuts |= _joins_at_turns(strides, poses, cuts)
         kinds = _step_gaits(strides, body)
         walk_run = {j for j in range(1, len(kinds)) if kinds[j][0] != kinds[j - 1][0]}
         lo, hi = _steady_ends(strides, poses, cuts | walk_run)
