@@ -132,8 +132,8 @@ def real_sessions(folder: Path, data: Path, minutes: list[float], fps: float, qu
     out = []
     for stem, order in (("bandai_youthful", BANDAI_SESSION), ("bandai_issue_order", BANDAI_ISSUE_ORDER)):
         takes = [(label, mocycle.read(files[name])) for label, name in order if name in files]
-        out.append(_write(folder, f"{stem}_30fps", takes, None))
-        if not quick:
+        out.append(_write(folder, f"{stem}_30fps", takes, None))  # the takes' own rate
+        if not quick and fps != 30:
             out.append(_write(folder, f"{stem}_{fps:g}fps", takes, fps))
     pool = [(_label(n), p) for n, p in files.items() if mocycle.read(p).n_frames > 3 * CROSSFADE]
     cache: dict[Path, object] = {}
