@@ -767,3 +767,67 @@ def test_the_issues_session_order_gives_no_loop_across_the_last_turns_join(share
         assert sorted(inside)[-2] <= p.period_frames / 2, (p.kind, p.start, p.stop, session.stretches)
     last_walk = session.stretches[-1]
     assert any(p.start >= last_walk[1] - 16 and p.kind == "walk straight" for p in loops)
+
+
+def _chain_figures(motion):
+    """The one gait chain of ``motion``: its landing frames and stride figures."""
+    from mocycle.activities import (
+        _gait_chains,
+        _horizontal_path,
+        _stride_figures,
+        find_landings,
+        heading_degrees,
+    )
+
+    landings = find_landings(motion)
+    chains = _gait_chains(landings, motion.fps, least=2)
+    assert len(chains) == 1
+    frames = landings.frames[chains[0]]
+    return frames, _stride_figures(chains[0], landings, heading_degrees(motion), _horizontal_path(motion),
+                                   motion.fps)
+
+
+def test_a_join_of_one_gait_at_another_phase_is_a_phase_break():
+    """Two takes of one walk joined at another phase keep the landings' rhythm but not the legs' repeat across
+    the join: the break lies in the step that holds the join; joined at the same phase (or one take) there is
+    none."""
+    from mocycle.activities import _phase_breaks
+    from mocycle.datasets import join_takes
+
+    walk = synthetic_walk(n_frames=400, fps=30, period_s=1.0, noise_deg=1.0, seed=1).motion
+    for offset, broken in ((0, False), (22, True)):
+        session = join_takes([walk[60:340], walk[60 + offset:340]], ["walk", "walk"])
+        frames, strides = _chain_figures(session.motion)
+        join = session.stretches[0][2]
+        breaks = _phase_breaks(session.motion, frames, strides)
+        if broken:
+            assert len(breaks) == 1
+            c = breaks.pop()
+            assert frames[c] <= join < frames[c + 1], (frames.tolist(), c, join)
+        else:
+            assert breaks == set()
+    frames, strides = _chain_figures(walk[60:340])
+    assert _phase_breaks(walk[60:340], frames, strides) == set()
+    # a cut already made near the join: not looked at again
+    session = join_takes([walk[60:340], walk[82:340]], ["walk", "walk"])
+    frames, strides = _chain_figures(session.motion)
+    c = int(np.searchsorted(frames, session.stretches[0][2])) - 1
+    assert _phase_breaks(session.motion, frames, strides, cuts={c + 1}) == set()
+
+
+def test_two_takes_of_one_walk_joined_at_another_phase_loop_apart(shared_data):
+    """A Bandai walk joined to itself 15 frames on (one performer, one tempo and posture, another phase: the
+    strides show no change, the legs' repeat breaks at the join): no looped part reaches more than half a stride
+    across the join (one loop across both before)."""
+    from mocycle.datasets import join_takes
+
+    path = shared_data / "bandai" / "dataset-1_walk_tired_001.bvh"
+    if not path.is_file():
+        pytest.skip("dataset-1_walk_tired_001.bvh is absent from ../shared/data/bandai")
+    take = read(path)
+    session = join_takes([take, take[15:]], ["walk", "walk"])
+    loops = [p for p in segment_activities(session.motion).parts if p.loop]
+    assert len(loops) >= 2
+    for p in loops:
+        inside = [min(p.stop, b) - max(p.start, a) for _, a, b in session.stretches]
+        assert sorted(inside)[-2] <= p.period_frames / 2, (p.kind, p.start, p.stop, session.stretches)

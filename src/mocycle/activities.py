@@ -672,6 +672,61 @@ def _joins_at_turns(strides: np.ndarray, poses: np.ndarray | None, cuts: Collect
     return out
 
 
+#: A join of two takes of one gait at one tempo and posture shows in no stride figure: the cross-fade keeps the
+#: landings' rhythm.  What it breaks is the legs' repeat: before it the legs are like themselves a stride later,
+#: after it too, but a stride's frames before it are unlike the stride after it when the second take starts at
+#: another phase.  A landing is such a break where the legs' unlikeness over the stride straddling it (each frame
+#: against the frame a stride later, :func:`_unlike`'s measure) is at least BREAK_UNLIKE and STEADY_SIDES times
+#: that over the stride before it and the stride after it (a join near one phase is as seamless as the take: no
+#: break, nothing a loop across it would spoil).
+BREAK_UNLIKE = 0.2
+
+
+def _phase_breaks(motion: Motion, frames: np.ndarray, strides: np.ndarray, cuts: Collection[int] = ()) -> set[int]:
+    """Landings (chain indices, as :func:`_gait_changes`') where the legs stop repeating across one stride and
+    repeat again on either side (:data:`BREAK_UNLIKE`): where one take of a gait meets another of the same
+    tempo and posture at another phase.  ``frames``: the chain's landing frames; ``strides``: its figures
+    (:func:`_stride_figures`).  Each break lies between landings ``c`` and ``c + 1`` (the step dropped by a cut at
+    ``c``); only straight strides are looked at, two strides on either side, none across a cut already made."""
+    n = strides.shape[0]
+    if n < 5:
+        return set()
+    P = int(round(float(np.median(strides[:, 0]))))
+    a, b = int(frames[0]), int(frames[-1]) + 1
+    X = _leg_features(motion, a, b)
+    if X is None or P < 2 or X.shape[0] < 4 * P + 1:
+        return set()
+    var = float(X.var(axis=0).sum())
+    if not var > 0:
+        return set()
+    step = ((X[P:] - X[:-P]) ** 2).sum(axis=1) / (2.0 * var)  # frame s against s + P, s = a .. b-1-P
+    sums = np.concatenate([[0.0], np.cumsum(step)])
+    t = np.arange(2 * P, X.shape[0] - 2 * P + 1)  # a break at frame a + t: strides [t-2P, t-P), [t-P, t), [t, t+P)
+    if not t.size:
+        return set()
+    before, across, after = ((sums[t + k * P] - sums[t + (k - 1) * P]) / P for k in (-1, 0, 1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        score = np.where(across >= BREAK_UNLIKE, across / np.maximum(before, after), 0.0)
+    turning = np.abs(strides[:, 1]) > TURN_DEG
+    blocked = [c for c in cuts]
+    out: set[int] = set()
+    for k in np.argsort(-score, kind="stable"):
+        if score[k] < STEADY_SIDES:
+            break
+        frame = a + int(t[k])
+        c = int(np.searchsorted(frames, frame, side="right")) - 1  # landing c <= frame < landing c + 1
+        if c < 1 or c + 2 > n:
+            continue
+        # the strides whose frames the windows hold: stride i runs from landing i to i + 2
+        lo = int(np.searchsorted(frames, frame - 2 * P, side="right")) - 1
+        hi = int(np.searchsorted(frames, frame + 2 * P, side="left"))
+        if turning[max(lo, 0):min(hi, n)].any() or any(lo - 1 <= x <= hi for x in blocked):
+            continue
+        out.add(c)
+        blocked.append(c)
+    return out
+
+
 def stride_rate(heading: np.ndarray, period: float, start: int, stop: int) -> np.ndarray:
     """The hips' turning rate ``(stop - start,)`` in degrees per stride: the heading's change over one stride
     (``period`` frames) about each frame, where the hips' sway within a stride cancels; near the take's ends the
@@ -817,6 +872,7 @@ def segment_activities(motion: Motion, *, min_periods: float = MIN_PERIODS, join
         poses = _stride_poses(motion, landings.frames[chain])
         cuts = _gait_changes(strides, poses)
         cuts |= _joins_at_turns(strides, poses, cuts)
+        cuts |= _phase_breaks(motion, landings.frames[chain], strides, cuts)
         kinds = _step_gaits(strides, body)
         walk_run = {j for j in range(1, len(kinds)) if kinds[j][0] != kinds[j - 1][0]}
         lo, hi = _steady_ends(strides, poses, cuts | walk_run)
