@@ -720,7 +720,7 @@ def _phase_breaks(motion: Motion, frames: np.ndarray, strides: np.ndarray, cuts:
         # the strides whose frames the windows hold: stride i runs from landing i to i + 2
         lo = int(np.searchsorted(frames, frame - 2 * P, side="right")) - 1
         hi = int(np.searchsorted(frames, frame + 2 * P, side="left"))
-        if turning[max(lo, 0):min(hi, n)].any() or any(lo - 1 <= x <= hi for x in blocked):
+        if turning[max(lo, 0):min(hi, n)].any() or any(abs(x - c) <= 1 for x in blocked):
             continue
         out.add(c)
         blocked.append(c)
