@@ -10,10 +10,13 @@
    its mean position, or at one of its positions during the contact when that
    needs less lowering of the root.  The toe of a foot whose ankle and toe are
    both held is held at the ankle's point plus the foot vector in the middle
-   of their overlap, so a rigid foot meets both holds exactly.  While only one
-   of the foot's joints is held, the other is carried with it rigidly (the
-   foot keeps its own roll), and where a held toe leaves the ankle beyond the
-   leg's reach the heel lifts (the foot turns about the toe).
+   of their overlap, so a rigid foot meets both holds exactly; a heel that comes
+   down again within the same toe contact is held where the rigid foot puts it
+   about the toe's hold (held at its own place it would pull the held toe away).
+   While only one of the foot's joints is held, the other is carried with it
+   rigidly (the foot keeps its own roll), and where a held (or low) toe leaves
+   the ankle beyond the leg's reach the heel lifts (the foot turns about the
+   toe).
 3. **Low frames around a contact.** Before and after each contact, while the
    joint is still within ``EXTEND_HEIGHT`` of the held height and within
    ``EXTEND_DISTANCE`` of the held point (at most ``EXTEND_SECONDS``), it is
@@ -38,7 +41,10 @@
    (smoothed over the blend window so it never jumps and is never less than
    needed); every foot keeps its goal in the world, so a swing foot does not
    dip with the root.  Goals not held are then brought within reach softly
-   (soft IK: raised, or pulled toward the hip, with an exponential ease).
+   (soft IK: raised, or pulled toward the hip, with an exponential ease); next
+   to a held frame they are brought within the reach as the held ones are and
+   eased to the soft reach over the blend, so a leg leaving a hold nearly
+   straight (a toe-off) is not bent by the soft zone in one frame.
 6. **Two-bone IK.** The knee bends about the normal of the hip-knee-ankle
    plane until the hip-ankle distance is right, then the thigh swings by the
    smallest rotation that puts the ankle on its goal (the knee stays in the
@@ -342,6 +348,7 @@ def _foot_goals(W: ChainArray, contacts: Contacts, f: int, n_extend: int, n_brid
                 offsets.append((t[mid] - a[mid]) - (t[only] - a[only]))
         fr, off = np.concatenate(frames), np.concatenate(offsets)
         held_a.append(_best_hold(a[s:e], off, hips[fr], R[fr], up, body))
+    _heels_about_toes(held_a, ra, rt, partner, a, t)
     corr_a, level_a = _own_holds(a, ma, held_a, up, low, near, n_extend)
     corr_t = None
     if foot.toe is not None:
@@ -360,6 +367,29 @@ def _foot_goals(W: ChainArray, contacts: Contacts, f: int, n_extend: int, n_brid
     corr_t = _bridge(corr_t, n_bridge, n_fade)
     corr_t += np.outer(_lift(t + corr_t, level_t, up, clear_t, body, contacts.frame_time), up)
     return a + corr_a, t + corr_t, level_a >= FOLLOW, changed | np.any(corr_t != 0, axis=1)
+
+
+def _heels_about_toes(held_a: list, ra: list, rt: list, partner: dict, a: np.ndarray, t: np.ndarray) -> None:
+    """Re-hold (in ``held_a``, in place) each ankle contact that lies within a toe contact whose rigid-foot hold
+    is made with another ankle contact (``partner``, :func:`_foot_goals`): a heel that lifts and comes down
+    again while the toe stays, or, in a loop's repeats, one long toe contact beside each repeat's heel
+    contact.  Held at its own place the heel would pull the held toe to where the foot puts it (a jump of
+    the toe as that heel contact starts, and back as it ends); it is held instead where the rigid foot puts
+    it about the toe's hold, in the middle of their overlap.  ``ra``, ``rt``: the ankle's and the toe's
+    contacts; ``a``, ``t``: their paths ``(T, 3)``."""
+    partners = {k for k, _ in partner.values()}
+    toe_of: dict[int, tuple[int, int]] = {}  # ankle contact -> (the toe contact it overlaps most, the overlap)
+    for i, (s, e) in enumerate(rt):
+        for k, (x, y) in enumerate(ra):
+            overlap = min(e, y) - max(s, x)
+            if overlap > 0 and overlap > toe_of.get(k, (-1, 0))[1]:
+                toe_of[k] = (i, overlap)
+    for k, (i, _) in toe_of.items():
+        if k in partners or i not in partner:
+            continue
+        k0, mid0 = partner[i]
+        mid = (max(rt[i][0], ra[k][0]) + min(rt[i][1], ra[k][1]) - 1) // 2
+        held_a[k] = held_a[k0] + (t[mid0] - a[mid0]) + (a[mid] - t[mid])
 
 
 def _lift(path: np.ndarray, level: np.ndarray, up: np.ndarray, clear: float, body: float,
@@ -453,7 +483,7 @@ def _toe_holds(ankle: _Contact, toe: _Contact, partner: dict, h: _Holding) -> No
     _follow(corr_t, level_t, corr_a, level_a)
     # a held toe with the ankle out of the leg's reach: the heel lifts (the foot turns about the toe) until
     # the ankle is back within reach, rather than the root going down
-    on_toe = level_a == FOLLOW
+    on_toe = (level_a == FOLLOW) | (level_a == FOLLOW_LOW)
     if on_toe.any():
         length = _norms(t[on_toe] - a[on_toe])
         goal_t = t[on_toe] + corr_t[on_toe]
@@ -734,7 +764,13 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         free = ~h
         base, hips = W[free, foot.ankle], W[free, foot.hip]
         R, zone = _reach(W, foot, reach)[free], SOFT_ZONE * _leg_length(W, foot)[free]
-        g[free] = base + _soft_reach(base, g[free] - base, hips, R, zone, contacts.up)
+        soft = _soft_reach(base, g[free] - base, hips, R, zone, contacts.up)
+        # next to a held frame (whose goal is within the reach, the root lowered or the heel lifted for it) the
+        # goal is held within the reach as there and eased to the soft one over the blend: a leg leaving a
+        # hold near straight (a toe-off) is not bent by the soft zone in one frame
+        hard = _soft_reach(base, g[free] - base, hips, R, 1e-6 * zone, contacts.up)
+        ease = _smoothstep(_frames_from(h)[free] / (n_blend + 1))[:, None]
+        g[free] = base + hard + ease * (soft - hard)
     window = np.zeros(motion.n_frames, bool)
     window[frames if frames is not None else slice(None)] = True
     solved = [np.flatnonzero((ch | lowered) & window) for ch in changed]  # the frames each leg's IK changes
