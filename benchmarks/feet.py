@@ -1,6 +1,6 @@
 """Feet that stay planted: foot locking on the loops of every walk and run in ../shared/data.
 
-    python benchmarks/feet.py [--quick] [--data DIR] [--bend DEG]
+    python benchmarks/feet.py [--quick] [--data DIR] [--bend DEG] [--fps FPS]
 
 Per take: a harmonic M1 cycle with its root motion (``extract_cycle`` as
 ``mocycle loop`` runs it), then :func:`mocycle.cycle.lock_cycle`.  Printed,
@@ -11,6 +11,9 @@ input vs output:
   cleaned cycle repeated twice; the cleaned over the input's;
 * the largest frame-to-frame change of any leg joint's local rotation (rad)
   before and after clean-up (a knee pop shows here);
+* foot jumps: frames of the loop (played round) where an ankle or toe jumps
+  vertically in one frame (:func:`mocycle.contacts.foot_jumps`), fitted and
+  cleaned (a held toe let go by its heel shows here, not in the leg step);
 * bone lengths: the largest change of any joint-to-parent distance (joints
   whose translation is constant), in file units;
 * the planted feet: the largest movement of a contact joint during its
@@ -45,7 +48,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mocycle.contacts import detect_contacts, largest_leg_step, lock_feet, ranges
+from mocycle.contacts import detect_contacts, foot_jumps, largest_leg_step, lock_feet, ranges
 from mocycle.contacts import skate as skate_measure
 from mocycle.contacts.skate import leg_joints
 from mocycle.cycle import extract_cycle, lock_cycle
@@ -241,6 +244,9 @@ def main() -> None:
     ap.add_argument("--bend", type=float, default=0.0,
                     help="loops of turning walks: each take's path bent onto a circle, DEG degrees of turn per body "
                          "height of travel (the body turned with it), before its loop is made")
+    ap.add_argument("--fps", type=float, default=None,
+                    help="loops of the takes resampled to this rate first (a capture day's 120 fps: a foot's jump "
+                         "of a frame is a jump there)")
     ap.add_argument("--data", type=Path, default=Path(__file__).resolve().parents[1].parent / "shared" / "data")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
@@ -262,10 +268,13 @@ def main() -> None:
 def loops(args) -> None:
     rows = []
     print(f"{'take':34s} {'skate in':>8s} {'fitted':>7s} {'locked':>7s} {'lock/in':>7s} {'step before':>11s} "
-          f"{'after':>6s} {'bones':>8s} {'planted':>8s} {'held':>8s} {'turn':>5s} {'seam':>5s} {'fit':>5s} "
+          f"{'after':>6s} {'jumps':>5s} {'bones':>8s} {'planted':>8s} {'held':>8s} {'turn':>5s} {'seam':>5s} "
+          f"{'fit':>5s} "
           f"{'loop s':>7s} {'lock s':>7s}")
     for path in takes(args.data, args.quick):
         motion = read(path)
+        if args.fps:
+            motion = motion.resample(args.fps)
         if args.bend:
             motion = bend(motion, args.bend)
         t0 = time.perf_counter()
@@ -284,11 +293,14 @@ def loops(args) -> None:
         ext = cycle.repeat(3, root="motion")
         con = detect_contacts(ext)
         locked = lock_feet(ext, con, **LOCK)  # bones and held feet checked on the whole repeated take
-        job = loop_task.run(motion if args.bend else path, loop_task.Options(root="motion"))   # `mocycle loop`
+        job = loop_task.run(motion if args.bend or args.fps else path,  # what `mocycle loop` runs
+                            loop_task.Options(root="motion"))
         row = dict(take=path.name, s_in=s_in, s_fit=s_fit, s_out=s_out, ratio=s_out / s_in,
                    t_job=job.timings_s["total"], t_job_feet=job.timings_s.get("feet", 0.0),
                    fast=fast_share(motion[frames[0]:frames[-1] + 1]),
                    step_before=largest_leg_step(before), step_after=largest_leg_step(after),
+                   jumps_fit=len(foot_jumps(cycle.repeat(1, root="motion"), contacts.feet, wrap=True)),
+                   jumps=len(foot_jumps(cleaned.repeat(1, root="motion"), contacts.feet, wrap=True)),
                    bones=bone_error(ext, locked), planted=planted(locked, con),
                    held=held_across_seams(cleaned, contacts),
                    turn=float(np.degrees(cycle.drift[3])), seam=seam_ratio(cleaned, contacts.feet),
@@ -296,7 +308,8 @@ def loops(args) -> None:
                    t_loop=t1 - t0, t_lock=t2 - t1)
         rows.append(row)
         print(f"{path.name:34s} {s_in:8.2f} {s_fit:7.2f} {s_out:7.2f} {row['ratio']:7.2f} "
-              f"{row['step_before']:11.3f} {row['step_after']:6.3f} {row['bones']:8.1e} {row['planted']:8.1e} "
+              f"{row['step_before']:11.3f} {row['step_after']:6.3f} {row['jumps']:5d} {row['bones']:8.1e} "
+              f"{row['planted']:8.1e} "
               f"{row['held']:8.1e} {row['turn']:5.1f} {row['seam']:5.2f} {row['seam_fit']:5.2f} {row['t_loop']:7.2f} "
               f"{row['t_lock']:7.3f}")
     if not rows:
@@ -315,6 +328,9 @@ def loops(args) -> None:
           f"landing at speed; not a planted foot): median {statistics.median(r['fast'] for r in rows):.0%}")
     print(f"takes whose locked loop skates more than the input: {len(worse)} (goal 0) {' '.join(worse[:12])}")
     print(f"takes with a leg step > 1.5x before: {len(pops)} (goal 0) {' '.join(pops[:12])}")
+    jumped = [r["take"] for r in rows if r["jumps"]]
+    print(f"foot jumps of one frame: fitted loops {sum(r['jumps_fit'] for r in rows)}, cleaned "
+          f"{sum(r['jumps'] for r in rows)} in {len(jumped)} loops {' '.join(jumped[:12])}")
     print(f"largest bone-length change: {max(r['bones'] for r in rows):.1e} (goal 1e-9); largest contact-joint "
           f"movement during a contact: {max(r['planted'] for r in rows):.1e}; in the loop repeated 3 times, seams "
           f"included: {max(r['held'] for r in rows):.1e} (largest turn per cycle "

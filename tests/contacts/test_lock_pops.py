@@ -3,28 +3,10 @@
 import numpy as np
 import pytest
 
-from mocycle.axes import vertical_axis
-from mocycle.contacts import body_height, find_feet
+from mocycle.contacts import foot_jumps
 from mocycle.contacts.lock import _heels_about_toes
 from mocycle.cycle import extract_cycle, lock_cycle
 from mocycle.io import read
-
-
-def _foot_pops(motion) -> list[int]:
-    """Frames (of a loop, its seam included) where an ankle or toe moves vertically by more than 0.2 % of the
-    body height and four times as much as in any of the two frames on either side: a jump of one frame."""
-    feet = find_feet(motion.skeleton)
-    up = vertical_axis(motion)
-    joints = sorted({j for f in feet for j in (f.ankle, f.toe) if j is not None})
-    h = motion.world_positions()[:, joints] @ up
-    wrapped = np.concatenate([h[-2:], h, h[:3]])
-    d = np.abs(np.diff(wrapped, axis=0)) / body_height(motion, up)
-    out = []
-    for i in range(2, 2 + h.shape[0]):
-        near = np.maximum.reduce([d[i - 2], d[i - 1], d[i + 1], d[i + 2]])
-        if np.any((d[i] > 0.002) & (d[i] > 4 * np.maximum(near, 0.00025))):
-            out.append(i - 2)
-    return out
 
 
 def test_a_heel_down_again_within_a_toe_contact_is_held_about_the_toe():
@@ -61,5 +43,21 @@ def test_a_locked_walk_at_120_fps_has_no_foot_pops(shared_data):
     take = read(path).resample(120)
     cycle = extract_cycle(take)
     locked, _ = lock_cycle(cycle, reference=take)
-    assert _foot_pops(cycle.repeat(1, root="motion")) == []
-    assert _foot_pops(locked.repeat(1, root="motion")) == []
+    assert foot_jumps(cycle.repeat(1, root="motion"), wrap=True) == []
+    assert foot_jumps(locked.repeat(1, root="motion"), wrap=True) == []
+
+
+def test_foot_jumps_finds_a_jump_of_one_frame_and_not_a_swing():
+    """A walk's feet swing fast and smoothly: no jump; the body moved up by 1 % of its height from one frame on:
+    one jump, at that frame; played round as a loop, the seam's step counts too."""
+    from mocycle.contacts import body_height, up_axis
+    from mocycle.datasets import synthetic_walk
+
+    walk = synthetic_walk(n_frames=120, fps=60, noise_deg=0.0, seed=1).motion
+    assert foot_jumps(walk) == []
+    j = walk.travel_joint
+    track = walk.joint_translations(j).copy()
+    track[50:] += 0.01 * body_height(walk, up_axis(walk)) * up_axis(walk)
+    jumped = walk.replace(tracks={j: track})
+    assert foot_jumps(jumped) == [49]
+    assert foot_jumps(jumped, wrap=True) == [49, walk.n_frames - 1]

@@ -88,3 +88,31 @@ def largest_leg_step(motion: Motion, feet: Sequence[Foot] | None = None) -> floa
     dots = np.clip(np.abs(a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
                           + a[..., 3] * b[..., 3]), 0.0, 1.0)
     return float(2.0 * np.arccos(dots).max())
+
+
+#: A foot jump (:func:`foot_jumps`): a vertical step of an ankle or toe over JUMP_STEP of the body height in one
+#: frame and JUMP_RATIO times its largest step over the two frames on either side (a jump, not a fast swing)
+JUMP_STEP, JUMP_RATIO = 0.002, 4.0
+
+
+def foot_jumps(motion: Motion, feet: Sequence[Foot] | None = None, *, wrap: bool = False) -> list[int]:
+    """Frames ``t`` where an ankle or toe jumps vertically from frame ``t`` to ``t + 1`` (:data:`JUMP_STEP`,
+    :data:`JUMP_RATIO`): a foot pop that :func:`largest_leg_step` misses when the legs' rotations change
+    little (a held toe let go by its heel).  ``wrap``: the motion is a loop played round (the step from its
+    last frame to its first counts, heights only, a loop's travel being horizontal)."""
+    feet = find_feet(motion.skeleton) if feet is None else feet
+    up = up_axis(motion)
+    joints = sorted({j for f in feet for j in f.contact_joints})
+    h = along(motion.world_positions()[:, joints], up)
+    T = h.shape[0]
+    if T < 2:
+        return []
+    ext = np.concatenate([h[-2:], h, h[:3]]) if wrap else np.concatenate([h[:1].repeat(2, 0), h, h[-1:].repeat(2, 0)])
+    d = np.abs(np.diff(ext, axis=0)) / body_height(motion, up)  # d[i]: the step from ext[i] to ext[i + 1]
+    out = []
+    for t in range(T if wrap else T - 1):
+        i = t + 2
+        near = np.maximum.reduce([d[i - 2], d[i - 1], d[i + 1], d[i + 2]])
+        if np.any((d[i] > JUMP_STEP) & (d[i] > JUMP_RATIO * np.maximum(near, JUMP_STEP / 8))):
+            out.append(t)
+    return out
