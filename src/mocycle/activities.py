@@ -686,41 +686,46 @@ def _phase_breaks(motion: Motion, frames: np.ndarray, strides: np.ndarray, cuts:
     """Landings (chain indices, as :func:`_gait_changes`') where the legs stop repeating across one stride and
     repeat again on either side (:data:`BREAK_UNLIKE`): where one take of a gait meets another of the same
     tempo and posture at another phase.  ``frames``: the chain's landing frames; ``strides``: its figures
-    (:func:`_stride_figures`).  Each break lies between landings ``c`` and ``c + 1`` (the step dropped by a cut at
-    ``c``); only straight strides are looked at, two strides on either side, none across a cut already made."""
+    (:func:`_stride_figures`).  A break between landings ``c`` and ``c + 1`` is cut at ``c`` (the step between
+    them dropped); each step is looked at with the stride of the strides about it (a chain may hold takes of
+    several tempos), only where the strides of its windows are straight and no cut is made at or next to it."""
     n = strides.shape[0]
     if n < 5:
         return set()
-    P = int(round(float(np.median(strides[:, 0]))))
-    a, b = int(frames[0]), int(frames[-1]) + 1
-    X = _leg_features(motion, a, b)
-    if X is None or P < 2 or X.shape[0] < 4 * P + 1:
+    f0 = int(frames[0])
+    X = _leg_features(motion, f0, int(frames[-1]) + 1)
+    if X is None:
         return set()
-    var = float(X.var(axis=0).sum())
-    if not var > 0:
-        return set()
-    step = ((X[P:] - X[:-P]) ** 2).sum(axis=1) / (2.0 * var)  # frame s against s + P, s = a .. b-1-P
-    sums = np.concatenate([[0.0], np.cumsum(step)])
-    t = np.arange(2 * P, X.shape[0] - 2 * P + 1)  # a break at frame a + t: strides [t-2P, t-P), [t-P, t), [t, t+P)
-    if not t.size:
-        return set()
-    before, across, after = ((sums[t + k * P] - sums[t + (k - 1) * P]) / P for k in (-1, 0, 1))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        score = np.where(across >= BREAK_UNLIKE, across / np.maximum(before, after), 0.0)
     turning = np.abs(strides[:, 1]) > TURN_DEG
-    blocked = [c for c in cuts]
-    out: set[int] = set()
-    for k in np.argsort(-score, kind="stable"):
-        if score[k] < STEADY_SIDES:
-            break
-        frame = a + int(t[k])
-        c = int(np.searchsorted(frames, frame, side="right")) - 1  # landing c <= frame < landing c + 1
-        if c < 1 or c + 2 > n:
+    scores = []
+    for c in range(1, n - 1):  # the step from landing c to c + 1 (strides c - 1 and c hold it)
+        # the stride of the strides beyond those the step's blend may spoil (c - 2 .. c + 1)
+        P = int(round(float(np.median(np.concatenate([strides[max(0, c - 5):max(0, c - 2), 0],
+                                                      strides[c + 2:c + 5, 0]]) if c + 2 < n or c > 2
+                                      else strides[:, 0]))))
+        a, b = int(frames[c]) - 2 * P - f0, int(frames[c + 1]) + 2 * P - f0  # frames a .. b-1 of X
+        if P < 2 or a < 0 or b > X.shape[0]:
             continue
-        # the strides whose frames the windows hold: stride i runs from landing i to i + 2
-        lo = int(np.searchsorted(frames, frame - 2 * P, side="right")) - 1
-        hi = int(np.searchsorted(frames, frame + 2 * P, side="left"))
-        if turning[max(lo, 0):min(hi, n)].any() or any(abs(x - c) <= 1 for x in blocked):
+        lo = int(np.searchsorted(frames, frames[c] - 2 * P, side="right")) - 1  # strides lo .. hi-1 in the windows
+        hi = int(np.searchsorted(frames, frames[c + 1] + 2 * P, side="left"))
+        if turning[max(lo, 0):min(hi, n)].any():
+            continue
+        Y = X[a:b]
+        var = float(Y.var(axis=0).sum())
+        if not var > 0:
+            continue
+        step = ((Y[P:] - Y[:-P]) ** 2).sum(axis=1) / (2.0 * var)  # frame s against s + P
+        sums = np.concatenate([[0.0], np.cumsum(step)])
+        t = np.arange(2 * P, Y.shape[0] - 2 * P + 1)  # a break at t: strides [t-2P, t-P), [t-P, t), [t, t+P)
+        before, across, after = ((sums[t + k * P] - sums[t + (k - 1) * P]) / P for k in (-1, 0, 1))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            score = np.where(across >= BREAK_UNLIKE, across / np.maximum(before, after), 0.0)
+        if score.size and score.max() >= STEADY_SIDES:
+            scores.append((float(score.max()), c))
+    blocked = list(cuts)
+    out: set[int] = set()
+    for _, c in sorted(scores, reverse=True):
+        if any(abs(x - c) <= 1 for x in blocked):
             continue
         out.add(c)
         blocked.append(c)
