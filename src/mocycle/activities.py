@@ -687,8 +687,9 @@ def _phase_breaks(motion: Motion, frames: np.ndarray, strides: np.ndarray, cuts:
     repeat again on either side (:data:`BREAK_UNLIKE`): where one take of a gait meets another of the same
     tempo and posture at another phase.  ``frames``: the chain's landing frames; ``strides``: its figures
     (:func:`_stride_figures`).  A break between landings ``c`` and ``c + 1`` is cut at ``c`` (the step between
-    them dropped); each step is looked at with the stride of the strides about it (a chain may hold takes of
-    several tempos), only where the strides of its windows are straight and no cut is made at or next to it."""
+    them dropped); each step is looked at with the stride of the strides before it, of those after it and of
+    both (a chain may hold takes of several tempos, and a lag a frame off at 30 fps hides a break), only where
+    the strides of its windows are straight and no cut is made at or next to it."""
     n = strides.shape[0]
     if n < 5:
         return set()
@@ -699,29 +700,16 @@ def _phase_breaks(motion: Motion, frames: np.ndarray, strides: np.ndarray, cuts:
     turning = np.abs(strides[:, 1]) > TURN_DEG
     scores = []
     for c in range(1, n - 1):  # the step from landing c to c + 1 (strides c - 1 and c hold it)
-        # the stride of the strides beyond those the step's blend may spoil (c - 2 .. c + 1)
-        P = int(round(float(np.median(np.concatenate([strides[max(0, c - 5):max(0, c - 2), 0],
-                                                      strides[c + 2:c + 5, 0]]) if c + 2 < n or c > 2
-                                      else strides[:, 0]))))
-        a, b = int(frames[c]) - 2 * P - f0, int(frames[c + 1]) + 2 * P - f0  # frames a .. b-1 of X
-        if P < 2 or a < 0 or b > X.shape[0]:
-            continue
-        lo = int(np.searchsorted(frames, frames[c] - 2 * P, side="right")) - 1  # strides lo .. hi-1 in the windows
-        hi = int(np.searchsorted(frames, frames[c + 1] + 2 * P, side="left"))
-        if turning[max(lo, 0):min(hi, n)].any():
-            continue
-        Y = X[a:b]
-        var = float(Y.var(axis=0).sum())
-        if not var > 0:
-            continue
-        step = ((Y[P:] - Y[:-P]) ** 2).sum(axis=1) / (2.0 * var)  # frame s against s + P
-        sums = np.concatenate([[0.0], np.cumsum(step)])
-        t = np.arange(2 * P, Y.shape[0] - 2 * P + 1)  # a break at t: strides [t-2P, t-P), [t-P, t), [t, t+P)
-        before, across, after = ((sums[t + k * P] - sums[t + (k - 1) * P]) / P for k in (-1, 0, 1))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            score = np.where(across >= BREAK_UNLIKE, across / np.maximum(before, after), 0.0)
-        if score.size and score.max() >= STEADY_SIDES:
-            scores.append((float(score.max()), c))
+        # the stride of the strides beyond those the step's blend may spoil (c - 2 .. c + 1): before the step,
+        # after it, and both (the two may be takes of a walk and a run, not yet cut apart)
+        sides = [strides[max(0, c - 5):max(0, c - 2), 0], strides[c + 2:c + 5, 0]]
+        lags = {int(round(float(np.median(x)))) for x in (*sides, np.concatenate(sides)) if x.size}
+        best = max((_break_score(X, frames, c, P, f0) for P in sorted(lags) if P >= 2), default=0.0)
+        if best >= STEADY_SIDES:
+            lo = int(np.searchsorted(frames, frames[c] - 2 * max(lags), side="right")) - 1  # strides in the windows
+            hi = int(np.searchsorted(frames, frames[c + 1] + 2 * max(lags), side="left"))
+            if not turning[max(lo, 0):min(hi, n)].any():
+                scores.append((best, c))
     blocked = list(cuts)
     out: set[int] = set()
     for _, c in sorted(scores, reverse=True):
@@ -730,6 +718,27 @@ def _phase_breaks(motion: Motion, frames: np.ndarray, strides: np.ndarray, cuts:
         out.add(c)
         blocked.append(c)
     return out
+
+
+def _break_score(X: np.ndarray, frames: np.ndarray, c: int, P: int, f0: int) -> float:
+    """How much more the legs ``X`` (the chain's frames from ``f0`` on) are unlike themselves ``P`` frames later
+    over a stride straddling a frame of the step from landing ``c`` to ``c + 1`` than over the stride before and
+    the stride after it (:func:`_phase_breaks`), the most over the step's frames; 0 where the windows do not fit
+    in the chain or the straddling stride is alike (:data:`BREAK_UNLIKE`)."""
+    a, b = max(0, int(frames[c]) - 2 * P - f0), min(X.shape[0], int(frames[c + 1]) + 2 * P - f0)
+    if b - a < 4 * P + 1:
+        return 0.0
+    Y = X[a:b]  # two strides either side of the step (those of its frames whose windows fit in the chain)
+    var = float(Y.var(axis=0).sum())
+    if not var > 0:
+        return 0.0
+    step = ((Y[P:] - Y[:-P]) ** 2).sum(axis=1) / (2.0 * var)  # frame s against s + P
+    sums = np.concatenate([[0.0], np.cumsum(step)])
+    t = np.arange(2 * P, Y.shape[0] - 2 * P + 1)  # a break at t: strides [t-2P, t-P), [t-P, t), [t, t+P)
+    before, across, after = ((sums[t + k * P] - sums[t + (k - 1) * P]) / P for k in (-1, 0, 1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        score = np.where(across >= BREAK_UNLIKE, across / np.maximum(before, after), 0.0)
+    return float(score.max()) if score.size else 0.0
 
 
 def stride_rate(heading: np.ndarray, period: float, start: int, stop: int) -> np.ndarray:
