@@ -58,6 +58,7 @@ joint's translation, so every bone keeps its length exactly.
 
 from __future__ import annotations
 
+import bisect
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -331,21 +332,23 @@ def _foot_goals(W: ChainArray, contacts: Contacts, f: int, n_extend: int, n_brid
     t = W[:, foot.toe] if foot.toe is not None else a
     # each toe contact with the ankle contact it overlaps most: one rigid-foot hold
     partner = {}
+    stops_a = [y for _, y in ra]
     for i, (s, e) in enumerate(rt):
-        overlaps = [min(e, y) - max(s, x) for x, y in ra]
-        k = int(np.argmax(overlaps)) if overlaps else -1
-        if k >= 0 and overlaps[k] >= 0:  # overlapping or back to back: one rigid-foot hold
+        k, overlap = _most_overlap(ra, stops_a, s, e)
+        if overlap >= 0:  # overlapping or back to back: one rigid-foot hold
             partner[i] = (k, (max(s, ra[k][0]) + min(e, ra[k][1]) - 1) // 2)
+    toes_of: dict[int, list[tuple[int, int]]] = {}  # ankle contact -> its partner toe contacts and their middles
+    for i, (k, mid) in partner.items():
+        toes_of.setdefault(k, []).append((i, mid))
     held_a = []
     for k, (s, e) in enumerate(ra):
         frames = [np.arange(s, e)]
         offsets = [np.zeros((e - s, 3))]
-        for i, (k2, mid) in partner.items():
-            if k2 == k:  # toe-only frames of the partner contact: the ankle follows the held toe
-                only = np.arange(*rt[i])
-                only = only[~ma[only]]
-                frames.append(only)
-                offsets.append((t[mid] - a[mid]) - (t[only] - a[only]))
+        for i, mid in toes_of.get(k, ()):  # toe-only frames of the partner contact: the ankle follows the held toe
+            only = np.arange(*rt[i])
+            only = only[~ma[only]]
+            frames.append(only)
+            offsets.append((t[mid] - a[mid]) - (t[only] - a[only]))
         fr, off = np.concatenate(frames), np.concatenate(offsets)
         held_a.append(_best_hold(a[s:e], off, hips[fr], R[fr], up, body))
     _heels_about_toes(held_a, ra, rt, partner, a, t)
@@ -369,6 +372,22 @@ def _foot_goals(W: ChainArray, contacts: Contacts, f: int, n_extend: int, n_brid
     return a + corr_a, t + corr_t, level_a >= FOLLOW, changed | np.any(corr_t != 0, axis=1)
 
 
+def _most_overlap(runs: list, stops: list, s: int, e: int) -> tuple[int, int]:
+    """Of ``runs`` (disjoint ``(start, stop)`` in order; ``stops`` their stops), the first that overlaps ``[s, e)``
+    most and by how many frames (0 back to back; ``(-1, -1)`` when none overlaps or touches): found by bisection,
+    so that the contacts of a long take are paired in ``O(n log n)``."""
+    lo = bisect.bisect_left(stops, s)   # the first run that ends at s or later
+    best, most = -1, -1
+    for k in range(lo, len(runs)):
+        x, y = runs[k]
+        if x > e:
+            break
+        overlap = min(e, y) - max(s, x)
+        if overlap > most:
+            best, most = k, overlap
+    return best, most
+
+
 def _heels_about_toes(held_a: list, ra: list, rt: list, partner: dict, a: np.ndarray, t: np.ndarray) -> None:
     """Re-hold (in ``held_a``, in place) each ankle contact that lies within a toe contact whose rigid-foot hold
     is made with another ankle contact (``partner``, :func:`_foot_goals`): a heel that lifts and comes down
@@ -378,14 +397,10 @@ def _heels_about_toes(held_a: list, ra: list, rt: list, partner: dict, a: np.nda
     it about the toe's hold, in the middle of their overlap.  ``ra``, ``rt``: the ankle's and the toe's
     contacts; ``a``, ``t``: their paths ``(T, 3)``."""
     partners = {k for k, _ in partner.values()}
-    toe_of: dict[int, tuple[int, int]] = {}  # ankle contact -> (the toe contact it overlaps most, the overlap)
-    for i, (s, e) in enumerate(rt):
-        for k, (x, y) in enumerate(ra):
-            overlap = min(e, y) - max(s, x)
-            if overlap > 0 and overlap > toe_of.get(k, (-1, 0))[1]:
-                toe_of[k] = (i, overlap)
-    for k, (i, _) in toe_of.items():
-        if k in partners or i not in partner:
+    stops_t = [e for _, e in rt]
+    for k, (x, y) in enumerate(ra):
+        i, overlap = _most_overlap(rt, stops_t, x, y)  # the toe contact this ankle contact overlaps most
+        if overlap <= 0 or k in partners or i not in partner:
             continue
         k0, mid0 = partner[i]
         mid = (max(rt[i][0], ra[k][0]) + min(rt[i][1], ra[k][1]) - 1) // 2
@@ -764,13 +779,17 @@ def lock_feet(motion: Motion, contacts: Contacts, *, blend: float = BLEND_SECOND
         free = ~h
         base, hips = W[free, foot.ankle], W[free, foot.hip]
         R, zone = _reach(W, foot, reach)[free], SOFT_ZONE * _leg_length(W, foot)[free]
-        soft = _soft_reach(base, g[free] - base, hips, R, zone, contacts.up)
+        corr = g[free] - base
+        out = _soft_reach(base, corr, hips, R, zone, contacts.up)
         # next to a held frame (whose goal is within the reach, the root lowered or the heel lifted for it) the
         # goal is held within the reach as there and eased to the soft one over the blend: a leg leaving a
         # hold near straight (a toe-off) is not bent by the soft zone in one frame
-        hard = _soft_reach(base, g[free] - base, hips, R, 1e-6 * zone, contacts.up)
-        ease = _smoothstep(_frames_from(h)[free] / (n_blend + 1))[:, None]
-        g[free] = base + hard + ease * (soft - hard)
+        ease = _smoothstep(_frames_from(h)[free] / (n_blend + 1))
+        m = ease < 1.0
+        if m.any():
+            hard = _soft_reach(base[m], corr[m], hips[m], R[m], 1e-6 * zone[m], contacts.up)
+            out[m] = hard + ease[m, None] * (out[m] - hard)
+        g[free] = base + out
     window = np.zeros(motion.n_frames, bool)
     window[frames if frames is not None else slice(None)] = True
     solved = [np.flatnonzero((ch | lowered) & window) for ch in changed]  # the frames each leg's IK changes

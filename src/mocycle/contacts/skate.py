@@ -103,16 +103,15 @@ def foot_jumps(motion: Motion, feet: Sequence[Foot] | None = None, *, wrap: bool
     feet = find_feet(motion.skeleton) if feet is None else feet
     up = up_axis(motion)
     joints = sorted({j for f in feet for j in f.contact_joints})
-    h = along(motion.world_positions()[:, joints], up)
+    W = motion.world_positions(end_sites=True)  # once, for the feet and the body height
+    h = along(W[:, joints], up)
     T = h.shape[0]
     if T < 2:
         return []
-    ext = np.concatenate([h[-2:], h, h[:3]]) if wrap else np.concatenate([h[:1].repeat(2, 0), h, h[-1:].repeat(2, 0)])
-    d = np.abs(np.diff(ext, axis=0)) / body_height(motion, up)  # d[i]: the step from ext[i] to ext[i + 1]
-    out = []
-    for t in range(T if wrap else T - 1):
-        i = t + 2
-        near = np.maximum.reduce([d[i - 2], d[i - 1], d[i + 1], d[i + 2]])
-        if np.any((d[i] > JUMP_STEP) & (d[i] > JUMP_RATIO * np.maximum(near, JUMP_STEP / 8))):
-            out.append(t)
-    return out
+    ext = np.concatenate([h[-2:], h, h[:3]]) if wrap else np.concatenate([h[:1], h[:1], h, h[-1:], h[-1:]])
+    d = np.abs(np.diff(ext, axis=0)) / body_height(motion, up, W)  # d[t + 2]: the step from frame t to t + 1
+    n = T if wrap else T - 1
+    step = d[2:n + 2]
+    near = np.maximum.reduce([d[0:n], d[1:n + 1], d[3:n + 3], d[4:n + 4]])  # two steps on either side
+    jumps = (step > JUMP_STEP) & (step > JUMP_RATIO * np.maximum(near, JUMP_STEP / 8))
+    return np.flatnonzero(jumps.any(axis=1)).tolist()
