@@ -831,3 +831,32 @@ def test_two_takes_of_one_walk_joined_at_another_phase_loop_apart(shared_data):
     for p in loops:
         inside = [min(p.stop, b) - max(p.start, a) for _, a, b in session.stretches]
         assert sorted(inside)[-2] <= p.period_frames / 2, (p.kind, p.start, p.stop, session.stretches)
+
+
+@pytest.mark.parametrize("make", [synthetic_walk, synthetic_run])
+@pytest.mark.parametrize("off", [1.1, 1.2])
+def test_a_short_gait_part_repeats_at_its_legs_stride_when_its_landings_put_it_off(make, off):
+    """A part of 1.7 strides whose few landings make the stride 10-20 % long (the floating feet of a retargeted
+    rig, measured from their stances' own levels: an iClone jog's 50 frames where its legs repeat at 45) is still
+    a gait: its legs repeat a stride later by their own stride (legs_check then gives the part that period)."""
+    from mocycle.activities import Activity, _legs_repeat_in
+
+    take = make(fps=60, seed=3)
+    period = float(np.nanmedian(take.period_frames))
+    motion = take.motion[:int(1.7 * period)]
+    part = Activity(start=0, stop=motion.n_frames, kind="run", limbs="legs", period_frames=off * period)
+    assert _legs_repeat_in(motion, part)
+
+
+def test_a_short_part_whose_legs_do_not_repeat_is_no_gait():
+    """Most of a walk's stride joined to most of a run's: at no lag do the legs repeat."""
+    from mocycle.activities import Activity, _legs_repeat_in
+    from mocycle.datasets import join_takes
+
+    walk, run = synthetic_walk(fps=60, seed=3), synthetic_run(fps=60, seed=3)
+    period = float(np.nanmedian(walk.period_frames))
+    motion = join_takes([walk.motion[:int(0.9 * period)], run.motion[:int(0.9 * period)]], ["walk", "run"],
+                        crossfade=6).motion
+    for off in (1.0, 1.1):
+        part = Activity(start=0, stop=motion.n_frames, kind="walk", limbs="legs", period_frames=off * period)
+        assert not _legs_repeat_in(motion, part)

@@ -758,7 +758,12 @@ def _turn_runs(rate: np.ndarray, period: float, least: float) -> list[tuple[int,
     :data:`TURN_CORE_SHARE` of that turn's fastest rate), 2 a turn's slow start or end (a transition).  A core
     shorter than ``least`` frames (the cycles a loop needs) grows into its turn's slower frames, evenly on both
     sides, as far as they turn by more than :data:`TURN_DEG`: a sharp turn of a stride and a half is still a
-    turn to loop.  Runs shorter than a quarter of a stride take the way of their longer neighbour."""
+    turn to loop.  Runs shorter than a quarter of a stride take the way of their longer neighbour.
+
+    A moment's swing past :data:`TURN_DEG` that turns the hips only a few degrees in all is kept as a turn too
+    (a piece too short to loop): where one take meets the next the blended heading swings so, and the pieces
+    keep a loop from spanning the join.  Treating such swings as straight looped one more run take in the
+    120 fps hour but made two loops over a border in the 4- and 15-minute sessions (2026-12-08)."""
     n = rate.size
     way = np.where(np.abs(rate) >= TURN_DEG, np.sign(rate), 0).astype(np.int8)
     label = np.zeros(n, dtype=np.int8)
@@ -1289,18 +1294,27 @@ def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
     that a stride can be compared with the next): unlikeness under :data:`UNLIKE` where a stride or more of
     frames can be compared, under :data:`UNLIKE_ONE_STEP` where less can.  A part of two strides or more is
     judged on its own frames only: in a session the frames beside it are another activity; so is a shorter one
-    whose own frames compare a step or more and are alike (the frames beside it are looked at only where its
-    own cannot tell).  A step on either side first: a part's landings may start a step or more into its take
+    whose own frames compare a step or more and are alike, a stride later by the landings or by the legs' own
+    stride (:func:`short_period`, as :func:`legs_check` finds it; the frames beside it are looked at only where
+    its own cannot tell).  A step on either side first: a part's landings may start a step or more into its take
     (a landing lost where the take is joined to the one before), and a stride's reach then takes in the next
     activity, which is unlike the part's legs however alike its own strides are."""
     P = part.period_frames
     if not (np.isfinite(P) and P >= 2):
         return False
     lag = int(round(P))
-    if lag / 2 <= part.n_frames - lag < lag:
+    if part.n_frames < 2 * lag:
         X = _leg_features(motion, part.start, part.stop)
-        if X is not None and _unlike(X, lag) < UNLIKE_ONE_STEP:
-            return True
+        if X is not None:
+            # one stride later by the landings, or by the legs' own stride where legs_check looks for it (a few
+            # landings of floating feet, measured from their stances' own levels, may make a stride some frames
+            # long or short: an iClone jog's 50 frames where its legs repeat at 45)
+            lags = [lag]
+            legs, _ = _short_period_of(X, P)
+            if np.isfinite(legs):
+                lags.append(int(round(legs)))
+            if any(k / 2 <= part.n_frames - k < k and _unlike(X, k) < UNLIKE_ONE_STEP for k in lags):
+                return True
     reaches = [0.0] if part.n_frames >= 2 * P else [0.5 * P, P]
     for reach in reaches:
         lo, hi = max(0, int(part.start - reach)), min(motion.n_frames, int(np.ceil(part.stop + reach)))
