@@ -860,3 +860,22 @@ def test_a_short_part_whose_legs_do_not_repeat_is_no_gait():
     for off in (1.0, 1.1):
         part = Activity(start=0, stop=motion.n_frames, kind="walk", limbs="legs", period_frames=off * period)
         assert not _legs_repeat_in(motion, part)
+
+
+def test_a_gait_found_by_the_cohomology_takes_its_legs_period_where_they_overrule():
+    """A walk whose chain of landings broke is found by the cohomology (_stepping_part); over a cycle and a half
+    its period came out 2-6 % short of the legs' own.  The legs check it as they check a gait part's."""
+    from mocycle.activities import _stepping_part, find_landings, line_periodic
+
+    take = synthetic_walk(fps=60, seed=3)
+    period = float(np.nanmedian(take.period_frames))
+    motion = take.motion[:int(1.6 * period)]
+    steps = find_landings(motion)
+    n = motion.n_frames
+    for said, want in ((0.94 * period, period), (period, period)):
+        pm = line_periodic(np.arange(n) / said, said, motion.frame_time, "cohomology", "all", "")
+        part = _stepping_part(motion, 0, n, pm, steps, "periodic")
+        assert abs(part.period_frames / want - 1) < 0.01
+        assert part.periodic.period_frames == part.period_frames
+        assert abs(part.periodic.unwrapped[-1] - part.periodic.unwrapped[0] - (n - 1) / part.period_frames) < 1e-9
+    assert part.periodic.period_source == "cohomology"  # the legs agree: the cohomology's phase is kept
