@@ -12,6 +12,7 @@ ended, 10-frame cross-fade; the take's label is the truth of its stretch):
   (walk, turn, run, wave, gesture, turn, walk: a turn take that walks out into a walk) at 30 fps and at 120 fps,
   and sessions of ``--minutes`` minutes drawn (seeded) from every Bandai take of that rig (walks, runs, dashes,
   walk-turn-walks, waves, raised hands), resampled to ``--fps``;
+* the issue-order session again on a game tool's conventions (Mixamo's joint names, metres, Z up, 60 fps);
 * from ``../shared/data/cmu-iclone`` (when present): CMU takes retargeted to the iClone rig at 60 fps (other
   performers, another skeleton, floors that drift within a take), one session per rig the takes come on
   (``CC_Base_Hip``: walks of three subjects, two dance phrases, a run of punches, a jump; ``RL_BoneRoot``: three
@@ -135,6 +136,10 @@ def real_sessions(folder: Path, data: Path, minutes: list[float], fps: float, qu
         out.append(_write(folder, f"{stem}_30fps", takes, None))  # the takes' own rate
         if not quick and fps != 30:
             out.append(_write(folder, f"{stem}_{fps:g}fps", takes, fps))
+    # the issue-order session on a game tool's conventions: Mixamo's joint names, metres, Z up, 60 fps
+    takes = [(label, mocycle.read(files[name])) for label, name in BANDAI_ISSUE_ORDER if name in files]
+    if takes and not quick:
+        out.append(_write(folder, "bandai_mixamo_zup_60fps", takes, 60.0, _game_rig))
     pool = [(_label(n), p) for n, p in files.items() if mocycle.read(p).n_frames > 3 * CROSSFADE]
     cache: dict[Path, object] = {}
     rng = random.Random(35)
@@ -198,11 +203,37 @@ def _onto(motion, first):
     return resized.resample(first.fps) if abs(motion.fps - first.fps) > 1e-6 else resized
 
 
-def _write(folder: Path, name: str, takes, fps: float | None) -> Session:
+#: Bandai's joint names as Mixamo names them (a game tool's rig: ``mixamorig:`` joints under an ``Armature``)
+MIXAMO_NAMES = {"joint_Root": "Armature", "Hips": "mixamorig:Hips", "Spine": "mixamorig:Spine",
+                "Chest": "mixamorig:Spine1", "Neck": "mixamorig:Neck", "Head": "mixamorig:Head",
+                **{f"{bandai}_{side[0]}": f"mixamorig:{side}{mixamo}" for side in ("Left", "Right")
+                   for bandai, mixamo in (("Shoulder", "Shoulder"), ("UpperArm", "Arm"), ("LowerArm", "ForeArm"),
+                                          ("Hand", "Hand"), ("UpperLeg", "UpLeg"), ("LowerLeg", "Leg"),
+                                          ("Foot", "Foot"), ("Toes", "ToeBase"))}}
+
+
+def _game_rig(motion):
+    """A Bandai session on a game tool's conventions: Mixamo's joint names, metres (Bandai's centimetres / 100),
+    Z up (the root turned +90 degrees about X, as :func:`mocycle.datasets.synthetic.to_z_up` turns a take)."""
+    from mocycle.datasets.synthetic import to_z_up
+    from mocycle.motion import EndSite, Skeleton
+
+    s, k = motion.skeleton, 0.01
+    skeleton = Skeleton(tuple(MIXAMO_NAMES.get(n, n) for n in s.names), s.parents, np.asarray(s.offsets) * k,
+                        s.channels, [EndSite(e.parent, tuple(np.asarray(e.offset) * k), e.name) for e in s.end_sites])
+    return to_z_up(mocycle.Motion(skeleton, motion.rotations, np.asarray(motion.translations) * k,
+                                  motion.frame_time))
+
+
+def _write(folder: Path, name: str, takes, fps: float | None, rig=None) -> Session:
+    """``takes`` joined into a session written to ``folder`` (resampled to ``fps``; ``rig``: a change of
+    conventions made on the joined motion), its truth beside it."""
     motions = [t.motion if hasattr(t, "motion") else t for _, t in takes]
     motions = [_onto(m, motions[0]) for m in motions]
     s = join_takes(motions, [label for label, _ in takes], crossfade=CROSSFADE)
     motion, stretches = s.motion, s.stretches
+    if rig is not None:
+        motion = rig(motion)
     if fps is not None and abs(fps - motion.fps) > 1e-6:
         scale = fps / motion.fps
         motion = motion.resample(fps)
