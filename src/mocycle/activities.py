@@ -732,7 +732,7 @@ def _break_score(X: np.ndarray, frames: np.ndarray, c: int, P: int, f0: int) -> 
     var = float(Y.var(axis=0).sum())
     if not var > 0:
         return 0.0
-    step = ((Y[P:] - Y[:-P]) ** 2).sum(axis=1) / (2.0 * var)  # frame s against s + P
+    step = _lag_steps(Y, P) / (2.0 * var)  # frame s against s + P
     sums = np.concatenate([[0.0], np.cumsum(step)])
     t = np.arange(2 * P, Y.shape[0] - 2 * P + 1)  # a break at t: strides [t-2P, t-P), [t-P, t), [t, t+P)
     before, across, after = ((sums[t + k * P] - sums[t + (k - 1) * P]) / P for k in (-1, 0, 1))
@@ -1277,7 +1277,12 @@ def _unlike_var(X: np.ndarray, lag: int, var: float) -> float:
     """:func:`_unlike` with the total variance of ``X`` given (many lags of one ``X``)."""
     if not var > 0 or not 0 < lag < X.shape[0]:
         return float("nan")
-    return float(((X[lag:] - X[:-lag]) ** 2).sum(axis=1).mean()) / (2.0 * var)
+    return float(_lag_steps(X, lag).mean()) / (2.0 * var)
+
+
+def _lag_steps(X: np.ndarray, lag: int) -> np.ndarray:
+    """``(T - lag,)``: the squared distance of each row of ``X`` ``(T, D)`` from the row ``lag`` later."""
+    return ((X[lag:] - X[:-lag]) ** 2).sum(axis=1)
 
 
 def legs_repeat(motion: Motion, start: int, stop: int, period: float) -> float:
@@ -1306,14 +1311,13 @@ def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
     if part.n_frames < 2 * lag:
         X = _leg_features(motion, part.start, part.stop)
         if X is not None:
-            # one stride later by the landings, or by the legs' own stride where legs_check looks for it (a few
-            # landings of floating feet, measured from their stances' own levels, may make a stride some frames
-            # long or short: an iClone jog's 50 frames where its legs repeat at 45)
-            lags = [lag]
+            # one stride later by the landings, or else by the legs' own stride where legs_check looks for it
+            # (a few landings of floating feet, measured from their stances' own levels, may make a stride some
+            # frames long or short: an iClone jog's 50 frames where its legs repeat at 45)
+            if _alike_over_a_step(X, lag):
+                return True
             legs, _ = _short_period_of(X, P)
-            if np.isfinite(legs):
-                lags.append(int(round(legs)))
-            if any(k / 2 <= part.n_frames - k < k and _unlike(X, k) < UNLIKE_ONE_STEP for k in lags):
+            if np.isfinite(legs) and _alike_over_a_step(X, int(round(legs))):
                 return True
     reaches = [0.0] if part.n_frames >= 2 * P else [0.5 * P, P]
     for reach in reaches:
@@ -1325,6 +1329,12 @@ def _legs_repeat_in(motion: Motion, part: Activity) -> bool:
         if overlap >= _least_overlap(lag) and _unlike(X, lag) < (UNLIKE if overlap >= lag else UNLIKE_ONE_STEP):
             return True
     return False
+
+
+def _alike_over_a_step(X: np.ndarray, lag: int) -> bool:
+    """Whether the rows of ``X`` ``(T, D)`` are like themselves ``lag`` rows later (:data:`UNLIKE_ONE_STEP`) where
+    they compare a step or more but less than a stride (``lag / 2 <= T - lag < lag``)."""
+    return lag / 2 <= X.shape[0] - lag < lag and _unlike(X, lag) < UNLIKE_ONE_STEP
 
 
 #: The legs' self-similar period overrules the landings' when it is this far off and the legs are at least
@@ -1754,7 +1764,7 @@ def _return_distance(X: np.ndarray, period: float, w: int) -> np.ndarray:
     mean = np.stack([moving_average(X[:, d], w) for d in range(X.shape[1])], axis=1)
     square = np.stack([moving_average(X[:, d] ** 2, w) for d in range(X.shape[1])], axis=1)
     spread = np.maximum((square - mean ** 2).sum(axis=1), 1e-12)
-    step = ((X[P:] - X[:-P]) ** 2).sum(axis=1)
+    step = _lag_steps(X, P)
     # a frame with no pose a period away on either side (a period over half the frames) cannot be seen to come
     # back: far from alike, and finite, so that the running mean stays a number
     d = np.full((2, T), 2.0 * w / ALIKE)

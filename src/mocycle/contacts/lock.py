@@ -336,7 +336,7 @@ def _foot_goals(W: ChainArray, contacts: Contacts, f: int, n_extend: int, n_brid
     for i, (s, e) in enumerate(rt):
         k, overlap = _most_overlap(ra, stops_a, s, e)
         if overlap >= 0:  # overlapping or back to back: one rigid-foot hold
-            partner[i] = (k, (max(s, ra[k][0]) + min(e, ra[k][1]) - 1) // 2)
+            partner[i] = (k, _middle((s, e), ra[k]))
     toes_of: dict[int, list[tuple[int, int]]] = {}  # ankle contact -> its partner toe contacts and their middles
     for i, (k, mid) in partner.items():
         toes_of.setdefault(k, []).append((i, mid))
@@ -388,6 +388,12 @@ def _most_overlap(runs: list, stops: list, s: int, e: int) -> tuple[int, int]:
     return best, most
 
 
+def _middle(r: tuple[int, int], q: tuple[int, int]) -> int:
+    """The middle frame of the overlap of runs ``r`` and ``q`` (``(start, stop)``; back to back: the last of the
+    first)."""
+    return (max(r[0], q[0]) + min(r[1], q[1]) - 1) // 2
+
+
 def _heels_about_toes(held_a: list, ra: list, rt: list, partner: dict, a: np.ndarray, t: np.ndarray) -> None:
     """Re-hold (in ``held_a``, in place) each ankle contact that lies within a toe contact whose rigid-foot hold
     is made with another ankle contact (``partner``, :func:`_foot_goals`): a heel that lifts and comes down
@@ -403,7 +409,7 @@ def _heels_about_toes(held_a: list, ra: list, rt: list, partner: dict, a: np.nda
         if overlap <= 0 or k in partners or i not in partner:
             continue
         k0, mid0 = partner[i]
-        mid = (max(rt[i][0], ra[k][0]) + min(rt[i][1], ra[k][1]) - 1) // 2
+        mid = _middle(rt[i], ra[k])
         held_a[k] = held_a[k0] + (t[mid0] - a[mid0]) + (a[mid] - t[mid])
 
 
