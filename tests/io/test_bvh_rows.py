@@ -160,6 +160,22 @@ def test_the_helper_thread_ends_with_the_read(tmp_path, monkeypatch, fast):
     assert threading.active_count() == before
 
 
+@pytest.mark.parametrize("total", [1, 5 << 20, (16 << 20) + 3, 531 << 20])
+def test_pieces_grow_from_a_small_first_one_and_shrink_towards_the_end(total):
+    sizes, left = [], total
+    while left:
+        sizes.append(bvh_rows.piece_bytes(len(sizes), left))
+        left -= sizes[-1]
+    small = bvh_rows.CHUNK_BYTES * bvh_rows.SMALL_SHARE
+    assert sum(sizes) == total and min(sizes) > 0 and max(sizes) < bvh_rows.CHUNK_BYTES + small
+    assert sizes[0] <= max(small, total - small)  # the first parse starts after a small read
+    if len(sizes) > 2:
+        assert sizes[-1] < 2 * small  # the last pieces' conversions are short
+        peak = sizes.index(max(sizes))
+        assert sizes[:peak + 1] == sorted(sizes[:peak + 1])
+        assert sizes[peak:-1] == sorted(sizes[peak:-1], reverse=True)
+
+
 def test_a_long_file_reads_fast_only_when_polars_is_worth_importing(monkeypatch):
     monkeypatch.setitem(__import__("sys").modules, "polars", __import__("polars"))
     assert bvh_rows.wanted(bvh_rows.MIN_BYTES_IMPORTED) and not bvh_rows.wanted(bvh_rows.MIN_BYTES_IMPORTED - 1)

@@ -9,9 +9,11 @@ of the line the piece cut), and parses them and runs the caller's conversion on 
 once (polars and numpy release the GIL); the caller takes them in order. Polars parses on its own pool, which the
 command line sizes to one thread (``POLARS_MAX_THREADS=1``): the pieces' parses then run one after another on that
 thread and the conversions beside them on the other core, so a long read takes about as long as the parses alone
-(32 pieces of 44 ms for the 22-joint hour: 1.3 times polars' parse of the whole text on two threads; 1.7 times for
-CMU's 31 joints, whose conversion costs more than its parse). Polars' pool is global; letting it run two threads
-here measured no faster (its threads and the conversions then share the two cores).
+(about 1.37 s for the 22-joint hour: 1.27-1.30 times polars' parse of the whole text on two threads; 1.7 times for
+CMU's 31 joints, whose conversion costs more than its parse). The first pieces are small (the first parse starts
+after a 1 MB read, not a 16 MB one) and so are the last (the last conversion ends a few ms after the last parse, not
+one 16 MB conversion later): :func:`piece_bytes`. Polars' pool is global; letting it run two threads here measured
+no faster (its threads and the conversions then share the two cores).
 
 Only plain rows are taken: numbers separated by single spaces (a space at the end of every line allowed),
 ``\\n`` or ``\\r\\n`` line ends.  Anything else — tabs, runs of spaces, a value missing or extra, text polars
@@ -32,6 +34,12 @@ import numpy as np
 
 #: bytes of text parsed at a time (about 12,000 rows of 132 channels)
 CHUNK_BYTES = 16 << 20
+#: the first and the last pieces are smaller (:func:`piece_bytes`): the first parse starts sooner, and the last
+#: pieces' conversions end soon after their parses; down to this share of :data:`CHUNK_BYTES`
+SMALL_SHARE = 1 / 16
+#: near the end a piece is this share of the rows left: each piece's conversion (about 0.6 of its parse) then
+#: ends within the next, smaller piece's parse
+TAIL_SHARE = 0.4
 #: below this much text ``np.loadtxt`` is as fast as importing polars (0.2 s) and parsing with it
 MIN_BYTES = 8 << 20
 #: the same once polars is imported (a batch of takes, a second read): a second read of 0.36 MB of rows took 4.4 ms
@@ -86,6 +94,15 @@ def helpers() -> int:
     return min(4, max(2, cores))
 
 
+def piece_bytes(k: int, left: int) -> int:
+    """Bytes to read for the ``k``-th piece (from 0) when ``left`` bytes of rows remain: :data:`CHUNK_BYTES`,
+    but doubling up to it from ``SMALL_SHARE`` of it at the start and shrinking by ``1 - TAIL_SHARE`` a piece
+    near the end (the rest in one piece once it is small)."""
+    small = max(1, int(CHUNK_BYTES * SMALL_SHARE))
+    size = min(CHUNK_BYTES, small << min(k, 62), max(small, int(left * TAIL_SHARE)))
+    return left if left - size < small else size
+
+
 def row_chunks(path: str | os.PathLike, offset: int, n_channels: int,
                then: Callable[[int, np.ndarray], T] | None = None) -> Generator[tuple[int, np.ndarray, T | None]]:
     """The rows from byte ``offset`` of ``path`` on, in file order: ``(r0, values, then(r0, values))`` per
@@ -104,26 +121,39 @@ def row_chunks(path: str | os.PathLike, offset: int, n_channels: int,
         raise Unreadable("polars is not installed") from None
     with open(path, "rb") as fh:
         fh.seek(offset)
-        first = fh.readline()
-        fh.seek(offset)
-        trailing = first.rstrip(b"\r\n").endswith(b" ")  # iClone, Bandai: a space closes every row
-        names = [f"c{i}" for i in range(n_channels + trailing)]
-        schema = {name: pl.Float64 for name in names}
+        names = [f"c{i}" for i in range(n_channels + 1)]
+        # polars takes a piece's columns from its first line: a space closing it (iClone, Bandai: a space closes
+        # every row, perhaps but the last) is one column more, which must be empty
+        schemas = {trailing: {name: pl.Float64 for name in names[:n_channels + trailing]} for trailing in (0, 1)}
+        size_of_file = os.fstat(fh.fileno()).st_size
         r0 = 0
+        k = 0
 
         def next_piece() -> tuple[bytes, int] | None:
             """The next piece as read (no copy: polars reads its first ``rows`` lines and no further) and its
-            count of whole lines, about CHUNK_BYTES of them (``None`` at the end).  The file is left at the
-            start of the next line."""
-            block = fh.read(CHUNK_BYTES)
+            count of whole lines, about :func:`piece_bytes` of them (``None`` at the end).  The file is left at
+            the start of the next line."""
+            nonlocal k
+            at = fh.tell()
+            size = piece_bytes(k, size_of_file - at)
+            k += 1
+            block = fh.read(size)
             if block.startswith(_BOM):  # polars would skip it; the usual parse refuses it with its line
                 raise Unreadable("a byte-order mark")
-            if len(block) == CHUNK_BYTES:
+            if at + len(block) < size_of_file:  # more follows: the piece ends at its last line end
                 cut = block.rfind(b"\n") + 1
+                if not cut and size < CHUNK_BYTES:  # a small piece within one line: read on to a whole piece
+                    block += fh.read(CHUNK_BYTES - size)
+                    cut = block.rfind(b"\n") + 1
                 if not cut:  # a line of 16 MB is no frame row (nor a CR-only file's rows)
                     raise Unreadable("no line end within a piece")
+                last = cut - 1
+                while last >= 0 and block[last] in _SPACE:
+                    last -= 1
+                if last >= 0:  # blank lines at the piece's end go to the next piece: they may end the file
+                    cut = block.find(b"\n", last) + 1
                 if cut < len(block):
-                    fh.seek(cut - len(block), os.SEEK_CUR)
+                    fh.seek(at + cut)
                 return block, count_lines(block, cut)  # a blank line within: a row of nulls (NaN)
             # the last piece: its blank lines at the end go (np.loadtxt skips them; polars would make rows of
             # nulls); its last row may lack a line end
@@ -136,8 +166,11 @@ def row_chunks(path: str | os.PathLike, offset: int, n_channels: int,
 
         def parse(piece: bytes, rows: int, r0: int):
             try:
-                frame = pl.read_csv(piece, has_header=False, separator=" ", schema=schema, quote_char=None,
-                                    n_rows=rows)
+                line_end = piece.find(b"\n")
+                first = (piece if line_end < 0 else piece[:line_end]).rstrip(b"\r")
+                trailing = int(first.endswith(b" "))
+                frame = pl.read_csv(piece, has_header=False, separator=" ", schema=schemas[trailing],
+                                    quote_char=None, n_rows=rows)
                 if trailing:
                     if frame[names[-1]].null_count() != frame.height:
                         raise Unreadable("a value after the last channel")
