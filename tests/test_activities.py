@@ -313,9 +313,61 @@ def test_a_repeat_found_where_the_feet_step_but_make_no_stride_is_checked_by_the
         assert parts[0].kind == "transition" and "unlike themselves" in parts[0].reason
 
 
+@pytest.mark.parametrize("period_share, loops", [(0.25, False), (1.0, True)])
+def test_a_repeat_found_where_the_legs_move_but_no_foot_lands_is_checked_by_the_legs(monkeypatch, period_share,
+                                                                                    loops):
+    """A shuffle's last steps, where the feet lift too little to land (no landing within the frames): a repeat
+    found there at a quarter of the stride (a 1.2 s stride "looped" at 0.3 s) is no loop, one at the stride is;
+    the legs move, so the whole body repeats only where they do."""
+    import mocycle.activities as A
+
+    fps, period = 60.0, 1.0
+    walk = synthetic_walk(n_frames=int(1.6 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
+    steps = _steps(walk)
+    none = A.Landings(steps.frames[:0], steps.foot[:0], steps.sides, steps.down)
+    P = period_share * period * fps
+    found = A.line_periodic(np.arange(walk.n_frames) / P, P, walk.frame_time, "cohomology", "all", "found")
+    monkeypatch.setattr(A, "_periodic_in", lambda *args, **kwargs: ("all", "periodic", found, (0, walk.n_frames)))
+    parts = A._other(walk, 0, walk.n_frames, 1.2, True, {"joints": None, "step": 1}, steps=none)
+    assert [p.loop for p in parts] == [loops], [(p.kind, p.reason) for p in parts]
+    if not loops:
+        assert parts[0].kind == "transition" and "the legs move but are unlike themselves" in parts[0].reason
+
+
+@pytest.mark.parametrize("travels", [True, False])
+def test_a_repeat_whose_feet_make_no_stride_is_named_a_walk_when_the_body_travels(monkeypatch, travels):
+    """A shuffle whose one foot lifts too little to land (only the other foot's landings, a stride apart: no
+    stride of alternate landings in step): the repeat the cohomology finds at the stride is a walk, named by its
+    feet, when the body travels as a walk does; the same legs stepping in place stay a periodic part."""
+    import mocycle.activities as A
+
+    fps, period = 60.0, 1.0
+    walk = synthetic_walk(n_frames=int(3.2 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
+    if not travels:
+        j = walk.travel_joint
+        still = walk.joint_translations(j).copy()
+        still[:, [0, 2]] = still[0, [0, 2]]  # the hips keep their height and sway but go nowhere
+        walk = walk.replace(tracks={j: still})
+    steps = _steps(walk)
+    one = steps.foot == steps.foot[0]
+    one_foot = A.Landings(steps.frames[one], steps.foot[one], steps.sides, steps.down)
+    assert A._foot_periods(one_foot, 0, walk.n_frames, fps).size == 0  # no stride of alternate landings
+    P = period * fps
+    found = A.line_periodic(np.arange(walk.n_frames) / P, P, walk.frame_time, "cohomology", "all", "found")
+    monkeypatch.setattr(A, "_periodic_in", lambda *args, **kwargs: ("all", "periodic", found, (0, walk.n_frames)))
+    parts = A._other(walk, 0, walk.n_frames, 1.2, True, {"joints": None, "step": 1}, steps=one_foot)
+    assert len(parts) == 1 and parts[0].loop, [(p.kind, p.reason) for p in parts]
+    if travels:
+        assert parts[0].kind == "walk straight" and "the body travels as a gait does" in parts[0].reason
+        assert parts[0].in_step and abs(parts[0].period_frames / P - 1) < 0.05
+    else:
+        assert parts[0].kind == "periodic"
+
+
 def test_a_walk_running_off_without_a_chain_of_landings_is_not_looped_across_the_change():
     """Frames without a gait part where a short walk turns into a run: looked at blind, the whole body "repeats"
-    across both (one loop holding a walk and a run); with the landings, the part that loops lies in one gait."""
+    across both, but the legs, which move, are unlike themselves a period later, so no loop holds a walk and a run;
+    with the landings, the part that loops lies in one gait."""
     from mocycle.activities import _decide, _other
     from mocycle.datasets import join_takes
 
@@ -337,7 +389,7 @@ def test_a_walk_running_off_without_a_chain_of_landings_is_not_looped_across_the
     _decide(blind, 1.2)
     seen = _other(m, 0, m.n_frames, 1.2, True, options, steps=_steps(m))
     _decide(seen, 1.2)
-    assert spans(blind)  # what the landings are for: without them one loop holds both gaits
+    assert not spans(blind) and any("the legs move but are unlike themselves" in p.reason for p in blind)
     assert not spans(seen), [(p.kind, p.start, p.stop, p.reason) for p in seen]
     assert any(p.loop for p in seen)
 

@@ -86,6 +86,10 @@ MIXED_SHARE = 0.03
 #: Where the feet cannot tell (neither flight nor double support, or both), faster than this many body heights per
 #: second is a run (people switch from walking to running at about 2 m/s, 1.1-1.2 body heights per second).
 RUN_SPEED = 1.25
+#: A motion without a chain of landings whose legs move and repeat, and which travels at least this many body
+#: heights a cycle, is a gait named by its feet (a slow shuffle travels 0.5, a walk about 0.8; punches, sword
+#: swings and steps in place 0.01-0.03).
+GAIT_TRAVEL = 0.3
 #: Frames without gait shorter than this many seconds are transitions, not looked at for another motion.
 MIN_OTHER_S = 1.0
 #: A joint of an arm moves when its rotation's spread is at least this share of the most moving arm joint's.
@@ -1593,17 +1597,27 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
     if s > 0:
         out.extend(_other(motion, start, start + s, min_periods, gait_near, options, "before", steps))
     P = pm.period_frames
-    # feet that land in it (a stride or only a step or two) say whether the legs come back a period later
+    # feet that land in it (a stride or only a step or two) say whether the legs come back a period later; so do
+    # legs that move where no foot lands (a shuffle's last steps): a whole body that repeats repeats its legs too
     steps_in = kind == "periodic" and steps is not None and \
         bool(np.any((steps.frames >= start + s) & (steps.frames < start + e)))
-    legs = legs_repeat(motion, start + s, start + e, P) if steps_in else float("nan")
+    legs_move = kind == "periodic" and not _legs_still(piece.skeleton, _rotation_spread(piece[s:e]))
+    legs = legs_repeat(motion, start + s, start + e, P) if steps_in or legs_move else float("nan")
     why = f"{kind}: {(e - s) / P:.1f} periods of {P:.1f} frames"
     if np.isfinite(legs) and legs >= UNLIKE:
+        said = ("the feet step but the legs are unlike themselves a period ({P:.1f} frames) later: the gait changes "
+                "here" if steps_in else "the legs move but are unlike themselves a period ({P:.1f} frames) later: "
+                "the body does not repeat at that period")
         out.append(Activity(start=start + s, stop=start + e, kind="transition", limbs="none", legs_still=still,
-                            reason=f"the feet step but the legs are unlike themselves a period ({P:.1f} frames) "
-                                   f"later: the gait changes here, no one motion"))
+                            reason=said.format(P=P) + ", no one motion"))
     elif in_step and steps is not None:
         out.append(_stepping_part(motion, start + s, start + e, pm, steps, why))
+    elif legs_move and np.isfinite(legs) and steps is not None and (e - s) / P >= MIN_REPEATS and \
+            _walks_on(motion, start + s, start + e, P, steps):
+        out.append(_stepping_part(motion, start + s, start + e, pm, steps, why,
+                                  "the legs repeat at it, the feet land about it and the body travels as a gait "
+                                  "does (a gait whose feet make no stride in step with it: a shuffle, a foot "
+                                  "that lands unseen)"))
     else:
         out.append(Activity(start=start + s, stop=start + e, kind=kind, limbs=limbs, period_frames=pm.period_frames,
                             loop=True, periodic=pm, legs_still=still))
@@ -1612,14 +1626,28 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
     return out
 
 
+def _walks_on(motion: Motion, start: int, stop: int, period: float, steps: Landings) -> bool:
+    """Whether frames ``start .. stop-1`` of a motion repeating every ``period`` frames travel as a gait does: at
+    least :data:`GAIT_TRAVEL` body heights a cycle, with feet landing (two landings or more) within a period of
+    them.  Punches, sword swings and dance steps in place travel a few hundredths of that."""
+    near = (steps.frames >= start - period) & (steps.frames < stop + period)
+    if int(np.count_nonzero(near)) < 2:
+        return False
+    path = _horizontal_path(motion[start:stop])
+    per_cycle = float(np.linalg.norm(path[-1] - path[0])) * period / max(stop - start - 1, 1)
+    return per_cycle >= GAIT_TRAVEL * _body_height(motion[start:stop])
+
+
 def _stepping_part(motion: Motion, start: int, stop: int, pm: PeriodicMotion, steps: Landings,
-                   why: str) -> Activity:
+                   why: str, how: str = "the feet landing a period apart (a gait whose chain of landings broke)"
+                   ) -> Activity:
     """Frames ``start .. stop-1`` of ``motion`` where the body repeats every ``pm.period_frames`` and the feet
     (``steps``, in ``motion``'s frames) land in step with it: a gait whose chain of landings broke, named by its
     feet (:func:`gait_of` over its frames) and its turn per cycle (:data:`TURN_DEG`), its phase ``pm``'s, or,
     where its legs overrule that period as they do a gait part's (:func:`legs_check`: over a cycle and a half
     the cohomology's period came out 2-6 % short of the legs' own), a line at the legs' period from ``pm``'s
-    first phase."""
+    first phase.  ``how``: why it is a gait, the end of its reason (:func:`_walks_on`: feet that land about it
+    but make no stride in step with it)."""
     P = pm.period_frames
     legs, check = legs_check(motion, start, stop, P, said="the cohomology's")
     if np.isfinite(legs):
@@ -1644,7 +1672,7 @@ def _stepping_part(motion: Motion, start: int, stop: int, pm: PeriodicMotion, st
         own.setdefault(steps.sides[k], []).append(int(f))
     return Activity(start=start, stop=stop, kind=f"{gait} {way}", limbs="legs", period_frames=P, speed=speed,
                     turn_deg=turn, loop=True, periodic=pm, legs_still=False, in_step=True, landings=own,
-                    reason=f"{why}, the feet landing a period apart (a gait whose chain of landings broke)")
+                    reason=f"{why}, {how}")
 
 
 def _rotation_spread(motion: Motion) -> np.ndarray:
