@@ -931,3 +931,19 @@ def test_a_gait_found_by_the_cohomology_takes_its_legs_period_where_they_overrul
         assert part.periodic.period_frames == part.period_frames
         assert abs(part.periodic.unwrapped[-1] - part.periodic.unwrapped[0] - (n - 1) / part.period_frames) < 1e-9
     assert part.periodic.period_source == "cohomology"  # the legs agree: the cohomology's phase is kept
+
+
+def test_a_take_played_again_and_again_is_no_motion_that_repeats():
+    """A session that plays one non-periodic take (smooth random motion, a wandering walk) five times in a row
+    repeats every 9.7 s, and the cohomology sees that circle; a sequence done again is no cyclic motion to loop
+    (:data:`MAX_REPEAT_S`): no part repeats more slowly than that, none is looped at the take's length."""
+    from mocycle.activities import MAX_REPEAT_S, segment_activities
+    from mocycle.datasets import join_takes, synthetic_nonperiodic
+
+    fps = 30.0
+    take = synthetic_nonperiodic(n_frames=300, fps=fps, seed=2).motion
+    session = join_takes([take] * 5, ["take"] * 5).motion
+    parts = segment_activities(session).parts
+    periods = [p.period_frames for p in parts if np.isfinite(p.period_frames)]
+    assert all(P <= MAX_REPEAT_S * fps for P in periods), [(p.kind, p.start, p.stop, p.period_frames) for p in parts]
+    assert not any(p.loop and p.period_frames > 0.5 * take.n_frames for p in parts)

@@ -86,6 +86,10 @@ MIXED_SHARE = 0.03
 #: Where the feet cannot tell (neither flight nor double support, or both), faster than this many body heights per
 #: second is a run (people switch from walking to running at about 2 m/s, 1.1-1.2 body heights per second).
 RUN_SPEED = 1.25
+#: A motion repeating more slowly than once in this many seconds is a sequence done again (a take played twice in
+#: a session), not one cyclic motion: no part of its own (strides last at most 2 × MAX_STEP_S; waves, dance steps,
+#: punches and sword swings repeat in 0.3-3 s).
+MAX_REPEAT_S = 8.0
 #: A motion without a chain of landings whose legs move and repeat, and which travels at least this many body
 #: heights a cycle, is a gait named by its feet (a slow shuffle travels 0.5, a walk about 0.8; punches, sword
 #: swings and steps in place 0.01-0.03).
@@ -978,9 +982,11 @@ def one_cycle(motion: Motion) -> int | None:
     (:data:`WRAP_JUMP`, :data:`MOVING_WRAP`; the joints' rotations decide, not the root's travel).  Of the
     two readings, an open cycle of all the frames or a cycle closed by its last frame, the one whose wrap
     changes the velocity less.  A take like itself a third to four fifths of its length later holds more
-    than one cycle and is no such clip."""
+    than one cycle and is no such clip.  A take longer than :data:`MAX_REPEAT_S` is no cycle either (and the
+    search for a repeat within it, over lags up to its length, would cost its length squared: minutes for a
+    few minutes of capture where nothing loops)."""
     T = motion.n_frames
-    if T < 8:
+    if T < 8 or T > MAX_REPEAT_S * motion.fps + 1:
         return None
     X, _ = pose_matrix(motion, rep="expmap", root_features="drop", joints=None, normalize=False, weights=None)
     if not float(np.degrees(np.sqrt(X.var(axis=0).sum()))) >= STILL_DEG:
@@ -1629,7 +1635,10 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
 def _walks_on(motion: Motion, start: int, stop: int, period: float, steps: Landings) -> bool:
     """Whether frames ``start .. stop-1`` of a motion repeating every ``period`` frames travel as a gait does: at
     least :data:`GAIT_TRAVEL` body heights a cycle, with feet landing (two landings or more) within a period of
-    them.  Punches, sword swings and dance steps in place travel a few hundredths of that."""
+    them, at a stride's period (at most two steps of :data:`MAX_STEP_S`).  Punches, sword swings and dance steps
+    in place travel a few hundredths of that."""
+    if period > 2 * MAX_STEP_S * motion.fps:  # no stride lasts so long
+        return False
     near = (steps.frames >= start - period) & (steps.frames < stop + period)
     if int(np.count_nonzero(near)) < 2:
         return False
@@ -1838,12 +1847,14 @@ def _periodic_in(piece: Motion, spread: np.ndarray, min_periods: float, options:
             classes = result.classes
         except (NoPeriodicMotion, MocycleError):
             classes = []
-        agree = [c for c in classes if not np.isfinite(acf) or abs(c.period_frames / acf - 1) <= 2 * PERIOD_AGREEMENT]
+        longest = MAX_REPEAT_S * piece.fps
+        agree = [c for c in classes if (not np.isfinite(acf) or abs(c.period_frames / acf - 1) <= 2 * PERIOD_AGREEMENT)
+                 and c.period_frames <= longest]
         if agree:
             pm = max(agree, key=lambda c: len(c.frames()))
             a, b = pm.excitation[0][0], pm.excitation[-1][1]
             return limbs, kind, _rebased(pm, a, b), (s + a, s + b)
-        if not np.isfinite(acf) or joints is None:
+        if not np.isfinite(acf) or joints is None or acf > longest:
             continue  # the whole body needs the cohomology's word; an arm that swings on its own, the autocorrelation's
         x = np.arange(e - s, dtype=np.float64) / acf
         why = (f"the autocorrelation of the {'moving arm joints' if kind == 'arms' else 'joints'}' velocities: "

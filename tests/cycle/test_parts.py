@@ -227,3 +227,16 @@ def test_a_gesture_that_ends_where_it_began_is_no_cycle():
 
     assert one_cycle(synthetic_gesture(n_frames=120, fps=60.0, seed=1).motion) is None
     assert one_cycle(synthetic_walk(n_frames=90, fps=60.0, noise_deg=0.0).motion) is None  # 1.5 cycles
+
+
+@pytest.mark.parametrize("seconds", [2.0, 9.0])
+def test_a_take_longer_than_the_longest_repeat_is_no_clip_of_one_cycle(seconds):
+    """One stride of a walk lasting ``seconds`` is a clip of one cycle when it lasts no longer than a repeating
+    motion may (:data:`~mocycle.activities.MAX_REPEAT_S`); a longer take is none, and is not searched for a repeat
+    over lags up to its length (its length squared: minutes for a few minutes of capture where nothing loops)."""
+    from mocycle.activities import MAX_REPEAT_S, one_cycle
+
+    fps = 30.0
+    n = int(round(seconds * fps))
+    take = synthetic_walk(n_frames=n, fps=fps, period_s=seconds, noise_deg=0.0, seed=1).motion
+    assert one_cycle(take) == (n if seconds <= MAX_REPEAT_S else None)
