@@ -334,36 +334,6 @@ def test_a_repeat_found_where_the_legs_move_but_no_foot_lands_is_checked_by_the_
         assert parts[0].kind == "transition" and "the legs move but are unlike themselves" in parts[0].reason
 
 
-@pytest.mark.parametrize("travels", [True, False])
-def test_a_repeat_whose_feet_make_no_stride_is_named_a_walk_when_the_body_travels(monkeypatch, travels):
-    """A shuffle whose one foot lifts too little to land (only the other foot's landings, a stride apart: no
-    stride of alternate landings in step): the repeat the cohomology finds at the stride is a walk, named by its
-    feet, when the body travels as a walk does; the same legs stepping in place stay a periodic part."""
-    import mocycle.activities as A
-
-    fps, period = 60.0, 1.0
-    walk = synthetic_walk(n_frames=int(3.2 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
-    if not travels:
-        j = walk.travel_joint
-        still = walk.joint_translations(j).copy()
-        still[:, [0, 2]] = still[0, [0, 2]]  # the hips keep their height and sway but go nowhere
-        walk = walk.replace(tracks={j: still})
-    steps = _steps(walk)
-    one = steps.foot == steps.foot[0]
-    one_foot = A.Landings(steps.frames[one], steps.foot[one], steps.sides, steps.down)
-    assert A._foot_periods(one_foot, 0, walk.n_frames, fps).size == 0  # no stride of alternate landings
-    P = period * fps
-    found = A.line_periodic(np.arange(walk.n_frames) / P, P, walk.frame_time, "cohomology", "all", "found")
-    monkeypatch.setattr(A, "_periodic_in", lambda *args, **kwargs: ("all", "periodic", found, (0, walk.n_frames)))
-    parts = A._other(walk, 0, walk.n_frames, 1.2, True, {"joints": None, "step": 1}, steps=one_foot)
-    assert len(parts) == 1 and parts[0].loop, [(p.kind, p.reason) for p in parts]
-    if travels:
-        assert parts[0].kind == "walk straight" and "the body travels as a gait does" in parts[0].reason
-        assert parts[0].in_step and abs(parts[0].period_frames / P - 1) < 0.05
-    else:
-        assert parts[0].kind == "periodic"
-
-
 def test_a_walk_running_off_without_a_chain_of_landings_is_not_looped_across_the_change():
     """Frames without a gait part where a short walk turns into a run: looked at blind, the whole body "repeats"
     across both, but the legs, which move, are unlike themselves a period later, so no loop holds a walk and a run;

@@ -90,10 +90,6 @@ RUN_SPEED = 1.25
 #: a session), not one cyclic motion: no part of its own (strides last at most 2 × MAX_STEP_S; waves, dance steps,
 #: punches and sword swings repeat in 0.3-3 s).
 MAX_REPEAT_S = 8.0
-#: A motion without a chain of landings whose legs move and repeat, and which travels at least this many body
-#: heights a cycle, is a gait named by its feet (a slow shuffle travels 0.5, a walk about 0.8; punches, sword
-#: swings and steps in place 0.01-0.03).
-GAIT_TRAVEL = 0.3
 #: Frames without gait shorter than this many seconds are transitions, not looked at for another motion.
 MIN_OTHER_S = 1.0
 #: A joint of an arm moves when its rotation's spread is at least this share of the most moving arm joint's.
@@ -1618,12 +1614,6 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
                             reason=said.format(P=P) + ", no one motion"))
     elif in_step and steps is not None:
         out.append(_stepping_part(motion, start + s, start + e, pm, steps, why))
-    elif legs_move and np.isfinite(legs) and steps is not None and (e - s) / P >= MIN_REPEATS and \
-            _walks_on(motion, start + s, start + e, P, steps):
-        out.append(_stepping_part(motion, start + s, start + e, pm, steps, why,
-                                  "the legs repeat at it, the feet land about it and the body travels as a gait "
-                                  "does (a gait whose feet make no stride in step with it: a shuffle, a foot "
-                                  "that lands unseen)"))
     else:
         out.append(Activity(start=start + s, stop=start + e, kind=kind, limbs=limbs, period_frames=pm.period_frames,
                             loop=True, periodic=pm, legs_still=still))
@@ -1632,31 +1622,14 @@ def _other(motion: Motion, start: int, stop: int, min_periods: float, gait_near:
     return out
 
 
-def _walks_on(motion: Motion, start: int, stop: int, period: float, steps: Landings) -> bool:
-    """Whether frames ``start .. stop-1`` of a motion repeating every ``period`` frames travel as a gait does: at
-    least :data:`GAIT_TRAVEL` body heights a cycle, with feet landing (two landings or more) within a period of
-    them, at a stride's period (at most two steps of :data:`MAX_STEP_S`).  Punches, sword swings and dance steps
-    in place travel a few hundredths of that."""
-    if period > 2 * MAX_STEP_S * motion.fps:  # no stride lasts so long
-        return False
-    near = (steps.frames >= start - period) & (steps.frames < stop + period)
-    if int(np.count_nonzero(near)) < 2:
-        return False
-    path = _horizontal_path(motion[start:stop])
-    per_cycle = float(np.linalg.norm(path[-1] - path[0])) * period / max(stop - start - 1, 1)
-    return per_cycle >= GAIT_TRAVEL * _body_height(motion[start:stop])
-
-
 def _stepping_part(motion: Motion, start: int, stop: int, pm: PeriodicMotion, steps: Landings,
-                   why: str, how: str = "the feet landing a period apart (a gait whose chain of landings broke)"
-                   ) -> Activity:
+                   why: str) -> Activity:
     """Frames ``start .. stop-1`` of ``motion`` where the body repeats every ``pm.period_frames`` and the feet
     (``steps``, in ``motion``'s frames) land in step with it: a gait whose chain of landings broke, named by its
     feet (:func:`gait_of` over its frames) and its turn per cycle (:data:`TURN_DEG`), its phase ``pm``'s, or,
     where its legs overrule that period as they do a gait part's (:func:`legs_check`: over a cycle and a half
     the cohomology's period came out 2-6 % short of the legs' own), a line at the legs' period from ``pm``'s
-    first phase.  ``how``: why it is a gait, the end of its reason (:func:`_walks_on`: feet that land about it
-    but make no stride in step with it)."""
+    first phase."""
     P = pm.period_frames
     legs, check = legs_check(motion, start, stop, P, said="the cohomology's")
     if np.isfinite(legs):
@@ -1681,7 +1654,7 @@ def _stepping_part(motion: Motion, start: int, stop: int, pm: PeriodicMotion, st
         own.setdefault(steps.sides[k], []).append(int(f))
     return Activity(start=start, stop=stop, kind=f"{gait} {way}", limbs="legs", period_frames=P, speed=speed,
                     turn_deg=turn, loop=True, periodic=pm, legs_still=False, in_step=True, landings=own,
-                    reason=f"{why}, {how}")
+                    reason=f"{why}, the feet landing a period apart (a gait whose chain of landings broke)")
 
 
 def _rotation_spread(motion: Motion) -> np.ndarray:

@@ -131,7 +131,7 @@ def test_output_suffixes_per_command():
 
 @pytest.mark.parametrize("command, options, suffix, outputs", [
     ("info", {}, None, []), ("phase", {}, None, []),
-    ("loop", {"which": "all"}, ".bvh", ["walk.part0-walk-straight.bvh"]),
+    ("loop", {"which": "all"}, ".bvh", ["walk.part0-periodic.bvh"]),
     ("swings", {}, ".json", ["walk.json"]), ("compress", {}, ".mck", ["walk.mck"]),
     ("stretch", {"factor": 1.5}, ".bvh", ["walk.bvh"])])
 def test_every_command_writes_its_output_and_figures(tmp_path, short_walk, command, options, suffix, outputs):
