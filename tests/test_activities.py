@@ -290,6 +290,19 @@ def test_a_walk_too_short_to_be_seen_repeating_loops_when_its_feet_land_a_period
     assert "the feet landing a period apart" in looped[0].reason
 
 
+def _repeat_found_in_a_walk(monkeypatch, period_share: float, landings_of):
+    """The parts :func:`_other` makes of 1.6 strides of a 1 s walk at 60 fps where the cohomology "finds" a repeat
+    at ``period_share`` of the stride, the feet's landings being ``landings_of(the walk's landings)``."""
+    import mocycle.activities as A
+
+    fps, period = 60.0, 1.0
+    walk = synthetic_walk(n_frames=int(1.6 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
+    P = period_share * period * fps
+    found = A.line_periodic(np.arange(walk.n_frames) / P, P, walk.frame_time, "cohomology", "all", "found")
+    monkeypatch.setattr(A, "_periodic_in", lambda *args, **kwargs: ("all", "periodic", found, (0, walk.n_frames)))
+    return A._other(walk, 0, walk.n_frames, 1.2, True, {"joints": None, "step": 1}, steps=landings_of(_steps(walk)))
+
+
 @pytest.mark.parametrize("period_share, loops", [(0.4, False), (1.0, True)])
 def test_a_repeat_found_where_the_feet_step_but_make_no_stride_is_checked_by_the_legs(monkeypatch, period_share,
                                                                                      loops):
@@ -298,16 +311,13 @@ def test_a_repeat_found_where_the_feet_step_but_make_no_stride_is_checked_by_the
     of the walk, one at the stride is."""
     import mocycle.activities as A
 
-    fps, period = 60.0, 1.0
-    walk = synthetic_walk(n_frames=int(1.6 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
-    steps = _steps(walk)
-    first = int(np.flatnonzero(steps.foot != steps.foot[0])[0])
-    two = A.Landings(steps.frames[first - 1:first + 1], steps.foot[first - 1:first + 1], steps.sides, steps.down)
-    assert A._foot_periods(two, 0, walk.n_frames, fps).size == 0  # two steps: no stride to be in step with
-    P = period_share * period * fps
-    found = A.line_periodic(np.arange(walk.n_frames) / P, P, walk.frame_time, "cohomology", "all", "found")
-    monkeypatch.setattr(A, "_periodic_in", lambda *args, **kwargs: ("all", "periodic", found, (0, walk.n_frames)))
-    parts = A._other(walk, 0, walk.n_frames, 1.2, True, {"joints": None, "step": 1}, steps=two)
+    def two_steps(steps):
+        first = int(np.flatnonzero(steps.foot != steps.foot[0])[0])
+        two = A.Landings(steps.frames[first - 1:first + 1], steps.foot[first - 1:first + 1], steps.sides, steps.down)
+        assert A._foot_periods(two, 0, steps.down.size, 60.0).size == 0  # two steps: no stride to be in step with
+        return two
+
+    parts = _repeat_found_in_a_walk(monkeypatch, period_share, two_steps)
     assert [p.loop for p in parts] == [loops], [(p.kind, p.reason) for p in parts]
     if not loops:
         assert parts[0].kind == "transition" and "unlike themselves" in parts[0].reason
@@ -321,14 +331,10 @@ def test_a_repeat_found_where_the_legs_move_but_no_foot_lands_is_checked_by_the_
     the legs move, so the whole body repeats only where they do."""
     import mocycle.activities as A
 
-    fps, period = 60.0, 1.0
-    walk = synthetic_walk(n_frames=int(1.6 * period * fps), fps=fps, period_s=period, noise_deg=0.5, seed=3).motion
-    steps = _steps(walk)
-    none = A.Landings(steps.frames[:0], steps.foot[:0], steps.sides, steps.down)
-    P = period_share * period * fps
-    found = A.line_periodic(np.arange(walk.n_frames) / P, P, walk.frame_time, "cohomology", "all", "found")
-    monkeypatch.setattr(A, "_periodic_in", lambda *args, **kwargs: ("all", "periodic", found, (0, walk.n_frames)))
-    parts = A._other(walk, 0, walk.n_frames, 1.2, True, {"joints": None, "step": 1}, steps=none)
+    def no_landing(steps):
+        return A.Landings(steps.frames[:0], steps.foot[:0], steps.sides, steps.down)
+
+    parts = _repeat_found_in_a_walk(monkeypatch, period_share, no_landing)
     assert [p.loop for p in parts] == [loops], [(p.kind, p.reason) for p in parts]
     if not loops:
         assert parts[0].kind == "transition" and "the legs move but are unlike themselves" in parts[0].reason
